@@ -1,0 +1,36 @@
+//! The bus every program on the emulated MCU talks through.
+//!
+//! As in mooneye-gb, time is right by construction: every access advances the MCU clock by the
+//! states of the area it touches ([`crate::memmap::Area`]), so a program (the Rust controller
+//! or machine code run by the H8/300H core) cannot touch the hardware without paying for it.
+//! Internal operation states (the manual's N·S_N) are charged with [`Bus::internal`].
+
+/// A bus on the H8/3052F's 24-bit address space with a clock in states.
+///
+/// Conventions shared by every implementation:
+/// - addresses are masked to 24 bits ([`crate::memmap::ADDRESS_MASK`]);
+/// - word accesses ignore address bit 0 (the H8/300H always accesses words at even addresses);
+/// - the clock advances by the access's states *before* the access takes effect, so a device
+///   sees a read or write at the instant the bus cycle ends;
+/// - a read from an unmapped address returns 0xFF (a floating bus reads high) and costs an
+///   8-bit 3-state cycle; the H8/300H core refuses to *fetch* from there (SPEC §7).
+pub trait Bus {
+    /// The current time in states since reset.
+    fn now(&self) -> u64;
+    /// Reads one byte.
+    fn read8(&mut self, addr: u32) -> u8;
+    /// Reads one word (big-endian, address bit 0 ignored).
+    fn read16(&mut self, addr: u32) -> u16;
+    /// Writes one byte.
+    fn write8(&mut self, addr: u32, value: u8);
+    /// Writes one word (big-endian, address bit 0 ignored).
+    fn write16(&mut self, addr: u32, value: u16);
+    /// Charges `states` internal operation states (no bus access).
+    fn internal(&mut self, states: u32);
+    /// The vector number of the highest-priority interrupt that is requested and enabled at its
+    /// source, if any. Masking by CCR.I is the CPU's business, not the bus's.
+    fn pending_irq(&self) -> Option<u8>;
+    /// SLEEP: advances the clock until an interrupt request is pending or the clock reaches
+    /// `deadline`, whichever is first. Returns whether an interrupt is pending.
+    fn sleep_until_irq(&mut self, deadline: u64) -> bool;
+}

@@ -1,0 +1,2 @@
+//! The embedded learner (work in progress).
+#![no_std]

@@ -1,0 +1,2 @@
+//! h8swarm command-line tool (work in progress).
+fn main() {}
