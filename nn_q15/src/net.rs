@@ -1,0 +1,635 @@
+//! The two-layer network: the forward pass of SPEC §2.3 and the update of SPEC §2.4, bit-exact to
+//! the integer definitions there, charged to a [`Meter`] as the H8 routine would spend it.
+//!
+//! Weights are stored row-major, one row of N inputs per output neuron (the layout of the replay
+//! format, SPEC §2.6, and the order the H8 routine walks them with post-increment loads).
+
+use crate::cost::{Meter, Op, Phase};
+use crate::error::{ParamError, ShapeError};
+use crate::format::{Q7, Q15, Q22, round_half_away_shr7, sat16};
+
+/// Most inputs a network may have: with |w·x| ≤ 2^15 · 2^7 = 2^22 per product, 256 products sum
+/// to at most 2^30, inside an `i32` (SPEC §2.1: "no overflow for N ≤ 256").
+pub const MAX_INPUTS: usize = 256;
+/// Fewest enabled behaviours (the corridor's forward and backward, SPEC §2.2).
+pub const MIN_OUTPUTS: usize = 2;
+/// Most enabled behaviours (the four primitive behaviours, SPEC §2.2).
+pub const MAX_OUTPUTS: usize = 4;
+/// 1.0 in Q22: a weighted sum at or above it switches the forward pass to Eq. 2's division by
+/// the largest sum (SPEC §2.3 step 3).
+pub const ONE_Q22: i32 = 1 << 22;
+
+/// A validated network shape: 1 ≤ N ≤ [`MAX_INPUTS`] inputs, [`MIN_OUTPUTS`] ≤ M ≤
+/// [`MAX_OUTPUTS`] outputs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Shape {
+    n_in: u16,
+    n_out: u8,
+}
+
+impl Shape {
+    /// Checks a shape against the no-overflow bound and the number of behaviours.
+    ///
+    /// # Errors
+    /// [`ShapeError::Inputs`] or [`ShapeError::Outputs`] naming the bad count and the valid range.
+    pub const fn new(n_in: usize, n_out: usize) -> Result<Shape, ShapeError> {
+        if n_in == 0 || n_in > MAX_INPUTS {
+            return Err(ShapeError::Inputs { got: n_in });
+        }
+        if n_out < MIN_OUTPUTS || n_out > MAX_OUTPUTS {
+            return Err(ShapeError::Outputs { got: n_out });
+        }
+        Ok(Shape {
+            n_in: n_in as u16,
+            n_out: n_out as u8,
+        })
+    }
+
+    /// Number of inputs N.
+    #[must_use]
+    pub const fn n_in(self) -> usize {
+        self.n_in as usize
+    }
+
+    /// Number of outputs M.
+    #[must_use]
+    pub const fn n_out(self) -> usize {
+        self.n_out as usize
+    }
+
+    /// Number of weights N · M.
+    #[must_use]
+    pub const fn n_weights(self) -> usize {
+        self.n_in() * self.n_out()
+    }
+}
+
+/// The learning parameters: η (Q15, ≥ 0) and the dead-zone threshold T (du, ≥ 0).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Params {
+    eta: i16,
+    threshold: i16,
+}
+
+impl Params {
+    /// The corridor's parameters (paper env. 1): η = 0.1 → 3277, T = 10.
+    pub const CORRIDOR: Params = Params {
+        eta: 3277,
+        threshold: 10,
+    };
+    /// The arena's parameters (paper env. 2): η = 0.001 → 33, T = 10.
+    pub const ARENA: Params = Params {
+        eta: 33,
+        threshold: 10,
+    };
+
+    /// Parameters from raw integers: η in Q15 (0 … 32767), T in du (0 … 32767).
+    ///
+    /// # Errors
+    /// [`ParamError`] naming the parameter, its value and the valid range.
+    pub const fn new(eta: i32, threshold: i32) -> Result<Params, ParamError> {
+        if eta < 0 || eta > i16::MAX as i32 {
+            return Err(ParamError::Eta { got: eta });
+        }
+        if threshold < 0 || threshold > i16::MAX as i32 {
+            return Err(ParamError::Threshold { got: threshold });
+        }
+        Ok(Params {
+            eta: eta as i16,
+            threshold: threshold as i16,
+        })
+    }
+
+    /// η as a Q15 number.
+    #[must_use]
+    pub const fn eta(self) -> Q15 {
+        Q15::from_bits(self.eta)
+    }
+
+    /// T in du.
+    #[must_use]
+    pub const fn threshold(self) -> i16 {
+        self.threshold
+    }
+}
+
+/// What the forward pass produced: the sums y, the outputs O, the winner.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ForwardOut {
+    y: [i32; MAX_OUTPUTS],
+    o: [i16; MAX_OUTPUTS],
+    n_out: u8,
+    win: u8,
+}
+
+impl ForwardOut {
+    /// The weighted sums y_j as raw Q22 integers (M values).
+    #[must_use]
+    pub fn y_bits(&self) -> &[i32] {
+        &self.y[..usize::from(self.n_out)]
+    }
+
+    /// The outputs O_j as raw Q15 integers (M values).
+    #[must_use]
+    pub fn o_bits(&self) -> &[i16] {
+        &self.o[..usize::from(self.n_out)]
+    }
+
+    /// Sum y_j as a Q22 number.
+    ///
+    /// Returns `None` when `j` is not an output of this network.
+    #[must_use]
+    pub fn y(&self, j: usize) -> Option<Q22> {
+        self.y_bits().get(j).map(|&v| Q22::from_bits(v))
+    }
+
+    /// Output O_j as a Q15 number.
+    ///
+    /// Returns `None` when `j` is not an output of this network.
+    #[must_use]
+    pub fn o(&self, j: usize) -> Option<Q15> {
+        self.o_bits().get(j).map(|&v| Q15::from_bits(v))
+    }
+
+    /// The winning output: the index of the largest sum, ties to the lowest index.
+    #[must_use]
+    pub const fn win(&self) -> usize {
+        self.win as usize
+    }
+}
+
+/// Which branch of Eq. 8 an update took.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum UpdateKind {
+    /// |E| ≤ T: no change (α = 0).
+    DeadZone,
+    /// E > T: the winner pushed up, the others down, for the same input.
+    Reward,
+    /// E < −T: the winner pushed down, the others up.
+    Punish,
+}
+
+/// The forward pass on raw slices: `w` holds M rows of N weights, `x` N inputs.
+/// The caller guarantees `w.len() == x.len() * n_out`, `1 ≤ x.len() ≤ 256` and `2 ≤ n_out ≤ 4`.
+#[inline]
+pub(crate) fn forward_core<Mt: Meter>(
+    w: &[Q15],
+    x: &[Q7],
+    n_out: usize,
+    meter: &mut Mt,
+) -> ForwardOut {
+    let n_in = x.len();
+    let mut y = [0i32; MAX_OUTPUTS];
+    let mut o = [0i16; MAX_OUTPUTS];
+
+    meter.enter(Phase::Forward);
+    meter.charge(Op::CallFrame, 1);
+
+    // Step 1: y_j = Σ_i w_ij · x_i, exact in i32.
+    for (row, yj) in w.chunks_exact(n_in).zip(y.iter_mut()) {
+        *yj = row
+            .iter()
+            .zip(x)
+            .map(|(wi, xi)| i32::from(wi.to_bits()) * i32::from(xi.to_bits()))
+            .sum();
+    }
+    let (m_in, m_out) = (n_in as u32, n_out as u32);
+    meter.charge(Op::PtrInit, 2 + m_out);
+    meter.charge(Op::LoopInitB, 1);
+    meter.charge(Op::LoopInitW, m_out);
+    meter.charge(Op::AccClear, m_out);
+    meter.charge(Op::Mac, m_in * m_out);
+    meter.charge(Op::LoopIter, m_in * m_out + m_out);
+    meter.charge(Op::StoreL, m_out);
+
+    // Steps 2 and 4: the maximum and the winner, ties to the lowest index.
+    let ys = &y[..n_out];
+    let mut win = 0usize;
+    let mut max = ys[0];
+    let mut new_max = 0u32;
+    for (j, &v) in ys.iter().enumerate().skip(1) {
+        if v > max {
+            max = v;
+            win = j;
+            new_max += 1;
+        }
+    }
+    meter.charge(Op::PtrInit, 1);
+    meter.charge(Op::LoadL, m_out);
+    meter.charge(Op::LoopInitB, 3);
+    meter.charge(Op::CmpBranch, m_out - 1);
+    meter.charge(Op::IndexInc, m_out - 1);
+    meter.charge(Op::LoopIter, m_out - 1);
+    meter.charge(Op::NewMax, new_max);
+    meter.charge(Op::StoreVarB, 1);
+
+    // Step 3: the activation of Eq. 2.
+    meter.charge(Op::CmpImmBranch, 1);
+    meter.charge(Op::PtrInit, 2);
+    meter.charge(Op::LoopInitB, 1);
+    meter.charge(Op::LoadL, m_out);
+    meter.charge(Op::StoreW, m_out);
+    meter.charge(Op::LoopIter, m_out);
+    if max < ONE_Q22 {
+        let mut clamps = 0u32;
+        for (oj, &yj) in o.iter_mut().zip(ys) {
+            let v = yj >> 7;
+            *oj = sat16(v);
+            if Mt::ACTIVE {
+                clamps += u32::from(i32::from(*oj) != v);
+            }
+        }
+        meter.charge(Op::Shr1, 7 * m_out);
+        meter.charge(Op::Sat16, m_out);
+        meter.charge(Op::SatClamp, clamps);
+    } else {
+        // Eq. 2's division by the largest sum, as a 32/16 DIVXS.W: bring m into [2^14, 2^15).
+        let s = (i32::BITS - max.leading_zeros()) - 15;
+        let m_s = max >> s;
+        let (mut divides, mut lows, mut highs) = (0u32, 0u32, 0u32);
+        for (oj, &yj) in o.iter_mut().zip(ys) {
+            let y_s = yj >> s;
+            *oj = if y_s <= -m_s {
+                lows += 1;
+                i16::MIN
+            } else if y_s >= m_s {
+                // (m' << 15) / m' = 32768 does not fit: the firmware tests for it first.
+                highs += 1;
+                i16::MAX
+            } else {
+                divides += 1;
+                ((y_s << 15) / m_s) as i16
+            };
+        }
+        meter.charge(Op::LoopInitB, 1);
+        meter.charge(Op::NormShiftStep, s);
+        meter.charge(Op::NormSetup, 1);
+        meter.charge(Op::RegOp, m_out);
+        meter.charge(Op::VarShiftStep, s * m_out);
+        meter.charge(Op::CmpBranch, m_out + divides + highs);
+        meter.charge(Op::Shl15, divides);
+        meter.charge(Op::Div, divides);
+        meter.charge(Op::Branch, divides + lows);
+        meter.charge(Op::ClampW, lows + highs);
+    }
+
+    ForwardOut {
+        y,
+        o,
+        n_out: n_out as u8,
+        win: win as u8,
+    }
+}
+
+/// The update of SPEC §2.4 on raw slices, with `delta` as the scratch for σ·Δ_i.
+/// The caller guarantees `w.len() == x.len() * n_out` with `1 ≤ x.len() ≤ 256`,
+/// `delta.len() >= x.len()` and `win < n_out`.
+#[inline]
+pub(crate) fn update_core<Mt: Meter>(
+    w: &mut [Q15],
+    x: &[Q7],
+    win: usize,
+    e: i16,
+    params: Params,
+    delta: &mut [i16],
+    meter: &mut Mt,
+) -> UpdateKind {
+    let n_in = x.len();
+    let n_out = w.len() / n_in;
+    meter.enter(Phase::Update);
+    meter.charge(Op::CallFrame, 1);
+    // |E| ≤ T? (E and T loaded, |E| formed, compared.)
+    meter.charge(Op::LoadW, 2);
+    meter.charge(Op::AbsTest, 1);
+    meter.charge(Op::RegOp, u32::from(e < 0));
+    meter.charge(Op::CmpBranchW, 1);
+    if e.unsigned_abs() <= params.threshold.unsigned_abs() {
+        return UpdateKind::DeadZone;
+    }
+    let kind = if e > 0 {
+        UpdateKind::Reward
+    } else {
+        UpdateKind::Punish
+    };
+    // σ·η: round-half-away-from-zero is odd, so σ·round(η·x/2^7) = round(σ·η·x/2^7).
+    let signed_eta = if e > 0 {
+        i32::from(params.eta)
+    } else {
+        -i32::from(params.eta)
+    };
+    meter.charge(Op::LoadW, 1);
+    meter.charge(Op::Branch, 1);
+    meter.charge(Op::RegOp, u32::from(e < 0));
+
+    let delta = &mut delta[..n_in];
+    for (d, xi) in delta.iter_mut().zip(x) {
+        // |σ·η·x| ≤ 32767 · 128, so the rounded quotient fits in an i16.
+        *d = round_half_away_shr7(signed_eta * i32::from(xi.to_bits())) as i16;
+    }
+    let (m_in, m_out) = (n_in as u32, n_out as u32);
+    meter.charge(Op::PtrInit, 2);
+    meter.charge(Op::LoopInitW, 1);
+    meter.charge(Op::DeltaCompute, m_in);
+    meter.charge(Op::LoopIter, m_in);
+
+    let (mut clamp_hi, mut clamp_lo) = (0u32, 0u32);
+    for (j, row) in w.chunks_exact_mut(n_in).enumerate() {
+        let sign: i32 = if j == win { 1 } else { -1 };
+        for (wi, &d) in row.iter_mut().zip(delta.iter()) {
+            let v = i32::from(wi.to_bits()) + sign * i32::from(d);
+            *wi = Q15::from_bits(sat16(v));
+            if Mt::ACTIVE {
+                clamp_hi += u32::from(v > i32::from(i16::MAX));
+                clamp_lo += u32::from(v < i32::from(i16::MIN));
+            }
+        }
+    }
+    meter.charge(Op::PtrInit, 1);
+    meter.charge(Op::LoopInitB, 1);
+    meter.charge(Op::UpdateRow, m_out);
+    meter.charge(Op::WeightApply, m_in * m_out);
+    meter.charge(Op::LoopIter, m_in * m_out);
+    meter.charge(Op::Branch, 1);
+    meter.charge(Op::WeightClampHi, clamp_hi);
+    meter.charge(Op::WeightClampLo, clamp_lo);
+    kind
+}
+
+/// The forward pass on a runtime-shaped network (used by the replay, SPEC §2.6): `w` holds
+/// `shape.n_out()` rows of `shape.n_in()` weights.
+///
+/// # Errors
+/// [`ShapeError::Length`] when a slice does not match the shape.
+pub fn forward_slice<Mt: Meter>(
+    shape: Shape,
+    w: &[Q15],
+    x: &[Q7],
+    meter: &mut Mt,
+) -> Result<ForwardOut, ShapeError> {
+    check_len("weights", shape.n_weights(), w.len())?;
+    check_len("x", shape.n_in(), x.len())?;
+    Ok(forward_core(w, x, shape.n_out(), meter))
+}
+
+/// The update on a runtime-shaped network (used by the replay, SPEC §2.6).
+///
+/// # Errors
+/// [`ShapeError::Length`] when a slice does not match the shape, [`ShapeError::Winner`] when
+/// `win` is not an output.
+pub fn update_slice<Mt: Meter>(
+    shape: Shape,
+    w: &mut [Q15],
+    x: &[Q7],
+    win: usize,
+    e: i16,
+    params: Params,
+    meter: &mut Mt,
+) -> Result<UpdateKind, ShapeError> {
+    check_len("weights", shape.n_weights(), w.len())?;
+    check_len("x", shape.n_in(), x.len())?;
+    if win >= shape.n_out() {
+        return Err(ShapeError::Winner {
+            got: win,
+            n_out: shape.n_out(),
+        });
+    }
+    let mut delta = [0i16; MAX_INPUTS];
+    Ok(update_core(w, x, win, e, params, &mut delta, meter))
+}
+
+fn check_len(what: &'static str, expected: usize, got: usize) -> Result<(), ShapeError> {
+    if expected == got {
+        Ok(())
+    } else {
+        Err(ShapeError::Length {
+            what,
+            expected,
+            got,
+        })
+    }
+}
+
+/// A network of N inputs and M outputs with its weights, shape checked at compile time.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Network<const N: usize, const M: usize> {
+    w: [[Q15; N]; M],
+}
+
+impl<const N: usize, const M: usize> Network<N, M> {
+    /// Evaluating this constant fails to compile for a shape outside the no-overflow bound
+    /// (N > 256 or N = 0) or outside 2–4 behaviours.
+    const SHAPE_OK: () = assert!(
+        N >= 1 && N <= MAX_INPUTS && M >= MIN_OUTPUTS && M <= MAX_OUTPUTS,
+        "network shape out of range: need 1 <= N <= 256 inputs and 2 <= M <= 4 outputs"
+    );
+
+    /// The network's shape.
+    pub const SHAPE: Shape = Shape {
+        n_in: N as u16,
+        n_out: M as u8,
+    };
+
+    /// A network with the given weights, one row of N per output.
+    #[must_use]
+    pub const fn new(weights: [[Q15; N]; M]) -> Self {
+        let () = Self::SHAPE_OK;
+        Self { w: weights }
+    }
+
+    /// A network with the given raw Q15 weights, one row of N per output.
+    #[must_use]
+    pub fn from_bits(weights: [[i16; N]; M]) -> Self {
+        Self::new(weights.map(|row| row.map(Q15::from_bits)))
+    }
+
+    /// A network with every weight zero.
+    #[must_use]
+    pub const fn zeroed() -> Self {
+        Self::new([[Q15::ZERO; N]; M])
+    }
+
+    /// The weights, one row of N per output.
+    #[must_use]
+    pub const fn weights(&self) -> &[[Q15; N]; M] {
+        &self.w
+    }
+
+    /// The weights as one flat row-major slice (output-major, as stored on the H8).
+    #[must_use]
+    pub fn weights_flat(&self) -> &[Q15] {
+        self.w.as_flattened()
+    }
+
+    pub(crate) fn weights_flat_mut(&mut self) -> &mut [Q15] {
+        self.w.as_flattened_mut()
+    }
+
+    /// The forward pass of SPEC §2.3 on `x`.
+    #[inline]
+    pub fn forward<Mt: Meter>(&self, x: &[Q7; N], meter: &mut Mt) -> ForwardOut {
+        forward_core(self.w.as_flattened(), x, M, meter)
+    }
+
+    /// The update of SPEC §2.4: evaluation `e` for input `x`, whose winner was `win`.
+    ///
+    /// # Errors
+    /// [`ShapeError::Winner`] when `win ≥ M`.
+    #[inline]
+    pub fn update<Mt: Meter>(
+        &mut self,
+        x: &[Q7; N],
+        win: usize,
+        e: i16,
+        params: Params,
+        meter: &mut Mt,
+    ) -> Result<UpdateKind, ShapeError> {
+        if win >= M {
+            return Err(ShapeError::Winner { got: win, n_out: M });
+        }
+        let mut delta = [0i16; N];
+        Ok(update_core(
+            self.w.as_flattened_mut(),
+            x,
+            win,
+            e,
+            params,
+            &mut delta,
+            meter,
+        ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cost::{H8Meter, NoopMeter};
+
+    fn q7s<const N: usize>(v: [i8; N]) -> [Q7; N] {
+        v.map(Q7::from_bits)
+    }
+
+    #[test]
+    fn small_sums_are_shifted_to_q15() {
+        // y_0 = 16384·64 = 2^20 (0.25), y_1 = −2^20: below 1.0, so O = y >> 7.
+        let net = Network::<1, 2>::from_bits([[16384], [-16384]]);
+        let f = net.forward(&q7s([64]), &mut NoopMeter);
+        assert_eq!(f.y_bits(), &[1 << 20, -(1 << 20)]);
+        assert_eq!(f.o_bits(), &[8192, -8192]);
+        assert_eq!(f.win(), 0);
+    }
+
+    #[test]
+    fn large_sums_are_divided_by_the_largest() {
+        // y = [2^23, 2^22, −2^24]: m = 2^23, bitlen 24, s = 9, m' = 2^14.
+        let net = Network::<2, 3>::from_bits([[32767, 32767], [16384, 16384], [-32768, -32768]]);
+        let f = net.forward(&q7s([127, 127]), &mut NoopMeter);
+        let y0 = 32767 * 127 * 2;
+        assert_eq!(f.y_bits()[0], y0);
+        assert_eq!(f.win(), 0);
+        assert_eq!(
+            f.o_bits()[0],
+            i16::MAX,
+            "the largest output saturates at 32767"
+        );
+        let s = 32 - y0.leading_zeros() - 15;
+        let m_s = y0 >> s;
+        let y1 = 16384 * 127 * 2;
+        assert_eq!(f.o_bits()[1], (((y1 >> s) << 15) / m_s) as i16);
+        assert_eq!(f.o_bits()[2], i16::MIN);
+    }
+
+    #[test]
+    fn ties_go_to_the_lowest_index() {
+        let net = Network::<1, 4>::from_bits([[5], [9], [9], [9]]);
+        assert_eq!(net.forward(&q7s([1]), &mut NoopMeter).win(), 1);
+    }
+
+    #[test]
+    fn reward_moves_winner_up_and_others_down() {
+        let mut net = Network::<2, 2>::from_bits([[0, 0], [0, 0]]);
+        let x = q7s([64, -64]);
+        let p = Params::new(3277, 10).unwrap();
+        let kind = net.update(&x, 1, 11, p, &mut NoopMeter).unwrap();
+        assert_eq!(kind, UpdateKind::Reward);
+        // Δ = round(3277·64/128) = round(1638.5) = 1639 (half away from zero).
+        assert_eq!(net.weights()[1].map(|q| q.to_bits()), [1639, -1639]);
+        assert_eq!(net.weights()[0].map(|q| q.to_bits()), [-1639, 1639]);
+        assert_eq!(
+            net.update(&x, 1, 10, p, &mut NoopMeter).unwrap(),
+            UpdateKind::DeadZone
+        );
+        assert_eq!(
+            net.update(&x, 1, -11, p, &mut NoopMeter).unwrap(),
+            UpdateKind::Punish
+        );
+        assert_eq!(net.weights()[1].map(|q| q.to_bits()), [0, 0]);
+    }
+
+    #[test]
+    fn saturation_clamps_weights() {
+        let mut net = Network::<1, 2>::from_bits([[32000], [-32000]]);
+        let p = Params::new(32767, 0).unwrap();
+        net.update(&q7s([127]), 0, 1, p, &mut NoopMeter).unwrap();
+        assert_eq!(net.weights()[0][0].to_bits(), i16::MAX);
+        assert_eq!(net.weights()[1][0].to_bits(), i16::MIN);
+    }
+
+    #[test]
+    fn a_bad_winner_is_an_error() {
+        let mut net = Network::<1, 2>::zeroed();
+        let err = net
+            .update(&q7s([1]), 2, 100, Params::ARENA, &mut NoopMeter)
+            .unwrap_err();
+        assert_eq!(err, ShapeError::Winner { got: 2, n_out: 2 });
+    }
+
+    #[test]
+    fn slice_api_checks_lengths() {
+        let shape = Shape::new(3, 2).unwrap();
+        let w = [Q15::ZERO; 6];
+        assert!(forward_slice(shape, &w, &[Q7::ZERO; 3], &mut NoopMeter).is_ok());
+        assert_eq!(
+            forward_slice(shape, &w[..5], &[Q7::ZERO; 3], &mut NoopMeter),
+            Err(ShapeError::Length {
+                what: "weights",
+                expected: 6,
+                got: 5
+            })
+        );
+        assert!(Shape::new(0, 2).is_err());
+        assert!(Shape::new(257, 2).is_err());
+        assert!(Shape::new(256, 4).is_ok());
+        assert!(Shape::new(3, 1).is_err());
+        assert!(Shape::new(3, 5).is_err());
+    }
+
+    #[test]
+    fn forward_cost_of_13x4_matches_the_routine() {
+        // All-zero weights: y = 0, plain branch, no new maximum, no clamps.
+        let net = Network::<13, 4>::zeroed();
+        let mut m = H8Meter::new();
+        net.forward(&[Q7::ZERO; 13], &mut m);
+        let (n, k) = (13u64, 4u64);
+        let st = |op: Op| u64::from(op.states());
+        let expected = st(Op::CallFrame)
+            // sums
+            + (2 + k) * st(Op::PtrInit)
+            + st(Op::LoopInitB)
+            + k * (st(Op::LoopInitW) + st(Op::AccClear) + st(Op::StoreL))
+            + n * k * (st(Op::Mac) + st(Op::LoopIter))
+            + k * st(Op::LoopIter)
+            // argmax
+            + st(Op::PtrInit)
+            + k * st(Op::LoadL)
+            + 3 * st(Op::LoopInitB)
+            + (k - 1) * (st(Op::CmpBranch) + st(Op::IndexInc) + st(Op::LoopIter))
+            + st(Op::StoreVarB)
+            // scaling, plain branch
+            + st(Op::CmpImmBranch)
+            + 2 * st(Op::PtrInit)
+            + st(Op::LoopInitB)
+            + k * (st(Op::LoadL) + 7 * st(Op::Shr1) + st(Op::Sat16) + st(Op::StoreW) + st(Op::LoopIter));
+        assert_eq!(m.states(Phase::Forward), expected);
+        assert_eq!(m.count(Op::Mac), n * k);
+    }
+}
