@@ -1,3 +1,456 @@
-//! The H8/300H CPU core (advanced mode).
+//! The H8/300H CPU core in advanced mode (24-bit addresses, 32-bit ER0–ER7, ER7 = SP).
+//!
+//! Split as in moa: [`decode`] turns instruction words into an [`decode::Instr`], `exec`
+//! carries it out, [`timing`] holds the manual's internal-state counts, and [`disasm`] prints
+//! instructions the way `h8300-hms-objdump -d` does.
+//!
+//! The core is generic over [`Bus`] (static dispatch). Time is right by construction, as in
+//! mooneye-gb: every instruction fetch and data access goes through the bus, which charges the
+//! states of the area it touches, and the internal states N are charged with
+//! [`Bus::internal`]. An instruction therefore costs `I·S_I + J·S_J + K·S_K + L·S_L + M·S_M +
+//! N·S_N` states (programming manual, Appendix A).
+//!
+//! Speed: instructions fetched from ROM are decoded once and kept in a predecode cache indexed
+//! by address (ROM cannot change while a program runs: the flash is not writable through the
+//! bus). The fetch cycles are still charged on every execution. Code in RAM is decoded every
+//! time. Call [`Cpu::flush_decode_cache`] if the ROM image is replaced.
+//!
+//! Choices where the manual leaves the result open (documented behaviour of this core):
+//! - DIVXU/DIVXS by zero leave the destination register unchanged (flags as the manual says:
+//!   Z = 1, N from the divisor's sign for DIVXU and from the dividend's sign for DIVXS); on
+//!   overflow the low 8/16 bits of the quotient and the remainder are stored.
+//! - DAA/DAS leave H and V unchanged (the manual: "undetermined").
+//! - STC to memory writes the CCR to both bytes of the word.
+//! - `MOV Rn,@-ERn` with the same register stores the value before the decrement.
+//! - JSR/BSR push the 24-bit return address as a longword whose top byte is 0; interrupts and
+//!   TRAPA push CCR in the top byte (advanced-mode stack frame).
+//! - CCR.UI is treated as a user bit (SYSCR.UE = 1, the reset value): only CCR.I masks
+//!   interrupts, NMI (vector 7) is never masked. Interrupts are not accepted right after LDC,
+//!   ANDC, ORC, XORC (H8/3052F hardware manual, "Instructions that disable interrupts").
+//! - MOVFPE/MOVTPE decode and disassemble but stop the program with
+//!   [`CpuError::Unsupported`]: they need the E clock, which the H8/3052F does not provide.
+//! - Interrupt entry costs the priority decision (1 state internal, 2 external) plus 16 states
+//!   (stack 2 words, vector 2 words, 2 prefetches, 4 internal): H8/3052F hardware manual Table
+//!   5-5 without the "wait for the end of the current instruction", which this core overlaps
+//!   with the instruction (interrupts are taken between instructions).
+
 pub mod decode;
 pub mod disasm;
+mod exec;
+pub mod timing;
+
+use crate::bus::Bus;
+use crate::memmap::Area;
+use decode::{DecodeError, Decoded, Instr, WordSource, decode};
+
+/// CCR bit 7: interrupt mask.
+pub const CCR_I: u8 = 0x80;
+/// CCR bit 6: user bit / interrupt mask (UI).
+pub const CCR_UI: u8 = 0x40;
+/// CCR bit 5: half-carry.
+pub const CCR_H: u8 = 0x20;
+/// CCR bit 4: user bit.
+pub const CCR_U: u8 = 0x10;
+/// CCR bit 3: negative.
+pub const CCR_N: u8 = 0x08;
+/// CCR bit 2: zero.
+pub const CCR_Z: u8 = 0x04;
+/// CCR bit 1: overflow.
+pub const CCR_V: u8 = 0x02;
+/// CCR bit 0: carry.
+pub const CCR_C: u8 = 0x01;
+
+/// Vector number of the reset exception (SPEC §4.1).
+pub const VECTOR_RESET: u8 = 0;
+/// Vector number of NMI (H8/3052F hardware manual, Table 5-3).
+pub const VECTOR_NMI: u8 = 7;
+/// First TRAPA vector (TRAPA #0 = 8 ... #3 = 11; SPEC §4.1).
+pub const VECTOR_TRAPA0: u8 = 8;
+/// Vector number of IRQ0 (H8/3052F hardware manual, Table 5-3; IRQ0–IRQ5 = 12–17).
+pub const VECTOR_IRQ0: u8 = 12;
+/// Vector number of IRQ5.
+pub const VECTOR_IRQ5: u8 = 17;
+/// Bytes per vector in advanced mode.
+pub const VECTOR_BYTES: u32 = 4;
+
+/// Why the core stopped a program.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum CpuError {
+    /// The bytes at PC are no H8/300H instruction.
+    #[error("undefined opcode at PC H'{pc:06X}: {bytes}")]
+    UndefinedOpcode {
+        /// Address of the instruction.
+        pc: u32,
+        /// The bytes read, as `xx xx ...`.
+        bytes: String,
+    },
+    /// An instruction fetch went outside ROM and RAM (SPEC §7).
+    #[error(
+        "instruction fetch outside ROM and RAM at H'{addr:06X} (instruction at PC H'{pc:06X}, area {area:?}); code may run only from ROM H'000000-H'07FFFF or RAM H'FFDF10-H'FFFF0F"
+    )]
+    FetchOutside {
+        /// Address of the instruction.
+        pc: u32,
+        /// The address of the refused fetch.
+        addr: u32,
+        /// The area that address lies in.
+        area: Area,
+    },
+    /// An instruction the H8/3052F cannot execute.
+    #[error("unsupported instruction at PC H'{pc:06X}: {text} ({why})")]
+    Unsupported {
+        /// Address of the instruction.
+        pc: u32,
+        /// The instruction, disassembled.
+        text: String,
+        /// Why it cannot run.
+        why: &'static str,
+    },
+}
+
+/// What one call of [`Cpu::step`] did.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Event {
+    /// One instruction ran.
+    Executed,
+    /// An interrupt was accepted (exception handling ran; no instruction).
+    Interrupt(u8),
+    /// SLEEP ran with CCR.I = 1 and no NMI pending: the program has halted (SPEC §7). Further
+    /// steps do nothing and report this again.
+    Halted,
+    /// The CPU is in sleep mode and the deadline passed with no interrupt to wake it.
+    Asleep,
+}
+
+/// Run state of the CPU.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum RunState {
+    Running,
+    Sleeping,
+    Halted,
+}
+
+/// An empty predecode-cache slot (length 0 marks it).
+const EMPTY_SLOT: Decoded = Decoded {
+    instr: Instr::Nop,
+    words: 0,
+};
+
+/// The H8/300H CPU: registers, run state and the predecode cache.
+#[derive(Clone, Debug)]
+pub struct Cpu {
+    er: [u32; 8],
+    pc: u32,
+    ccr: u8,
+    state: RunState,
+    /// Set by LDC/ANDC/ORC/XORC: no interrupt is accepted before the next instruction.
+    irq_inhibit: bool,
+    /// Predecoded ROM instructions, indexed by address / 2; grows on demand.
+    cache: Vec<Decoded>,
+    instructions: u64,
+    /// The instruction executed last (for traces).
+    last: Decoded,
+}
+
+impl Default for Cpu {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// Fetches instruction words through the bus, refusing areas that are not executable.
+struct BusFetch<'b, B: Bus> {
+    bus: &'b mut B,
+    addr: u32,
+    refused: Option<u32>,
+}
+
+impl<B: Bus> WordSource for BusFetch<'_, B> {
+    #[inline]
+    fn next_word(&mut self) -> Option<u16> {
+        let a = self.addr & crate::memmap::ADDRESS_MASK;
+        if !Area::of(a).executable() {
+            self.refused = Some(a);
+            return None;
+        }
+        self.addr = self.addr.wrapping_add(2);
+        Some(self.bus.read16(a))
+    }
+}
+
+impl Cpu {
+    /// A CPU before reset: registers 0, CCR.I set, PC 0.
+    #[must_use]
+    pub fn new() -> Self {
+        Cpu {
+            er: [0; 8],
+            pc: 0,
+            ccr: CCR_I,
+            state: RunState::Running,
+            irq_inhibit: false,
+            cache: Vec::new(),
+            instructions: 0,
+            last: EMPTY_SLOT,
+        }
+    }
+
+    /// Reset exception: CCR.I = 1, PC = the longword at vector 0 (read through the bus, 2 word
+    /// reads). General registers are cleared (the manual leaves them undefined).
+    pub fn reset<B: Bus>(&mut self, bus: &mut B) {
+        self.er = [0; 8];
+        self.ccr = CCR_I;
+        self.state = RunState::Running;
+        self.irq_inhibit = false;
+        let v = u32::from(VECTOR_RESET) * VECTOR_BYTES;
+        let hi = u32::from(bus.read16(v));
+        let lo = u32::from(bus.read16(v + 2));
+        self.pc = ((hi << 16) | lo) & crate::memmap::ADDRESS_MASK & !1;
+    }
+
+    /// The program counter (24 bits).
+    #[must_use]
+    pub const fn pc(&self) -> u32 {
+        self.pc
+    }
+
+    /// Sets the program counter (masked to 24 bits, bit 0 cleared: instructions are
+    /// word-aligned).
+    pub fn set_pc(&mut self, pc: u32) {
+        self.pc = pc & crate::memmap::ADDRESS_MASK & !1;
+    }
+
+    /// The condition code register.
+    #[must_use]
+    pub const fn ccr(&self) -> u8 {
+        self.ccr
+    }
+
+    /// Sets the condition code register.
+    pub fn set_ccr(&mut self, ccr: u8) {
+        self.ccr = ccr;
+    }
+
+    /// General register ERn (n = 0–7; other values are taken modulo 8).
+    #[must_use]
+    pub const fn er(&self, n: usize) -> u32 {
+        self.er[n & 7]
+    }
+
+    /// Sets general register ERn (n modulo 8).
+    pub fn set_er(&mut self, n: usize, value: u32) {
+        self.er[n & 7] = value;
+    }
+
+    /// All eight general registers.
+    #[must_use]
+    pub const fn regs(&self) -> [u32; 8] {
+        self.er
+    }
+
+    /// Instructions executed since this CPU was created.
+    #[must_use]
+    pub const fn instructions(&self) -> u64 {
+        self.instructions
+    }
+
+    /// The instruction executed last (a NOP of length 0 before the first).
+    #[must_use]
+    pub const fn last_executed(&self) -> Decoded {
+        self.last
+    }
+
+    /// Whether SLEEP has halted the program (SPEC §7).
+    #[must_use]
+    pub fn halted(&self) -> bool {
+        self.state == RunState::Halted
+    }
+
+    /// Whether the CPU is in sleep mode waiting for an interrupt.
+    #[must_use]
+    pub fn sleeping(&self) -> bool {
+        self.state == RunState::Sleeping
+    }
+
+    /// Forgets every predecoded instruction (call after replacing the ROM image).
+    pub fn flush_decode_cache(&mut self) {
+        self.cache.clear();
+    }
+
+    /// Decodes the instruction at `pc` through the bus without executing it, charging its fetch
+    /// states like an execution would. Used by tracing; most callers want [`Cpu::step`].
+    fn fetch_decode<B: Bus>(&mut self, bus: &mut B) -> Result<Decoded, CpuError> {
+        let pc = self.pc;
+        if Area::of(pc) == Area::Rom {
+            let idx = (pc >> 1) as usize;
+            if let Some(d) = self.cache.get(idx)
+                && d.words != 0
+            {
+                let d = *d;
+                // Charge the instruction fetches the cached copy saved us from reading.
+                let mut a = pc;
+                for _ in 0..d.words {
+                    bus.read16(a);
+                    a = a.wrapping_add(2);
+                }
+                return Ok(d);
+            }
+            let d = self.decode_through_bus(bus)?;
+            if Area::of(pc + d.len_bytes() - 1) == Area::Rom {
+                if self.cache.len() <= idx {
+                    self.cache.resize(idx + 1, EMPTY_SLOT);
+                }
+                self.cache[idx] = d;
+            }
+            return Ok(d);
+        }
+        self.decode_through_bus(bus)
+    }
+
+    fn decode_through_bus<B: Bus>(&mut self, bus: &mut B) -> Result<Decoded, CpuError> {
+        let pc = self.pc;
+        let mut src = BusFetch {
+            bus,
+            addr: pc,
+            refused: None,
+        };
+        match decode(&mut src) {
+            Ok(d) => Ok(d),
+            Err(e) => {
+                if let Some(addr) = src.refused {
+                    return Err(CpuError::FetchOutside {
+                        pc,
+                        addr,
+                        area: Area::of(addr),
+                    });
+                }
+                let words = match &e {
+                    DecodeError::Undefined { words } | DecodeError::Truncated { words } => words,
+                };
+                Err(CpuError::UndefinedOpcode {
+                    pc,
+                    bytes: decode::hex_words(words),
+                })
+            }
+        }
+    }
+
+    /// Whether an interrupt with vector `v` gets through the CCR mask.
+    #[inline]
+    fn accepts(&self, v: u8) -> bool {
+        v == VECTOR_NMI || self.ccr & CCR_I == 0
+    }
+
+    /// Runs one step: accepts a pending interrupt, or executes one instruction, or (in sleep
+    /// mode) waits for an interrupt until the clock reaches `deadline`.
+    ///
+    /// # Errors
+    /// [`CpuError`] on an undefined opcode, a fetch outside ROM/RAM or an unsupported
+    /// instruction; the CPU state is left as it was before the instruction (PC at it).
+    #[inline]
+    pub fn step<B: Bus>(&mut self, bus: &mut B, deadline: u64) -> Result<Event, CpuError> {
+        match self.state {
+            RunState::Running => {}
+            RunState::Halted => return Ok(Event::Halted),
+            RunState::Sleeping => {
+                loop {
+                    if let Some(v) = bus.pending_irq()
+                        && self.accepts(v)
+                    {
+                        break;
+                    }
+                    if bus.now() >= deadline || !bus.sleep_until_irq(deadline) {
+                        return Ok(Event::Asleep);
+                    }
+                }
+                self.state = RunState::Running;
+            }
+        }
+        if self.irq_inhibit {
+            self.irq_inhibit = false;
+        } else if let Some(v) = bus.pending_irq()
+            && self.accepts(v)
+        {
+            self.interrupt(bus, v);
+            return Ok(Event::Interrupt(v));
+        }
+        let d = self.fetch_decode(bus)?;
+        self.execute(bus, d)
+    }
+
+    /// Decodes the instruction at PC without side effects on the CPU, reading the words through
+    /// `bus` (which charges them: use it on a scratch bus or accept the states).
+    ///
+    /// # Errors
+    /// As [`Cpu::step`].
+    pub fn peek_decode<B: Bus>(&mut self, bus: &mut B) -> Result<Decoded, CpuError> {
+        self.decode_through_bus(bus)
+    }
+
+    /// Pushes a longword on the stack (ER7 -= 4; two word writes).
+    #[inline]
+    fn push32<B: Bus>(&mut self, bus: &mut B, v: u32) {
+        let sp = self.er[7].wrapping_sub(4);
+        self.er[7] = sp;
+        bus.write16(sp, (v >> 16) as u16);
+        bus.write16(sp.wrapping_add(2), v as u16);
+    }
+
+    /// Pops a longword from the stack (two word reads; ER7 += 4).
+    #[inline]
+    fn pop32<B: Bus>(&mut self, bus: &mut B) -> u32 {
+        let sp = self.er[7];
+        let hi = u32::from(bus.read16(sp));
+        let lo = u32::from(bus.read16(sp.wrapping_add(2)));
+        self.er[7] = sp.wrapping_add(4);
+        (hi << 16) | lo
+    }
+
+    /// Reads the 24-bit address in vector `v` (two word reads: J = 2).
+    #[inline]
+    fn read_vector<B: Bus>(bus: &mut B, v: u8) -> u32 {
+        let a = u32::from(v) * VECTOR_BYTES;
+        let hi = u32::from(bus.read16(a));
+        let lo = u32::from(bus.read16(a + 2));
+        ((hi << 16) | lo) & crate::memmap::ADDRESS_MASK & !1
+    }
+
+    /// Exception handling shared by interrupts and TRAPA: push PC and CCR, set I, load PC from
+    /// the vector.
+    fn enter_exception<B: Bus>(&mut self, bus: &mut B, v: u8, return_pc: u32) {
+        let frame = (u32::from(self.ccr) << 24) | (return_pc & crate::memmap::ADDRESS_MASK);
+        self.push32(bus, frame);
+        self.ccr |= CCR_I;
+        self.pc = Self::read_vector(bus, v);
+    }
+
+    /// Interrupt exception handling (H8/3052F hardware manual, section 5.4 and Table 5-5).
+    fn interrupt<B: Bus>(&mut self, bus: &mut B, v: u8) {
+        let external = v == VECTOR_NMI || (VECTOR_IRQ0..=VECTOR_IRQ5).contains(&v);
+        bus.internal(if external {
+            timing::N_PRIORITY_DECISION_EXTERNAL
+        } else {
+            timing::N_PRIORITY_DECISION_INTERNAL
+        });
+        let ret = self.pc;
+        // Prefetch after acceptance (at the return address; not executed).
+        Self::fetch_charge(bus, ret);
+        self.enter_exception(bus, v, ret);
+        // Prefetch of the first instruction of the handler.
+        let target = self.pc;
+        Self::fetch_charge(bus, target);
+        bus.internal(timing::N_INTERRUPT_INTERNAL);
+    }
+
+    /// Charges one instruction-fetch cycle at `addr` (a branch-target prefetch: the extra I of
+    /// one-word branches). Reads only executable areas, so a bad target has no side effects on
+    /// devices; elsewhere it charges the area's word states as internal time.
+    #[inline]
+    fn fetch_charge<B: Bus>(bus: &mut B, addr: u32) {
+        let area = Area::of(addr);
+        if area.executable() {
+            bus.read16(addr);
+        } else {
+            bus.internal(area.word_states());
+        }
+    }
+}

@@ -1,0 +1,244 @@
+//! Running a program image on the core: the API behind `h8swarm emu`.
+//!
+//! [`run_image`] parses a `.mot` image, loads it into a [`Machine`] (512 KB flash, 8 KB RAM,
+//! SCI1 as console), resets the CPU through vector 0 and runs it until the program halts
+//! (SLEEP with CCR.I = 1 and no NMI pending; exit status = low byte of R0, SPEC §7), the state
+//! budget runs out, or the core stops on an error (undefined opcode, fetch outside ROM/RAM).
+//! Bytes the program transmits on SCI1 go to the console writer as they leave TDR; the
+//! optional trace writer gets one line per instruction: address, disassembly (objdump's form)
+//! and the states it took.
+
+use std::fmt::Write as _;
+use std::io::Write;
+
+use crate::bus::Bus;
+use crate::cpu::disasm::format_instr;
+use crate::cpu::{Cpu, CpuError, Event};
+use crate::machine::{LoadError, Machine};
+use crate::srec::{self, SrecError};
+
+/// The system clock φ of the AKI-H8/3052F board: 25 MHz, 1 state = 40 ns (SPEC §4.1).
+pub const PHI_HZ: u64 = 25_000_000;
+
+/// Options of a run.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RunOptions {
+    /// Stop once the clock reaches this many states (checked between instructions, so the
+    /// last instruction may end a few states past it). `None`: no limit.
+    pub max_states: Option<u64>,
+}
+
+/// How a run ended.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Outcome {
+    /// SLEEP with CCR.I = 1 and no NMI pending (SPEC §7).
+    Halted {
+        /// The low byte of R0.
+        exit_status: u8,
+    },
+    /// The clock reached [`RunOptions::max_states`].
+    MaxStates,
+    /// The core refused to go on (undefined opcode, fetch outside ROM/RAM, unsupported
+    /// instruction); the error names the PC and the bytes.
+    Error(CpuError),
+    /// SLEEP with interrupts enabled and no interrupt source that could ever wake the CPU, with
+    /// no state budget to run out: the program would sleep forever.
+    SleptForever {
+        /// PC after the SLEEP instruction.
+        pc: u32,
+    },
+}
+
+/// Counters of a run.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RunStats {
+    /// Instructions executed.
+    pub instructions: u64,
+    /// States elapsed (the MCU clock at the end).
+    pub states: u64,
+    /// `states / φ` in seconds at φ = 25 MHz.
+    pub emulated_seconds: f64,
+    /// Interrupts accepted.
+    pub interrupts: u64,
+    /// Bytes transmitted on SCI1.
+    pub console_bytes: u64,
+}
+
+/// The result of a run: how it ended and what it cost.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RunReport {
+    /// How the run ended.
+    pub outcome: Outcome,
+    /// Counters.
+    pub stats: RunStats,
+}
+
+impl RunReport {
+    /// The report as one JSON object (for `--stats` on stderr): outcome, exit status (or
+    /// null), error text (or null), instructions, states, emulated seconds, φ, interrupts,
+    /// console bytes.
+    #[must_use]
+    pub fn to_json(&self) -> String {
+        let (outcome, status, error) = match &self.outcome {
+            Outcome::Halted { exit_status } => ("halted", exit_status.to_string(), None),
+            Outcome::MaxStates => ("max_states", "null".to_string(), None),
+            Outcome::Error(e) => ("error", "null".to_string(), Some(e.to_string())),
+            Outcome::SleptForever { .. } => ("slept_forever", "null".to_string(), None),
+        };
+        let mut s = String::new();
+        let _ = write!(
+            s,
+            "{{\"outcome\":\"{outcome}\",\"exit_status\":{status},\"error\":{},\"instructions\":{},\"states\":{},\"emulated_seconds\":{:.9},\"phi_hz\":{PHI_HZ},\"interrupts\":{},\"console_bytes\":{}}}",
+            error.map_or_else(|| "null".to_string(), |e| json_string(&e)),
+            self.stats.instructions,
+            self.stats.states,
+            self.stats.emulated_seconds,
+            self.stats.interrupts,
+            self.stats.console_bytes,
+        );
+        s
+    }
+}
+
+fn json_string(s: &str) -> String {
+    let mut out = String::from("\"");
+    for c in s.chars() {
+        match c {
+            '"' => out.push_str("\\\""),
+            '\\' => out.push_str("\\\\"),
+            c if (c as u32) < 0x20 => {
+                let _ = write!(out, "\\u{:04x}", c as u32);
+            }
+            c => out.push(c),
+        }
+    }
+    out.push('"');
+    out
+}
+
+/// Why a run could not start or could not write its output.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// The image is not a valid S-record file.
+    #[error("bad image: {0}")]
+    Srec(#[from] SrecError),
+    /// The image does not fit the flash.
+    #[error("cannot load image: {0}")]
+    Load(#[from] LoadError),
+    /// Writing the console or the trace failed.
+    #[error("writing output failed: {0}")]
+    Io(#[from] std::io::Error),
+}
+
+/// Parses `mot` (S-record text), loads it into a fresh [`Machine`], resets the CPU and runs it
+/// (see [`run_machine`]).
+///
+/// # Errors
+/// [`RunError`] if the image is malformed or does not fit the flash, or output cannot be
+/// written. How the *program* ended (including core errors) is in [`RunReport::outcome`].
+pub fn run_image(
+    mot: &[u8],
+    options: &RunOptions,
+    console: &mut dyn Write,
+    trace: Option<&mut dyn Write>,
+) -> Result<RunReport, RunError> {
+    let image = srec::parse(mot)?;
+    let mut machine = Machine::with_image(&image)?;
+    let mut cpu = Cpu::new();
+    cpu.reset(&mut machine);
+    Ok(run_machine(
+        &mut cpu,
+        &mut machine,
+        options,
+        console,
+        trace,
+    )?)
+}
+
+/// Runs `cpu` on `machine` from its current state until the program halts, the budget runs
+/// out or the core stops on an error; SCI1's output goes to `console`, one line per
+/// instruction to `trace` if given.
+///
+/// # Errors
+/// Only I/O errors of the writers.
+pub fn run_machine(
+    cpu: &mut Cpu,
+    machine: &mut Machine,
+    options: &RunOptions,
+    console: &mut dyn Write,
+    mut trace: Option<&mut dyn Write>,
+) -> std::io::Result<RunReport> {
+    let deadline = options.max_states.unwrap_or(u64::MAX);
+    let start_instructions = cpu.instructions();
+    let mut interrupts = 0u64;
+    let mut line = String::new();
+    let outcome = loop {
+        if machine.now() >= deadline {
+            break Outcome::MaxStates;
+        }
+        let pc = cpu.pc();
+        let t0 = machine.now();
+        let event = cpu.step(machine, deadline);
+        if let Some(w) = trace.as_deref_mut() {
+            line.clear();
+            let states = machine.now() - t0;
+            match &event {
+                Ok(Event::Executed | Event::Halted) => {
+                    let text = format_instr(cpu.last_executed(), pc).replacen('\t', " ", 1);
+                    let _ = writeln!(line, "{pc:06x}: {text:<40} {states:>4} states");
+                }
+                Ok(Event::Interrupt(v)) => {
+                    let _ = writeln!(
+                        line,
+                        "{pc:06x}: <interrupt vector {v} -> {:06x}> {states:>4} states",
+                        cpu.pc()
+                    );
+                }
+                Ok(Event::Asleep) => {
+                    let _ = writeln!(line, "{pc:06x}: <asleep> {states:>4} states");
+                }
+                Err(e) => {
+                    let _ = writeln!(line, "{pc:06x}: <error: {e}>");
+                }
+            }
+            w.write_all(line.as_bytes())?;
+        }
+        match event {
+            Ok(Event::Executed) => {}
+            Ok(Event::Interrupt(_)) => interrupts += 1,
+            Ok(Event::Halted) => {
+                break Outcome::Halted {
+                    exit_status: cpu.er(0) as u8,
+                };
+            }
+            Ok(Event::Asleep) => {
+                if deadline == u64::MAX {
+                    break Outcome::SleptForever { pc: cpu.pc() };
+                }
+                break Outcome::MaxStates;
+            }
+            Err(e) => break Outcome::Error(e),
+        }
+        if machine.sci().has_output() {
+            console.write_all(&machine.sci_mut().take_output())?;
+        }
+    };
+    let now = machine.now();
+    machine.sci_mut().flush(now);
+    console.write_all(&machine.sci_mut().take_output())?;
+    console.flush()?;
+    if let Some(w) = trace {
+        w.flush()?;
+    }
+    let states = machine.now();
+    Ok(RunReport {
+        outcome,
+        stats: RunStats {
+            instructions: cpu.instructions() - start_instructions,
+            states,
+            emulated_seconds: states as f64 / PHI_HZ as f64,
+            interrupts,
+            console_bytes: machine.sci().bytes_sent(),
+        },
+    })
+}
