@@ -8,10 +8,13 @@
 //! 4. the forward pass of SPEC §2.3 on x(t), whose winner picks the behaviour.
 
 use crate::cost::{Meter, Op, Phase};
-use crate::error::ConfigError;
+use crate::error::{ConfigError, ShapeError};
 use crate::format::{Q7, Q15, evaluation_to_q7, output_to_q7, proximity_to_q7};
 use crate::input::{InputLayout, SENSORS};
-use crate::net::{ForwardOut, Network, Params, UpdateKind, update_core};
+use crate::net::{
+    ForwardOut, MAX_INPUTS, MAX_OUTPUTS, Network, Params, Shape, UpdateKind, forward_core,
+    update_core,
+};
 
 /// The four primitive behaviours (SPEC §2.3 step 4).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -79,43 +82,30 @@ pub const fn align2(bytes: u32) -> u32 {
     (bytes + 1) & !1
 }
 
-/// The continuously learning controller: the network, its parameters and the state it carries
-/// from step to step.
-#[derive(Clone, Debug)]
-pub struct Learner<const N: usize, const M: usize> {
-    net: Network<N, M>,
-    params: Params,
-    layout: InputLayout,
-    behaviours: [Behaviour; M],
-    x: [Q7; N],
-    o: [Q15; M],
-    win: u8,
-    d_prev: i16,
-    started: bool,
-}
-
-impl<const N: usize, const M: usize> Learner<N, M> {
-    /// The learner's RAM items on the H8, in placement order.
-    pub const RAM_ITEMS: [RamItem; 7] = [
+/// The learner's RAM items on the H8 for N inputs and M outputs, in placement order.
+#[must_use]
+pub const fn ram_items(n_in: usize, n_out: usize) -> [RamItem; 7] {
+    let (n, m) = (n_in as u32, n_out as u32);
+    [
         RamItem {
             name: "weights w (i16, N x M)",
-            bytes: 2 * (N * M) as u32,
+            bytes: 2 * n * m,
         },
         RamItem {
             name: "input vector x (i8, N)",
-            bytes: align2(N as u32),
+            bytes: align2(n),
         },
         RamItem {
             name: "update deltas (i16, N)",
-            bytes: 2 * N as u32,
+            bytes: 2 * n,
         },
         RamItem {
             name: "sums y (i32, M)",
-            bytes: 4 * M as u32,
+            bytes: 4 * m,
         },
         RamItem {
             name: "outputs O (i16, M)",
-            bytes: 2 * M as u32,
+            bytes: 2 * m,
         },
         RamItem {
             name: "eta, T (i16 each)",
@@ -125,18 +115,161 @@ impl<const N: usize, const M: usize> Learner<N, M> {
             name: "D(t-1) (i16), winner and started flag (u8 each)",
             bytes: 4,
         },
-    ];
+    ]
+}
+
+/// The learner's RAM footprint on the H8 in bytes for N inputs and M outputs: the sum of
+/// [`ram_items`].
+#[must_use]
+pub const fn ram_bytes(n_in: usize, n_out: usize) -> u32 {
+    let items = ram_items(n_in, n_out);
+    let mut total = 0;
+    let mut i = 0;
+    while i < items.len() {
+        total += items[i].bytes;
+        i += 1;
+    }
+    total
+}
+
+/// The state a learner carries from one step to the next besides its vectors.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+struct Carried {
+    win: u8,
+    d_prev: i16,
+    started: bool,
+}
+
+/// The vectors one step works on, borrowed from whichever learner owns them.
+struct StepData<'a> {
+    w: &'a mut [Q15],
+    x: &'a mut [Q7],
+    o: &'a mut [Q15],
+    delta: &'a mut [i16],
+}
+
+/// One step (SPEC §3.5) on borrowed storage: shared by [`Learner`] and [`DynLearner`].
+#[inline]
+fn step_core<Mt: Meter>(
+    data: StepData<'_>,
+    carried: &mut Carried,
+    layout: InputLayout,
+    params: Params,
+    p: &[u8; SENSORS],
+    meter: &mut Mt,
+) -> (ForwardOut, i16, i16, Option<UpdateKind>) {
+    let StepData { w, x, o, delta } = data;
+    let n_out = o.len();
+    meter.enter(Phase::Input);
+    meter.charge(Op::CallFrame, 1);
+
+    // 1. D(t), E(t−1). D ≤ 4 · 255 = 1020 and |E| ≤ 1020: both fit an i16.
+    let d = p.iter().map(|&v| i16::from(v)).sum::<i16>();
+    let k = SENSORS as u32;
+    meter.charge(Op::PtrInit, 1);
+    meter.charge(Op::AccClear, 1);
+    meter.charge(Op::LoopInitB, 1);
+    meter.charge(Op::SumIn, k);
+    meter.charge(Op::LoopIter, k);
+    meter.charge(Op::FlagTest, 1);
+    let e = if carried.started {
+        meter.charge(Op::LoadW, 1);
+        meter.charge(Op::RegOp, 1);
+        d - carried.d_prev
+    } else {
+        0
+    };
+    meter.charge(Op::StoreVarW, 1);
+
+    // 2. The update on the previous input and winner.
+    let update = if carried.started {
+        Some(update_core(
+            w,
+            x,
+            usize::from(carried.win),
+            e,
+            params,
+            delta,
+            meter,
+        ))
+    } else {
+        None
+    };
+
+    // 3. x(t): history one block deeper, the new readings, past outputs, E, bias.
+    meter.enter(Phase::Input);
+    let h = layout.history();
+    if h > 0 {
+        x.copy_within(0..SENSORS * h, SENSORS);
+        meter.charge(Op::PtrInit, 2);
+        meter.charge(Op::LoopInitB, 1);
+        meter.charge(Op::HistoryShift, h as u32);
+    }
+    for (xk, &pk) in x.iter_mut().zip(p) {
+        *xk = Q7::from_bits(proximity_to_q7(pk));
+    }
+    meter.charge(Op::PtrInit, 2);
+    meter.charge(Op::LoopInitB, 1);
+    meter.charge(Op::ProximityIn, k);
+    meter.charge(Op::LoopIter, k);
+    let at = layout.outputs_at();
+    for (xj, oj) in x[at..at + n_out].iter_mut().zip(o.iter()) {
+        *xj = Q7::from_bits(output_to_q7(oj.to_bits()));
+    }
+    meter.charge(Op::PtrInit, 2);
+    meter.charge(Op::LoopInitB, 1);
+    meter.charge(Op::OutputIn, n_out as u32);
+    meter.charge(Op::LoopIter, n_out as u32);
+    let e_in = evaluation_to_q7(e);
+    x[at + n_out] = Q7::from_bits(e_in);
+    meter.charge(Op::RegOp, 1);
+    meter.charge(Op::EvalIn, 1);
+    if Mt::ACTIVE && i16::from(e_in) != e >> 3 {
+        meter.charge(Op::ClampW, 1);
+    }
+    if layout.bias() {
+        x[at + n_out + 1] = Q7::from_bits(i8::MAX);
+        meter.charge(Op::BiasIn, 1);
+    }
+
+    // 4. The forward pass picks the behaviour.
+    let forward = forward_core(w, x, n_out, meter);
+    for (oj, &bits) in o.iter_mut().zip(forward.o_bits()) {
+        *oj = Q15::from_bits(bits);
+    }
+    carried.win = forward.win() as u8;
+    carried.d_prev = d;
+    carried.started = true;
+    (forward, d, e, update)
+}
+
+fn default_behaviours<const M: usize>() -> [Behaviour; M] {
+    let mut behaviours = [Behaviour::Forward; M];
+    for (b, a) in behaviours.iter_mut().zip(Behaviour::ALL) {
+        *b = a;
+    }
+    behaviours
+}
+
+/// The continuously learning controller with its shape fixed at compile time: the network, its
+/// parameters and the state it carries from step to step.
+#[derive(Clone, Debug)]
+pub struct Learner<const N: usize, const M: usize> {
+    net: Network<N, M>,
+    params: Params,
+    layout: InputLayout,
+    behaviours: [Behaviour; M],
+    x: [Q7; N],
+    o: [Q15; M],
+    carried: Carried,
+}
+
+impl<const N: usize, const M: usize> Learner<N, M> {
+    /// The learner's RAM items on the H8, in placement order.
+    pub const RAM_ITEMS: [RamItem; 7] = ram_items(N, M);
 
     /// The learner's RAM footprint on the H8 in bytes: the sum of [`Self::RAM_ITEMS`].
-    pub const RAM_BYTES: u32 = {
-        let mut total = 0;
-        let mut i = 0;
-        while i < Self::RAM_ITEMS.len() {
-            total += Self::RAM_ITEMS[i].bytes;
-            i += 1;
-        }
-        total
-    };
+    pub const RAM_BYTES: u32 = ram_bytes(N, M);
 
     /// A learner starting from `net` (weights as initialised), with `params` and the input
     /// `layout`; output j runs behaviour `Behaviour::ALL[j]`.
@@ -155,20 +288,14 @@ impl<const N: usize, const M: usize> Learner<N, M> {
                 network: N,
             });
         }
-        let mut behaviours = [Behaviour::Forward; M];
-        for (b, a) in behaviours.iter_mut().zip(Behaviour::ALL) {
-            *b = a;
-        }
         Ok(Self {
             net,
             params,
             layout,
-            behaviours,
+            behaviours: default_behaviours(),
             x: [Q7::ZERO; N],
             o: [Q15::ZERO; M],
-            win: 0,
-            d_prev: 0,
-            started: false,
+            carried: Carried::default(),
         })
     }
 
@@ -217,7 +344,7 @@ impl<const N: usize, const M: usize> Learner<N, M> {
     /// Whether a step has run since construction (or [`Self::restart`]).
     #[must_use]
     pub const fn started(&self) -> bool {
-        self.started
+        self.carried.started
     }
 
     /// Forgets the carried state (inputs, outputs, D, the started flag) but keeps the weights:
@@ -225,9 +352,7 @@ impl<const N: usize, const M: usize> Learner<N, M> {
     pub fn restart(&mut self) {
         self.x = [Q7::ZERO; N];
         self.o = [Q15::ZERO; M];
-        self.win = 0;
-        self.d_prev = 0;
-        self.started = false;
+        self.carried = Carried::default();
     }
 
     /// Replaces the weights (restored from a record, say), keeping the carried state.
@@ -237,87 +362,173 @@ impl<const N: usize, const M: usize> Learner<N, M> {
 
     /// One step with the proximities `p` (du) read after the last behaviour.
     pub fn step<Mt: Meter>(&mut self, p: &[u8; SENSORS], meter: &mut Mt) -> StepOut {
-        meter.enter(Phase::Input);
-        meter.charge(Op::CallFrame, 1);
-
-        // 1. D(t), E(t−1). D ≤ 4 · 255 = 1020 and |E| ≤ 1020: both fit an i16.
-        let d = p.iter().map(|&v| i16::from(v)).sum::<i16>();
-        let k = SENSORS as u32;
-        meter.charge(Op::PtrInit, 1);
-        meter.charge(Op::AccClear, 1);
-        meter.charge(Op::LoopInitB, 1);
-        meter.charge(Op::SumIn, k);
-        meter.charge(Op::LoopIter, k);
-        meter.charge(Op::FlagTest, 1);
-        let e = if self.started {
-            meter.charge(Op::LoadW, 1);
-            meter.charge(Op::RegOp, 1);
-            d - self.d_prev
-        } else {
-            0
+        let mut delta = [0i16; N];
+        let data = StepData {
+            w: self.net.weights_flat_mut(),
+            x: &mut self.x,
+            o: &mut self.o,
+            delta: &mut delta,
         };
-        meter.charge(Op::StoreVarW, 1);
+        let (forward, d, e, update) =
+            step_core(data, &mut self.carried, self.layout, self.params, p, meter);
+        StepOut {
+            behaviour: self.behaviours[forward.win()],
+            forward,
+            d,
+            e,
+            update,
+        }
+    }
+}
 
-        // 2. The update on the previous input and winner.
-        let update = if self.started {
-            let mut delta = [0i16; N];
-            Some(update_core(
-                self.net.weights_flat_mut(),
-                &self.x,
-                usize::from(self.win),
-                e,
-                self.params,
-                &mut delta,
-                meter,
-            ))
-        } else {
-            None
+/// Capacity of a [`DynLearner`]'s weight storage: the largest network, 256 × 4.
+pub const MAX_WEIGHTS: usize = MAX_INPUTS * MAX_OUTPUTS;
+
+/// The same learner with its shape chosen at run time (within the bounds of [`Shape`]), for
+/// what-if studies and the emulated controller. Storage is `heapless` at the largest shape, so
+/// it never allocates; it computes bit for bit what [`Learner`] computes.
+#[derive(Clone, Debug)]
+pub struct DynLearner {
+    shape: Shape,
+    params: Params,
+    layout: InputLayout,
+    behaviours: heapless::Vec<Behaviour, MAX_OUTPUTS>,
+    w: heapless::Vec<Q15, MAX_WEIGHTS>,
+    x: heapless::Vec<Q7, MAX_INPUTS>,
+    o: heapless::Vec<Q15, MAX_OUTPUTS>,
+    carried: Carried,
+}
+
+impl DynLearner {
+    /// A learner for `n_out` behaviours with the input `layout`, starting from `weights`
+    /// (row-major, one row of N per output).
+    ///
+    /// # Errors
+    /// [`ShapeError`] when N or M is out of range or `weights` has the wrong length.
+    pub fn new(
+        n_out: usize,
+        layout: InputLayout,
+        params: Params,
+        weights: &[Q15],
+    ) -> Result<Self, ShapeError> {
+        let shape = Shape::new(layout.n_inputs(n_out), n_out)?;
+        if weights.len() != shape.n_weights() {
+            return Err(ShapeError::Length {
+                what: "weights",
+                expected: shape.n_weights(),
+                got: weights.len(),
+            });
+        }
+        let mut behaviours = heapless::Vec::new();
+        let mut w = heapless::Vec::new();
+        let mut x = heapless::Vec::new();
+        let mut o = heapless::Vec::new();
+        // Every length below was checked against the capacities by `Shape::new`.
+        let filled = behaviours
+            .extend_from_slice(&Behaviour::ALL[..n_out])
+            .and(w.extend_from_slice(weights))
+            .and(x.resize(shape.n_in(), Q7::ZERO))
+            .and(o.resize(n_out, Q15::ZERO));
+        if filled.is_err() {
+            return Err(ShapeError::Length {
+                what: "weights",
+                expected: MAX_WEIGHTS,
+                got: weights.len(),
+            });
+        }
+        Ok(Self {
+            shape,
+            params,
+            layout,
+            behaviours,
+            w,
+            x,
+            o,
+            carried: Carried::default(),
+        })
+    }
+
+    /// The network shape.
+    #[must_use]
+    pub const fn shape(&self) -> Shape {
+        self.shape
+    }
+
+    /// The input layout.
+    #[must_use]
+    pub const fn layout(&self) -> InputLayout {
+        self.layout
+    }
+
+    /// The learning parameters.
+    #[must_use]
+    pub const fn params(&self) -> Params {
+        self.params
+    }
+
+    /// Changes the learning parameters.
+    pub fn set_params(&mut self, params: Params) {
+        self.params = params;
+    }
+
+    /// The weights, row-major.
+    #[must_use]
+    pub fn weights(&self) -> &[Q15] {
+        &self.w
+    }
+
+    /// Replaces the weights (restored from a record, say), keeping the carried state.
+    ///
+    /// # Errors
+    /// [`ShapeError::Length`] when `weights` has the wrong length.
+    pub fn set_weights(&mut self, weights: &[Q15]) -> Result<(), ShapeError> {
+        if weights.len() != self.w.len() {
+            return Err(ShapeError::Length {
+                what: "weights",
+                expected: self.w.len(),
+                got: weights.len(),
+            });
+        }
+        self.w.copy_from_slice(weights);
+        Ok(())
+    }
+
+    /// The input vector of the last step.
+    #[must_use]
+    pub fn inputs(&self) -> &[Q7] {
+        &self.x
+    }
+
+    /// The learner's RAM items on the H8.
+    #[must_use]
+    pub const fn ram_items(&self) -> [RamItem; 7] {
+        ram_items(self.shape.n_in(), self.shape.n_out())
+    }
+
+    /// The learner's RAM footprint on the H8 in bytes.
+    #[must_use]
+    pub const fn ram_bytes(&self) -> u32 {
+        ram_bytes(self.shape.n_in(), self.shape.n_out())
+    }
+
+    /// Forgets the carried state but keeps the weights (see [`Learner::restart`]).
+    pub fn restart(&mut self) {
+        self.x.fill(Q7::ZERO);
+        self.o.fill(Q15::ZERO);
+        self.carried = Carried::default();
+    }
+
+    /// One step with the proximities `p` (du) read after the last behaviour.
+    pub fn step<Mt: Meter>(&mut self, p: &[u8; SENSORS], meter: &mut Mt) -> StepOut {
+        let mut delta = [0i16; MAX_INPUTS];
+        let data = StepData {
+            w: &mut self.w,
+            x: &mut self.x,
+            o: &mut self.o,
+            delta: &mut delta,
         };
-
-        // 3. x(t): history one block deeper, the new readings, past outputs, E, bias.
-        meter.enter(Phase::Input);
-        let h = self.layout.history();
-        if h > 0 {
-            self.x.copy_within(0..SENSORS * h, SENSORS);
-            meter.charge(Op::PtrInit, 2);
-            meter.charge(Op::LoopInitB, 1);
-            meter.charge(Op::HistoryShift, h as u32);
-        }
-        for (xk, &pk) in self.x.iter_mut().zip(p) {
-            *xk = Q7::from_bits(proximity_to_q7(pk));
-        }
-        meter.charge(Op::PtrInit, 2);
-        meter.charge(Op::LoopInitB, 1);
-        meter.charge(Op::ProximityIn, k);
-        meter.charge(Op::LoopIter, k);
-        let at = self.layout.outputs_at();
-        for (xj, oj) in self.x[at..at + M].iter_mut().zip(&self.o) {
-            *xj = Q7::from_bits(output_to_q7(oj.to_bits()));
-        }
-        meter.charge(Op::PtrInit, 2);
-        meter.charge(Op::LoopInitB, 1);
-        meter.charge(Op::OutputIn, M as u32);
-        meter.charge(Op::LoopIter, M as u32);
-        let e_in = evaluation_to_q7(e);
-        self.x[at + M] = Q7::from_bits(e_in);
-        meter.charge(Op::RegOp, 1);
-        meter.charge(Op::EvalIn, 1);
-        if Mt::ACTIVE && i16::from(e_in) != e >> 3 {
-            meter.charge(Op::ClampW, 1);
-        }
-        if self.layout.bias() {
-            self.x[at + M + 1] = Q7::from_bits(i8::MAX);
-            meter.charge(Op::BiasIn, 1);
-        }
-
-        // 4. The forward pass picks the behaviour.
-        let forward = self.net.forward(&self.x, meter);
-        for (oj, &bits) in self.o.iter_mut().zip(forward.o_bits()) {
-            *oj = Q15::from_bits(bits);
-        }
-        self.win = forward.win() as u8;
-        self.d_prev = d;
-        self.started = true;
+        let (forward, d, e, update) =
+            step_core(data, &mut self.carried, self.layout, self.params, p, meter);
         StepOut {
             behaviour: self.behaviours[forward.win()],
             forward,
@@ -388,6 +599,34 @@ mod tests {
         assert_eq!(&bits[4..8], &[-126; 4]);
         assert_eq!(&bits[8..12], &[-127; 4]);
         assert_eq!(bits[15], 127, "bias");
+    }
+
+    #[test]
+    fn dyn_learner_matches_the_static_one_bit_for_bit() {
+        let rows = [[1200; 13], [-700; 13], [300; 13], [5; 13]];
+        let net = Network::<13, 4>::from_bits(rows);
+        let mut a = Arena::new(net.clone(), Params::CORRIDOR, InputLayout::DEFAULT).unwrap();
+        let mut b = DynLearner::new(
+            4,
+            InputLayout::DEFAULT,
+            Params::CORRIDOR,
+            net.weights_flat(),
+        )
+        .unwrap();
+        let (mut ma, mut mb) = (H8Meter::new(), H8Meter::new());
+        for t in 0..200u32 {
+            let p = [
+                (t * 37 % 256) as u8,
+                (t * 11 % 256) as u8,
+                (t % 7) as u8,
+                (255 - t % 256) as u8,
+            ];
+            assert_eq!(a.step(&p, &mut ma), b.step(&p, &mut mb), "step {t}");
+        }
+        assert_eq!(a.network().weights_flat(), b.weights());
+        assert_eq!(ma.phase_states(), mb.phase_states());
+        assert_eq!(b.ram_bytes(), Arena::RAM_BYTES);
+        assert!(DynLearner::new(4, InputLayout::DEFAULT, Params::ARENA, &[Q15::ZERO; 51]).is_err());
     }
 
     #[test]

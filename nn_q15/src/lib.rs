@@ -38,7 +38,9 @@ pub use cost::{H8Meter, Meter, NoopMeter, Op, Phase};
 pub use error::{ConfigError, ParamError, ShapeError};
 pub use format::{Q7, Q15, Q22};
 pub use input::{InputLayout, MAX_HISTORY, SENSORS};
-pub use learner::{Behaviour, Learner, RamItem, StepOut};
+pub use learner::{
+    Behaviour, DynLearner, Learner, MAX_WEIGHTS, RamItem, StepOut, ram_bytes, ram_items,
+};
 pub use net::{
     ForwardOut, MAX_INPUTS, MAX_OUTPUTS, MIN_OUTPUTS, Network, Params, Shape, UpdateKind,
     forward_slice, update_slice,
