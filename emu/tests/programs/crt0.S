@@ -32,9 +32,8 @@ __vectors:
 	.long	__vector_stubs + 6 * (vn - 1)	; vectors 1..60
 	.set	vn, vn + 1
 	.endr
-	.global	__vectors_end
-__vectors_end:
 
+; _start follows the table directly, at H'0000F4 (the linker script checks).
 	.global	_start
 _start:
 	mov.l	#__stack_top, er7
