@@ -11,7 +11,8 @@
 //! with Vref = 5.0 V. Negative volts (and NaN, which no real pin carries) give 0; volts at or
 //! above `1023 · Vref / 1024` give 1023. The code is computed against the exact transition
 //! voltages (each `k · 5 / 1024` is exact in `f64`), so it is exact at every code boundary, even
-//! for the float just below a transition, where a plain `floor(V / Vref * 1024)` can round up.
+//! for the float just below a transition, where a plain `floor(V / Vref * 1024)` can round up
+//! (the division can round onto the next integer).
 //!
 //! The result sits left-justified in the 16-bit data register (ADDRA–ADDRD, SPEC §3.2):
 //! `ADDRn = code10 << 6`. The firmware reads only the upper byte, `c = code10 >> 2`, one step
@@ -51,16 +52,15 @@ pub fn adc10_code(volts: f64) -> u16 {
     if volts >= adc10_threshold_volts(ADC10_MAX) {
         return ADC10_MAX;
     }
-    // A first guess, then fix it against the exact thresholds (at most one step off).
-    let guess = (volts / ADC10_LSB_VOLTS) as u16;
-    let mut k = guess.clamp(1, ADC10_MAX - 1);
-    while k > 0 && volts < adc10_threshold_volts(k) {
-        k -= 1;
+    // The step 5/1024 is exact in f64 and division is correctly rounded, so the quotient is
+    // never below the true code k (k itself is representable) and at most rounds up onto k + 1;
+    // the exact threshold check then steps back once.
+    let k = (volts / ADC10_LSB_VOLTS) as u16; // in 1..=1023 here
+    if volts < adc10_threshold_volts(k) {
+        k - 1
+    } else {
+        k
     }
-    while k < ADC10_MAX && volts >= adc10_threshold_volts(k + 1) {
-        k += 1;
-    }
-    k
 }
 
 /// The 16-bit contents of ADDRn for a 10-bit result: `code10 << 6` (bits above 10 ignored).
@@ -106,9 +106,17 @@ mod tests {
     fn exact_at_every_10bit_boundary() {
         for k in 1..=ADC10_MAX {
             let t = adc10_threshold_volts(k);
-            assert_eq!(t, f64::from(k) * 5.0 / 1024.0, "threshold {k} must be exact");
+            assert_eq!(
+                t,
+                f64::from(k) * 5.0 / 1024.0,
+                "threshold {k} must be exact"
+            );
             assert_eq!(adc10_code(t), k, "at the transition into {k}");
-            assert_eq!(adc10_code(t.next_down()), k - 1, "just below the transition into {k}");
+            assert_eq!(
+                adc10_code(t.next_down()),
+                k - 1,
+                "just below the transition into {k}"
+            );
         }
     }
 
@@ -131,7 +139,11 @@ mod tests {
         assert_eq!(addr_register(0), 0);
         assert_eq!(addr_register(1), 0x0040);
         assert_eq!(addr_register(1023), 0xFFC0);
-        assert_eq!(addr_register(0x3FF | 0xFC00), 0xFFC0, "bits above 10 ignored");
+        assert_eq!(
+            addr_register(0x3FF | 0xFC00),
+            0xFFC0,
+            "bits above 10 ignored"
+        );
         assert_eq!(code8_from_adc10(1023), 255);
         assert_eq!(code8_from_adc10(4), 1);
         assert_eq!(code8_from_adc10(3), 0);

@@ -194,11 +194,20 @@ mod tests {
     #[test]
     fn pins_are_active_low_with_pull_ups() {
         assert_eq!(port2_pins(BumperSet::EMPTY), 0xFF);
-        assert_eq!(port2_pins(BumperSet::EMPTY.with(Bumper::Front)), 0b1111_1110);
+        assert_eq!(
+            port2_pins(BumperSet::EMPTY.with(Bumper::Front)),
+            0b1111_1110
+        );
         assert_eq!(port2_pins(BumperSet::EMPTY.with(Bumper::Rear)), 0b1111_1101);
         assert_eq!(port2_pins(BumperSet::EMPTY.with(Bumper::Left)), 0b1111_1011);
-        assert_eq!(port2_pins(BumperSet::EMPTY.with(Bumper::Right)), 0b1111_0111);
-        assert_eq!(port2_pins(BumperSet::from_flags(true, true, true, true)), 0xF0);
+        assert_eq!(
+            port2_pins(BumperSet::EMPTY.with(Bumper::Right)),
+            0b1111_0111
+        );
+        assert_eq!(
+            port2_pins(BumperSet::from_flags(true, true, true, true)),
+            0xF0
+        );
         // Only P2.0–P2.3 are bumpers: low upper bits (say, outputs) are not presses.
         assert_eq!(pressed_from_port2(0x0F), BumperSet::EMPTY);
     }

@@ -89,10 +89,16 @@ mod tests {
     /// (unclamped, out to 10^10 cm), not through the closed-form inverse the table uses.
     fn du_by_bisection(volts: f64) -> f64 {
         let (mut near_cm, mut far_cm) = (8.0, 1e10);
-        assert!(far_branch_volts_at_cm(near_cm) >= volts && far_branch_volts_at_cm(far_cm) <= volts);
+        assert!(
+            far_branch_volts_at_cm(near_cm) >= volts && far_branch_volts_at_cm(far_cm) <= volts
+        );
         for _ in 0..200 {
             let mid = 0.5 * (near_cm + far_cm);
-            if far_branch_volts_at_cm(mid) > volts { near_cm = mid } else { far_cm = mid }
+            if far_branch_volts_at_cm(mid) > volts {
+                near_cm = mid
+            } else {
+                far_cm = mid
+            }
         }
         mm_to_du(near_cm * 10.0)
     }
@@ -106,15 +112,20 @@ mod tests {
     #[test]
     fn monotone_non_increasing() {
         for c in 1..=255usize {
-            assert!(DU_TABLE[c] <= DU_TABLE[c - 1], "code {c}: {} > {}", DU_TABLE[c], DU_TABLE[c - 1]);
+            assert!(
+                DU_TABLE[c] <= DU_TABLE[c - 1],
+                "code {c}: {} > {}",
+                DU_TABLE[c],
+                DU_TABLE[c - 1]
+            );
         }
     }
 
     #[test]
     fn end_points() {
         // 255 for every code whose centre is at or below V(80 cm) = 0.402 V (c ≤ 20) ...
-        for c in 0..=20 {
-            assert_eq!(DU_TABLE[c], 255, "code {c}");
+        for (c, &du) in DU_TABLE.iter().enumerate().take(21) {
+            assert_eq!(du, 255, "code {c}");
         }
         // ... and not above it.
         assert!(DU_TABLE[21] < 255);
@@ -138,7 +149,11 @@ mod tests {
         for c in STEEP_CODES {
             let exact = du_by_bisection(code8_centre_volts(c));
             let err = (f64::from(DU_TABLE[usize::from(c)]) - exact).abs();
-            assert!(err <= 0.5, "code {c}: table {} vs curve {exact:.3}", DU_TABLE[usize::from(c)]);
+            assert!(
+                err <= 0.5,
+                "code {c}: table {} vs curve {exact:.3}",
+                DU_TABLE[usize::from(c)]
+            );
         }
     }
 
@@ -156,7 +171,10 @@ mod tests {
             checked += 1;
             let err = (f64::from(DU_TABLE[usize::from(c)]) - mm_to_du(d_mm)).abs();
             let bound = 0.5 + span_du(c);
-            assert!(err <= bound, "{d_mm} mm: code {c}, err {err:.3} > {bound:.3}");
+            assert!(
+                err <= bound,
+                "{d_mm} mm: code {c}, err {err:.3} > {bound:.3}"
+            );
             assert!(err < 1.5);
         }
         assert!(checked > 10_000);
@@ -169,7 +187,10 @@ mod tests {
         for i in 0..=700 {
             let d_mm = f64::from(i) * 0.1;
             let read = DU_TABLE[usize::from(code8(v(d_mm)))];
-            assert!(f64::from(read) > mm_to_du(d_mm) + 1.5, "{d_mm} mm read as {read} du");
+            assert!(
+                f64::from(read) > mm_to_du(d_mm) + 1.5,
+                "{d_mm} mm read as {read} du"
+            );
         }
         // 5 cm (16 du) reads as code 99, about 12.1 cm: 39 du.
         assert_eq!(code8(v(50.0)), 99);

@@ -56,10 +56,11 @@
 //! datasheet's 28.7–47.9 ms, and the schedule depends only on the seed, never on when the
 //! caller happens to look (the jitter of cycle k is a counter-based draw). At a call at or after
 //! a refresh instant the held value becomes the sensor's curve at the distance given with that
-//! call: the world calls [`IrSensor::sample`] with the distance *at the read instant*
-//! (the robot moves ≤ 7 mm in a period; a world that wants the distance at the refresh instant
-//! itself can call [`IrSensor::update`] at [`IrSensor::next_refresh_states`]). The first call
-//! latches at once: the sensor was already measuring before the emulation began.
+//! call: the world calls [`IrSensor::sample`] with the distance *at the read instant* (at
+//! 0.15 m/s a robot moves at most about 7 mm in a 47.9 ms period; a world that wants the
+//! distance at the refresh instant itself can call [`IrSensor::update`] at
+//! [`IrSensor::next_refresh_states`]). The first call latches at once: the sensor was already
+//! measuring before the emulation began.
 //!
 //! **Read noise**, per A/D sample: Gaussian σ = 15 mV, plus with probability 0.1 a spike uniform
 //! in +150…200 mV. SPEC's spikes are ~0.1 ms wide every ~1 ms; a 5–11 µs conversion lands in
@@ -103,7 +104,7 @@ pub mod ir;
 mod rng;
 
 pub use adc::{
-    ADC_VREF_VOLTS, ADC10_MAX, CODE8_LSB_VOLTS, addr_register, adc10_code, code8,
+    ADC_VREF_VOLTS, ADC10_MAX, CODE8_LSB_VOLTS, adc10_code, addr_register, code8,
     code8_centre_volts, code8_from_adc10,
 };
 pub use bumpers::{
