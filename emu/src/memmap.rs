@@ -128,7 +128,7 @@ mod tests {
         assert_eq!(Area::of(0xFF_FF1C), Area::Io);
         assert_eq!(Area::of(0xFF_FFFF), Area::Io);
         // Only 24 address lines: the top byte of a 32-bit pointer is ignored.
-        assert_eq!(Area::of(0xAB_FF_DF10), Area::Ram);
+        assert_eq!(Area::of(0xABFF_DF10), Area::Ram);
         assert_eq!(RAM_BYTES, 8192);
         assert_eq!(ROM_BYTES, 512 * 1024);
     }

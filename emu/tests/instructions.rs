@@ -292,7 +292,8 @@ fn neg_not_exts_extu() {
 #[test]
 fn shifts_and_rotates() {
     // (text, bytes, value, C in, result, flags out)
-    let cases: &[(&str, &[u8], u32, bool, u32, u8)] = &[
+    type Case = (&'static str, &'static [u8], u32, bool, u32, u8);
+    let cases: &[Case] = &[
         (
             "shal.b\tr0l",
             &[0x10, 0x88],
