@@ -220,12 +220,14 @@ pub fn run_machine(
             Err(e) => break Outcome::Error(e),
         }
         if machine.sci().has_output() {
-            console.write_all(&machine.sci_mut().take_output())?;
+            console.write_all(machine.sci().output())?;
+            machine.sci_mut().clear_output();
         }
     };
     let now = machine.now();
     machine.sci_mut().flush(now);
-    console.write_all(&machine.sci_mut().take_output())?;
+    console.write_all(machine.sci().output())?;
+    machine.sci_mut().clear_output();
     console.flush()?;
     if let Some(w) = trace {
         w.flush()?;

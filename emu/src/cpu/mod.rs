@@ -1,6 +1,6 @@
 //! The H8/300H CPU core in advanced mode (24-bit addresses, 32-bit ER0–ER7, ER7 = SP).
 //!
-//! Split as in moa: [`decode`] turns instruction words into an [`decode::Instr`], `exec`
+//! Split as in moa: [`mod@decode`] turns instruction words into an [`decode::Instr`], `exec`
 //! carries it out, [`timing`] holds the manual's internal-state counts, and [`disasm`] prints
 //! instructions the way `h8300-hms-objdump -d` does.
 //!

@@ -286,9 +286,15 @@ impl Sci {
         !self.out.is_empty()
     }
 
-    /// Moves the bytes transmitted so far into `sink`, leaving the internal buffer empty.
-    pub fn drain_output_into(&mut self, sink: &mut Vec<u8>) {
-        sink.append(&mut self.out);
+    /// The bytes transmitted and not yet collected.
+    #[must_use]
+    pub fn output(&self) -> &[u8] {
+        &self.out
+    }
+
+    /// Forgets the collected bytes (keeps the buffer's capacity).
+    pub fn clear_output(&mut self) {
+        self.out.clear();
     }
 
     /// Ends transmission at time `now`: a byte still waiting in TDR is sent (the chip keeps
