@@ -182,7 +182,10 @@ impl I2cBus {
     /// The earliest scheduled device output change, if any (a hook for event-driven callers).
     #[must_use]
     pub fn next_event_states(&self) -> Option<u64> {
-        self.devices.iter().filter_map(Eeprom24lc256::next_event).min()
+        self.devices
+            .iter()
+            .filter_map(Eeprom24lc256::next_event)
+            .min()
     }
 
     /// Brings the bus to `now`, applying scheduled device output changes in time order.
@@ -196,6 +199,7 @@ impl I2cBus {
                 last: self.now,
             });
         }
+        // Devices end their write cycles lazily, whenever they are next touched.
         loop {
             let next = self
                 .devices
@@ -214,10 +218,6 @@ impl I2cBus {
             }
         }
         self.now = now;
-        for d in &mut self.devices {
-            // Ends write cycles whose time is up; cannot fail: `now` >= every device's time.
-            let _ = d.advance_to(now);
-        }
         Ok(())
     }
 
@@ -256,7 +256,12 @@ impl I2cBus {
     ///
     /// # Errors
     /// [`EepromError::TimeWentBackwards`] if `now` is before [`I2cBus::now`].
-    pub fn set_master(&mut self, now: u64, scl_low: bool, sda_low: bool) -> Result<(), EepromError> {
+    pub fn set_master(
+        &mut self,
+        now: u64,
+        scl_low: bool,
+        sda_low: bool,
+    ) -> Result<(), EepromError> {
         self.advance_to(now)?;
         self.master_scl_low = scl_low;
         self.master_sda_low = sda_low;

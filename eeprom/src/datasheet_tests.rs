@@ -75,8 +75,19 @@ fn repeated_start_ends_a_write_without_writing() {
     let s = m.pins().bus().device(0x50).unwrap().stats();
     assert_eq!(s.starts, 2, "START + repeated START");
     assert_eq!(s.write_cycles, 0);
-    assert!(m.pins().bus().device(0x50).unwrap().write_counts().iter().all(|&c| c == 0));
-    assert_eq!(m.pins().bus().device(0x50).unwrap().address_pointer(), 0x0124);
+    assert!(
+        m.pins()
+            .bus()
+            .device(0x50)
+            .unwrap()
+            .write_counts()
+            .iter()
+            .all(|&c| c == 0)
+    );
+    assert_eq!(
+        m.pins().bus().device(0x50).unwrap().address_pointer(),
+        0x0124
+    );
 }
 
 #[test]
@@ -127,7 +138,10 @@ fn device_pulls_sda_low_during_the_ninth_clock_after_its_output_delay() {
     p.wait_states(30);
     p.scl_release();
     p.wait_states(20);
-    assert!(!p.sda_is_high(), "ACK held while SCL is high in the 9th clock");
+    assert!(
+        !p.sda_is_high(),
+        "ACK held while SCL is high in the 9th clock"
+    );
     p.scl_low();
     p.wait_states(delay);
     assert!(p.sda_is_high(), "ACK released after the 9th clock");
@@ -147,7 +161,10 @@ fn scl_edges_of_a_byte_write_are_exactly_37_clocks_plus_start_and_stop() {
     assert_eq!(e.scl_rising, 36 + 1);
     // SDA: START fall and STOP rise at least, and every edge is counted in the total.
     assert!(e.sda_falling >= 1 && e.sda_rising >= 1);
-    assert_eq!(e.total(), e.scl_falling + e.scl_rising + e.sda_falling + e.sda_rising);
+    assert_eq!(
+        e.total(),
+        e.scl_falling + e.scl_rising + e.sda_falling + e.sda_rising
+    );
 }
 
 // ---- writes ----------------------------------------------------------------------------
@@ -173,8 +190,16 @@ fn page_write_wraps_to_the_start_of_the_same_page() {
     m.ack_poll(0x50, 1000).unwrap();
     assert_eq!(peek(&mut m, 0x50, 0x00BC, 4), [1, 2, 3, 4]);
     assert_eq!(peek(&mut m, 0x50, 0x0080, 6), [5, 6, 7, 8, 9, 10]);
-    assert_eq!(peek(&mut m, 0x50, 0x0086, 54), vec![0xFF; 54], "untouched in the page");
-    assert_eq!(peek(&mut m, 0x50, 0x00C0, 8), vec![0xFF; 8], "next page untouched");
+    assert_eq!(
+        peek(&mut m, 0x50, 0x0086, 54),
+        vec![0xFF; 54],
+        "untouched in the page"
+    );
+    assert_eq!(
+        peek(&mut m, 0x50, 0x00C0, 8),
+        vec![0xFF; 8],
+        "next page untouched"
+    );
     assert_eq!(writes(&m, 0x50, 2), 1);
     assert_eq!(writes(&m, 0x50, 3), 0);
 }
@@ -196,7 +221,14 @@ fn more_than_64_bytes_overwrite_the_earliest() {
 fn page_write_refuses_to_cross_a_page_and_bad_arguments() {
     let mut m = robot(9);
     let e = m.page_write(0x50, 0x003E, &[1, 2, 3]).unwrap_err();
-    assert!(matches!(e, MasterError::CrossesPage { room: 2, boundary: 0x40, .. }));
+    assert!(matches!(
+        e,
+        MasterError::CrossesPage {
+            room: 2,
+            boundary: 0x40,
+            ..
+        }
+    ));
     assert!(e.to_string().contains("0x0040"), "{e}");
     assert!(matches!(
         m.page_write(0x50, 0x0000, &[]),
@@ -272,9 +304,20 @@ fn stop_in_the_middle_of_a_byte_writes_only_whole_bytes() {
 fn address_only_write_sets_the_pointer_and_starts_no_write_cycle() {
     let mut m = robot(11);
     m.write_raw(0x50, 0x0456, &[]).unwrap();
-    assert_eq!(m.pins().bus().device(0x50).unwrap().address_pointer(), 0x0456);
+    assert_eq!(
+        m.pins().bus().device(0x50).unwrap().address_pointer(),
+        0x0456
+    );
     assert_eq!(m.ack_poll(0x50, 1).unwrap(), 1, "not busy");
-    assert!(m.pins().bus().device(0x50).unwrap().write_counts().iter().all(|&c| c == 0));
+    assert!(
+        m.pins()
+            .bus()
+            .device(0x50)
+            .unwrap()
+            .write_counts()
+            .iter()
+            .all(|&c| c == 0)
+    );
 }
 
 // ---- reads -----------------------------------------------------------------------------
@@ -285,8 +328,16 @@ fn current_address_read_follows_the_last_write_and_read() {
     m.page_write(0x50, 0x0300, &[10, 11, 12]).unwrap();
     m.ack_poll(0x50, 1000).unwrap();
     // After a write the pointer is just past the last byte written.
-    assert_eq!(m.pins().bus().device(0x50).unwrap().address_pointer(), 0x0303);
-    m.pins_mut().bus_mut().device_mut(0x50).unwrap().load(0x0303, &[13]).unwrap();
+    assert_eq!(
+        m.pins().bus().device(0x50).unwrap().address_pointer(),
+        0x0303
+    );
+    m.pins_mut()
+        .bus_mut()
+        .device_mut(0x50)
+        .unwrap()
+        .load(0x0303, &[13])
+        .unwrap();
     let mut b = [0u8; 1];
     m.current_address_read(0x50, &mut b).unwrap();
     assert_eq!(b, [13]);
@@ -301,7 +352,10 @@ fn after_a_wrapping_page_write_the_pointer_wraps_too() {
     let mut m = robot(13);
     m.write_raw(0x50, 0x003F, &[1, 2]).unwrap();
     m.ack_poll(0x50, 1000).unwrap();
-    assert_eq!(m.pins().bus().device(0x50).unwrap().address_pointer(), 0x0001);
+    assert_eq!(
+        m.pins().bus().device(0x50).unwrap().address_pointer(),
+        0x0001
+    );
 }
 
 #[test]
@@ -315,10 +369,18 @@ fn sequential_read_rolls_over_from_7fff_to_0000() {
     let mut b = [0u8; 5];
     m.random_read(0x51, 0x7FFD, &mut b).unwrap();
     assert_eq!(b, [1, 2, 3, 4, 5]);
-    assert_eq!(m.pins().bus().device(0x51).unwrap().address_pointer(), 0x0002);
+    assert_eq!(
+        m.pins().bus().device(0x51).unwrap().address_pointer(),
+        0x0002
+    );
     // A long sequential read across many pages.
     let pattern: Vec<u8> = (0..200u32).map(|i| (i * 7 + 3) as u8).collect();
-    m.pins_mut().bus_mut().device_mut(0x51).unwrap().load(0x1000, &pattern).unwrap();
+    m.pins_mut()
+        .bus_mut()
+        .device_mut(0x51)
+        .unwrap()
+        .load(0x1000, &pattern)
+        .unwrap();
     let mut long = vec![0u8; 200];
     m.random_read(0x51, 0x1000, &mut long).unwrap();
     assert_eq!(long, pattern);
@@ -328,14 +390,25 @@ fn sequential_read_rolls_over_from_7fff_to_0000() {
 #[test]
 fn a_master_that_samples_before_t_aa_reads_stale_bits() {
     let mut m = robot(15);
-    m.pins_mut().bus_mut().device_mut(0x50).unwrap().load(0x0000, &[0x55]).unwrap();
+    m.pins_mut()
+        .bus_mut()
+        .device_mut(0x50)
+        .unwrap()
+        .load(0x0000, &[0x55])
+        .unwrap();
     let mut fast = *m.timing();
     fast.scl_low_states = 5; // 200 ns, far below T_LOW and T_AA
     let mut bad = I2cMaster::new(m.into_pins(), fast);
     let mut b = [0u8; 1];
     let r = bad.random_read(0x50, 0x0000, &mut b);
-    assert!(r.is_err() || b != [0x55], "too-fast clocking must not read correctly");
-    assert!(bad.pins().bus().timing_violation_count() > 0, "the chip noticed");
+    assert!(
+        r.is_err() || b != [0x55],
+        "too-fast clocking must not read correctly"
+    );
+    assert!(
+        bad.pins().bus().timing_violation_count() > 0,
+        "the chip noticed"
+    );
 }
 
 // ---- write cycle, busy, polling --------------------------------------------------------
@@ -344,9 +417,18 @@ fn a_master_that_samples_before_t_aa_reads_stale_bits() {
 fn busy_chip_does_not_ack_its_control_byte_and_polling_counts_tries() {
     let mut m = robot(16);
     m.byte_write(0x50, 0x0000, 1).unwrap();
-    let cycle = m.pins().bus().device(0x50).unwrap().current_write_cycle().unwrap();
+    let cycle = m
+        .pins()
+        .bus()
+        .device(0x50)
+        .unwrap()
+        .current_write_cycle()
+        .unwrap();
     let t_wc = cycle.end_states - cycle.start_states;
-    assert!((75_000..=125_000).contains(&t_wc), "3..5 ms at 25 MHz: {t_wc}");
+    assert!(
+        (75_000..=125_000).contains(&t_wc),
+        "3..5 ms at 25 MHz: {t_wc}"
+    );
     // Busy: a read is refused at the control byte.
     let mut b = [0u8; 1];
     assert_eq!(
@@ -360,12 +442,25 @@ fn busy_chip_does_not_ack_its_control_byte_and_polling_counts_tries() {
     m.random_read(0x51, 0, &mut b).unwrap();
     // A bound too small times out with an error naming the chip.
     let e = m.ack_poll(0x50, 3).unwrap_err();
-    assert!(matches!(e, MasterError::PollTimeout { device: 0x50, polls: 3, .. }), "{e}");
+    assert!(
+        matches!(
+            e,
+            MasterError::PollTimeout {
+                device: 0x50,
+                polls: 3,
+                ..
+            }
+        ),
+        "{e}"
+    );
     let t_before = now(&m);
     let polls = m.ack_poll(0x50, 1000).unwrap();
     assert!(polls > 1);
     let t_after = now(&m);
-    assert!(t_after >= cycle.end_states, "ACK only after the cycle ended");
+    assert!(
+        t_after >= cycle.end_states,
+        "ACK only after the cycle ended"
+    );
     // The last NACKed poll began before the end: the poll count fits the remaining time.
     let per_poll = (t_after - t_before) / u64::from(polls);
     assert!(t_before + (u64::from(polls) - 1) * per_poll <= cycle.end_states + per_poll);
@@ -380,7 +475,13 @@ fn write_cycle_time_is_seeded_and_stays_in_range() {
         let mut v = Vec::new();
         for i in 0..20u16 {
             m.byte_write(0x50, i * 64, 0).unwrap();
-            let c = m.pins().bus().device(0x50).unwrap().current_write_cycle().unwrap();
+            let c = m
+                .pins()
+                .bus()
+                .device(0x50)
+                .unwrap()
+                .current_write_cycle()
+                .unwrap();
             v.push(c.end_states - c.start_states);
             m.ack_poll(0x50, 1000).unwrap();
         }
@@ -396,13 +497,22 @@ fn write_cycle_time_is_seeded_and_stays_in_range() {
         c.t_wc_max_ns = T_WC_MAX_NS;
     });
     m.byte_write(0x50, 0, 0).unwrap();
-    let c = m.pins().bus().device(0x50).unwrap().current_write_cycle().unwrap();
+    let c = m
+        .pins()
+        .bus()
+        .device(0x50)
+        .unwrap()
+        .current_write_cycle()
+        .unwrap();
     assert_eq!(c.end_states - c.start_states, 125_000);
     let m = with_config(|c| {
         c.t_wc_min_ns = T_WC_MODEL_MIN_NS;
         c.t_wc_max_ns = T_WC_MODEL_MIN_NS;
     });
-    assert_eq!(m.pins().bus().device(0x50).unwrap().t_wc_range_states(), (75_000, 75_000));
+    assert_eq!(
+        m.pins().bus().device(0x50).unwrap().t_wc_range_states(),
+        (75_000, 75_000)
+    );
 }
 
 #[test]
@@ -419,7 +529,14 @@ fn write_counter_counts_every_write_cycle_per_page() {
     assert_eq!(writes(&m, 0x50, 1), 4);
     assert_eq!(writes(&m, 0x51, 1), 1);
     assert_eq!(writes(&m, 0x50, 0), 0);
-    let total: u32 = m.pins().bus().device(0x50).unwrap().write_counts().iter().sum();
+    let total: u32 = m
+        .pins()
+        .bus()
+        .device(0x50)
+        .unwrap()
+        .write_counts()
+        .iter()
+        .sum();
     assert_eq!(total, 4);
 }
 
@@ -440,7 +557,11 @@ fn past_the_endurance_limit_bits_stick() {
             assert_eq!(stuck, 0, "no wear within the limit");
         }
     }
-    assert_eq!(peek(&mut m, 0x50, 0, 64), vec![0x22; 64], "3rd write had no effect");
+    assert_eq!(
+        peek(&mut m, 0x50, 0, 64),
+        vec![0x22; 64],
+        "3rd write had no effect"
+    );
     assert_eq!(m.pins().bus().device(0x50).unwrap().stuck_bit_count(), 512);
     // Other pages still work.
     m.byte_write(0x50, 0x0040, 0x44).unwrap();
@@ -466,7 +587,10 @@ fn wear_is_probabilistic_and_seeded() {
     let (n, page) = run(5);
     assert!(n > 0 && n < 512, "some but not all bits stuck: {n}");
     let zeros: u32 = page.iter().map(|b| b.count_zeros()).sum();
-    assert!(zeros > 0 && u64::from(zeros) <= n, "stuck-at-0 bits show in the 0xFF write");
+    assert!(
+        zeros > 0 && u64::from(zeros) <= n,
+        "stuck-at-0 bits show in the 0xFF write"
+    );
     assert_eq!(run(5), (n, page), "same seed, same wear");
     assert_ne!(run(6).1, run(5).1);
 }
@@ -487,7 +611,13 @@ fn power_cut_during_the_write_cycle_leaves_the_page_undefined_and_others_intact(
             d.load(0x03C0, &[0xA5; 64]).unwrap();
         }
         m.page_write(0x50, 0x0400, &new).unwrap();
-        let c = m.pins().bus().device(0x50).unwrap().current_write_cycle().unwrap();
+        let c = m
+            .pins()
+            .bus()
+            .device(0x50)
+            .unwrap()
+            .current_write_cycle()
+            .unwrap();
         let t = c.start_states + (c.end_states - c.start_states) / 2;
         let out = m.pins_mut().bus_mut().power_cut(t).unwrap();
         assert_eq!(out[0].interrupted_write, Some(c));
@@ -520,8 +650,17 @@ fn power_cut_outcome_is_seeded() {
     let run = |seed| {
         let mut m = robot(seed);
         m.page_write(0x50, 0, &[0; 64]).unwrap();
-        let c = m.pins().bus().device(0x50).unwrap().current_write_cycle().unwrap();
-        m.pins_mut().bus_mut().power_cut(c.start_states + 1).unwrap();
+        let c = m
+            .pins()
+            .bus()
+            .device(0x50)
+            .unwrap()
+            .current_write_cycle()
+            .unwrap();
+        m.pins_mut()
+            .bus_mut()
+            .power_cut(c.start_states + 1)
+            .unwrap();
         m.pins_mut().bus_mut().power_on(c.end_states + 1).unwrap();
         peek(&mut m, 0x50, 0, 64)
     };
@@ -533,7 +672,13 @@ fn power_cut_outcome_is_seeded() {
 fn power_cut_at_the_end_of_the_write_cycle_keeps_the_new_data() {
     let mut m = robot(18);
     m.page_write(0x50, 0, &[7; 64]).unwrap();
-    let c = m.pins().bus().device(0x50).unwrap().current_write_cycle().unwrap();
+    let c = m
+        .pins()
+        .bus()
+        .device(0x50)
+        .unwrap()
+        .current_write_cycle()
+        .unwrap();
     let out = m.pins_mut().bus_mut().power_cut(c.end_states).unwrap();
     assert_eq!(out[0].interrupted_write, None, "cycle over at end_states");
     m.pins_mut().bus_mut().power_on(c.end_states + 10).unwrap();
@@ -602,7 +747,11 @@ fn powered_off_chip_does_not_ack_releases_sda_and_refuses_api_reads() {
     let t = now(&m);
     let mut v = [0u8; 1];
     assert_eq!(
-        m.pins_mut().bus_mut().device_mut(0x51).unwrap().read(t, 0x10, &mut v),
+        m.pins_mut()
+            .bus_mut()
+            .device_mut(0x51)
+            .unwrap()
+            .read(t, 0x10, &mut v),
         Err(EepromError::PoweredOff { address: 0x51 })
     );
     // Chip 0x50 still works.
@@ -618,7 +767,12 @@ fn powered_off_chip_does_not_ack_releases_sda_and_refuses_api_reads() {
 #[test]
 fn power_cut_while_the_chip_drives_sda_releases_the_line() {
     let mut m = robot(21);
-    m.pins_mut().bus_mut().device_mut(0x50).unwrap().load(0, &[0x00; 4]).unwrap();
+    m.pins_mut()
+        .bus_mut()
+        .device_mut(0x50)
+        .unwrap()
+        .load(0, &[0x00; 4])
+        .unwrap();
     let mut p = m.into_pins();
     // Random read by hand up to the first data bit (0): the chip pulls SDA.
     let mut tmp = I2cMaster::new(&mut p, MasterTiming::default());
@@ -695,7 +849,8 @@ fn master_meets_every_datasheet_minimum_in_both_modes_and_with_pin_costs() {
             timing,
         );
         m.init();
-        m.page_write(0x50, 0x0000, &[0x00, 0xFF, 0x5A, 0xA5]).unwrap();
+        m.page_write(0x50, 0x0000, &[0x00, 0xFF, 0x5A, 0xA5])
+            .unwrap();
         m.ack_poll(0x50, 5000).unwrap();
         let mut b = [0u8; 4];
         m.random_read(0x50, 0x0000, &mut b).unwrap();
@@ -717,7 +872,10 @@ fn master_timing_at_25_mhz_is_400_khz_class() {
     let t = MasterTiming::fast_mode(25_000_000).unwrap();
     assert_eq!(t.scl_high_states, 15);
     assert_eq!(t.scl_low_states, 48);
-    assert!(t.scl_low_states + t.scl_high_states >= 63, "period >= 2.5 us");
+    assert!(
+        t.scl_low_states + t.scl_high_states >= 63,
+        "period >= 2.5 us"
+    );
     assert_eq!(t.data_setup_states, 3);
     assert_eq!(t.bus_free_states, 33);
     assert!(matches!(
@@ -731,13 +889,18 @@ fn master_timing_at_25_mhz_is_400_khz_class() {
 
 #[test]
 fn too_fast_master_is_reported_by_the_timing_monitor() {
-    let mut t = MasterTiming::default();
-    t.scl_high_states = 10; // 400 ns < 600 ns
+    let t = MasterTiming {
+        scl_high_states: 10, // 400 ns < 600 ns
+        ..MasterTiming::default()
+    };
     let mut m = I2cMaster::new(SimPins::new(I2cBus::robot(23).unwrap()), t);
     m.init();
     let _ = m.byte_write(0x50, 0, 0);
     let v = m.pins().bus().device(0x50).unwrap().timing_violations();
-    assert!(v.iter().any(|v| v.check == crate::TimingCheck::SclHigh && v.measured_states == 10));
+    assert!(
+        v.iter()
+            .any(|v| v.check == crate::TimingCheck::SclHigh && v.measured_states == 10)
+    );
 }
 
 #[test]

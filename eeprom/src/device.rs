@@ -132,7 +132,8 @@ pub struct TimingViolation {
 /// device does (a real chip may misbehave in many ways; this one just reports).
 #[derive(Clone, Debug)]
 struct TimingMonitor {
-    clock: Clock,
+    /// Minimum of each check in whole states (`TimingCheck as usize` indexes it).
+    min_states: [u64; 8],
     last_rise: Option<u64>,
     last_fall: Option<u64>,
     last_data_change: Option<u64>,
@@ -144,8 +145,20 @@ struct TimingMonitor {
 
 impl TimingMonitor {
     fn new(clock: Clock) -> Self {
+        let checks = [
+            TimingCheck::SclHigh,
+            TimingCheck::SclLow,
+            TimingCheck::ClockPeriod,
+            TimingCheck::DataSetup,
+            TimingCheck::StartHold,
+            TimingCheck::StartSetup,
+            TimingCheck::StopSetup,
+            TimingCheck::BusFree,
+        ];
+        // `measured · 1e9 ≥ min_ns · φ` ⇔ `measured ≥ ceil(min_ns · φ / 1e9)`: exact.
+        let min_states = checks.map(|c| clock.states_at_least(c.min_ns()));
         TimingMonitor {
-            clock,
+            min_states,
             last_rise: None,
             last_fall: None,
             last_data_change: None,
@@ -167,8 +180,8 @@ impl TimingMonitor {
     fn check(&mut self, check: TimingCheck, from: Option<u64>, now: u64) {
         let Some(from) = from else { return };
         let measured = now.saturating_sub(from);
-        let min_ns = check.min_ns();
-        if !self.clock.lasts_at_least(measured, min_ns) {
+        if measured < self.min_states[check as usize] {
+            let min_ns = check.min_ns();
             self.count += 1;
             if self.log.len() < VIOLATION_LOG_LEN {
                 self.log.push(TimingViolation {
@@ -388,7 +401,9 @@ impl Eeprom24lc256 {
         }
         // The drawn time must stay inside [min, max] in ns: round the ends inwards.
         let t_wc_min_states = clock.states_at_least(config.t_wc_min_ns);
-        let t_wc_max_states = clock.states_at_most(config.t_wc_max_ns).max(t_wc_min_states);
+        let t_wc_max_states = clock
+            .states_at_most(config.t_wc_max_ns)
+            .max(t_wc_min_states);
         Ok(Eeprom24lc256 {
             rng_t_wc: stream(config.seed, config.address, STREAM_T_WC),
             rng_cut: stream(config.seed, config.address, STREAM_CUT),
@@ -474,11 +489,7 @@ impl Eeprom24lc256 {
     /// Whether a write cycle is running at `now` (states).
     #[must_use]
     pub fn is_busy_at(&self, now: u64) -> bool {
-        self.powered
-            && self
-                .cycle
-                .as_ref()
-                .is_some_and(|c| now < c.info.end_states)
+        self.powered && self.cycle.as_ref().is_some_and(|c| now < c.info.end_states)
     }
 
     /// The write cycle started and not yet seen to end (it may have ended by now: see

@@ -86,7 +86,9 @@ pub enum EepromError {
         clock_hz: u32,
     },
     /// An endurance limit of zero.
-    #[error("endurance limit of {cycles} write cycles is invalid: valid is >= 1 (datasheet: 1 000 000)")]
+    #[error(
+        "endurance limit of {cycles} write cycles is invalid: valid is >= 1 (datasheet: 1 000 000)"
+    )]
     InvalidEndurance {
         /// The limit asked for.
         cycles: u32,
@@ -98,7 +100,9 @@ pub enum EepromError {
         p: f64,
     },
     /// A time earlier than one the bus or device has already seen.
-    #[error("time {now} states is before the last time seen, {last} states: time only moves forward")]
+    #[error(
+        "time {now} states is before the last time seen, {last} states: time only moves forward"
+    )]
     TimeWentBackwards {
         /// The time given.
         now: u64,

@@ -390,6 +390,12 @@ pub enum ChipReading {
     Invalid(RecordError),
     /// The chip did not answer (absent, off, or the bus failed).
     NoResponse(MasterError),
+    /// A sane commit block for this sequence, but the other chip holds a newer valid record,
+    /// so the body was not read.
+    Superseded {
+        /// Sequence number in the commit block.
+        sequence: u32,
+    },
 }
 
 /// The outcome of recovery at boot.
@@ -475,47 +481,84 @@ impl Persistence {
         })
     }
 
-    /// Reads and checks the record on one chip: the commit block, then (if it is sane) the body
-    /// it describes, in two random reads.
-    pub fn read_chip<P: I2cPins>(
+    /// Reads and checks the commit block on one chip.
+    fn read_commit<P: I2cPins>(
         &self,
         master: &mut I2cMaster<P>,
         chip: u8,
-    ) -> Result<Record, ChipReading> {
+    ) -> Result<Commit, ChipReading> {
         let mut commit_bytes = [0u8; COMMIT_BYTES];
         master
             .random_read(chip, self.layout.slot_addr(), &mut commit_bytes)
             .map_err(ChipReading::NoResponse)?;
         let commit = Commit::decode(&commit_bytes, self.layout.max_payload_bytes)
             .map_err(ChipReading::Invalid)?;
+        check_chip(chip, commit.sequence).map_err(ChipReading::Invalid)?;
+        Ok(commit)
+    }
+
+    /// Reads and checks the body `commit` describes on one chip.
+    fn read_body<P: I2cPins>(
+        &self,
+        master: &mut I2cMaster<P>,
+        chip: u8,
+        commit: &Commit,
+    ) -> Result<Record, ChipReading> {
         let mut body = vec![0u8; usize::from(commit.payload_len) + BODY_OVERHEAD_BYTES];
         master
             .random_read(chip, self.layout.body_addr(), &mut body)
             .map_err(ChipReading::NoResponse)?;
-        let record = decode_body(&commit, &body).map_err(ChipReading::Invalid)?;
-        check_chip(chip, record.sequence).map_err(ChipReading::Invalid)?;
-        Ok(record)
+        decode_body(commit, &body).map_err(ChipReading::Invalid)
     }
 
-    /// Boot-time recovery: reads both chips and returns the newest valid record (by
-    /// sequence number, serial arithmetic), or `None` if neither holds one. Never fails: a
-    /// chip that does not answer counts as holding nothing.
+    /// Reads and checks the record on one chip: the commit block, then (if it is sane) the body
+    /// it describes, in two random reads.
+    ///
+    /// # Errors
+    /// What the chip held instead of a valid record ([`ChipReading::Invalid`] or
+    /// [`ChipReading::NoResponse`]).
+    pub fn read_chip<P: I2cPins>(
+        &self,
+        master: &mut I2cMaster<P>,
+        chip: u8,
+    ) -> Result<Record, ChipReading> {
+        let commit = self.read_commit(master, chip)?;
+        self.read_body(master, chip, &commit)
+    }
+
+    /// Boot-time recovery: reads both chips' commit blocks, then the bodies newest first
+    /// (by sequence number, serial arithmetic) until one checks out, and returns that record,
+    /// or `None` if neither chip holds a valid one. An older record whose newer rival is valid
+    /// is not read ([`ChipReading::Superseded`]): the result is the same and boot is faster.
+    /// Never fails: a chip that does not answer counts as holding nothing.
     pub fn recover<P: I2cPins>(&self, master: &mut I2cMaster<P>) -> Recovery {
-        let a = self.read_chip(master, CHIP_A);
-        let b = self.read_chip(master, CHIP_B);
-        let reading = |r: &Result<Record, ChipReading>| match r {
-            Ok(rec) => ChipReading::Valid {
-                sequence: rec.sequence,
-            },
-            Err(e) => e.clone(),
+        let chips_addr = [CHIP_A, CHIP_B];
+        let commits = chips_addr.map(|chip| self.read_commit(master, chip));
+        let order = match (&commits[0], &commits[1]) {
+            (Ok(a), Ok(b)) if is_newer(b.sequence, a.sequence) => [1, 0],
+            _ => [0, 1],
         };
-        let chips = [reading(&a), reading(&b)];
-        let newest = match (a, b) {
-            (Ok(a), Ok(b)) => Some(if is_newer(b.sequence, a.sequence) { b } else { a }),
-            (Ok(a), Err(_)) => Some(a),
-            (Err(_), Ok(b)) => Some(b),
-            (Err(_), Err(_)) => None,
-        };
+        let mut chips = [
+            ChipReading::Superseded { sequence: 0 },
+            ChipReading::Superseded { sequence: 0 },
+        ];
+        let mut newest: Option<Record> = None;
+        for i in order {
+            chips[i] = match &commits[i] {
+                Err(reading) => reading.clone(),
+                Ok(commit) if newest.is_some() => ChipReading::Superseded {
+                    sequence: commit.sequence,
+                },
+                Ok(commit) => match self.read_body(master, chips_addr[i], commit) {
+                    Ok(record) => {
+                        let sequence = record.sequence;
+                        newest = Some(record);
+                        ChipReading::Valid { sequence }
+                    }
+                    Err(reading) => reading,
+                },
+            };
+        }
         Recovery { newest, chips }
     }
 }
@@ -556,7 +599,7 @@ impl SavePolicy {
     /// Whether a save is due after step `step` (steps counted from 1).
     #[must_use]
     pub fn is_due(&self, step: u64) -> bool {
-        step > 0 && step % u64::from(self.every_steps) == 0
+        step > 0 && step.is_multiple_of(u64::from(self.every_steps))
     }
 
     /// Saves made in a run of `steps` steps.
@@ -590,5 +633,300 @@ impl SavePolicy {
     #[must_use]
     pub fn endurance_lifetime_hours(&self, step_period_s: f64, endurance_cycles: u32) -> f64 {
         f64::from(endurance_cycles) / self.page_writes_per_hour(step_period_s)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{I2cBus, MasterTiming, SimPins};
+    use proptest::prelude::*;
+
+    fn slot_image(layout: &RecordLayout, record: &Record) -> Vec<u8> {
+        let (commit, body) = layout.encode(record).unwrap();
+        let mut image = vec![0xFF; PAGE_BYTES];
+        image[..COMMIT_BYTES].copy_from_slice(&commit);
+        image.extend_from_slice(&body);
+        image
+    }
+
+    #[test]
+    fn record_layout_and_page_count() {
+        let l = RecordLayout::default();
+        assert_eq!((l.slot_addr(), l.body_addr()), (0x0000, 0x0040));
+        assert_eq!(l.max_payload_bytes(), 32_696);
+        assert_eq!(l.slot_pages(), 512);
+        // 104-byte payload (13 x 4 Q15 weights): body 112 bytes = 2 pages, + commit page.
+        assert_eq!(l.pages_per_record(104), 3);
+        assert_eq!(l.pages_of_record(104), 0..3);
+        assert_eq!(l.pages_per_record(56), 2);
+        assert_eq!(l.pages_per_record(57), 3);
+        assert_eq!(l.pages_per_record(0), 2);
+        assert_eq!(l.bytes_per_save(104), 126);
+        let l = RecordLayout::new(0x1000, 200).unwrap();
+        assert_eq!(l.pages_of_record(200), 64..69);
+    }
+
+    #[test]
+    fn layout_errors_say_what_fits() {
+        assert_eq!(
+            RecordLayout::new(0x0010, 10),
+            Err(PersistError::SlotNotPageAligned { slot_addr: 0x0010 })
+        );
+        let e = RecordLayout::new(0x7FC0, 10).unwrap_err();
+        assert!(
+            matches!(e, PersistError::SlotDoesNotFit { largest: 0, .. }),
+            "{e}"
+        );
+        let e = RecordLayout::new(0x7F00, 1000).unwrap_err();
+        assert!(
+            matches!(e, PersistError::SlotDoesNotFit { largest: 184, .. }),
+            "{e}"
+        );
+        assert!(RecordLayout::new(0x7F00, 184).is_ok());
+        assert!(RecordLayout::new(0x7F00, 185).is_err());
+        let l = RecordLayout::new(0, 100).unwrap();
+        let big = Record {
+            sequence: 0,
+            payload: vec![0; 101],
+        };
+        assert_eq!(
+            l.encode(&big),
+            Err(PersistError::PayloadTooLarge { len: 101, max: 100 })
+        );
+        let huge = Record {
+            sequence: 0,
+            payload: vec![0; 70_000],
+        };
+        assert!(RecordLayout::default().encode(&huge).is_err());
+        assert_eq!(Persistence::new(l, 0), Err(PersistError::InvalidPollBound));
+    }
+
+    #[test]
+    fn a_b_chips_and_serial_order() {
+        assert_eq!(chip_for_sequence(0), CHIP_A);
+        assert_eq!(chip_for_sequence(1), CHIP_B);
+        assert_eq!(chip_for_sequence(u32::MAX), CHIP_B);
+        assert!(is_newer(1, 0));
+        assert!(!is_newer(0, 1));
+        assert!(!is_newer(5, 5));
+        assert!(is_newer(0, u32::MAX), "wraps");
+        assert!(is_newer(3, u32::MAX - 2));
+    }
+
+    #[test]
+    fn malformed_records_are_reported_as_invalid() {
+        let l = RecordLayout::new(0, 300).unwrap();
+        let rec = Record {
+            sequence: 6,
+            payload: (0..200u32).map(|i| i as u8).collect(),
+        };
+        let good = slot_image(&l, &rec);
+        assert_eq!(l.decode_slot(CHIP_A, &good), Ok(rec.clone()));
+        assert!(matches!(
+            l.decode_slot(CHIP_B, &good),
+            Err(RecordError::WrongChip {
+                sequence: 6,
+                chip: CHIP_B
+            })
+        ));
+        let mut g = good.clone();
+        g[0] = b'X';
+        assert!(matches!(
+            l.decode_slot(CHIP_A, &g),
+            Err(RecordError::BadMagic { .. })
+        ));
+        let mut g = good.clone();
+        g[5] ^= 1;
+        assert!(matches!(
+            l.decode_slot(CHIP_A, &g),
+            Err(RecordError::BadCommitCrc { .. })
+        ));
+        let mut g = good.clone();
+        g[PAGE_BYTES + 100] ^= 0x10;
+        assert!(matches!(
+            l.decode_slot(CHIP_A, &g),
+            Err(RecordError::BadBodyCrc { .. })
+        ));
+        // A sane commit block with a bad version, reserved byte or length.
+        let patch = |f: &dyn Fn(&mut [u8])| {
+            let mut g = good.clone();
+            f(&mut g[..COMMIT_BYTES]);
+            let crc = crc16_ccitt_false(&g[..12]);
+            g[12..14].copy_from_slice(&crc.to_be_bytes());
+            l.decode_slot(CHIP_A, &g)
+        };
+        assert!(matches!(
+            patch(&|b| b[2] = 2),
+            Err(RecordError::BadVersion { found: 2, .. })
+        ));
+        assert!(matches!(
+            patch(&|b| b[3] = 1),
+            Err(RecordError::BadReserved { found: 1 })
+        ));
+        assert!(matches!(
+            patch(&|b| b[8..10].copy_from_slice(&301u16.to_be_bytes())),
+            Err(RecordError::BadLength { len: 301, max: 300 })
+        ));
+        assert!(matches!(
+            patch(&|b| b[8..10].copy_from_slice(&199u16.to_be_bytes())),
+            Err(RecordError::BadBodyCrc { .. })
+        ));
+        assert!(matches!(
+            patch(&|b| b[4..8].copy_from_slice(&8u32.to_be_bytes())),
+            Err(RecordError::Mismatch {
+                field: "sequence",
+                commit: 8,
+                body: 6
+            })
+        ));
+        assert!(matches!(
+            patch(&|b| b[10] ^= 0xFF),
+            Err(RecordError::Mismatch {
+                field: "body CRC",
+                ..
+            })
+        ));
+        // Truncated anywhere: an error, never a panic.
+        for n in 0..good.len() {
+            let r = l.decode_slot(CHIP_A, &good[..n]);
+            assert!(r.is_err(), "truncated to {n} bytes");
+        }
+        assert!(matches!(
+            l.decode_slot(CHIP_A, &good[..PAGE_BYTES + 10]),
+            Err(RecordError::Truncated {
+                part: "record body",
+                needed: 208,
+                got: 10
+            })
+        ));
+        // An erased chip.
+        assert!(matches!(
+            l.decode_slot(CHIP_A, &[0xFF; 1024]),
+            Err(RecordError::BadMagic { .. })
+        ));
+    }
+
+    proptest! {
+        #[test]
+        fn encode_decode_round_trip(seq in any::<u32>(), payload in proptest::collection::vec(any::<u8>(), 0..400)) {
+            let l = RecordLayout::new(0, 400).unwrap();
+            let rec = Record { sequence: seq, payload };
+            let image = slot_image(&l, &rec);
+            prop_assert_eq!(l.decode_slot(chip_for_sequence(seq), &image), Ok(rec));
+        }
+
+        #[test]
+        fn any_corrupted_record_byte_is_rejected(
+            seq in any::<u32>(),
+            payload in proptest::collection::vec(any::<u8>(), 0..200),
+            pos in any::<usize>(),
+            flip in 1u8..=255,
+        ) {
+            let l = RecordLayout::new(0, 200).unwrap();
+            let rec = Record { sequence: seq, payload };
+            let mut image = slot_image(&l, &rec);
+            // Only the bytes the record uses (commit block and body).
+            let used: Vec<usize> = (0..COMMIT_BYTES).chain(PAGE_BYTES..image.len()).collect();
+            let i = used[pos % used.len()];
+            image[i] ^= flip;
+            prop_assert!(l.decode_slot(chip_for_sequence(seq), &image).is_err());
+        }
+
+        #[test]
+        fn garbage_never_panics(image in proptest::collection::vec(any::<u8>(), 0..700), chip in 0x50u8..=0x51) {
+            let l = RecordLayout::new(0, 500).unwrap();
+            let _ = l.decode_slot(chip, &image);
+            let _ = Commit::decode(&image, 500);
+        }
+    }
+
+    #[test]
+    fn save_policy_counts() {
+        assert_eq!(SavePolicy::new(0), Err(PersistError::InvalidSavePeriod));
+        let p = SavePolicy::default();
+        assert_eq!(p.every_steps(), 20);
+        assert!(!p.is_due(0) && !p.is_due(19) && p.is_due(20) && p.is_due(1000));
+        assert_eq!(p.saves_in(1000), 50);
+        assert_eq!(p.writes_per_record_page(1000, 0), [25, 25]);
+        assert_eq!(p.writes_per_record_page(1020, 0), [26, 25]);
+        assert_eq!(p.writes_per_record_page(1020, 7), [25, 26]);
+        // SPEC §3.6: arena step 0.45 s, one save per 20 steps, A/B: ~5 000 h to 1e6 writes.
+        let h = p.endurance_lifetime_hours(0.45, 1_000_000);
+        assert!((h - 5_000.0).abs() < 1e-6, "{h}");
+        assert!((p.page_writes_per_hour(0.45) - 200.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn save_then_recover_through_the_bus_alternates_chips() {
+        let mut m = I2cMaster::new(
+            SimPins::new(I2cBus::robot(9).unwrap()),
+            MasterTiming::default(),
+        );
+        m.init();
+        let p = Persistence::new(RecordLayout::new(0, 256).unwrap(), DEFAULT_MAX_POLLS).unwrap();
+        let r = p.recover(&mut m);
+        assert_eq!(r.newest, None);
+        assert_eq!(r.next_sequence(), 0);
+        assert!(matches!(
+            r.chips[0],
+            ChipReading::Invalid(RecordError::BadMagic { .. })
+        ));
+        for seq in 0..5u32 {
+            let rec = Record {
+                sequence: seq,
+                payload: vec![seq as u8; 100 + seq as usize],
+            };
+            let rep = p.save(&mut m, &rec).unwrap();
+            assert_eq!(rep.chip, chip_for_sequence(seq));
+            assert_eq!(rep.pages_written, 3);
+            assert!(rep.polls_per_page.iter().all(|&n| n > 1));
+            let r = p.recover(&mut m);
+            assert_eq!(r.newest, Some(rec));
+            assert_eq!(r.next_sequence(), seq + 1);
+        }
+        let r = p.recover(&mut m);
+        assert_eq!(
+            r.chips,
+            [
+                ChipReading::Valid { sequence: 4 },
+                ChipReading::Superseded { sequence: 3 }
+            ]
+        );
+        assert_eq!(p.read_chip(&mut m, CHIP_B).map(|r| r.sequence), Ok(3));
+        assert_eq!(m.pins().bus().timing_violation_count(), 0);
+        // A bad body on the newest record: recovery falls back to the other chip.
+        let t = m.pins().now();
+        let d = m.pins_mut().bus_mut().device_mut(CHIP_A).unwrap();
+        let mut byte = [0u8; 1];
+        d.read(t, 0x0050, &mut byte).unwrap();
+        d.load(0x0050, &[byte[0] ^ 0x01]).unwrap();
+        let r = p.recover(&mut m);
+        assert_eq!(r.newest.as_ref().map(|r| r.sequence), Some(3));
+        assert!(matches!(
+            r.chips[0],
+            ChipReading::Invalid(RecordError::BadBodyCrc { .. })
+        ));
+        assert_eq!(r.chips[1], ChipReading::Valid { sequence: 3 });
+        // A chip that does not answer counts as empty.
+        let t = m.pins().now();
+        m.pins_mut().bus_mut().power_off_device(t, CHIP_A).unwrap();
+        let r = p.recover(&mut m);
+        assert_eq!(r.newest.map(|r| r.sequence), Some(3));
+        assert!(matches!(r.chips[0], ChipReading::NoResponse(_)));
+        // Saving to a chip that is off fails with a NACK, not a panic.
+        let e = p
+            .save(
+                &mut m,
+                &Record {
+                    sequence: 6,
+                    payload: vec![1],
+                },
+            )
+            .unwrap_err();
+        assert!(matches!(
+            e,
+            PersistError::Master(MasterError::Nack { device: CHIP_A, .. })
+        ));
     }
 }

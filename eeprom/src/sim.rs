@@ -107,11 +107,9 @@ impl SimPins {
     fn set(&mut self, scl: Option<bool>, sda: Option<bool>) {
         self.step();
         let (scl_low, sda_low) = self.bus.master_pulls();
-        let r = self.bus.set_master(
-            self.now,
-            scl.unwrap_or(scl_low),
-            sda.unwrap_or(sda_low),
-        );
+        let r = self
+            .bus
+            .set_master(self.now, scl.unwrap_or(scl_low), sda.unwrap_or(sda_low));
         self.record(r);
     }
 }
