@@ -238,11 +238,13 @@ impl Bus for Machine {
         match self.sci.next_irq_time(self.now) {
             Some(t) if t <= deadline => {
                 self.now = self.now.max(t);
+                self.sci.sync(self.now);
                 true
             }
             _ => {
                 if deadline != u64::MAX {
                     self.now = self.now.max(deadline);
+                    self.sci.sync(self.now);
                 }
                 false
             }

@@ -908,3 +908,37 @@ fn code_runs_from_ram_too() {
     assert_eq!(cpu.step(&mut m, u64::MAX), Ok(Event::Executed));
     assert_eq!(cpu.er(0) & 0xffff, 0x1234);
 }
+
+#[test]
+fn sleep_fast_forwards_to_the_sci_interrupt_that_wakes_it() {
+    use emu::periph::sci::{SCI1_SSR, SCI1_TDR, SSR_TDRE};
+    let (mut cpu, mut m) = machine();
+    m.poke(CODE, &[0x01, 0x80]); // sleep
+    m.poke(u32::from(VECTOR_TXI1) * 4, &0x3000u32.to_be_bytes());
+    m.poke(0x3000, &[0x00, 0x00]);
+    m.write8(SCI1_SCR, SCR_TE);
+    // Two bytes: the first goes straight to the shift register, the second waits a frame.
+    for b in [b'a', b'b'] {
+        let ssr = m.read8(SCI1_SSR);
+        assert_ne!(ssr & SSR_TDRE, 0);
+        m.write8(SCI1_TDR, b);
+        m.write8(SCI1_SSR, ssr & !SSR_TDRE);
+    }
+    let frame = m.sci().frame_states();
+    assert_eq!(frame, 10 * 32 * 256, "8N1 at the reset BRR of H'FF");
+    m.write8(SCI1_SCR, SCR_TE | SCR_TIE);
+    let wake_at = m.sci().next_irq_time(m.now()).expect("TXI will come");
+    cpu.set_pc(CODE);
+    cpu.set_ccr(0);
+    assert_eq!(cpu.step(&mut m, u64::MAX), Ok(Event::Executed));
+    assert!(cpu.sleeping());
+    assert_eq!(
+        cpu.step(&mut m, u64::MAX),
+        Ok(Event::Interrupt(VECTOR_TXI1))
+    );
+    // Woken exactly when TDRE came back, then 17 states of interrupt entry.
+    assert_eq!(m.now(), wake_at + 17);
+    assert_eq!(cpu.pc(), 0x3000);
+    assert_eq!(peek32(&m, 0xff_fefc), CODE + 2, "returns after the SLEEP");
+    assert_eq!(m.sci_mut().take_output(), b"ab");
+}

@@ -188,6 +188,13 @@ impl Sci {
         }
     }
 
+    /// Brings the transmitter up to time `now` (a waiting byte whose time has come moves to
+    /// the shift register and the console). Register accesses do this themselves; call it
+    /// when time jumps without an access (sleep).
+    pub fn sync(&mut self, now: u64) {
+        self.settle(now);
+    }
+
     /// Reads a register at time `now` (the instant the bus cycle ends).
     pub fn read(&mut self, addr: u32, now: u64) -> u8 {
         self.settle(now);
