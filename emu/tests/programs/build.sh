@@ -79,6 +79,7 @@ build_all() {
   local obj="$work/obj"
   mkdir -p "$obj" "$out"
 
+  # The .S files use no preprocessor directives: assemble them as they are.
   "${H8_PREFIX}gcc" "${TARGET_CFLAGS[@]}" -x assembler -c crt0.S -o "$obj/crt0.o"
   "${H8_PREFIX}gcc" "${TARGET_CFLAGS[@]}" -x assembler -c runtime.S -o "$obj/runtime.o"
   local support_objs=()
