@@ -1,2 +1,182 @@
-//! h8swarm command-line tool (work in progress).
-fn main() {}
+//! `h8swarm`: the command-line tool of the hardware-faithful H8/3052F swarm emulator.
+//!
+//! Exit status: 0 on success; 2 for bad input (a malformed replay line, an unreadable input
+//! file, an option out of range, a usage error); 1 when the tool itself fails (an output that
+//! cannot be written).
+#![forbid(unsafe_code)]
+
+mod cost_report;
+mod replay;
+
+use std::fs::File;
+use std::io::{self, BufRead, BufReader, BufWriter, Write};
+use std::process::ExitCode;
+
+use clap::{Args, Parser, Subcommand};
+
+/// Hardware-faithful, fixed-point emulator of the Hartono–Kakita (2008) swarm of H8/3052F robots
+/// that learn obstacle avoidance together.
+#[derive(Parser, Debug)]
+#[command(name = "h8swarm", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Feed the learner core from JSON Lines and print one JSON line per step (SPEC §2.6).
+    Learn(LearnArgs),
+    /// Measure the learner's H8/300H states per step and its RAM footprint (the default job).
+    Cost(CostArgs),
+}
+
+#[derive(Args, Debug)]
+struct LearnArgs {
+    /// The replay file (JSON Lines), or `-` for standard input.
+    #[arg(long, value_name = "FILE")]
+    replay: String,
+    /// Add the H8/300H states of each step's forward pass and update to every output line.
+    #[arg(long)]
+    states: bool,
+}
+
+#[derive(Args, Debug)]
+struct CostArgs {
+    /// Enabled behaviours M: 2 (corridor) to 4 (arena).
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u8).range(2..=4))]
+    outputs: u8,
+    /// History depth H: delayed copies of the four proximities (0 to 8).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u8).range(0..=8))]
+    history: u8,
+    /// Add the bias input +127.
+    #[arg(long)]
+    bias: bool,
+    /// Learning rate η as a Q15 integer (0.001 = 33, 0.1 = 3277).
+    #[arg(long, default_value_t = 33, value_parser = clap::value_parser!(i32).range(0..=32767))]
+    eta: i32,
+    /// Dead-zone threshold T in distance units.
+    #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(i32).range(0..=32767))]
+    threshold: i32,
+    /// Steps to measure.
+    #[arg(long, default_value_t = 10_000, value_parser = clap::value_parser!(u32).range(1..))]
+    steps: u32,
+    /// Seed of the proximities and initial weights.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Step period in seconds for the CPU share (0.45 s in the arena, 0.60 s in the corridor).
+    #[arg(long, default_value_t = 0.45)]
+    step_period_s: f64,
+    /// Print the report as JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+impl Default for CostArgs {
+    fn default() -> Self {
+        Self {
+            outputs: 4,
+            history: 1,
+            bias: false,
+            eta: 33,
+            threshold: 10,
+            steps: 10_000,
+            seed: 1,
+            step_period_s: 0.45,
+            json: false,
+        }
+    }
+}
+
+/// A failure with its exit status.
+enum Failure {
+    /// Bad input: exit status 2.
+    Input(anyhow::Error),
+    /// The tool failed: exit status 1.
+    Tool(anyhow::Error),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Some(Command::Learn(args)) => learn(&args),
+        Some(Command::Cost(args)) => cost(&args),
+        None => cost(&CostArgs::default()),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(Failure::Input(e)) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(2)
+        }
+        Err(Failure::Tool(e)) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(1)
+        }
+    }
+}
+
+/// Maps a write error to the right outcome: a closed pipe downstream (`h8swarm … | head`) is a
+/// normal end, anything else a tool failure.
+fn write_failure(e: io::Error) -> Result<(), Failure> {
+    if e.kind() == io::ErrorKind::BrokenPipe {
+        Ok(())
+    } else {
+        Err(Failure::Tool(
+            anyhow::Error::new(e).context("writing the output"),
+        ))
+    }
+}
+
+fn learn(args: &LearnArgs) -> Result<(), Failure> {
+    let stdin = io::stdin();
+    let mut input: Box<dyn BufRead> = if args.replay == "-" {
+        Box::new(stdin.lock())
+    } else {
+        let file = File::open(&args.replay).map_err(|e| {
+            Failure::Input(anyhow::anyhow!(
+                "cannot open replay file `{}`: {e} (give a JSON Lines file, or - for standard input)",
+                args.replay
+            ))
+        })?;
+        Box::new(BufReader::new(file))
+    };
+    let stdout = io::stdout();
+    let mut out = BufWriter::new(stdout.lock());
+    let result = replay::run(&mut input, &mut out, args.states);
+    // Whatever happened, the lines already produced are delivered.
+    let flushed = out.flush();
+    match result {
+        Ok(_) => flushed.or_else(write_failure),
+        Err(replay::ReplayFailure::Input(e)) => Err(Failure::Input(
+            anyhow::Error::new(e).context(format!("replay `{}`", args.replay)),
+        )),
+        Err(replay::ReplayFailure::Io(e)) if e.kind() == io::ErrorKind::BrokenPipe => Ok(()),
+        Err(replay::ReplayFailure::Io(e)) => Err(Failure::Input(
+            anyhow::Error::new(e).context(format!("reading replay `{}`", args.replay)),
+        )),
+    }
+}
+
+fn cost(args: &CostArgs) -> Result<(), Failure> {
+    let cfg = cost_report::CostConfig {
+        outputs: usize::from(args.outputs),
+        history: usize::from(args.history),
+        bias: args.bias,
+        eta: args.eta,
+        threshold: args.threshold,
+        steps: args.steps,
+        seed: args.seed,
+        step_period_s: args.step_period_s,
+    };
+    let report = cost_report::measure(&cfg).map_err(Failure::Input)?;
+    let text = if args.json {
+        serde_json::to_string_pretty(&report).map_err(|e| Failure::Tool(e.into()))? + "\n"
+    } else {
+        cost_report::render(&report)
+    };
+    io::stdout()
+        .lock()
+        .write_all(text.as_bytes())
+        .or_else(write_failure)
+}

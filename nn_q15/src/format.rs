@@ -44,18 +44,18 @@ pub const fn sat8(v: i16) -> i8 {
     }
 }
 
-/// `round_half_away_from_zero(v / 2^7)`: the Q15 × Q7 → Q15 rescaling of the update (SPEC §2.4).
+/// `round_half_away_from_zero(v / 2^7)`: the Q15 × Q7 → Q15 rescaling of the update (SPEC §2.4),
+/// for |v| ≤ 2^30 (the update's products are at most 32767 · 128 < 2^22).
 ///
 /// Odd-symmetric (`round7(−v) = −round7(v)`), which lets the firmware fold the sign of E into η
-/// before multiplying.
+/// before multiplying. Computed without a branch (the sign is a mask), because the sign of η·x_i
+/// is as good as random and a mispredicted branch per input costs more than the arithmetic.
 #[inline(always)]
 #[must_use]
 pub const fn round_half_away_shr7(v: i32) -> i32 {
-    if v >= 0 {
-        (v + 64) >> 7
-    } else {
-        -((-v + 64) >> 7)
-    }
+    let sign = v >> 31; // 0 or −1
+    let magnitude = (v ^ sign) - sign;
+    (((magnitude + 64) >> 7) ^ sign) - sign
 }
 
 /// A proximity reading in distance units (0 = touching … 255 = 80 cm or more) as a Q7 input:

@@ -1,0 +1,245 @@
+//! `h8swarm cost`: what one learner step costs on the H8/300H, measured by running the learner
+//! with the H8 meter, and the RAM it holds.
+//!
+//! The learner runs `steps` steps on proximities drawn from a seeded generator (uniform 0–255 per
+//! sensor, so every branch of the step is taken: rewards, punishments, dead zones, saturations);
+//! its initial weights are drawn from the same seed, uniform in ±0.5. The report gives the
+//! minimum, mean and maximum states per phase and per step, their time at φ = 25 MHz, the share
+//! of a step period that is, and the RAM items.
+
+use std::fmt::Write as _;
+
+use anyhow::{Context, Result, bail};
+use nn_q15::{DynLearner, H8Meter, InputLayout, Params, Phase, Q15};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use serde::Serialize;
+
+/// The H8/3052F clock of the AKI-H8/3052F board (SPEC §4.1): 25 MHz, 40 ns per state.
+pub const PHI_HZ: f64 = 25.0e6;
+
+/// What to measure.
+#[derive(Clone, Copy, Debug)]
+pub struct CostConfig {
+    /// Enabled behaviours M (2–4).
+    pub outputs: usize,
+    /// History depth H (0–8).
+    pub history: usize,
+    /// Whether the bias input is on.
+    pub bias: bool,
+    /// η as a Q15 integer.
+    pub eta: i32,
+    /// T in du.
+    pub threshold: i32,
+    /// Steps to run.
+    pub steps: u32,
+    /// Seed of the proximities and initial weights.
+    pub seed: u64,
+    /// Step period in seconds, for the CPU share.
+    pub step_period_s: f64,
+}
+
+/// Minimum, mean and maximum of a per-step quantity.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct Stats {
+    /// Smallest value seen.
+    pub min: u64,
+    /// Mean over the steps.
+    pub mean: f64,
+    /// Largest value seen.
+    pub max: u64,
+}
+
+impl Stats {
+    fn of(values: &[u64]) -> Stats {
+        let min = values.iter().copied().min().unwrap_or(0);
+        let max = values.iter().copied().max().unwrap_or(0);
+        let mean = if values.is_empty() {
+            0.0
+        } else {
+            values.iter().sum::<u64>() as f64 / values.len() as f64
+        };
+        Stats { min, mean, max }
+    }
+}
+
+/// One RAM item in the report.
+#[derive(Clone, Debug, Serialize)]
+pub struct RamLine {
+    /// What the item holds.
+    pub item: &'static str,
+    /// Bytes on the H8.
+    pub bytes: u32,
+}
+
+/// The measured cost.
+#[derive(Clone, Debug, Serialize)]
+pub struct CostReport {
+    /// Inputs N.
+    pub n_in: usize,
+    /// Outputs M.
+    pub n_out: usize,
+    /// History depth H.
+    pub history: usize,
+    /// Bias input on.
+    pub bias: bool,
+    /// η (Q15 integer).
+    pub eta: i32,
+    /// T (du).
+    pub threshold: i32,
+    /// Steps measured.
+    pub steps: u32,
+    /// Seed.
+    pub seed: u64,
+    /// States of the input phase (D, E, the input vector).
+    pub input_states: Stats,
+    /// States of the update.
+    pub update_states: Stats,
+    /// States of the forward pass.
+    pub forward_states: Stats,
+    /// States of the whole step.
+    pub step_states: Stats,
+    /// Largest step time in microseconds at 25 MHz.
+    pub step_max_us: f64,
+    /// Largest step time as a share of the step period, in percent.
+    pub cpu_share_max_percent: f64,
+    /// Step period used for the share, seconds.
+    pub step_period_s: f64,
+    /// RAM items.
+    pub ram: Vec<RamLine>,
+    /// RAM total in bytes.
+    pub ram_bytes: u32,
+}
+
+/// Runs the learner with the H8 meter and collects the report.
+///
+/// # Errors
+/// A configuration outside the learner's bounds, named with the valid range.
+pub fn measure(cfg: &CostConfig) -> Result<CostReport> {
+    if cfg.steps == 0 {
+        bail!("--steps must be at least 1");
+    }
+    if !(cfg.step_period_s.is_finite() && cfg.step_period_s > 0.0) {
+        bail!(
+            "--step-period-s must be a positive number of seconds, got {}",
+            cfg.step_period_s
+        );
+    }
+    let layout = InputLayout::new(cfg.history, cfg.bias).context("--history")?;
+    let params = Params::new(cfg.eta, cfg.threshold).context("--eta/--threshold")?;
+    let n_in = layout.n_inputs(cfg.outputs);
+    let mut rng = ChaCha8Rng::seed_from_u64(cfg.seed);
+    let weights: Vec<Q15> = (0..n_in * cfg.outputs)
+        .map(|_| Q15::from_bits(rng.random_range(-16384i16..=16384)))
+        .collect();
+    let mut learner =
+        DynLearner::new(cfg.outputs, layout, params, &weights).with_context(|| {
+            format!(
+                "{} outputs with history {} makes a network the learner cannot hold",
+                cfg.outputs, cfg.history
+            )
+        })?;
+
+    let mut per_phase: [Vec<u64>; Phase::COUNT] = Default::default();
+    let mut per_step = Vec::with_capacity(cfg.steps as usize);
+    for _ in 0..cfg.steps {
+        let p: [u8; 4] = rng.random();
+        let mut meter = H8Meter::new();
+        learner.step(&p, &mut meter);
+        for phase in Phase::ALL {
+            per_phase[phase as usize].push(meter.states(phase));
+        }
+        per_step.push(meter.total_states());
+    }
+    let step_states = Stats::of(&per_step);
+    let step_max_us = step_states.max as f64 / PHI_HZ * 1e6;
+    Ok(CostReport {
+        n_in,
+        n_out: cfg.outputs,
+        history: cfg.history,
+        bias: cfg.bias,
+        eta: cfg.eta,
+        threshold: cfg.threshold,
+        steps: cfg.steps,
+        seed: cfg.seed,
+        input_states: Stats::of(&per_phase[Phase::Input as usize]),
+        update_states: Stats::of(&per_phase[Phase::Update as usize]),
+        forward_states: Stats::of(&per_phase[Phase::Forward as usize]),
+        step_states,
+        step_max_us,
+        cpu_share_max_percent: step_max_us / (cfg.step_period_s * 1e6) * 100.0,
+        step_period_s: cfg.step_period_s,
+        ram: learner
+            .ram_items()
+            .iter()
+            .map(|i| RamLine {
+                item: i.name,
+                bytes: i.bytes,
+            })
+            .collect(),
+        ram_bytes: learner.ram_bytes(),
+    })
+}
+
+/// The report as a readable table.
+#[must_use]
+pub fn render(r: &CostReport) -> String {
+    let mut s = String::new();
+    let us = |states: f64| states / PHI_HZ * 1e6;
+    let _ = writeln!(
+        s,
+        "h8swarm: learner cost on the H8/300H at 25 MHz (1 state = 40 ns), from the H8 meter"
+    );
+    let _ = writeln!(
+        s,
+        "network {} inputs x {} outputs (history {}, bias {}), eta {} (Q15), T {}; {} steps, seed {}",
+        r.n_in,
+        r.n_out,
+        r.history,
+        if r.bias { "on" } else { "off" },
+        r.eta,
+        r.threshold,
+        r.steps,
+        r.seed
+    );
+    let _ = writeln!(s);
+    let _ = writeln!(
+        s,
+        "{:<10} {:>10} {:>10} {:>10} {:>10}",
+        "phase", "min", "mean", "max", "max µs"
+    );
+    for (name, st) in [
+        ("input", r.input_states),
+        ("update", r.update_states),
+        ("forward", r.forward_states),
+        ("step", r.step_states),
+    ] {
+        let _ = writeln!(
+            s,
+            "{:<10} {:>10} {:>10.1} {:>10} {:>10.1}",
+            name,
+            st.min,
+            st.mean,
+            st.max,
+            us(st.max as f64)
+        );
+    }
+    let _ = writeln!(
+        s,
+        "worst step: {:.1} µs = {:.4} % of a {} s step period",
+        r.step_max_us, r.cpu_share_max_percent, r.step_period_s
+    );
+    let _ = writeln!(s);
+    let _ = writeln!(s, "RAM on the H8 (bytes, words aligned to 2):");
+    for line in &r.ram {
+        let _ = writeln!(s, "  {:<52} {:>5}", line.item, line.bytes);
+    }
+    let _ = writeln!(
+        s,
+        "  {:<52} {:>5}  ({:.1} % of the 8 192-byte on-chip RAM)",
+        "total",
+        r.ram_bytes,
+        f64::from(r.ram_bytes) / 8192.0 * 100.0
+    );
+    s
+}

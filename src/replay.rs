@@ -1,0 +1,501 @@
+//! `h8swarm learn --replay FILE`: the learner core of SPEC §2.3–2.4 fed from JSON Lines, one
+//! output line per step (SPEC §2.6), so another implementation can be compared bit for bit.
+//!
+//! Input: line 1 is the header
+//! `{"n_in": N, "n_out": M, "eta": η, "threshold": T, "weights": [[w_1,1 … w_N,1], …]}` (one row
+//! of N Q15 integers per output), then one line per step `{"x": [N Q7 integers], "e": E}`: the
+//! forward pass on x, then the update with evaluation E for that x and its winner. Output, per
+//! step: `{"y": [M], "o": [M], "win": j, "weights": [[…] after the update]}`.
+//!
+//! Choices where SPEC §2.6 is silent: lines holding only white space are skipped (they still
+//! count for line numbers); unknown fields are errors, so a misspelt key never passes silently;
+//! numbers must be integers (no fraction, no exponent); η and T must be 0 … 32767 (Q15 ≥ 0 and
+//! a non-negative threshold); E may be any i16. `--states` adds the H8/300H states the step's
+//! forward pass and update cost (`"states": {"forward": …, "update": …}`); without it the output
+//! is exactly SPEC §2.6's.
+
+use std::fmt;
+use std::io::{self, BufRead, Write};
+
+use nn_q15::{H8Meter, Params, Phase, Q7, Q15, Shape, forward_slice, update_slice};
+use serde::Serialize;
+use serde_json::{Map, Value};
+
+/// A malformed input line: where, which field, what was wrong and what would be valid.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ReplayError {
+    /// 1-based line number.
+    pub line: usize,
+    /// The field, as a path such as `weights[2][5]`, when the problem is in one.
+    pub field: Option<String>,
+    /// What was wrong and what would be valid.
+    pub message: String,
+}
+
+impl fmt::Display for ReplayError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match &self.field {
+            Some(field) => write!(f, "line {}: field `{}`: {}", self.line, field, self.message),
+            None => write!(f, "line {}: {}", self.line, self.message),
+        }
+    }
+}
+
+impl std::error::Error for ReplayError {}
+
+/// Why a replay stopped early.
+#[derive(Debug)]
+pub enum ReplayFailure {
+    /// The input was malformed (exit status 2).
+    Input(ReplayError),
+    /// Reading the input or writing the output failed.
+    Io(io::Error),
+}
+
+impl From<io::Error> for ReplayFailure {
+    fn from(e: io::Error) -> Self {
+        ReplayFailure::Io(e)
+    }
+}
+
+#[derive(Serialize)]
+struct StepLine<'a> {
+    y: &'a [i32],
+    o: &'a [i16],
+    win: usize,
+    weights: Vec<&'a [i16]>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    states: Option<States>,
+}
+
+#[derive(Serialize)]
+struct States {
+    forward: u64,
+    update: u64,
+}
+
+struct Header {
+    shape: Shape,
+    params: Params,
+    weights: Vec<Q15>,
+}
+
+const HEADER_FIELDS: &str = "n_in, n_out, eta, threshold, weights";
+const STEP_FIELDS: &str = "x, e";
+
+/// Runs a replay from `input` to `out`. Returns the number of steps replayed.
+///
+/// # Errors
+/// [`ReplayFailure::Input`] for the first malformed line (everything before it has been
+/// written), [`ReplayFailure::Io`] when reading or writing fails.
+pub fn run(
+    input: &mut dyn BufRead,
+    out: &mut dyn Write,
+    with_states: bool,
+) -> Result<usize, ReplayFailure> {
+    let mut buf = Vec::new();
+    let mut line_no = 0usize;
+    let mut header: Option<Header> = None;
+    let mut steps = 0usize;
+    loop {
+        buf.clear();
+        if input.read_until(b'\n', &mut buf)? == 0 {
+            break;
+        }
+        line_no += 1;
+        let text = std::str::from_utf8(&buf).map_err(|e| {
+            ReplayFailure::Input(ReplayError {
+                line: line_no,
+                field: None,
+                message: format!("not valid UTF-8 (byte {})", e.valid_up_to() + 1),
+            })
+        })?;
+        if text.trim().is_empty() {
+            continue;
+        }
+        let obj = parse_object(text, line_no).map_err(ReplayFailure::Input)?;
+        match header.as_mut() {
+            None => header = Some(parse_header(&obj, line_no).map_err(ReplayFailure::Input)?),
+            Some(h) => {
+                let (x, e) = parse_step(&obj, line_no, h.shape).map_err(ReplayFailure::Input)?;
+                replay_step(h, &x, e, out, with_states)?;
+                steps += 1;
+            }
+        }
+    }
+    if header.is_none() {
+        return Err(ReplayFailure::Input(ReplayError {
+            line: line_no.max(1),
+            field: None,
+            message: format!(
+                "no header: the first non-blank line must be {{\"n_in\": N, \"n_out\": M, \
+                 \"eta\": η, \"threshold\": T, \"weights\": [[…], …]}} (fields {HEADER_FIELDS})"
+            ),
+        }));
+    }
+    out.flush()?;
+    Ok(steps)
+}
+
+fn replay_step(
+    h: &mut Header,
+    x: &[Q7],
+    e: i16,
+    out: &mut dyn Write,
+    with_states: bool,
+) -> io::Result<()> {
+    let mut meter = H8Meter::new();
+    // The shape and lengths were validated while parsing, so neither call can fail; a failure
+    // would still be reported, never unwrapped.
+    let forward = forward_slice(h.shape, &h.weights, x, &mut meter).map_err(invalid_data)?;
+    update_slice(
+        h.shape,
+        &mut h.weights,
+        x,
+        forward.win(),
+        e,
+        h.params,
+        &mut meter,
+    )
+    .map_err(invalid_data)?;
+    let raw: Vec<i16> = h.weights.iter().map(|w| w.to_bits()).collect();
+    let line = StepLine {
+        y: forward.y_bits(),
+        o: forward.o_bits(),
+        win: forward.win(),
+        weights: raw.chunks(h.shape.n_in()).collect(),
+        states: with_states.then(|| States {
+            forward: meter.states(Phase::Forward),
+            update: meter.states(Phase::Update),
+        }),
+    };
+    serde_json::to_writer(&mut *out, &line).map_err(io::Error::other)?;
+    out.write_all(b"\n")
+}
+
+fn invalid_data(e: nn_q15::ShapeError) -> io::Error {
+    io::Error::new(io::ErrorKind::InvalidData, e.to_string())
+}
+
+fn parse_object(text: &str, line: usize) -> Result<Map<String, Value>, ReplayError> {
+    match serde_json::from_str::<Value>(text) {
+        Ok(Value::Object(map)) => Ok(map),
+        Ok(other) => Err(ReplayError {
+            line,
+            field: None,
+            message: format!("expected a JSON object, found {}", kind(&other)),
+        }),
+        Err(e) => Err(ReplayError {
+            line,
+            field: None,
+            message: format!("bad JSON: {e}"),
+        }),
+    }
+}
+
+fn kind(v: &Value) -> &'static str {
+    match v {
+        Value::Null => "null",
+        Value::Bool(_) => "a boolean",
+        Value::Number(_) => "a number",
+        Value::String(_) => "a string",
+        Value::Array(_) => "an array",
+        Value::Object(_) => "an object",
+    }
+}
+
+fn check_fields(
+    obj: &Map<String, Value>,
+    line: usize,
+    allowed: &[&str],
+    listing: &str,
+) -> Result<(), ReplayError> {
+    // serde_json's map is ordered by key, so the first unknown field reported is deterministic.
+    match obj.keys().find(|k| !allowed.contains(&k.as_str())) {
+        Some(k) => Err(ReplayError {
+            line,
+            field: Some(k.clone()),
+            message: format!("unknown field: valid fields here are {listing}"),
+        }),
+        None => Ok(()),
+    }
+}
+
+fn field<'a>(
+    obj: &'a Map<String, Value>,
+    line: usize,
+    name: &str,
+) -> Result<&'a Value, ReplayError> {
+    obj.get(name).ok_or_else(|| ReplayError {
+        line,
+        field: Some(name.to_owned()),
+        message: "missing".to_owned(),
+    })
+}
+
+/// An integer in `lo ..= hi`, described as `what` in errors.
+fn int_in(
+    v: &Value,
+    line: usize,
+    path: &str,
+    lo: i64,
+    hi: i64,
+    what: &str,
+) -> Result<i64, ReplayError> {
+    let err = |message: String| ReplayError {
+        line,
+        field: Some(path.to_owned()),
+        message,
+    };
+    let n = match v {
+        Value::Number(n) => n,
+        other => {
+            return Err(err(format!(
+                "expected an integer ({what}, {lo} to {hi}), found {}",
+                kind(other)
+            )));
+        }
+    };
+    let i = n.as_i64().ok_or_else(|| {
+        err(format!(
+            "{n} is not an integer in range ({what}: valid is {lo} to {hi})"
+        ))
+    })?;
+    if i < lo || i > hi {
+        return Err(err(format!(
+            "{i} is out of range for {what}: valid is {lo} to {hi}"
+        )));
+    }
+    Ok(i)
+}
+
+fn array<'a>(
+    v: &'a Value,
+    line: usize,
+    path: &str,
+    len: usize,
+    what: &str,
+) -> Result<&'a [Value], ReplayError> {
+    let err = |message: String| ReplayError {
+        line,
+        field: Some(path.to_owned()),
+        message,
+    };
+    match v {
+        Value::Array(a) if a.len() == len => Ok(a),
+        Value::Array(a) => Err(err(format!(
+            "expected {len} values ({what}), found {}",
+            a.len()
+        ))),
+        other => Err(err(format!(
+            "expected an array of {len} values ({what}), found {}",
+            kind(other)
+        ))),
+    }
+}
+
+fn parse_header(obj: &Map<String, Value>, line: usize) -> Result<Header, ReplayError> {
+    check_fields(
+        obj,
+        line,
+        &["n_in", "n_out", "eta", "threshold", "weights"],
+        HEADER_FIELDS,
+    )?;
+    let n_in = int_in(
+        field(obj, line, "n_in")?,
+        line,
+        "n_in",
+        1,
+        256,
+        "the number of inputs N",
+    )?;
+    let n_out = int_in(
+        field(obj, line, "n_out")?,
+        line,
+        "n_out",
+        2,
+        4,
+        "the number of outputs M (enabled behaviours)",
+    )?;
+    let eta = int_in(
+        field(obj, line, "eta")?,
+        line,
+        "eta",
+        0,
+        32767,
+        "a Q15 learning rate ≥ 0",
+    )?;
+    let threshold = int_in(
+        field(obj, line, "threshold")?,
+        line,
+        "threshold",
+        0,
+        32767,
+        "a threshold T in du ≥ 0",
+    )?;
+    // Both ranges were checked above, so these conversions and constructors cannot fail.
+    let (n_in, n_out) = (n_in as usize, n_out as usize);
+    let shape = Shape::new(n_in, n_out).map_err(|e| ReplayError {
+        line,
+        field: Some("n_in".to_owned()),
+        message: e.to_string(),
+    })?;
+    let params = Params::new(eta as i32, threshold as i32).map_err(|e| ReplayError {
+        line,
+        field: Some("eta".to_owned()),
+        message: e.to_string(),
+    })?;
+    let rows = array(
+        field(obj, line, "weights")?,
+        line,
+        "weights",
+        n_out,
+        "one row per output (n_out)",
+    )?;
+    let mut weights = Vec::with_capacity(n_in * n_out);
+    for (j, row) in rows.iter().enumerate() {
+        let path = format!("weights[{j}]");
+        for (i, v) in array(row, line, &path, n_in, "one weight per input (n_in)")?
+            .iter()
+            .enumerate()
+        {
+            let w = int_in(
+                v,
+                line,
+                &format!("weights[{j}][{i}]"),
+                -32768,
+                32767,
+                "a Q15 weight (i16)",
+            )?;
+            weights.push(Q15::from_bits(w as i16));
+        }
+    }
+    Ok(Header {
+        shape,
+        params,
+        weights,
+    })
+}
+
+fn parse_step(
+    obj: &Map<String, Value>,
+    line: usize,
+    shape: Shape,
+) -> Result<(Vec<Q7>, i16), ReplayError> {
+    check_fields(obj, line, &["x", "e"], STEP_FIELDS)?;
+    let xs = array(
+        field(obj, line, "x")?,
+        line,
+        "x",
+        shape.n_in(),
+        "one input per n_in",
+    )?;
+    let mut x = Vec::with_capacity(xs.len());
+    for (i, v) in xs.iter().enumerate() {
+        let xi = int_in(v, line, &format!("x[{i}]"), -128, 127, "a Q7 input (i8)")?;
+        x.push(Q7::from_bits(xi as i8));
+    }
+    let e = int_in(
+        field(obj, line, "e")?,
+        line,
+        "e",
+        -32768,
+        32767,
+        "an evaluation E (i16)",
+    )?;
+    Ok((x, e as i16))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn replay(input: &str) -> (String, Result<usize, String>) {
+        let mut out = Vec::new();
+        let r = run(&mut input.as_bytes(), &mut out, false).map_err(|e| match e {
+            ReplayFailure::Input(e) => e.to_string(),
+            ReplayFailure::Io(e) => format!("io: {e}"),
+        });
+        (String::from_utf8(out).unwrap(), r)
+    }
+
+    const HEADER: &str = r#"{"n_in": 2, "n_out": 2, "eta": 3277, "threshold": 10, "weights": [[100, -200], [300, 400]]}"#;
+
+    #[test]
+    fn one_step_by_hand() {
+        let input = format!("{HEADER}\n{{\"x\": [64, -64], \"e\": 20}}\n");
+        let (out, r) = replay(&input);
+        assert_eq!(r, Ok(1));
+        // y0 = 100·64 − 200·(−64) = 19200; y1 = 300·64 − 400·64 = −6400; O = y >> 7.
+        // Reward for output 0: Δ = round(3277·64/128) = 1639, Δ' = −1639.
+        assert_eq!(
+            out,
+            "{\"y\":[19200,-6400],\"o\":[150,-50],\"win\":0,\"weights\":[[1739,-1839],[-1339,2039]]}\n"
+        );
+    }
+
+    #[test]
+    fn errors_name_line_and_field() {
+        let cases = [
+            (
+                format!("{HEADER}\n{{\"x\": [64, 200], \"e\": 0}}\n"),
+                "line 2: field `x[1]`: 200 is out of range for a Q7 input (i8): valid is -128 to 127",
+            ),
+            (
+                format!("{HEADER}\n{{\"x\": [64], \"e\": 0}}\n"),
+                "line 2: field `x`: expected 2 values (one input per n_in), found 1",
+            ),
+            (
+                format!("{HEADER}\n\n{{\"x\": [1, 2]}}\n"),
+                "line 3: field `e`: missing",
+            ),
+            (
+                format!("{HEADER}\n{{\"x\": [1, 2], \"e\": 40000}}\n"),
+                "line 2: field `e`: 40000 is out of range for an evaluation E (i16): valid is -32768 to 32767",
+            ),
+            (
+                format!("{HEADER}\n{{\"x\": [1, 2], \"e\": 1, \"z\": 0}}\n"),
+                "line 2: field `z`: unknown field: valid fields here are x, e",
+            ),
+            (
+                format!("{HEADER}\n{{\"x\": [1.5, 2], \"e\": 1}}\n"),
+                "line 2: field `x[0]`: 1.5 is not an integer in range (a Q7 input (i8): valid is -128 to 127)",
+            ),
+            (
+                format!("{HEADER}\n[1]\n"),
+                "line 2: expected a JSON object, found an array",
+            ),
+            (
+                r#"{"n_in": 0, "n_out": 2, "eta": 1, "threshold": 1, "weights": []}"#.to_owned(),
+                "line 1: field `n_in`: 0 is out of range for the number of inputs N: valid is 1 to 256",
+            ),
+            (
+                r#"{"n_in": 1, "n_out": 2, "eta": -1, "threshold": 1, "weights": []}"#.to_owned(),
+                "line 1: field `eta`: -1 is out of range for a Q15 learning rate ≥ 0: valid is 0 to 32767",
+            ),
+            (
+                r#"{"n_in": 1, "n_out": 2, "eta": 1, "threshold": 1, "weights": [[1], [40000]]}"#
+                    .to_owned(),
+                "line 1: field `weights[1][0]`: 40000 is out of range for a Q15 weight (i16): valid is -32768 to 32767",
+            ),
+            (
+                r#"{"n_in": 1, "n_out": 2, "eta": 1, "threshold": 1, "weights": [[1]]}"#.to_owned(),
+                "line 1: field `weights`: expected 2 values (one row per output (n_out)), found 1",
+            ),
+            (String::new(), "line 1: no header"),
+        ];
+        for (input, expected) in cases {
+            let (_, r) = replay(&input);
+            let msg = r.unwrap_err();
+            assert!(msg.starts_with(expected), "{msg}\nexpected: {expected}");
+        }
+    }
+
+    #[test]
+    fn bad_json_reports_the_line_and_keeps_earlier_output() {
+        let input = format!("{HEADER}\n{{\"x\": [1, 2], \"e\": 0}}\n{{\"x\": [1, 2\n");
+        let (out, r) = replay(&input);
+        assert_eq!(out.lines().count(), 1, "the good step was written");
+        assert!(r.unwrap_err().starts_with("line 3: bad JSON"));
+    }
+}

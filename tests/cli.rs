@@ -1,0 +1,228 @@
+//! Drives the real `h8swarm` binary: the replay of SPEC §2.6 checked line by line against an
+//! independent reference written here, its error reports, and the cost summary.
+
+use std::io::Write;
+use std::process::{Command, Output, Stdio};
+
+use serde_json::Value;
+
+fn h8swarm(args: &[&str], stdin: Option<&str>) -> Output {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_h8swarm"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the binary starts");
+    if let Some(text) = stdin {
+        child
+            .stdin
+            .take()
+            .expect("stdin is piped")
+            .write_all(text.as_bytes())
+            .expect("stdin takes the input");
+    }
+    child.wait_with_output().expect("the binary runs")
+}
+
+/// The learner core of SPEC §2.3–2.4 in i64, written from the spec for this test.
+struct Reference {
+    n: usize,
+    eta: i64,
+    t: i64,
+    w: Vec<Vec<i64>>,
+}
+
+impl Reference {
+    fn step(&mut self, x: &[i64], e: i64) -> Value {
+        let y: Vec<i64> = self
+            .w
+            .iter()
+            .map(|row| row.iter().zip(x).map(|(a, b)| a * b).sum())
+            .collect();
+        let win = (0..y.len()).fold(0, |best, j| if y[j] > y[best] { j } else { best });
+        let m = y[win];
+        let o: Vec<i64> = if m < 1 << 22 {
+            y.iter().map(|v| (v >> 7).clamp(-32768, 32767)).collect()
+        } else {
+            let s = 64 - m.leading_zeros() as i64 - 15;
+            let ms = m >> s;
+            y.iter()
+                .map(|v| {
+                    let vs = v >> s;
+                    if vs <= -ms {
+                        -32768
+                    } else {
+                        ((vs << 15) / ms).min(32767)
+                    }
+                })
+                .collect()
+        };
+        if e.abs() > self.t {
+            let se = if e > 0 { self.eta } else { -self.eta };
+            for (j, row) in self.w.iter_mut().enumerate() {
+                let s = if j == win { 1 } else { -1 };
+                for (wi, xi) in row.iter_mut().zip(x) {
+                    let exact = (se * xi) as f64 / 128.0;
+                    let d = (exact.abs() + 0.5).floor().copysign(exact) as i64;
+                    *wi = (*wi + s * d).clamp(-32768, 32767);
+                }
+            }
+        }
+        serde_json::json!({"y": y, "o": o, "win": win, "weights": self.w})
+    }
+}
+
+fn ints(v: &Value) -> Vec<i64> {
+    v.as_array()
+        .expect("an array")
+        .iter()
+        .map(|n| n.as_i64().expect("an integer"))
+        .collect()
+}
+
+#[test]
+fn replay_of_the_shipped_example_matches_the_reference_line_by_line() {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/replay-arena.jsonl"
+    ))
+    .expect("the example exists");
+    let mut lines = text.lines();
+    let header: Value = serde_json::from_str(lines.next().expect("a header")).expect("json");
+    let mut reference = Reference {
+        n: header["n_in"].as_u64().expect("n_in") as usize,
+        eta: header["eta"].as_i64().expect("eta"),
+        t: header["threshold"].as_i64().expect("threshold"),
+        w: header["weights"]
+            .as_array()
+            .expect("rows")
+            .iter()
+            .map(ints)
+            .collect(),
+    };
+    let out = h8swarm(&["learn", "--replay", "examples/replay-arena.jsonl"], None);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8(out.stdout).expect("utf-8");
+    let produced: Vec<&str> = stdout.lines().collect();
+    let steps: Vec<&str> = lines.collect();
+    assert_eq!(produced.len(), steps.len());
+    let mut updates = 0;
+    for (k, (step, got)) in steps.iter().zip(&produced).enumerate() {
+        let step: Value = serde_json::from_str(step).expect("json");
+        let x = ints(&step["x"]);
+        assert_eq!(x.len(), reference.n);
+        let before = reference.w.clone();
+        let expected = reference.step(&x, step["e"].as_i64().expect("e"));
+        updates += usize::from(before != reference.w);
+        let got: Value = serde_json::from_str(got).expect("output is json");
+        assert_eq!(got, expected, "step {}", k + 1);
+    }
+    assert!(
+        updates > 10,
+        "the example exercises the update ({updates} steps changed weights)"
+    );
+}
+
+#[test]
+fn replay_reads_standard_input_and_writes_compact_lines() {
+    let input = "{\"n_in\": 1, \"n_out\": 2, \"eta\": 32767, \"threshold\": 0, \"weights\": [[1], [0]]}\n{\"x\": [-128], \"e\": 1}\n";
+    let out = h8swarm(&["learn", "--replay", "-"], Some(input));
+    assert!(out.status.success());
+    // y = [−128, 0]: win 1; Δ = round(32767·−128/128) = −32767; winner 0 − 32767, loser 1 + 32767.
+    assert_eq!(
+        String::from_utf8(out.stdout).expect("utf-8"),
+        "{\"y\":[-128,0],\"o\":[-1,0],\"win\":1,\"weights\":[[32767],[-32767]]}\n"
+    );
+}
+
+#[test]
+fn replay_with_states_adds_the_h8_cost() {
+    let out = h8swarm(
+        &[
+            "learn",
+            "--replay",
+            "examples/replay-arena.jsonl",
+            "--states",
+        ],
+        None,
+    );
+    assert!(out.status.success());
+    let first: Value = serde_json::from_str(
+        String::from_utf8(out.stdout)
+            .expect("utf-8")
+            .lines()
+            .next()
+            .expect("a line"),
+    )
+    .expect("json");
+    assert!(first["states"]["forward"].as_u64().expect("forward states") > 52 * 40);
+    assert!(first["states"]["update"].is_u64());
+}
+
+#[test]
+fn malformed_lines_stop_with_line_field_and_status_2_keeping_earlier_output() {
+    let input = "{\"n_in\": 2, \"n_out\": 2, \"eta\": 1, \"threshold\": 1, \"weights\": [[1, 2], [3, 4]]}\n\
+                 {\"x\": [1, 2], \"e\": 5}\n\
+                 {\"x\": [1, -129], \"e\": 5}\n\
+                 {\"x\": [1, 2], \"e\": 5}\n";
+    let out = h8swarm(&["learn", "--replay", "-"], Some(input));
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(String::from_utf8_lossy(&out.stdout).lines().count(), 1);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("line 3: field `x[1]`: -129 is out of range"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}
+
+#[test]
+fn missing_file_and_bad_options_are_errors_not_panics() {
+    let out = h8swarm(&["learn", "--replay", "no/such/file.jsonl"], None);
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("cannot open replay file `no/such/file.jsonl`"),
+        "{stderr}"
+    );
+
+    for args in [
+        &["cost", "--outputs", "5"][..],
+        &["cost", "--history", "9"],
+        &["cost", "--eta", "-1"],
+        &["cost", "--steps", "0"],
+        &["learn"],
+        &["frobnicate"],
+    ] {
+        let out = h8swarm(args, None);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
+    }
+    let out = h8swarm(&["cost", "--step-period-s", "0", "--steps", "10"], None);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--step-period-s"));
+}
+
+#[test]
+fn cost_summary_reports_phases_and_ram() {
+    let out = h8swarm(&["cost", "--steps", "200", "--json"], None);
+    assert!(out.status.success());
+    let r: Value = serde_json::from_slice(&out.stdout).expect("json");
+    assert_eq!(r["n_in"], 13);
+    assert_eq!(r["n_out"], 4);
+    assert_eq!(r["ram_bytes"], 176);
+    let fwd_min = r["forward_states"]["min"].as_u64().expect("min");
+    // 52 multiply-accumulates at 40 states and 52 loop iterations at 6 are a floor.
+    assert!(fwd_min >= 52 * 46, "{fwd_min}");
+    let plain = h8swarm(&["cost", "--steps", "200"], None);
+    assert!(String::from_utf8_lossy(&plain.stdout).contains("RAM on the H8"));
+    let default = h8swarm(&[], None);
+    assert!(default.status.success());
+    assert!(String::from_utf8_lossy(&default.stdout).contains("worst step"));
+}
