@@ -65,7 +65,8 @@ pub struct I2cBus {
 }
 
 impl I2cBus {
-    /// A bus with these devices, both lines released and high, at state 0.
+    /// A bus with these devices, both lines released and high, at the latest time any of the
+    /// devices has seen (0 for new chips).
     ///
     /// # Errors
     /// Two devices with one address, or more than eight devices.
