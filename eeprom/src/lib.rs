@@ -52,6 +52,26 @@
 //!   return [`EepromError::PoweredOff`]. Power-on: standby, address pointer 0.
 //! - **Simultaneous changes.** When one bus call changes both lines, the chips see SCL first.
 //!
+//! # Example
+//!
+//! ```
+//! use eeprom::{I2cBus, I2cMaster, MasterTiming, Persistence, Record, SimPins};
+//!
+//! // The robot's bus (chips at 0x50 and 0x51) driven by the bit-banging master.
+//! let bus = I2cBus::robot(1)?;
+//! let mut master = I2cMaster::new(SimPins::new(bus), MasterTiming::default());
+//! master.init();
+//! let store = Persistence::default();
+//! let boot = store.recover(&mut master);
+//! assert!(boot.newest.is_none()); // blank chips: start from fresh random weights
+//! let record = Record { sequence: boot.next_sequence(), payload: vec![0x12; 104] };
+//! let report = store.save(&mut master, &record)?;
+//! assert_eq!((report.chip, report.pages_written), (0x50, 3));
+//! println!("{} bus edges", master.pins().edges().total());
+//! assert_eq!(store.recover(&mut master).newest, Some(record));
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
 //! Randomness: each chip has three ChaCha8 streams (write-cycle time, cut corruption, wear)
 //! keyed by its seed and address; the same seeds give the same results, and no global RNG is
 //! used.
