@@ -170,8 +170,10 @@ impl I2cBus {
         Ok(&self.devices[self.index_of(address)?])
     }
 
-    /// The device at `address`, mutable (for back-door loads and per-chip power control; a
-    /// device's own time-taking calls must not be given a time before [`I2cBus::now`]).
+    /// The device at `address`, mutable (for back-door loads and reads). A device's own
+    /// time-taking calls should get a time ≥ [`I2cBus::now`] and not later than the bus's next
+    /// call; switch a chip's power through [`I2cBus::power_off_device`] /
+    /// [`I2cBus::power_on_device`] so the lines settle.
     ///
     /// # Errors
     /// [`EepromError::NoSuchDevice`] if none is there.
