@@ -1,0 +1,312 @@
+//! Physical parameters of the robots and the simulation, with their sources and valid ranges.
+
+use crate::error::WorldError;
+
+/// Body length along the heading: 230 mm (SPEC §1, paper §4: robots of 230 × 180 × 130 mm).
+pub const BODY_LENGTH_M: f64 = 0.230;
+/// Body width across the heading: 180 mm (SPEC §1, paper §4).
+pub const BODY_WIDTH_M: f64 = 0.180;
+/// Default top wheel speed at 100 % duty: 0.15 m/s (SPEC §3.5; Tamiya 203:1 gearbox with 56 mm
+/// wheels gives 0.14–0.18 m/s).
+pub const TOP_SPEED_M_PER_S: f64 = 0.15;
+/// Largest accepted top speed: 1 m/s (our limit, so a body cannot cross another in one
+/// [`MAX_SUBSTEP_LIMIT_S`] sub-step; the real robot does about 0.15 m/s).
+pub const MAX_TOP_SPEED_M_PER_S: f64 = 1.0;
+/// Default motor time constant of the first-order wheel-speed lag: 60 ms (SPEC §3.5).
+pub const MOTOR_TIME_CONSTANT_S: f64 = 0.060;
+/// Shortest valid motor time constant: 20 ms (SPEC §3.5, range 20–100 ms).
+pub const MOTOR_TIME_CONSTANT_MIN_S: f64 = 0.020;
+/// Longest valid motor time constant: 100 ms (SPEC §3.5, range 20–100 ms).
+pub const MOTOR_TIME_CONSTANT_MAX_S: f64 = 0.100;
+/// Shortest accepted braking or coasting time constant: 5 ms (our limit).
+pub const STOP_TIME_CONSTANT_MIN_S: f64 = 0.005;
+/// Longest accepted braking or coasting time constant: 1 s (our limit).
+pub const STOP_TIME_CONSTANT_MAX_S: f64 = 1.0;
+/// Per-robot, per-wheel motor gain spread: ±5 % (SPEC §3.5).
+pub const MOTOR_GAIN_SPREAD: f64 = 0.05;
+/// Default wheel track (distance between the wheel contact lines): 160 mm. Our choice: the
+/// paper gives no figure; two 56 mm Tamiya wheels about 20 mm wide sit inside the 180 mm body.
+pub const WHEEL_TRACK_M: f64 = 0.160;
+/// Default longest internal sub-step: 20 ms (our choice; longer `advance` calls are split).
+pub const MAX_SUBSTEP_S: f64 = 0.020;
+/// Largest accepted `max_substep_s`: 100 ms (our limit: at 1 m/s two robots close 0.2 m, about
+/// the body width, so a longer sub-step could let bodies pass through each other).
+pub const MAX_SUBSTEP_LIMIT_S: f64 = 0.100;
+/// Largest time one `advance` call may cover: one hour (our limit, so a call always ends).
+pub const MAX_ADVANCE_S: f64 = 3600.0;
+/// Default sensor maximum range: 1.5 m (brief; the GP2Y0A21 is specified to 80 cm, beyond which
+/// its curve keeps falling as 1/d, SPEC §3.1, so "farther than 1.5 m" reads as far).
+pub const SENSOR_MAX_RANGE_M: f64 = 1.5;
+/// Default placement clearance between bodies, and between bodies and walls: 50 mm (our choice).
+pub const PLACEMENT_CLEARANCE_M: f64 = 0.050;
+/// Default number of collision-resolution passes per sub-step (our choice).
+pub const COLLISION_ITERATIONS: u32 = 4;
+/// Most rays a sensor cone may use (our limit).
+pub const MAX_RAYS_PER_SENSOR: u32 = 16;
+/// Widest accepted sensor cone half-angle: 0.5 rad (our limit; the Sharp beam is a few degrees).
+pub const MAX_CONE_HALF_ANGLE_RAD: f64 = 0.5;
+
+/// Where a sensor sits on the body and where it looks, in the body frame (x forward along the
+/// heading, y to the robot's left, angle counter-clockwise from the heading).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SensorMount {
+    /// Mount point, metres forward of the body centre.
+    pub x_m: f64,
+    /// Mount point, metres to the left of the body centre.
+    pub y_m: f64,
+    /// Viewing direction relative to the heading, radians counter-clockwise.
+    pub angle_rad: f64,
+}
+
+impl SensorMount {
+    /// The four default mounts (SPEC §3.1): middle of the front, rear, left and right sides,
+    /// facing out, in that order (sensor indices 0, 1, 2, 3).
+    pub fn default_mounts(body_length_m: f64, body_width_m: f64) -> Vec<SensorMount> {
+        let hl = 0.5 * body_length_m;
+        let hw = 0.5 * body_width_m;
+        vec![
+            SensorMount {
+                x_m: hl,
+                y_m: 0.0,
+                angle_rad: 0.0,
+            },
+            SensorMount {
+                x_m: -hl,
+                y_m: 0.0,
+                angle_rad: core::f64::consts::PI,
+            },
+            SensorMount {
+                x_m: 0.0,
+                y_m: hw,
+                angle_rad: core::f64::consts::FRAC_PI_2,
+            },
+            SensorMount {
+                x_m: 0.0,
+                y_m: -hw,
+                angle_rad: -core::f64::consts::FRAC_PI_2,
+            },
+        ]
+    }
+}
+
+/// All parameters of the physical world. [`WorldParams::default`] gives the SPEC values.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WorldParams {
+    /// Body length along the heading, metres.
+    pub body_length_m: f64,
+    /// Body width across the heading, metres.
+    pub body_width_m: f64,
+    /// Wheel speed at 100 % duty for a motor of gain 1, m/s.
+    pub top_speed_m_per_s: f64,
+    /// Time constant of the wheel-speed lag while driven (forward/reverse), seconds (20–100 ms).
+    pub motor_time_constant_s: f64,
+    /// Time constant toward standstill while braking (H/H), seconds (5 ms–1 s).
+    pub brake_time_constant_s: f64,
+    /// Time constant toward standstill while coasting (L/L), seconds (5 ms–1 s).
+    pub coast_time_constant_s: f64,
+    /// Half-width of the uniform per-wheel motor gain spread (0.05 = gains in 0.95..=1.05).
+    pub motor_gain_spread: f64,
+    /// Distance between the two wheels' contact lines, metres.
+    pub wheel_track_m: f64,
+    /// Longest internal sub-step; longer `advance` calls are split into equal sub-steps, seconds.
+    pub max_substep_s: f64,
+    /// Sensor mounts; sensor index `k` is `sensor_mounts[k]`.
+    pub sensor_mounts: Vec<SensorMount>,
+    /// Rays per sensor, spread evenly over the cone (1 = a single ray on the axis).
+    pub rays_per_sensor: u32,
+    /// Half-angle of the sensor cone, radians (ignored with one ray).
+    pub cone_half_angle_rad: f64,
+    /// Farthest distance a sensor reports; beyond it `sense` returns `None`, metres.
+    pub sensor_max_range_m: f64,
+    /// Minimum gap between bodies, and between bodies and walls, at random placement, metres.
+    pub placement_clearance_m: f64,
+    /// Collision-resolution passes per sub-step.
+    pub collision_iterations: u32,
+}
+
+impl Default for WorldParams {
+    fn default() -> Self {
+        WorldParams {
+            body_length_m: BODY_LENGTH_M,
+            body_width_m: BODY_WIDTH_M,
+            top_speed_m_per_s: TOP_SPEED_M_PER_S,
+            motor_time_constant_s: MOTOR_TIME_CONSTANT_S,
+            brake_time_constant_s: MOTOR_TIME_CONSTANT_S,
+            coast_time_constant_s: MOTOR_TIME_CONSTANT_S,
+            motor_gain_spread: MOTOR_GAIN_SPREAD,
+            wheel_track_m: WHEEL_TRACK_M,
+            max_substep_s: MAX_SUBSTEP_S,
+            sensor_mounts: SensorMount::default_mounts(BODY_LENGTH_M, BODY_WIDTH_M),
+            rays_per_sensor: 1,
+            cone_half_angle_rad: 0.0,
+            sensor_max_range_m: SENSOR_MAX_RANGE_M,
+            placement_clearance_m: PLACEMENT_CLEARANCE_M,
+            collision_iterations: COLLISION_ITERATIONS,
+        }
+    }
+}
+
+fn check_range(
+    name: &'static str,
+    value: f64,
+    min: f64,
+    max: f64,
+    valid: &'static str,
+) -> Result<(), WorldError> {
+    if value.is_nan() || value < min || value > max {
+        Err(WorldError::Parameter { name, value, valid })
+    } else {
+        Ok(())
+    }
+}
+
+fn check_time_constant(
+    name: &'static str,
+    value_s: f64,
+    min_s: f64,
+    max_s: f64,
+) -> Result<(), WorldError> {
+    if value_s.is_nan() || value_s < min_s || value_s > max_s {
+        Err(WorldError::TimeConstant {
+            name,
+            value_s,
+            min_s,
+            max_s,
+        })
+    } else {
+        Ok(())
+    }
+}
+
+impl WorldParams {
+    /// Checks every parameter; the error names the first bad one and its valid range.
+    pub fn validate(&self) -> Result<(), WorldError> {
+        check_range(
+            "body_length_m",
+            self.body_length_m,
+            0.01,
+            10.0,
+            "a length in 0.01..=10 m",
+        )?;
+        check_range(
+            "body_width_m",
+            self.body_width_m,
+            0.01,
+            10.0,
+            "a width in 0.01..=10 m",
+        )?;
+        if self.top_speed_m_per_s.is_nan()
+            || self.top_speed_m_per_s <= 0.0
+            || self.top_speed_m_per_s > MAX_TOP_SPEED_M_PER_S
+        {
+            return Err(WorldError::TopSpeed {
+                value_m_per_s: self.top_speed_m_per_s,
+                max_m_per_s: MAX_TOP_SPEED_M_PER_S,
+            });
+        }
+        check_time_constant(
+            "motor_time_constant_s",
+            self.motor_time_constant_s,
+            MOTOR_TIME_CONSTANT_MIN_S,
+            MOTOR_TIME_CONSTANT_MAX_S,
+        )?;
+        check_time_constant(
+            "brake_time_constant_s",
+            self.brake_time_constant_s,
+            STOP_TIME_CONSTANT_MIN_S,
+            STOP_TIME_CONSTANT_MAX_S,
+        )?;
+        check_time_constant(
+            "coast_time_constant_s",
+            self.coast_time_constant_s,
+            STOP_TIME_CONSTANT_MIN_S,
+            STOP_TIME_CONSTANT_MAX_S,
+        )?;
+        check_range(
+            "motor_gain_spread",
+            self.motor_gain_spread,
+            0.0,
+            0.5,
+            "a fraction in 0..=0.5",
+        )?;
+        check_range(
+            "wheel_track_m",
+            self.wheel_track_m,
+            0.01,
+            10.0,
+            "a distance in 0.01..=10 m",
+        )?;
+        if self.max_substep_s.is_nan()
+            || self.max_substep_s <= 0.0
+            || self.max_substep_s > MAX_SUBSTEP_LIMIT_S
+        {
+            return Err(WorldError::Parameter {
+                name: "max_substep_s",
+                value: self.max_substep_s,
+                valid: "a time > 0 and <= 0.1 s",
+            });
+        }
+        let hl = 0.5 * self.body_length_m;
+        let hw = 0.5 * self.body_width_m;
+        for m in &self.sensor_mounts {
+            // The mount must lie on or inside the body outline (a small tolerance for rounding).
+            check_range(
+                "sensor mount x_m",
+                m.x_m,
+                -hl - 1e-12,
+                hl + 1e-12,
+                "a point on or inside the body: |x_m| <= body_length_m / 2",
+            )?;
+            check_range(
+                "sensor mount y_m",
+                m.y_m,
+                -hw - 1e-12,
+                hw + 1e-12,
+                "a point on or inside the body: |y_m| <= body_width_m / 2",
+            )?;
+            check_range(
+                "sensor mount angle_rad",
+                m.angle_rad,
+                -4.0 * core::f64::consts::PI,
+                4.0 * core::f64::consts::PI,
+                "an angle in -4π..=4π rad",
+            )?;
+        }
+        if self.rays_per_sensor == 0 || self.rays_per_sensor > MAX_RAYS_PER_SENSOR {
+            return Err(WorldError::Parameter {
+                name: "rays_per_sensor",
+                value: f64::from(self.rays_per_sensor),
+                valid: "a count in 1..=16",
+            });
+        }
+        check_range(
+            "cone_half_angle_rad",
+            self.cone_half_angle_rad,
+            0.0,
+            MAX_CONE_HALF_ANGLE_RAD,
+            "an angle in 0..=0.5 rad",
+        )?;
+        check_range(
+            "sensor_max_range_m",
+            self.sensor_max_range_m,
+            0.001,
+            100.0,
+            "a distance in 0.001..=100 m",
+        )?;
+        check_range(
+            "placement_clearance_m",
+            self.placement_clearance_m,
+            0.0,
+            10.0,
+            "a distance in 0..=10 m",
+        )?;
+        if self.collision_iterations == 0 || self.collision_iterations > 64 {
+            return Err(WorldError::Parameter {
+                name: "collision_iterations",
+                value: f64::from(self.collision_iterations),
+                valid: "a count in 1..=64",
+            });
+        }
+        Ok(())
+    }
+}
