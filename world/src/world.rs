@@ -81,6 +81,8 @@ struct Candidates {
 const TOUCHED: u8 = 1;
 const REVERTED: u8 = 2;
 const VIOLATOR: u8 = 4;
+/// Held by a wall (or by a robot held by a wall) during this sub-step: takes no share of a push.
+const PINNED: u8 = 8;
 
 /// The physical world of one run: an arena, robots with motors, bumpers and sensors.
 ///
@@ -643,6 +645,7 @@ impl World {
         if hit {
             self.pose[i] = b;
             self.touch(i);
+            self.flags[i] |= PINNED;
         }
         hit
     }
@@ -661,12 +664,27 @@ impl World {
         let Some(o) = obb_overlap(&self.obb(i), &self.obb(j), 0.0) else {
             return false;
         };
-        // Equal bodies share the push; the MTV removes the motion into the contact.
-        let push = 0.5 * (o.depth_m + CONTACT_SKIN_M);
-        self.pose[i].x -= o.nx * push;
-        self.pose[i].y -= o.ny * push;
-        self.pose[j].x += o.nx * push;
-        self.pose[j].y += o.ny * push;
+        // Equal bodies share the push; a body held by a wall (directly or through a chain of
+        // bodies) does not give way, so the other takes all of it and is held in turn. The MTV
+        // removes the motion into the contact.
+        let total = o.depth_m + CONTACT_SKIN_M;
+        let pinned_i = self.flags[i] & PINNED != 0;
+        let pinned_j = self.flags[j] & PINNED != 0;
+        let (push_i, push_j) = match (pinned_i, pinned_j) {
+            (true, false) => {
+                self.flags[j] |= PINNED;
+                (0.0, total)
+            }
+            (false, true) => {
+                self.flags[i] |= PINNED;
+                (total, 0.0)
+            }
+            _ => (0.5 * total, 0.5 * total),
+        };
+        self.pose[i].x -= o.nx * push_i;
+        self.pose[i].y -= o.ny * push_i;
+        self.pose[j].x += o.nx * push_j;
+        self.pose[j].y += o.ny * push_j;
         self.press(i, o.nx, o.ny);
         self.press(j, -o.nx, -o.ny);
         self.touch(i);
@@ -1158,3 +1176,6 @@ fn place_open(
     }
     Ok(poses)
 }
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,1267 @@
+//! Unit and property tests of the world: kinematics, motors, collisions, bumpers, rays, broad
+//! phase against brute force, placement, determinism, errors, and a `parry2d` cross-check of
+//! the narrow phase.
+
+use super::*;
+use crate::motor::Behaviour;
+use crate::params::{BODY_LENGTH_M, BODY_WIDTH_M, SensorMount};
+use core::f64::consts::{FRAC_PI_2, PI};
+use proptest::prelude::*;
+
+const HX: f64 = 0.5 * BODY_LENGTH_M;
+const HY: f64 = 0.5 * BODY_WIDTH_M;
+const V: f64 = 0.15;
+const TAU: f64 = 0.060;
+
+/// SPEC parameters with no motor-gain spread, so wheel speeds are exactly duty × top speed.
+fn exact_params() -> WorldParams {
+    WorldParams {
+        motor_gain_spread: 0.0,
+        ..WorldParams::default()
+    }
+}
+
+fn pose(x_m: f64, y_m: f64, heading_rad: f64) -> Pose {
+    Pose {
+        x_m,
+        y_m,
+        heading_rad,
+    }
+}
+
+fn world_at(arena: Arena, params: WorldParams, poses: &[Pose]) -> World {
+    World::from_poses(arena, params, poses, 7).unwrap()
+}
+
+fn set_behaviour(w: &mut World, robot: usize, b: Behaviour) {
+    let (l, r) = b.wheels();
+    w.set_wheels(robot, l, r).unwrap();
+}
+
+fn run(w: &mut World, seconds: f64, dt: f64) {
+    let n = (seconds / dt).round() as usize;
+    for _ in 0..n {
+        w.advance(dt).unwrap();
+    }
+}
+
+/// Brute-force check that no body penetrates a wall or another body.
+fn assert_no_penetration(w: &World) {
+    for i in 0..w.robot_count() {
+        assert!(
+            !w.wall_penetration(i),
+            "robot {i} penetrates a wall: {:?}",
+            w.pose(i)
+        );
+        for j in i + 1..w.robot_count() {
+            assert!(
+                obb_overlap(&w.obb(i), &w.obb(j), 0.0).is_none(),
+                "robots {i} and {j} overlap: {:?} {:?}",
+                w.pose(i),
+                w.pose(j)
+            );
+        }
+    }
+}
+
+// ----- motors and kinematics ------------------------------------------------------------------
+
+#[test]
+fn straight_line_distance_is_v_t_less_the_lag() {
+    let arena = Arena::rectangle(3.0, 1.0).unwrap();
+    for (dt, label) in [(0.010, "10 ms"), (0.007, "7 ms"), (0.5, "one call")] {
+        let mut w = world_at(arena, exact_params(), &[pose(0.3, 0.5, 0.0)]);
+        w.set_wheels(0, WheelCommand::forward(1.0), WheelCommand::forward(1.0))
+            .unwrap();
+        let t = if dt == 0.007 { 0.497 } else { 0.5 };
+        run(&mut w, t, dt);
+        // From rest, a first-order lag covers v·(t − τ(1 − e^(−t/τ))).
+        let expect = V * (t - TAU * (1.0 - (-t / TAU).exp()));
+        let p = w.pose(0).unwrap();
+        assert!(
+            (p.x_m - 0.3 - expect).abs() < 1e-12,
+            "{label}: {} vs {expect}",
+            p.x_m - 0.3
+        );
+        assert!(
+            (p.y_m - 0.5).abs() < 1e-15 && p.heading_rad.abs() < 1e-15,
+            "{label}"
+        );
+        assert_eq!(w.bumpers(0).unwrap(), [false; 4]);
+    }
+}
+
+#[test]
+fn motor_lag_reaches_63_percent_after_tau() {
+    for tau in [0.020, 0.060, 0.100] {
+        let params = WorldParams {
+            motor_time_constant_s: tau,
+            ..exact_params()
+        };
+        let mut w = world_at(Arena::square(), params, &[pose(0.9, 0.9, 0.0)]);
+        w.set_wheels(0, WheelCommand::forward(1.0), WheelCommand::reverse(0.5))
+            .unwrap();
+        run(&mut w, tau, tau / 8.0);
+        let [l, r] = w.wheel_speeds(0).unwrap();
+        let k = 1.0 - (-1.0f64).exp();
+        assert!((l - k * V).abs() < 1e-12, "tau {tau}: left {l}");
+        assert!((r + 0.5 * k * V).abs() < 1e-12, "tau {tau}: right {r}");
+        assert!((l / V - 0.632).abs() < 0.001);
+    }
+}
+
+#[test]
+fn brake_and_coast_decay_with_their_own_time_constants() {
+    let params = WorldParams {
+        brake_time_constant_s: 0.020,
+        coast_time_constant_s: 0.200,
+        ..exact_params()
+    };
+    let mut w = world_at(Arena::square(), params, &[pose(0.3, 0.9, 0.0)]);
+    w.set_wheels(0, WheelCommand::forward(1.0), WheelCommand::forward(1.0))
+        .unwrap();
+    run(&mut w, 0.6, 0.01); // 10 τ: at speed to 5e-5
+    let [v0, _] = w.wheel_speeds(0).unwrap();
+    w.set_wheels(0, WheelCommand::brake(), WheelCommand::coast())
+        .unwrap();
+    run(&mut w, 0.02, 0.005);
+    let [l, r] = w.wheel_speeds(0).unwrap();
+    assert!((l - v0 * (-1.0f64).exp()).abs() < 1e-12, "brake {l}");
+    assert!((r - v0 * (-0.1f64).exp()).abs() < 1e-12, "coast {r}");
+}
+
+#[test]
+fn turning_radius_matches_theory() {
+    // Turn-left-forward: 0.3v left, v right; R = track/2 · (vr + vl)/(vr − vl).
+    let track = WHEEL_TRACK;
+    let (vl, vr) = (0.3 * V, V);
+    let radius = 0.5 * track * (vr + vl) / (vr - vl);
+    let omega = (vr - vl) / track;
+    let mut w = world_at(Arena::square(), exact_params(), &[pose(0.9, 0.9, 0.0)]);
+    set_behaviour(&mut w, 0, Behaviour::TurnLeftForward);
+    run(&mut w, 2.0, 0.01); // 33 τ: the lag has settled
+    let p0 = w.pose(0).unwrap();
+    // Centre of the circle: `radius` to the robot's left.
+    let (cx, cy) = (
+        p0.x_m - radius * p0.heading_rad.sin(),
+        p0.y_m + radius * p0.heading_rad.cos(),
+    );
+    for _ in 0..300 {
+        w.advance(0.01).unwrap();
+        let p = w.pose(0).unwrap();
+        let r = (p.x_m - cx).hypot(p.y_m - cy);
+        assert!((r - radius).abs() < 1e-9, "radius {r} vs {radius}");
+    }
+    let p1 = w.pose(0).unwrap();
+    let turned = (p1.heading_rad - p0.heading_rad).rem_euclid(2.0 * PI);
+    assert!((turned - (omega * 3.0).rem_euclid(2.0 * PI)).abs() < 1e-9);
+    assert!((radius - 0.148_571_428_571).abs() < 1e-9);
+}
+
+const WHEEL_TRACK: f64 = crate::params::WHEEL_TRACK_M;
+
+#[test]
+fn arc_integration_does_not_depend_on_substep_length() {
+    let params = WorldParams {
+        max_substep_s: 0.1,
+        ..exact_params()
+    };
+    let mut w = world_at(Arena::square(), params, &[pose(0.9, 0.9, 0.3)]);
+    set_behaviour(&mut w, 0, Behaviour::TurnRightForward);
+    run(&mut w, 3.0, 0.01); // 50 τ: wheel speeds constant to 1e-21
+    let mut reference: Option<Pose> = None;
+    for dt in [0.001f64, 0.01, 0.037, 0.1] {
+        let mut c = w.clone();
+        let n = (1.11 / dt).round() as usize;
+        let step = 1.11 / n as f64;
+        for _ in 0..n {
+            c.advance(step).unwrap();
+        }
+        let p = c.pose(0).unwrap();
+        if let Some(r) = reference {
+            assert!(
+                (p.x_m - r.x_m).abs() < 1e-12 && (p.y_m - r.y_m).abs() < 1e-12,
+                "dt {dt}: {p:?} {r:?}"
+            );
+            assert!((p.heading_rad - r.heading_rad).abs() < 1e-12);
+        }
+        reference = Some(p);
+    }
+    // One call covering the whole time (split internally into 0.1 s pieces).
+    let mut c = w.clone();
+    c.advance(1.11).unwrap();
+    let p = c.pose(0).unwrap();
+    let r = reference.unwrap();
+    assert!((p.x_m - r.x_m).abs() < 1e-12 && (p.y_m - r.y_m).abs() < 1e-12);
+}
+
+#[test]
+fn arc_with_lag_transient_converges_with_substep_length() {
+    // From rest the wheel speeds change within a sub-step; the mean-speed arc is then second
+    // order accurate. 1 ms and 20 ms sub-steps agree to well under a millimetre.
+    let run_with = |dt: f64| {
+        let mut w = world_at(Arena::square(), exact_params(), &[pose(0.9, 0.9, 0.0)]);
+        set_behaviour(&mut w, 0, Behaviour::TurnLeftForward);
+        run(&mut w, 0.4, dt);
+        w.pose(0).unwrap()
+    };
+    let a = run_with(0.001);
+    let b = run_with(0.020);
+    let d = (a.x_m - b.x_m).hypot(a.y_m - b.y_m);
+    assert!(d < 1e-4, "{d}");
+    assert!(
+        (a.heading_rad - b.heading_rad).abs() < 1e-12,
+        "heading change is exact"
+    );
+}
+
+#[test]
+fn motor_gains_are_seeded_per_robot_and_within_spread() {
+    let a = World::new(
+        Arena::scaled_square(20).unwrap(),
+        WorldParams::default(),
+        20,
+        99,
+    )
+    .unwrap();
+    let b = World::new(
+        Arena::scaled_square(5).unwrap(),
+        WorldParams::default(),
+        5,
+        99,
+    )
+    .unwrap();
+    let c = World::new(
+        Arena::scaled_square(5).unwrap(),
+        WorldParams::default(),
+        5,
+        100,
+    )
+    .unwrap();
+    for i in 0..5 {
+        assert_eq!(a.motor_gains(i).unwrap(), b.motor_gains(i).unwrap());
+        assert_ne!(a.motor_gains(i).unwrap(), c.motor_gains(i).unwrap());
+    }
+    let mut distinct = std::collections::BTreeSet::new();
+    for i in 0..20 {
+        for g in a.motor_gains(i).unwrap() {
+            assert!((0.95..=1.05).contains(&g), "{g}");
+            distinct.insert(g.to_bits());
+        }
+    }
+    assert_eq!(distinct.len(), 40);
+    // The gain scales the commanded speed.
+    let mut w = a.clone();
+    w.set_wheels(3, WheelCommand::forward(0.5), WheelCommand::reverse(1.0))
+        .unwrap();
+    let g = w.motor_gains(3).unwrap();
+    assert_eq!(w.motion[3].target, [0.5 * V * g[0], -V * g[1]]);
+}
+
+// ----- collisions and bumpers -----------------------------------------------------------------
+
+#[test]
+fn driving_into_a_wall_stops_at_it_and_presses_the_front_bumper() {
+    let mut w = world_at(Arena::square(), exact_params(), &[pose(1.2, 0.9, 0.0)]);
+    w.set_wheels(0, WheelCommand::forward(1.0), WheelCommand::forward(1.0))
+        .unwrap();
+    let mut pressed_at = None;
+    for k in 0..500 {
+        w.advance(0.01).unwrap();
+        let p = w.pose(0).unwrap();
+        assert!(
+            p.x_m + HX <= 1.8,
+            "penetrates at step {k}: {}",
+            p.x_m + HX - 1.8
+        );
+        let b = w.bumpers(0).unwrap();
+        if b[FRONT] && pressed_at.is_none() {
+            pressed_at = Some(k);
+        }
+        if pressed_at.is_some() {
+            assert_eq!(b, [true, false, false, false], "step {k}");
+        }
+    }
+    // 1.8 − 1.2 − 0.115 = 0.485 m at ≤ 0.15 m/s: about 3.3 s.
+    let k = pressed_at.expect("front bumper pressed");
+    assert!((320..=345).contains(&k), "{k}");
+    let p = w.pose(0).unwrap();
+    assert!(
+        (1.8 - (p.x_m + HX)).abs() < 1e-8,
+        "stops at the wall: gap {}",
+        1.8 - (p.x_m + HX)
+    );
+    assert!((p.y_m - 0.9).abs() < 1e-15 && p.heading_rad.abs() < 1e-15);
+    // The wheels keep turning (they slip); the front sensor reads ~0.
+    assert!((w.wheel_speeds(0).unwrap()[0] - V).abs() < 1e-9);
+    assert!(w.sense(0, FRONT).unwrap().unwrap() < 1e-3);
+    // Stopping the motors releases the switch once the robot no longer pushes.
+    w.set_wheels(0, WheelCommand::brake(), WheelCommand::brake())
+        .unwrap();
+    run(&mut w, 1.0, 0.01);
+    assert_eq!(w.bumpers(0).unwrap(), [false; 4]);
+}
+
+#[test]
+fn reversing_into_a_wall_presses_the_rear_bumper() {
+    let mut w = world_at(Arena::square(), exact_params(), &[pose(0.5, 0.9, 0.0)]);
+    w.set_wheels(0, WheelCommand::reverse(1.0), WheelCommand::reverse(1.0))
+        .unwrap();
+    run(&mut w, 4.0, 0.01);
+    assert_eq!(w.bumpers(0).unwrap(), [false, true, false, false]);
+    let p = w.pose(0).unwrap();
+    assert!(p.x_m - HX >= 0.0 && p.x_m - HX < 1e-8);
+}
+
+#[test]
+fn head_on_robots_press_both_front_bumpers() {
+    let mut w = world_at(
+        Arena::square(),
+        exact_params(),
+        &[pose(0.5, 0.9, 0.0), pose(1.3, 0.9, PI)],
+    );
+    for r in 0..2 {
+        set_behaviour(&mut w, r, Behaviour::Forward);
+    }
+    let mut both = false;
+    for _ in 0..400 {
+        w.advance(0.01).unwrap();
+        assert_no_penetration(&w);
+        let (a, b) = (w.bumpers(0).unwrap(), w.bumpers(1).unwrap());
+        if a[FRONT] || b[FRONT] {
+            assert_eq!(a, [true, false, false, false]);
+            assert_eq!(b, [true, false, false, false]);
+            both = true;
+        }
+    }
+    assert!(both);
+    let (p, q) = (w.pose(0).unwrap(), w.pose(1).unwrap());
+    // They meet in the middle, touching.
+    assert!(((p.x_m + q.x_m) / 2.0 - 0.9).abs() < 1e-9);
+    assert!((q.x_m - p.x_m - 2.0 * HX).abs() < 1e-8);
+}
+
+#[test]
+fn side_hits_press_left_and_right_bumpers() {
+    // Robot 0 faces +x; robot 1 below it drives north into its right side, robot 2 above it
+    // drives south into its left side.
+    let mut w = world_at(
+        Arena::square(),
+        exact_params(),
+        &[
+            pose(0.9, 0.9, 0.0),
+            pose(0.9, 0.5, FRAC_PI_2),
+            pose(0.9, 1.3, -FRAC_PI_2),
+        ],
+    );
+    set_behaviour(&mut w, 1, Behaviour::Forward);
+    set_behaviour(&mut w, 2, Behaviour::Forward);
+    let mut seen = [false; 3];
+    for _ in 0..400 {
+        w.advance(0.01).unwrap();
+        assert_no_penetration(&w);
+        let b0 = w.bumpers(0).unwrap();
+        let b1 = w.bumpers(1).unwrap();
+        let b2 = w.bumpers(2).unwrap();
+        if b1[FRONT] {
+            assert!(b0[RIGHT]);
+            seen[1] = true;
+        }
+        if b2[FRONT] {
+            assert!(b0[LEFT]);
+            seen[2] = true;
+        }
+        if b0.iter().any(|&x| x) {
+            assert!(!b0[FRONT] && !b0[REAR]);
+            seen[0] = true;
+        }
+        assert!(!b1[REAR] && !b1[LEFT] && !b1[RIGHT]);
+        assert!(!b2[REAR] && !b2[LEFT] && !b2[RIGHT]);
+    }
+    assert_eq!(seen, [true; 3]);
+}
+
+#[test]
+fn corner_contacts_go_to_the_larger_normal_component() {
+    // Heading 30° into the east wall: wall normal in the body frame (0.87, −0.5): front.
+    let mut w = world_at(Arena::square(), exact_params(), &[pose(1.5, 0.6, PI / 6.0)]);
+    set_behaviour(&mut w, 0, Behaviour::Forward);
+    let mut hit = None;
+    for _ in 0..300 {
+        w.advance(0.01).unwrap();
+        assert_no_penetration(&w);
+        let b = w.bumpers(0).unwrap();
+        if b.iter().any(|&x| x) {
+            hit = Some(b);
+            break;
+        }
+    }
+    assert_eq!(hit, Some([true, false, false, false]));
+    // Heading 60° next to the east wall: the right-front corner meets it; normal (0.5, −0.87)
+    // in the body frame: right.
+    let mut w = world_at(Arena::square(), exact_params(), &[pose(1.6, 0.4, PI / 3.0)]);
+    set_behaviour(&mut w, 0, Behaviour::Forward);
+    let mut hit = None;
+    for _ in 0..300 {
+        w.advance(0.01).unwrap();
+        assert_no_penetration(&w);
+        let b = w.bumpers(0).unwrap();
+        if b.iter().any(|&x| x) {
+            hit = Some(b);
+            break;
+        }
+    }
+    assert_eq!(hit, Some([false, false, false, true]));
+}
+
+#[test]
+fn a_robot_pushing_another_into_a_wall_is_blocked_without_penetration() {
+    let mut w = world_at(
+        Arena::square(),
+        exact_params(),
+        &[pose(1.2, 0.9, 0.0), pose(1.5, 0.9, 0.0)],
+    );
+    set_behaviour(&mut w, 0, Behaviour::Forward);
+    for _ in 0..600 {
+        w.advance(0.01).unwrap();
+        assert_no_penetration(&w);
+    }
+    let (p, q) = (w.pose(0).unwrap(), w.pose(1).unwrap());
+    assert!(1.8 - (q.x_m + HX) < 1e-6, "pushed to the wall: {p:?} {q:?}");
+    assert!(q.x_m - p.x_m - 2.0 * HX < 1e-6, "touching");
+    assert!(w.bumpers(0).unwrap()[FRONT]);
+    assert!(w.bumpers(1).unwrap()[REAR]);
+}
+
+#[test]
+fn veering_robot_in_the_corridor_slides_along_without_penetrating() {
+    // A strong gain mismatch turns the robot into the corridor wall; it must not pass through
+    // or stick, and it reaches the far end.
+    let params = WorldParams {
+        motor_gain_spread: 0.0,
+        ..WorldParams::default()
+    };
+    let arena = Arena::paper_corridor();
+    let mut w = world_at(arena, params, &[pose(0.3, 0.11, 0.0)]);
+    w.set_wheels(0, WheelCommand::forward(0.8), WheelCommand::forward(1.0))
+        .unwrap();
+    let mut side = false;
+    for _ in 0..3000 {
+        w.advance(0.01).unwrap();
+        assert_no_penetration(&w);
+        let b = w.bumpers(0).unwrap();
+        side |= b[LEFT] || b[FRONT];
+    }
+    assert!(side);
+    let p = w.pose(0).unwrap();
+    assert!(p.x_m > 2.5, "got stuck at {p:?}");
+}
+
+fn dense_swarm(seed: u64, n: usize, params: WorldParams) -> World {
+    let params = WorldParams {
+        placement_clearance_m: 0.01,
+        ..params
+    };
+    let mut w = World::new(Arena::square(), params, n, seed).unwrap();
+    let mut rng = stream_rng(seed, 1, 1);
+    for r in 0..n {
+        set_behaviour(&mut w, r, Behaviour::ALL[(unit(&mut rng) * 4.0) as usize]);
+    }
+    w
+}
+
+fn shuffle_behaviours(w: &mut World, rng: &mut Pcg64) {
+    for r in 0..w.robot_count() {
+        set_behaviour(w, r, Behaviour::ALL[(unit(rng) * 4.0) as usize]);
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// A crowded arena (20 robots in 1.8 m × 1.8 m, about 7 × the paper's density) with random
+    /// behaviours: no body ever penetrates a wall or another body after a sub-step.
+    #[test]
+    fn crowded_swarm_never_penetrates(seed in any::<u64>(), dt in 0.002f64..0.1) {
+        let params = WorldParams { max_substep_s: 0.1, ..WorldParams::default() };
+        let mut w = dense_swarm(seed, 20, params);
+        let mut rng = stream_rng(seed, 2, 2);
+        let steps = (12.0 / dt) as usize;
+        let per_behaviour = (0.45 / dt).ceil() as usize;
+        let mut contacts = 0;
+        for k in 0..steps {
+            if k % per_behaviour == 0 {
+                shuffle_behaviours(&mut w, &mut rng);
+            }
+            w.advance(dt).unwrap();
+            assert_no_penetration(&w);
+            contacts += (0..20).filter(|&r| w.bumpers(r).unwrap().iter().any(|&b| b)).count();
+        }
+        prop_assert!(contacts > 0);
+    }
+
+    /// Fast robots (1 m/s) with long sub-steps still never penetrate.
+    #[test]
+    fn fast_robots_never_penetrate(seed in any::<u64>()) {
+        let params = WorldParams {
+            top_speed_m_per_s: 1.0,
+            max_substep_s: 0.1,
+            motor_time_constant_s: 0.02,
+            ..WorldParams::default()
+        };
+        let mut w = dense_swarm(seed, 20, params);
+        let mut rng = stream_rng(seed, 2, 2);
+        for k in 0..200 {
+            if k % 5 == 0 {
+                shuffle_behaviours(&mut w, &mut rng);
+            }
+            w.advance(0.1).unwrap();
+            assert_no_penetration(&w);
+        }
+    }
+}
+
+// ----- sensor rays --------------------------------------------------------------------------
+
+fn mm(w: &World, robot: usize, sensor: usize) -> f64 {
+    w.sense(robot, sensor).unwrap().expect("a hit")
+}
+
+#[test]
+fn rays_measure_known_wall_distances() {
+    let w = world_at(Arena::square(), exact_params(), &[pose(0.9, 0.5, 0.0)]);
+    assert!((mm(&w, 0, FRONT) - 785.0).abs() < 1e-9);
+    assert!((mm(&w, 0, REAR) - 785.0).abs() < 1e-9);
+    assert!((mm(&w, 0, LEFT) - 1210.0).abs() < 1e-9);
+    assert!((mm(&w, 0, RIGHT) - 410.0).abs() < 1e-9);
+    let w = world_at(
+        Arena::square(),
+        exact_params(),
+        &[pose(0.9, 0.5, FRAC_PI_2)],
+    );
+    assert!((mm(&w, 0, FRONT) - 1185.0).abs() < 1e-9);
+    assert!((mm(&w, 0, REAR) - 385.0).abs() < 1e-9);
+    assert!((mm(&w, 0, LEFT) - 810.0).abs() < 1e-9);
+    assert!((mm(&w, 0, RIGHT) - 810.0).abs() < 1e-9);
+    // 45°: the front ray from (0.9 + 0.115/√2, 0.5 + 0.115/√2) meets x = 1.8 first.
+    let w = world_at(Arena::square(), exact_params(), &[pose(0.9, 0.5, PI / 4.0)]);
+    let ox = 0.9 + HX / 2f64.sqrt();
+    assert!((mm(&w, 0, FRONT) - 1000.0 * (1.8 - ox) * 2f64.sqrt()).abs() < 1e-9);
+}
+
+#[test]
+fn a_robot_in_front_is_hit_at_the_right_distance() {
+    // Robot 1 turned 90° presents its side (half extent 0.09) to robot 0's front sensor.
+    let w = world_at(
+        Arena::square(),
+        exact_params(),
+        &[pose(0.5, 0.9, 0.0), pose(1.0, 0.9, FRAC_PI_2)],
+    );
+    assert!((mm(&w, 0, FRONT) - 1000.0 * (1.0 - HY - 0.5 - HX)).abs() < 1e-9);
+    // And robot 1's left sensor (facing −x) sees robot 0's front face.
+    assert!((mm(&w, 1, LEFT) - 1000.0 * (1.0 - HY - 0.5 - HX)).abs() < 1e-9);
+    // A robot just off the ray is missed.
+    let w = world_at(
+        Arena::square(),
+        exact_params(),
+        &[pose(0.5, 0.9, 0.0), pose(1.0, 0.9 + HX + 1e-6, FRAC_PI_2)],
+    );
+    assert!((mm(&w, 0, FRONT) - 1000.0 * (1.8 - 0.5 - HX)).abs() < 1e-9);
+}
+
+#[test]
+fn the_own_body_is_not_hit() {
+    // A sensor at the body centre looking forward passes through its own body.
+    let mut params = exact_params();
+    params.sensor_mounts.push(SensorMount {
+        x_m: 0.0,
+        y_m: 0.0,
+        angle_rad: 0.0,
+    });
+    let w = world_at(Arena::square(), params, &[pose(0.9, 0.9, 0.0)]);
+    assert!((mm(&w, 0, 4) - 900.0).abs() < 1e-9);
+}
+
+#[test]
+fn beyond_max_range_is_none() {
+    let w = world_at(
+        Arena::paper_corridor(),
+        exact_params(),
+        &[pose(0.3, 0.11, 0.0)],
+    );
+    assert_eq!(
+        w.sense(0, FRONT).unwrap(),
+        None,
+        "2.585 m of empty corridor"
+    );
+    assert!((mm(&w, 0, REAR) - 185.0).abs() < 1e-9);
+    assert!((mm(&w, 0, LEFT) - 20.0).abs() < 1e-9);
+    assert!((mm(&w, 0, RIGHT) - 20.0).abs() < 1e-9);
+    let params = WorldParams {
+        sensor_max_range_m: 0.1,
+        ..exact_params()
+    };
+    let w = world_at(Arena::paper_corridor(), params, &[pose(0.3, 0.11, 0.0)]);
+    assert_eq!(w.sense(0, REAR).unwrap(), None);
+    // A hit exactly at the range counts.
+    let params = WorldParams {
+        sensor_max_range_m: 0.185,
+        ..exact_params()
+    };
+    let w = world_at(Arena::paper_corridor(), params, &[pose(0.3, 0.11, 0.0)]);
+    assert!(w.sense(0, REAR).unwrap().is_some());
+}
+
+#[test]
+fn a_cone_sees_what_the_axis_ray_misses() {
+    let poses = [pose(0.5, 0.9, 0.0), pose(1.0, 0.9 + HX + 0.02, FRAC_PI_2)];
+    let single = world_at(Arena::square(), exact_params(), &poses);
+    let params = WorldParams {
+        rays_per_sensor: 5,
+        cone_half_angle_rad: 0.1,
+        ..exact_params()
+    };
+    let cone = world_at(Arena::square(), params, &poses);
+    let far = mm(&single, 0, FRONT);
+    let near = mm(&cone, 0, FRONT);
+    assert!((far - 1185.0).abs() < 1e-9);
+    assert!(near < 500.0, "{near}");
+}
+
+// ----- broad phase against brute force --------------------------------------------------------
+
+/// The nearest hit by brute force over every wall and robot.
+fn brute_sense(w: &World, robot: usize, sensor: usize) -> Option<f64> {
+    let m = &w.mounts[sensor];
+    let b = w.pose[robot];
+    let ox = b.x + b.c * m.x - b.s * m.y;
+    let oy = b.y + b.s * m.x + b.c * m.y;
+    let range = w.params.sensor_max_range_m;
+    let mut best: Option<f64> = None;
+    for &(dc, ds) in &m.dirs {
+        let dx = b.c * dc - b.s * ds;
+        let dy = b.s * dc + b.c * ds;
+        let mut t = ray_walls(ox, oy, dx, dy, w.arena.width_m(), w.arena.height_m());
+        for j in 0..w.robot_count() {
+            if j != robot
+                && let Some(tj) = ray_obb(ox, oy, dx, dy, &w.obb(j), f64::INFINITY)
+            {
+                t = t.min(tj);
+            }
+        }
+        if t <= range && best.is_none_or(|bt| t < bt) {
+            best = Some(t);
+        }
+    }
+    best.map(|t| t * 1000.0)
+}
+
+fn random_scene(n: usize, side: f64, xs: &[(f64, f64, f64)]) -> World {
+    let arena = Arena::rectangle(side, side * 0.7).unwrap();
+    let params = WorldParams {
+        rays_per_sensor: 3,
+        cone_half_angle_rad: 0.05,
+        ..WorldParams::default()
+    };
+    let mut w = World::from_poses(arena, params, &[], 1).unwrap();
+    // Install arbitrary (possibly overlapping) poses directly, as a broad-phase test scene.
+    let body: Vec<BodyPose> = xs[..n]
+        .iter()
+        .map(|&(fx, fy, th)| body_pose(&pose(fx * side, fy * side * 0.7, th)))
+        .collect();
+    w.grid = Grid::new(side, side * 0.7, 2.0 * w.radius_m + BROAD_PHASE_MARGIN_M, n);
+    w.pose = body.clone();
+    w.prev = body;
+    w.motion = vec![Motion::default(); n];
+    w.kin = vec![[0.0; 2]; n];
+    w.bumpers = vec![0; n];
+    w.flags = vec![0; n];
+    w.gains = vec![[1.0; 2]; n];
+    w.chunk_cands = vec![Candidates::default(); n.div_ceil(PAR_CHUNK)];
+    w.rebuild_broad_phase(false);
+    w
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(200))]
+
+    /// Overlapping pairs and wall penetrations found through the grid equal brute force, and
+    /// every ray equals a brute-force cast against all walls and robots.
+    #[test]
+    fn broad_phase_equals_brute_force(
+        side in 1.0f64..8.0,
+        xs in proptest::collection::vec((0.0f64..1.0, 0.0f64..1.0, -PI..PI), 1..80),
+    ) {
+        let n = xs.len();
+        let w = random_scene(n, side, &xs);
+        let mut via_grid = std::collections::BTreeSet::new();
+        for &[i, j] in &w.cand.pairs {
+            if obb_overlap(&w.obb(i as usize), &w.obb(j as usize), 0.0).is_some() {
+                via_grid.insert((i as usize, j as usize));
+            }
+        }
+        let mut brute = std::collections::BTreeSet::new();
+        for i in 0..n {
+            for j in i + 1..n {
+                if obb_overlap(&w.obb(i), &w.obb(j), 0.0).is_some() {
+                    brute.insert((i, j));
+                }
+            }
+            if w.wall_penetration(i) {
+                prop_assert!(w.cand.walls.contains(&(i as u32)));
+            }
+        }
+        prop_assert_eq!(via_grid, brute);
+        for r in 0..n {
+            for s in 0..4 {
+                prop_assert_eq!(w.sense(r, s).unwrap(), brute_sense(&w, r, s));
+            }
+        }
+    }
+
+    /// After real motion (the grid is a sub-step old and robots moved since), rays still equal
+    /// brute force.
+    #[test]
+    fn rays_equal_brute_force_after_motion(seed in any::<u64>(), n in 1usize..60, steps in 0usize..200) {
+        let params = WorldParams { rays_per_sensor: 2, cone_half_angle_rad: 0.03, ..WorldParams::default() };
+        let mut w = World::new(Arena::scaled_square(n).unwrap(), params, n, seed).unwrap();
+        let mut rng = stream_rng(seed, 3, 3);
+        for k in 0..steps {
+            if k % 45 == 0 {
+                shuffle_behaviours(&mut w, &mut rng);
+            }
+            w.advance(0.01).unwrap();
+        }
+        for r in 0..n {
+            for s in 0..4 {
+                prop_assert_eq!(w.sense(r, s).unwrap(), brute_sense(&w, r, s));
+            }
+        }
+    }
+}
+
+// ----- placement ------------------------------------------------------------------------------
+
+fn assert_clearance(w: &World, clr: f64) {
+    for i in 0..w.robot_count() {
+        let (ex, ey) = w.obb(i).aabb_half_extents();
+        let b = w.pose[i];
+        if w.arena.kind() == ArenaKind::Open {
+            assert!(b.x - ex >= clr - 1e-12 && b.x + ex <= w.arena.width_m() - clr + 1e-12);
+            assert!(b.y - ey >= clr - 1e-12 && b.y + ey <= w.arena.height_m() - clr + 1e-12);
+        } else {
+            assert!(b.x - ex >= clr - 1e-12 && b.x + ex <= w.arena.width_m() - clr + 1e-12);
+            assert!(!w.wall_penetration(i));
+        }
+        for j in i + 1..w.robot_count() {
+            assert!(
+                obb_overlap(&w.obb(i), &w.obb(j), -clr + 1e-12).is_none(),
+                "{i} {j}"
+            );
+        }
+    }
+}
+
+#[test]
+fn placement_is_non_overlapping_and_deterministic() {
+    for (arena, n) in [
+        (Arena::square(), 3),
+        (Arena::square(), 15),
+        (Arena::scaled_square(300).unwrap(), 300),
+        (Arena::paper_corridor(), 3),
+        (Arena::paper_corridor(), 8),
+    ] {
+        let a = World::new(arena, WorldParams::default(), n, 5).unwrap();
+        let b = World::new(arena, WorldParams::default(), n, 5).unwrap();
+        let c = World::new(arena, WorldParams::default(), n, 6).unwrap();
+        assert_eq!(a.pose, b.pose);
+        assert_ne!(a.pose, c.pose);
+        assert_eq!(a.robot_count(), n);
+        assert_clearance(&a, PLACEMENT_CLEARANCE);
+        if arena.kind() == ArenaKind::Corridor {
+            for p in &a.pose {
+                assert_eq!(p.y, 0.11);
+                assert!(p.s == 0.0 && p.c.abs() == 1.0);
+            }
+        }
+    }
+    // Headings in the corridor are both ways across seeds.
+    let mut dirs = std::collections::BTreeSet::new();
+    for seed in 0..20 {
+        let w = World::new(Arena::paper_corridor(), WorldParams::default(), 3, seed).unwrap();
+        for p in &w.pose {
+            dirs.insert(p.c as i64);
+        }
+    }
+    assert_eq!(dirs.len(), 2);
+}
+
+const PLACEMENT_CLEARANCE: f64 = crate::params::PLACEMENT_CLEARANCE_M;
+
+#[test]
+fn crowded_placement_is_an_error_that_says_how_many_fit() {
+    // Corridor: 3.0 m holds floor((3.0 − 0.05) / 0.28) = 10 robots at 5 cm.
+    assert!(World::new(Arena::paper_corridor(), WorldParams::default(), 10, 1).is_ok());
+    let e = World::new(Arena::paper_corridor(), WorldParams::default(), 11, 1).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            WorldError::TooManyRobots {
+                requested: 11,
+                max_fit: 10,
+                ..
+            }
+        ),
+        "{e}"
+    );
+    assert!(e.to_string().contains("at most 10 fit"), "{e}");
+    // Square: the area bound is (1.75)² / (0.28 · 0.23) = 47.
+    let e = World::new(Arena::square(), WorldParams::default(), 48, 1).unwrap_err();
+    assert!(
+        matches!(e, WorldError::TooManyRobots { max_fit: 47, .. }),
+        "{e}"
+    );
+    // Below the bound but beyond what random placement reaches: bounded attempts, then an error.
+    let e = World::new(Arena::square(), WorldParams::default(), 46, 1).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            WorldError::PlacementFailed {
+                requested: 46,
+                attempts: 56_000,
+                ..
+            }
+        ),
+        "{e}"
+    );
+    assert!(e.to_string().contains("after 56000 random attempts"), "{e}");
+    // A body wider than the corridor.
+    let params = WorldParams {
+        body_width_m: 0.25,
+        ..WorldParams::default()
+    };
+    assert!(World::new(Arena::paper_corridor(), params, 1, 1).is_err());
+    // Zero robots is an empty world.
+    let w = World::new(Arena::square(), WorldParams::default(), 0, 1).unwrap();
+    assert_eq!(w.robot_count(), 0);
+    let mut w = w;
+    w.advance(0.01).unwrap();
+}
+
+#[test]
+fn from_poses_rejects_overlaps_and_bodies_outside() {
+    let e = World::from_poses(
+        Arena::square(),
+        WorldParams::default(),
+        &[pose(0.1, 0.9, 0.0)],
+        1,
+    )
+    .unwrap_err();
+    assert!(
+        matches!(e, WorldError::PoseOutsideArena { robot: 0, .. }),
+        "{e}"
+    );
+    let e = World::from_poses(
+        Arena::square(),
+        WorldParams::default(),
+        &[
+            pose(0.9, 0.9, 0.0),
+            pose(0.5, 0.9, 0.0),
+            pose(1.1, 0.9, 0.0),
+        ],
+        1,
+    )
+    .unwrap_err();
+    assert!(
+        matches!(e, WorldError::PosesOverlap { a: 0, b: 2, .. }),
+        "{e}"
+    );
+    let e = World::from_poses(
+        Arena::square(),
+        WorldParams::default(),
+        &[pose(f64::NAN, 0.9, 0.0)],
+        1,
+    )
+    .unwrap_err();
+    assert!(matches!(e, WorldError::PoseOutsideArena { .. }));
+    let mut w = World::from_poses(
+        Arena::square(),
+        WorldParams::default(),
+        &[pose(0.5, 0.9, 0.0), pose(1.2, 0.9, 0.0)],
+        1,
+    )
+    .unwrap();
+    assert!(w.set_pose(1, pose(0.6, 0.9, 1.0)).is_err());
+    assert_eq!(w.pose(1).unwrap().x_m, 1.2);
+    assert!(w.set_pose(1, pose(1.79, 0.9, 1.0)).is_err());
+    w.set_pose(1, pose(0.9, 0.5, 1.0)).unwrap();
+    assert!((w.sense(0, FRONT).unwrap().unwrap() - 1000.0 * (1.8 - 0.5 - HX)).abs() < 1e-9);
+}
+
+// ----- determinism ----------------------------------------------------------------------------
+
+fn state_bits(w: &World) -> Vec<u64> {
+    let mut v = Vec::new();
+    for i in 0..w.robot_count() {
+        let b = w.pose[i];
+        v.extend([b.x, b.y, b.c, b.s].map(f64::to_bits));
+        v.extend(w.motion[i].speed.map(f64::to_bits));
+        v.push(u64::from(w.bumpers[i]));
+    }
+    v
+}
+
+fn drive_run(w: &mut World, steps: usize, seed: u64, parallel: bool) {
+    let mut rng = stream_rng(seed, 4, 4);
+    for k in 0..steps {
+        if k % 45 == 0 {
+            shuffle_behaviours(w, &mut rng);
+        }
+        if parallel {
+            w.advance_par(0.01).unwrap();
+        } else {
+            w.advance(0.01).unwrap();
+        }
+    }
+}
+
+#[test]
+fn same_seed_gives_identical_state_after_10000_substeps() {
+    let n = 30;
+    let mk = || {
+        World::new(
+            Arena::scaled_square(n).unwrap(),
+            WorldParams::default(),
+            n,
+            2024,
+        )
+        .unwrap()
+    };
+    let (mut a, mut b) = (mk(), mk());
+    drive_run(&mut a, 10_000, 1, false);
+    drive_run(&mut b, 10_000, 1, false);
+    assert_eq!(state_bits(&a), state_bits(&b));
+    assert_eq!(a.substeps(), 10_000);
+    assert!((a.elapsed_s() - 100.0).abs() < 1e-9);
+    // And the robots did move and collide.
+    let c = mk();
+    assert_ne!(state_bits(&a), state_bits(&c));
+    assert_no_penetration(&a);
+}
+
+#[test]
+fn thread_count_does_not_change_the_result() {
+    // 1 500 robots: three parallel chunks; dense enough (3× paper density) for contacts.
+    let n = 1500;
+    let side = Arena::scaled_square(n).unwrap().width_m() / 3f64.sqrt();
+    let arena = Arena::rectangle(side, side).unwrap();
+    let mk = || World::new(arena, WorldParams::default(), n, 77).unwrap();
+    let mut seq = mk();
+    drive_run(&mut seq, 300, 9, false);
+    let reference = state_bits(&seq);
+    assert!(
+        seq.bumpers.iter().any(|&b| b != 0),
+        "some contacts happened"
+    );
+    for threads in [1, 2, 3, 4] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let mut w = mk();
+        pool.install(|| drive_run(&mut w, 300, 9, true));
+        assert_eq!(state_bits(&w), reference, "{threads} threads");
+    }
+}
+
+// ----- errors ---------------------------------------------------------------------------------
+
+#[test]
+fn bad_parameters_and_indices_are_errors() {
+    let bad = |f: fn(&mut WorldParams)| {
+        let mut p = WorldParams::default();
+        f(&mut p);
+        World::new(Arena::square(), p, 3, 1).unwrap_err()
+    };
+    let e = bad(|p| p.motor_time_constant_s = 0.019);
+    assert!(
+        matches!(
+            e,
+            WorldError::TimeConstant {
+                name: "motor_time_constant_s",
+                ..
+            }
+        ),
+        "{e}"
+    );
+    assert!(e.to_string().contains("0.02..=0.1 s"), "{e}");
+    assert!(matches!(
+        bad(|p| p.motor_time_constant_s = 0.101),
+        WorldError::TimeConstant { .. }
+    ));
+    assert!(matches!(
+        bad(|p| p.motor_time_constant_s = f64::NAN),
+        WorldError::TimeConstant { .. }
+    ));
+    assert!(matches!(
+        bad(|p| p.brake_time_constant_s = 0.0),
+        WorldError::TimeConstant { .. }
+    ));
+    assert!(matches!(
+        bad(|p| p.top_speed_m_per_s = 0.0),
+        WorldError::TopSpeed { .. }
+    ));
+    assert!(matches!(
+        bad(|p| p.top_speed_m_per_s = -1.0),
+        WorldError::TopSpeed { .. }
+    ));
+    assert!(matches!(
+        bad(|p| p.top_speed_m_per_s = f64::NAN),
+        WorldError::TopSpeed { .. }
+    ));
+    assert!(matches!(
+        bad(|p| p.top_speed_m_per_s = 5.0),
+        WorldError::TopSpeed { .. }
+    ));
+    assert!(matches!(
+        bad(|p| p.wheel_track_m = f64::NAN),
+        WorldError::Parameter {
+            name: "wheel_track_m",
+            ..
+        }
+    ));
+    assert!(matches!(
+        bad(|p| p.max_substep_s = 0.0),
+        WorldError::Parameter {
+            name: "max_substep_s",
+            ..
+        }
+    ));
+    assert!(matches!(
+        bad(|p| p.rays_per_sensor = 0),
+        WorldError::Parameter { .. }
+    ));
+    assert!(matches!(
+        bad(|p| p.sensor_mounts[0].x_m = 0.2),
+        WorldError::Parameter { .. }
+    ));
+    assert!(matches!(
+        bad(|p| p.motor_gain_spread = -0.1),
+        WorldError::Parameter { .. }
+    ));
+
+    let mut w = World::new(Arena::square(), WorldParams::default(), 3, 1).unwrap();
+    for dt in [0.0, -0.01, f64::NAN, f64::INFINITY, 1e9] {
+        let e = w.advance(dt).unwrap_err();
+        assert!(matches!(e, WorldError::TimeStep { .. }), "{e}");
+    }
+    let e = w.pose(3).unwrap_err();
+    assert_eq!(e, WorldError::RobotIndex { index: 3, count: 3 });
+    assert!(
+        e.to_string().contains("robot index 3 is out of range"),
+        "{e}"
+    );
+    assert!(w.bumpers(usize::MAX).is_err());
+    assert!(w.wheel_speeds(9).is_err());
+    assert!(w.corners(9).is_err());
+    assert!(
+        w.set_wheels(9, WheelCommand::coast(), WheelCommand::coast())
+            .is_err()
+    );
+    let e = w
+        .set_wheels(0, WheelCommand::forward(1.5), WheelCommand::coast())
+        .unwrap_err();
+    assert!(matches!(e, WorldError::Duty { wheel: "left", .. }), "{e}");
+    let e = w
+        .set_wheels(0, WheelCommand::coast(), WheelCommand::forward(f64::NAN))
+        .unwrap_err();
+    assert!(matches!(e, WorldError::Duty { wheel: "right", .. }), "{e}");
+    let e = w.sense(0, 4).unwrap_err();
+    assert_eq!(e, WorldError::UnknownSensor { index: 4, count: 4 });
+    assert!(w.sense(5, 0).is_err());
+    let e = w.corridor_gap_cv().unwrap_err();
+    assert!(matches!(e, WorldError::NotACorridor { .. }), "{e}");
+}
+
+// ----- corridor metric and outlines -------------------------------------------------------------
+
+#[test]
+fn corridor_gaps_and_their_coefficient_of_variation() {
+    let w = world_at(
+        Arena::paper_corridor(),
+        exact_params(),
+        &[
+            pose(2.0, 0.11, PI),
+            pose(0.5, 0.11, 0.0),
+            pose(1.0, 0.11, 0.0),
+        ],
+    );
+    let mut g = Vec::new();
+    w.corridor_gaps_m(&mut g).unwrap();
+    assert_eq!(g.len(), 2);
+    assert!((g[0] - (0.5 - 2.0 * HX)).abs() < 1e-12);
+    assert!((g[1] - (1.0 - 2.0 * HX)).abs() < 1e-12);
+    let (a, b) = (g[0], g[1]);
+    let mean = 0.5 * (a + b);
+    let cv = (0.5 * ((a - mean).powi(2) + (b - mean).powi(2))).sqrt() / mean;
+    assert!((w.corridor_gap_cv().unwrap().unwrap() - cv).abs() < 1e-12);
+    assert!(coefficient_of_variation(&[0.2, 0.2, 0.2]).unwrap() < 1e-15);
+    assert_eq!(coefficient_of_variation(&[]), None);
+    let one = world_at(
+        Arena::paper_corridor(),
+        exact_params(),
+        &[pose(1.0, 0.11, 0.0)],
+    );
+    assert_eq!(one.corridor_gap_cv().unwrap(), None);
+}
+
+#[test]
+fn corners_outline_the_body() {
+    let w = world_at(
+        Arena::square(),
+        exact_params(),
+        &[pose(0.9, 0.9, FRAC_PI_2)],
+    );
+    let c = w.corners(0).unwrap();
+    let expect = [
+        (0.9 - HY, 0.9 + HX),
+        (0.9 - HY, 0.9 - HX),
+        (0.9 + HY, 0.9 - HX),
+        (0.9 + HY, 0.9 + HX),
+    ];
+    for (a, b) in c.iter().zip(expect) {
+        assert!(
+            (a.0 - b.0).abs() < 1e-12 && (a.1 - b.1).abs() < 1e-12,
+            "{a:?} {b:?}"
+        );
+    }
+}
+
+// ----- parry2d cross-check of the narrow phase ----------------------------------------------------
+
+mod parry_check {
+    use super::*;
+    use parry2d::math::{Pose as PPose, Vector};
+    use parry2d::query::{Ray, RayCast, contact};
+    use parry2d::shape::Cuboid;
+
+    fn ppose(b: &Obb) -> PPose {
+        PPose::new(Vector::new(b.x as f32, b.y as f32), b.s.atan2(b.c) as f32)
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(5000))]
+
+        /// Same contact / no contact as parry2d (away from touching, where f32 cannot decide),
+        /// and the same depth and normal within f32 precision.
+        #[test]
+        fn obb_contact_agrees_with_parry(
+            bx in -0.4f64..0.4, by in -0.4f64..0.4, ta in -PI..PI, tb in -PI..PI,
+        ) {
+            let a = Obb::new(0.0, 0.0, ta, HX, HY);
+            let b = Obb::new(bx, by, tb, HX, HY);
+            let cub = Cuboid::new(Vector::new(HX as f32, HY as f32));
+            let pc = contact(&ppose(&a), &cub, &ppose(&b), &cub, 0.0).unwrap();
+            let ours = obb_overlap(&a, &b, 0.0);
+            match (ours, pc) {
+                (Some(o), Some(c)) if c.dist < 0.0 => {
+                    prop_assert!((o.depth_m + f64::from(c.dist)).abs() < 1e-5, "{o:?} {c:?}");
+                    if o.depth_m > 1e-4 {
+                        let dot = o.nx * f64::from(c.normal1.x) + o.ny * f64::from(c.normal1.y);
+                        prop_assert!(dot > 0.999, "{o:?} {c:?}");
+                    }
+                }
+                (None, None) => {}
+                (None, Some(c)) if c.dist >= 0.0 => {}
+                (o, c) => {
+                    // Only allowed within f32 reach of touching.
+                    let d = o.map_or(0.0, |o| o.depth_m);
+                    let pd = c.map_or(0.0, |c| f64::from(c.dist));
+                    prop_assert!(d.abs() < 1e-5 && pd.abs() < 1e-5, "ours {o:?} parry {c:?}");
+                }
+            }
+        }
+
+        /// Ray distances equal an independent f64 reference (intersection with the four edge
+        /// segments) within 1e-12 m, and parry2d's within 1e-6 m; parry2d computes in f32, so
+        /// for rays meeting a face at a grazing angle α its error grows as 1/sin α and the
+        /// tolerance is 1e-6 m / max(sin α, 0.01); hit/miss may differ only for rays passing
+        /// within f32 reach of a corner.
+        #[test]
+        fn ray_distance_agrees_with_reference_and_parry(
+            ox in -2.0f64..2.0, oy in -2.0f64..2.0, th in -PI..PI, aim in -0.3f64..0.3, tb in -PI..PI,
+        ) {
+            let b = Obb::new(0.0, 0.0, tb, HX, HY);
+            // Aim roughly at the box so that most rays hit.
+            let base = (-oy).atan2(-ox);
+            let dir = if th.abs() < 1.0 { base + aim } else { th };
+            let (dy, dx) = dir.sin_cos();
+            let ours = ray_obb(ox, oy, dx, dy, &b, 10.0);
+
+            // f64 reference: the nearest crossing of the four edges (0 from inside).
+            let lo = (ox * b.c + oy * b.s, -ox * b.s + oy * b.c);
+            let inside = lo.0.abs() < HX && lo.1.abs() < HY;
+            let mut reference: Option<f64> = if inside { Some(0.0) } else { None };
+            if !inside {
+                let c = b.corners();
+                for k in 0..4 {
+                    let (p, q) = (c[k], c[(k + 1) % 4]);
+                    let (ex, ey) = (q.0 - p.0, q.1 - p.1);
+                    let den = dx * ey - dy * ex;
+                    if den.abs() < 1e-15 {
+                        continue;
+                    }
+                    let (wx, wy) = (p.0 - ox, p.1 - oy);
+                    let t = (wx * ey - wy * ex) / den;
+                    let u = (wx * dy - wy * dx) / den;
+                    if t >= 0.0 && (0.0..=1.0).contains(&u) && reference.is_none_or(|r| t < r) {
+                        reference = Some(t);
+                    }
+                }
+            }
+            match (ours, reference) {
+                (Some(a), Some(r)) => prop_assert!((a - r).abs() < 1e-12, "ours {a} reference {r}"),
+                (None, None) => {}
+                (o, r) => {
+                    let t = o.or(r).unwrap();
+                    let (hx, hy) = (ox + dx * t, oy + dy * t);
+                    let lx = (hx * b.c + hy * b.s).abs();
+                    let ly = (-hx * b.s + hy * b.c).abs();
+                    prop_assert!((lx - HX).abs() < 1e-12 && (ly - HY).abs() < 1e-12, "ours {o:?} reference {r:?}");
+                }
+            }
+
+            let cub = Cuboid::new(Vector::new(HX as f32, HY as f32));
+            let ray = Ray::new(Vector::new(ox as f32, oy as f32), Vector::new(dx as f32, dy as f32));
+            let theirs = cub.cast_ray(&ppose(&b), &ray, 10.0, true).map(f64::from);
+            match (ours, theirs) {
+                (Some(a), Some(p)) => {
+                    // Grazing angle at our hit: the direction's component along the face normal.
+                    let (hx, hy) = (ox + dx * a, oy + dy * a);
+                    let lx = hx * b.c + hy * b.s;
+                    let ly = -hx * b.s + hy * b.c;
+                    let ldx = dx * b.c + dy * b.s;
+                    let ldy = -dx * b.s + dy * b.c;
+                    let sin_graze = if a == 0.0 {
+                        1.0
+                    } else if (lx.abs() - HX).abs() < (ly.abs() - HY).abs() {
+                        ldx.abs()
+                    } else {
+                        ldy.abs()
+                    };
+                    let tol = 1e-6 / sin_graze.max(0.01);
+                    prop_assert!((a - p).abs() < tol, "ours {a} parry {p} (sin graze {sin_graze})");
+                }
+                (None, None) => {}
+                (o, p) => {
+                    // A corner graze: the ray passes within f32 reach of the box outline.
+                    let t = o.or(p).unwrap();
+                    let (hx, hy) = (ox + dx * t, oy + dy * t);
+                    let lx = (hx * b.c + hy * b.s).abs();
+                    let ly = (-hx * b.s + hy * b.c).abs();
+                    prop_assert!((lx - HX).abs() < 1e-5 && (ly - HY).abs() < 1e-5, "ours {o:?} parry {p:?}");
+                }
+            }
+        }
+    }
+}
