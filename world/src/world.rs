@@ -13,10 +13,13 @@ use crate::params::{MAX_ADVANCE_S, WorldParams};
 
 /// Collisions are resolved to this gap (1 nm) so that resolved bodies do not touch.
 pub const CONTACT_SKIN_M: f64 = 1e-9;
-/// Broad-phase margin: pairs of bodies closer than their bounding circles plus this are
-/// narrow-phase candidates, and robots may move half of it after the grid is built before it
-/// is rebuilt (our choice: 50 mm, 17 sub-steps of 10 ms at full speed).
-pub const BROAD_PHASE_MARGIN_M: f64 = 0.05;
+/// Broad-phase margin (a Verlet skin): pairs of bodies whose bounding circles are closer than
+/// this, and bodies closer than this to a wall, are narrow-phase candidates; the grid and the
+/// candidate lists are kept until some robot has moved half of it since they were built
+/// (our choice: 200 mm, about 67 sub-steps of 10 ms at 0.15 m/s).
+pub const BROAD_PHASE_MARGIN_M: f64 = 0.2;
+/// How far a robot may move from where the broad phase filed it before it is rebuilt.
+const DRIFT_LIMIT_M: f64 = 0.5 * BROAD_PHASE_MARGIN_M;
 /// Robots per chunk in the parallel phases (fixed, so results never depend on thread count).
 const PAR_CHUNK: usize = 512;
 /// Most robots a world may hold (indices are stored as `u32`).
@@ -105,6 +108,14 @@ pub struct World {
     bumpers: Vec<u8>,
     grid: Grid,
     cand: Candidates,
+    /// The candidates that involve a robot moved since the sub-step's first pass.
+    hot: Candidates,
+    /// Resolution epoch: one per pass or stage, counted over the whole run.
+    epoch: u64,
+    /// Per robot, the epoch in which it last moved in collision resolution.
+    last_move: Vec<u64>,
+    /// Whether the next pass must go over all candidates (after the kinematics or a rebuild).
+    full_pass_pending: bool,
     chunk_cands: Vec<Candidates>,
     flags: Vec<u8>,
     touched: Vec<u32>,
@@ -266,6 +277,10 @@ impl World {
             bumpers: vec![0; n],
             grid,
             cand: Candidates::default(),
+            hot: Candidates::default(),
+            epoch: 1,
+            last_move: vec![0; n],
+            full_pass_pending: false,
             chunk_cands: vec![Candidates::default(); n_chunks],
             flags: vec![0; n],
             touched: Vec::new(),
@@ -482,28 +497,35 @@ impl World {
     }
 
     fn substep(&mut self, dt: f64, parallel: bool) {
-        let track = self.params.wheel_track_m;
-        let lag = self.lag;
-        if parallel && self.pose.len() > PAR_CHUNK {
+        let drive = Drive {
+            lag: self.lag,
+            inv_track: 1.0 / self.params.wheel_track_m,
+            dt,
+            drift_limit2: DRIFT_LIMIT_M * DRIFT_LIMIT_M,
+        };
+        let stale = if parallel && self.pose.len() > PAR_CHUNK {
             self.pose
                 .par_chunks_mut(PAR_CHUNK)
                 .zip(self.motion.par_chunks_mut(PAR_CHUNK))
                 .zip(self.prev.par_chunks_mut(PAR_CHUNK))
                 .zip(self.kin.par_chunks_mut(PAR_CHUNK))
-                .for_each(|(((p, m), pr), k)| drive_chunk(p, m, pr, k, &lag, track, dt));
+                .zip(self.grid.build_xy.par_chunks(PAR_CHUNK))
+                .map(|((((p, m), pr), k), b)| drive.chunk(p, m, pr, k, b))
+                .reduce(|| false, |a, b| a | b)
         } else {
-            drive_chunk(
+            drive.chunk(
                 &mut self.pose,
                 &mut self.motion,
                 &mut self.prev,
                 &mut self.kin,
-                &lag,
-                track,
-                dt,
-            );
-        }
+                &self.grid.build_xy,
+            )
+        };
         self.bumpers.fill(0);
-        self.rebuild_broad_phase(parallel);
+        if stale {
+            self.rebuild_broad_phase(parallel);
+        }
+        self.full_pass_pending = true;
         self.resolve_collisions(parallel);
         self.elapsed_s += dt;
         self.substeps += 1;
@@ -527,6 +549,7 @@ impl World {
         };
         self.cand.pairs.clear();
         self.cand.walls.clear();
+        self.full_pass_pending = true;
         if parallel && pose.len() > PAR_CHUNK {
             self.chunk_cands
                 .par_iter_mut()
@@ -554,11 +577,12 @@ impl World {
         if self.cand.pairs.is_empty() && self.cand.walls.is_empty() {
             return;
         }
-        self.resolve_passes();
-        self.refresh_if_drifted(parallel);
-        self.find_violators();
+        if !self.settle(parallel) {
+            self.find_violators();
+        }
         if !self.violators.is_empty() {
             // Stage 2: keep the translation, block the rotation.
+            self.epoch += 1;
             for k in 0..self.violators.len() {
                 let i = self.violators[k] as usize;
                 let p = self.prev[i];
@@ -571,12 +595,15 @@ impl World {
                 self.touch(i);
             }
             self.refresh_if_drifted(parallel);
-            self.resolve_passes();
-            self.refresh_if_drifted(parallel);
-            self.find_violators();
+            if self.settle(parallel) {
+                self.clear_violators();
+            } else {
+                self.find_violators();
+            }
             // Stage 3: undo the move of every robot still overlapping, until none does. The
             // previous state was free of overlaps, so this ends within n rounds.
             while !self.violators.is_empty() {
+                self.epoch += 1;
                 let mut reverted_any = false;
                 for k in 0..self.violators.len() {
                     let i = self.violators[k] as usize;
@@ -598,10 +625,32 @@ impl World {
             self.flags[i as usize] = 0;
         }
         self.touched.clear();
+        self.violators.clear();
     }
 
+    /// Resolution passes until a clean pass on a current candidate list (at most a few
+    /// rebuilds); returns whether the last pass was clean, i.e. nothing overlaps.
+    fn settle(&mut self, parallel: bool) -> bool {
+        for _ in 0..3 {
+            let clean = self.resolve_passes();
+            if !self.refresh_if_drifted(parallel) {
+                return clean;
+            }
+        }
+        false
+    }
+
+    fn clear_violators(&mut self) {
+        for &i in &self.violators {
+            self.flags[i as usize] &= !VIOLATOR;
+        }
+        self.violators.clear();
+    }
+
+    /// Records that robot `i` moved (or is about to be moved) in the current epoch.
     #[inline]
     fn touch(&mut self, i: usize) {
+        self.last_move[i] = self.epoch;
         if self.flags[i] & TOUCHED == 0 {
             self.flags[i] |= TOUCHED;
             self.touched.push(i as u32);
@@ -661,6 +710,11 @@ impl World {
 
     /// Resolves the pair (i, j); returns whether they overlapped.
     fn resolve_pair(&mut self, i: usize, j: usize) -> bool {
+        let (a, b) = (self.pose[i], self.pose[j]);
+        let (dx, dy) = (b.x - a.x, b.y - a.y);
+        if dx * dx + dy * dy >= 4.0 * self.radius_m * self.radius_m {
+            return false;
+        }
         let Some(o) = obb_overlap(&self.obb(i), &self.obb(j), 0.0) else {
             return false;
         };
@@ -693,37 +747,89 @@ impl World {
     }
 
     /// Up to `collision_iterations` passes over the candidates in robot index order (each
-    /// robot: walls, then its pairs with higher-index robots); stops early after a clean pass.
-    fn resolve_passes(&mut self) {
+    /// robot: walls, then its pairs with higher-index robots); stops early after a clean pass
+    /// and returns whether there was one (then nothing overlaps).
+    ///
+    /// The first pass after the kinematics (or after a broad-phase rebuild) goes over every
+    /// candidate; a later pass only over the candidates with a robot moved by the previous
+    /// pass (or by a stage of `resolve_collisions`): the others were clean when last checked
+    /// and neither robot has moved since.
+    fn resolve_passes(&mut self) -> bool {
         for _ in 0..self.params.collision_iterations {
-            let mut any = false;
-            let (mut pw, mut pp) = (0, 0);
-            loop {
-                let wi = self.cand.walls.get(pw).map_or(u32::MAX, |&i| i);
-                let pi = self.cand.pairs.get(pp).map_or(u32::MAX, |p| p[0]);
-                let i = wi.min(pi);
-                if i == u32::MAX {
-                    break;
-                }
-                if wi == i {
-                    any |= self.resolve_wall(i as usize);
-                    pw += 1;
-                }
-                while pp < self.cand.pairs.len() && self.cand.pairs[pp][0] == i {
-                    let j = self.cand.pairs[pp][1] as usize;
-                    any |= self.resolve_pair(i as usize, j);
-                    pp += 1;
-                }
-            }
+            let any = if self.full_pass_pending {
+                self.full_pass_pending = false;
+                self.epoch += 1;
+                let list = core::mem::take(&mut self.cand);
+                let any = self.pass(&list);
+                self.cand = list;
+                any
+            } else {
+                self.filter_hot(self.epoch);
+                self.epoch += 1;
+                let list = core::mem::take(&mut self.hot);
+                let any = self.pass(&list);
+                self.hot = list;
+                any
+            };
             if !any {
-                break;
+                return true;
             }
         }
+        false
     }
 
-    /// Rebuilds the broad phase if a robot moved more than half the margin since the build.
-    fn refresh_if_drifted(&mut self, parallel: bool) {
-        let lim2 = (0.5 * BROAD_PHASE_MARGIN_M) * (0.5 * BROAD_PHASE_MARGIN_M);
+    /// One pass over `list` in robot index order; returns whether anything overlapped.
+    fn pass(&mut self, list: &Candidates) -> bool {
+        let mut any = false;
+        let (mut pw, mut pp) = (0, 0);
+        loop {
+            let wi = list.walls.get(pw).map_or(u32::MAX, |&i| i);
+            let pi = list.pairs.get(pp).map_or(u32::MAX, |p| p[0]);
+            let i = wi.min(pi);
+            if i == u32::MAX {
+                break;
+            }
+            if wi == i {
+                any |= self.resolve_wall(i as usize);
+                pw += 1;
+            }
+            while pp < list.pairs.len() && list.pairs[pp][0] == i {
+                any |= self.resolve_pair(i as usize, list.pairs[pp][1] as usize);
+                pp += 1;
+            }
+        }
+        any
+    }
+
+    /// The candidates with a robot moved at or after `since` (all of them if a full pass is
+    /// pending), into `hot`, in the candidates' order.
+    fn filter_hot(&mut self, since: u64) {
+        self.hot.walls.clear();
+        self.hot.pairs.clear();
+        if self.full_pass_pending {
+            self.hot.walls.extend_from_slice(&self.cand.walls);
+            self.hot.pairs.extend_from_slice(&self.cand.pairs);
+            return;
+        }
+        let moved = &self.last_move;
+        self.hot.walls.extend(
+            self.cand
+                .walls
+                .iter()
+                .filter(|&&i| moved[i as usize] >= since),
+        );
+        self.hot.pairs.extend(
+            self.cand
+                .pairs
+                .iter()
+                .filter(|p| moved[p[0] as usize] >= since || moved[p[1] as usize] >= since),
+        );
+    }
+
+    /// Rebuilds the broad phase if a robot moved more than half the margin since the build;
+    /// returns whether it did.
+    fn refresh_if_drifted(&mut self, parallel: bool) -> bool {
+        let lim2 = DRIFT_LIMIT_M * DRIFT_LIMIT_M;
         let drifted = self.touched.iter().any(|&i| {
             let b = self.pose[i as usize];
             let [x0, y0] = self.grid.build_xy[i as usize];
@@ -732,23 +838,25 @@ impl World {
         if drifted {
             self.rebuild_broad_phase(parallel);
         }
+        drifted
     }
 
     /// Lists (in index order) every robot that penetrates a wall or another body, and presses
     /// the bumpers of those contacts.
     fn find_violators(&mut self) {
-        for &i in &self.violators {
-            self.flags[i as usize] &= !VIOLATOR;
-        }
-        self.violators.clear();
-        for k in 0..self.cand.walls.len() {
-            let i = self.cand.walls[k] as usize;
+        self.clear_violators();
+        // Only candidates with a robot moved in the latest pass or stage can overlap (see
+        // `resolve_passes`).
+        self.filter_hot(self.epoch);
+        self.full_pass_pending = false;
+        for k in 0..self.hot.walls.len() {
+            let i = self.hot.walls[k] as usize;
             if self.wall_penetration(i) {
                 self.flags[i] |= VIOLATOR;
             }
         }
-        for k in 0..self.cand.pairs.len() {
-            let [i, j] = self.cand.pairs[k];
+        for k in 0..self.hot.pairs.len() {
+            let [i, j] = self.hot.pairs[k];
             let (i, j) = (i as usize, j as usize);
             if let Some(o) = obb_overlap(&self.obb(i), &self.obb(j), 0.0) {
                 self.press(i, o.nx, o.ny);
@@ -759,12 +867,7 @@ impl World {
         }
         // Collect the flagged robots in index order.
         let mut list = core::mem::take(&mut self.violators);
-        for &i in self
-            .cand
-            .walls
-            .iter()
-            .chain(self.cand.pairs.iter().flatten())
-        {
+        for &i in self.hot.walls.iter().chain(self.hot.pairs.iter().flatten()) {
             if self.flags[i as usize] & VIOLATOR != 0 {
                 list.push(i);
             }
@@ -832,7 +935,7 @@ impl World {
         };
         // Cells whose robots (filed by their centre at the last build, which may have moved
         // up to half the margin since) can reach the segment.
-        let pad = self.radius_m + 0.5 * BROAD_PHASE_MARGIN_M;
+        let pad = self.radius_m + DRIFT_LIMIT_M;
         let (ex, ey) = (ox + dx * t_max, oy + dy * t_max);
         let c0 = self.grid.col(ox.min(ex) - pad);
         let c1 = self.grid.col(ox.max(ex) + pad);
@@ -950,41 +1053,57 @@ fn outside(robot: usize, p: &Pose, arena: &Arena) -> WorldError {
     }
 }
 
-/// Motors and kinematics for a slice of robots: wheel speeds follow their targets with the
-/// exact first-order lag, and the body moves along the exact arc of the sub-step's mean wheel
-/// speeds (exact heading change and, for straight motion, exact distance).
-fn drive_chunk(
-    pose: &mut [BodyPose],
-    motion: &mut [Motion],
-    prev: &mut [BodyPose],
-    kin: &mut [[f64; 2]],
-    lag: &LagCoefficients,
-    track: f64,
+/// What the motor and kinematics phase needs for one sub-step.
+#[derive(Clone, Copy)]
+struct Drive {
+    lag: LagCoefficients,
+    inv_track: f64,
     dt: f64,
-) {
-    let inv_track = 1.0 / track;
-    for (((p, m), pr), k) in pose
-        .iter_mut()
-        .zip(motion.iter_mut())
-        .zip(prev.iter_mut())
-        .zip(kin.iter_mut())
-    {
-        *pr = *p;
-        let mut mean = [0.0; 2];
-        for w in 0..2 {
-            let l = lag.by_mode[usize::from(m.mode[w])];
-            let diff = m.speed[w] - m.target[w];
-            mean[w] = m.target[w] + diff * l.mean_factor;
-            m.speed[w] = m.target[w] + diff * l.decay;
+    drift_limit2: f64,
+}
+
+impl Drive {
+    /// Motors and kinematics for a slice of robots: wheel speeds follow their targets with the
+    /// exact first-order lag, and the body moves along the exact arc of the sub-step's mean
+    /// wheel speeds (exact heading change and, for straight motion, exact distance). Returns
+    /// whether some robot is now farther than the drift limit from where the broad phase last
+    /// filed it.
+    fn chunk(
+        &self,
+        pose: &mut [BodyPose],
+        motion: &mut [Motion],
+        prev: &mut [BodyPose],
+        kin: &mut [[f64; 2]],
+        build_xy: &[[f64; 2]],
+    ) -> bool {
+        let mut stale = false;
+        for ((((p, m), pr), k), b) in pose
+            .iter_mut()
+            .zip(motion.iter_mut())
+            .zip(prev.iter_mut())
+            .zip(kin.iter_mut())
+            .zip(build_xy)
+        {
+            *pr = *p;
+            let mut mean = [0.0; 2];
+            for (w, mean_w) in mean.iter_mut().enumerate() {
+                let l = self.lag.by_mode[usize::from(m.mode[w]).min(2)];
+                let diff = m.speed[w] - m.target[w];
+                *mean_w = m.target[w] + diff * l.mean_factor;
+                m.speed[w] = m.target[w] + diff * l.decay;
+            }
+            let v = 0.5 * (mean[0] + mean[1]);
+            let omega = (mean[1] - mean[0]) * self.inv_track;
+            let (dx, dy, c, s) = arc_step(p.c, p.s, v, omega, self.dt);
+            p.x += dx;
+            p.y += dy;
+            p.c = c;
+            p.s = s;
+            *k = [p.x, p.y];
+            let (ddx, ddy) = (p.x - b[0], p.y - b[1]);
+            stale |= ddx * ddx + ddy * ddy > self.drift_limit2;
         }
-        let v = 0.5 * (mean[0] + mean[1]);
-        let omega = (mean[1] - mean[0]) * inv_track;
-        let (dx, dy, c, s) = arc_step(p.c, p.s, v, omega, dt);
-        p.x += dx;
-        p.y += dy;
-        p.c = c;
-        p.s = s;
-        *k = [p.x, p.y];
+        stale
     }
 }
 

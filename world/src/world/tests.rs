@@ -676,6 +676,7 @@ fn random_scene(n: usize, side: f64, xs: &[(f64, f64, f64)]) -> World {
     w.kin = vec![[0.0; 2]; n];
     w.bumpers = vec![0; n];
     w.flags = vec![0; n];
+    w.last_move = vec![0; n];
     w.gains = vec![[1.0; 2]; n];
     w.chunk_cands = vec![Candidates::default(); n.div_ceil(PAR_CHUNK)];
     w.rebuild_broad_phase(false);
