@@ -51,9 +51,13 @@
 //!   other); robots are processed in index order.
 //! - **Collisions** (robot–wall, robot–robot) are resolved after the move, in robot index
 //!   order (each robot: walls, then its pairs with higher-index robots), for a fixed number of
-//!   passes (default 4, stopping early after a clean pass). An overlap is removed by pushing
-//!   along the minimum-translation vector of the separating-axis test, a robot pair sharing it
-//!   equally (equal masses), to a gap of [`CONTACT_SKIN_M`] (1 nm). The model is kinematic (no
+//!   passes (default 4, stopping early after a clean pass). The first pass resolves the
+//!   contacts present after the move; each later pass re-tests only the pairs with a robot
+//!   moved by the pass before (the others were clean and have not moved), so a clean pass
+//!   proves that nothing overlaps. An overlap is removed by pushing along the
+//!   minimum-translation vector of the separating-axis test, a robot pair sharing it equally
+//!   (equal masses), to a gap of [`CONTACT_SKIN_M`] (1 nm); a robot held by a wall, or by a
+//!   robot held by a wall, does not give way, so the other takes the whole push. The model is kinematic (no
 //!   momentum: a 0.5 kg robot on 203:1 gear motors moves at its wheel speed), so removing the
 //!   displacement into the contact *is* cancelling the velocity component into it; the wheels
 //!   keep turning (they slip against the floor) and [`World::wheel_speeds`] still shows the
@@ -72,18 +76,25 @@
 //!   sensor (a cone) and range are parameters. [`World::sense`] casts from the mount against
 //!   the walls and every other robot's body and returns the distance to the nearest hit in mm,
 //!   or `None` beyond the range (default 1.5 m). Several cone rays report the nearest hit.
-//! - **Broad phase**: a uniform grid (cell ≥ two bounding radii + 50 mm, enlarged to about one
-//!   robot per cell) rebuilt by counting sort each sub-step, reused; collisions test the 3 × 3
-//!   neighbouring cells, rays the cells of the ray's padded bounding box. Cost grows linearly
-//!   with the number of robots.
+//! - **Broad phase**: a uniform grid, filled by counting sort into reused buffers, with cells of
+//!   at least two bounding radii (2 × 146 mm) plus a 200 mm margin, enlarged to about one
+//!   robot per cell (≈ 1.04 m at the paper's density). From it come the candidate pairs
+//!   (bounding circles within the margin, from the 3 × 3 neighbouring cells) and the robots
+//!   within the margin of a wall. Like a Verlet list, grid and candidates are kept until some
+//!   robot has moved more than half the margin (100 mm, about 0.67 s at full speed) from where
+//!   it was filed, then rebuilt; no overlap can be missed in between. Rays visit the cells of
+//!   their bounding box padded by a body radius plus that drift. Cost grows linearly with the
+//!   number of robots.
 //! - **Placement** ([`World::new`]): corridor: on the centre line, facing +x or −x at random,
 //!   spaced by the clearance plus uniform random spacings; open arena: uniform positions and
 //!   headings, rejection-sampled with the clearance (default 50 mm) to walls and bodies, at
 //!   most `1000·n + 10 000` attempts. Too many robots is an error that says how many fit.
 //! - **Randomness**: only from the seed: placement and each robot's motor gains have their own
 //!   streams (adding a robot changes no other robot's gains).
-//! - **Threads**: [`World::advance_par`] runs the per-robot phases on rayon's pool; results are
-//!   bit-identical to [`World::advance`] whatever the thread count.
+//! - **Threads**: [`World::advance_par`] runs the per-robot phases (motors and kinematics,
+//!   candidate search, the first pass's overlap tests) on rayon's pool in fixed chunks merged
+//!   in index order; the pushes run on one thread in index order. Results are bit-identical to
+//!   [`World::advance`] whatever the thread count.
 //! - **Corridor metric**: [`World::corridor_gaps_m`] gives the free gaps between neighbouring
 //!   bodies along the corridor (wall gaps excluded); [`World::corridor_gap_cv`] their
 //!   coefficient of variation (population standard deviation / mean).

@@ -151,8 +151,13 @@ impl Lag {
     pub(crate) fn new(dt_s: f64, tau_s: f64) -> Lag {
         let x = dt_s / tau_s;
         let decay = (-x).exp();
-        // (1 − e^−x)/x = −expm1(−x)/x, accurate for small x too.
-        let mean_factor = -(-x).exp_m1() / x;
+        // (1 − e^−x)/x = −expm1(−x)/x, accurate for small x too; its series below 1e-8
+        // (where the next term, x²/6, is below rounding), which also covers x = 0.
+        let mean_factor = if x < 1e-8 {
+            1.0 - 0.5 * x
+        } else {
+            -(-x).exp_m1() / x
+        };
         Lag { decay, mean_factor }
     }
 }
@@ -217,6 +222,10 @@ mod tests {
         // Tiny steps: the mean factor tends to 1 without cancellation.
         let t = Lag::new(1e-12, 0.06);
         assert!((t.mean_factor - 1.0).abs() < 1e-10);
+        let z = Lag::new(5e-324, 0.06);
+        assert_eq!((z.decay, z.mean_factor), (1.0, 1.0));
+        let x: f64 = 1e-8 * 1.000001;
+        assert!((Lag::new(x * 0.06, 0.06).mean_factor - (1.0 - 0.5 * x)).abs() < 1e-16);
     }
 
     #[test]

@@ -29,6 +29,8 @@ pub const MOTOR_GAIN_SPREAD: f64 = 0.05;
 pub const WHEEL_TRACK_M: f64 = 0.160;
 /// Default longest internal sub-step: 20 ms (our choice; longer `advance` calls are split).
 pub const MAX_SUBSTEP_S: f64 = 0.020;
+/// Smallest accepted `max_substep_s`: 10 µs (our limit, so an `advance` call stays bounded).
+pub const MIN_SUBSTEP_S: f64 = 1e-5;
 /// Largest accepted `max_substep_s`: 100 ms (our limit: at 1 m/s two robots close 0.2 m, about
 /// the body width, so a longer sub-step could let bodies pass through each other).
 pub const MAX_SUBSTEP_LIMIT_S: f64 = 0.100;
@@ -236,16 +238,13 @@ impl WorldParams {
             10.0,
             "a distance in 0.01..=10 m",
         )?;
-        if self.max_substep_s.is_nan()
-            || self.max_substep_s <= 0.0
-            || self.max_substep_s > MAX_SUBSTEP_LIMIT_S
-        {
-            return Err(WorldError::Parameter {
-                name: "max_substep_s",
-                value: self.max_substep_s,
-                valid: "a time > 0 and <= 0.1 s",
-            });
-        }
+        check_range(
+            "max_substep_s",
+            self.max_substep_s,
+            MIN_SUBSTEP_S,
+            MAX_SUBSTEP_LIMIT_S,
+            "a time in 0.00001..=0.1 s",
+        )?;
         let hl = 0.5 * self.body_length_m;
         let hw = 0.5 * self.body_width_m;
         for m in &self.sensor_mounts {

@@ -465,7 +465,8 @@ impl World {
     }
 
     /// As [`World::advance`], with the per-robot phases (motors and kinematics, broad-phase
-    /// candidates) split over rayon's current thread pool. Results are bit-identical to
+    /// candidates, the first collision pass's overlap tests) split over rayon's current
+    /// thread pool. Results are bit-identical to
     /// [`World::advance`] whatever the number of threads: the parallel work is per robot into
     /// fixed chunks, merged in index order; collision resolution runs in index order on one
     /// thread.
@@ -632,7 +633,7 @@ impl World {
     /// rebuilds); returns whether the last pass was clean, i.e. nothing overlaps.
     fn settle(&mut self, parallel: bool) -> bool {
         for _ in 0..3 {
-            let clean = self.resolve_passes();
+            let clean = self.resolve_passes(parallel);
             if !self.refresh_if_drifted(parallel) {
                 return clean;
             }
@@ -754,28 +755,69 @@ impl World {
     /// candidate; a later pass only over the candidates with a robot moved by the previous
     /// pass (or by a stage of `resolve_collisions`): the others were clean when last checked
     /// and neither robot has moved since.
-    fn resolve_passes(&mut self) -> bool {
+    fn resolve_passes(&mut self, parallel: bool) -> bool {
         for _ in 0..self.params.collision_iterations {
-            let any = if self.full_pass_pending {
+            if self.full_pass_pending {
                 self.full_pass_pending = false;
-                self.epoch += 1;
-                let list = core::mem::take(&mut self.cand);
-                let any = self.pass(&list);
-                self.cand = list;
-                any
+                self.detect_overlaps(parallel);
             } else {
                 self.filter_hot(self.epoch);
-                self.epoch += 1;
-                let list = core::mem::take(&mut self.hot);
-                let any = self.pass(&list);
-                self.hot = list;
-                any
-            };
+            }
+            self.epoch += 1;
+            let list = core::mem::take(&mut self.hot);
+            let any = self.pass(&list);
+            self.hot = list;
             if !any {
                 return true;
             }
         }
         false
+    }
+
+    /// The candidates that overlap now, into `hot` in the candidates' order: the first pass
+    /// of a sub-step (or after a rebuild) resolves exactly these, in index order. A pair that
+    /// only comes to overlap during that pass has a robot moved by it, so the next pass takes
+    /// it. The test only reads the poses, so it runs per chunk of candidates on rayon's pool
+    /// when `parallel`, with the same result.
+    fn detect_overlaps(&mut self, parallel: bool) {
+        let probe = Probe {
+            pose: &self.pose,
+            hx: self.hx,
+            hy: self.hy,
+            reach2: 4.0 * self.radius_m * self.radius_m,
+            w: self.arena.width_m(),
+            h: self.arena.height_m(),
+        };
+        self.hot.pairs.clear();
+        self.hot.walls.clear();
+        let n_pairs = self.cand.pairs.len();
+        let n_walls = self.cand.walls.len();
+        if parallel && n_pairs + n_walls > PAR_CHUNK {
+            let chunks = n_pairs.max(n_walls).div_ceil(PAR_CHUNK);
+            if self.chunk_cands.len() < chunks {
+                self.chunk_cands.resize_with(chunks, Candidates::default);
+            }
+            let cand = &self.cand;
+            self.chunk_cands[..chunks]
+                .par_iter_mut()
+                .enumerate()
+                .for_each(|(k, out)| {
+                    out.pairs.clear();
+                    out.walls.clear();
+                    let lo = k * PAR_CHUNK;
+                    let pairs = &cand.pairs[lo.min(n_pairs)..(lo + PAR_CHUNK).min(n_pairs)];
+                    let walls = &cand.walls[lo.min(n_walls)..(lo + PAR_CHUNK).min(n_walls)];
+                    probe.collect(pairs, walls, out);
+                });
+            for c in &self.chunk_cands[..chunks] {
+                self.hot.pairs.extend_from_slice(&c.pairs);
+            }
+            for c in &self.chunk_cands[..chunks] {
+                self.hot.walls.extend_from_slice(&c.walls);
+            }
+        } else {
+            probe.collect(&self.cand.pairs, &self.cand.walls, &mut self.hot);
+        }
     }
 
     /// One pass over `list` in robot index order; returns whether anything overlapped.
@@ -1104,6 +1146,58 @@ impl Drive {
             stale |= ddx * ddx + ddy * ddy > self.drift_limit2;
         }
         stale
+    }
+}
+
+/// What the overlap detection reads.
+struct Probe<'a> {
+    pose: &'a [BodyPose],
+    hx: f64,
+    hy: f64,
+    /// Squared distance between centres beyond which bodies cannot touch.
+    reach2: f64,
+    w: f64,
+    h: f64,
+}
+
+impl Probe<'_> {
+    /// Appends the overlapping pairs and the robots penetrating a wall, in the given order.
+    fn collect(&self, pairs: &[[u32; 2]], walls: &[u32], out: &mut Candidates) {
+        for &i in walls {
+            let b = self.pose[i as usize];
+            let (ac, as_) = (b.c.abs(), b.s.abs());
+            let ex = self.hx * ac + self.hy * as_;
+            let ey = self.hx * as_ + self.hy * ac;
+            if b.x - ex < 0.0 || b.x + ex > self.w || b.y - ey < 0.0 || b.y + ey > self.h {
+                out.walls.push(i);
+            }
+        }
+        for &[i, j] in pairs {
+            let (a, b) = (self.pose[i as usize], self.pose[j as usize]);
+            let (dx, dy) = (b.x - a.x, b.y - a.y);
+            if dx * dx + dy * dy >= self.reach2 {
+                continue;
+            }
+            let oa = Obb {
+                x: a.x,
+                y: a.y,
+                c: a.c,
+                s: a.s,
+                hx: self.hx,
+                hy: self.hy,
+            };
+            let ob = Obb {
+                x: b.x,
+                y: b.y,
+                c: b.c,
+                s: b.s,
+                hx: self.hx,
+                hy: self.hy,
+            };
+            if obb_overlap(&oa, &ob, 0.0).is_some() {
+                out.pairs.push([i, j]);
+            }
+        }
     }
 }
 

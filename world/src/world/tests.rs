@@ -1266,3 +1266,81 @@ mod parry_check {
         }
     }
 }
+
+// ----- nothing a caller passes panics -----------------------------------------------------------
+
+fn wild() -> impl Strategy<Value = f64> {
+    prop_oneof![
+        Just(f64::NAN),
+        Just(f64::INFINITY),
+        Just(f64::NEG_INFINITY),
+        Just(0.0),
+        Just(-0.0),
+        Just(-1.0),
+        Just(5e-324),
+        Just(1e-300),
+        Just(1e300),
+        Just(f64::MAX),
+        -10.0f64..10.0,
+    ]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(2000))]
+
+    /// Wild parameters, poses, commands, time steps and indices give errors, never panics.
+    #[test]
+    fn wild_inputs_never_panic(
+        field in 0usize..12,
+        value in wild(),
+        poses in proptest::collection::vec((wild(), wild(), wild()), 0..4),
+        duty in wild(),
+        dt in prop_oneof![wild(), Just(0.01), Just(0.5)],
+        robot in 0usize..6,
+        sensor in 0usize..6,
+        arena_w in wild(),
+        arena_h in wild(),
+        n in 0usize..60,
+        seed in any::<u64>(),
+    ) {
+        let mut p = WorldParams::default();
+        match field {
+            0 => p.body_length_m = value,
+            1 => p.body_width_m = value,
+            2 => p.top_speed_m_per_s = value,
+            3 => p.motor_time_constant_s = value,
+            4 => p.brake_time_constant_s = value,
+            5 => p.coast_time_constant_s = value,
+            6 => p.motor_gain_spread = value,
+            7 => p.wheel_track_m = value,
+            8 => p.max_substep_s = value,
+            9 => p.cone_half_angle_rad = value,
+            10 => p.sensor_max_range_m = value,
+            _ => p.placement_clearance_m = value,
+        }
+        let arenas = [
+            Arena::rectangle(arena_w, arena_h),
+            Arena::corridor(arena_w),
+            Ok(Arena::square()),
+            Arena::scaled_square(n),
+        ];
+        for arena in arenas.into_iter().flatten() {
+            let _ = World::new(arena, p.clone(), n, seed);
+            let ps: Vec<Pose> = poses.iter().map(|&(x, y, h)| pose(x, y, h)).collect();
+            let _ = World::from_poses(arena, p.clone(), &ps, seed);
+        }
+        let mut w = World::new(Arena::square(), WorldParams::default(), 3, seed).unwrap();
+        let _ = w.set_wheels(robot, WheelCommand::forward(duty), WheelCommand::reverse(duty));
+        let _ = w.set_wheels(robot, WheelCommand::brake(), WheelCommand::coast());
+        let _ = w.advance(dt);
+        let _ = w.advance_par(dt);
+        let _ = w.sense(robot, sensor);
+        let _ = w.bumpers(robot);
+        let _ = w.pose(robot);
+        let _ = w.corners(robot);
+        if let Some(&(x, y, h)) = poses.first() {
+            let _ = w.set_pose(robot, pose(x, y, h));
+        }
+        assert_no_penetration(&w);
+    }
+}
