@@ -40,7 +40,9 @@ fn data<const N: usize, const M: usize>() -> Data<N, M> {
 }
 
 /// The same step in plain `i32`: y, argmax, O (SPEC §2.3), then the update (SPEC §2.4).
+/// Deliberately the naive indexed loops a C programmer would write first.
 #[inline(never)]
+#[allow(clippy::needless_range_loop)]
 fn reference_step<const N: usize, const M: usize>(
     w: &mut [[i32; N]; M],
     x: &[i32; N],
@@ -117,14 +119,14 @@ fn bench_shape<const N: usize, const M: usize>(c: &mut Criterion, name: &str) {
     {
         let mut w = d.w.map(|row| row.map(i32::from));
         let mut net = Network::<N, M>::new(d.w.map(|row| row.map(Q15::from_bits)));
-        for k in 0..PAIRS {
-            let (win, o) = reference_step(&mut w, &d.xs[k].map(i32::from), i32::from(d.es[k]));
-            let f = net.forward(&xq[k], &mut NoopMeter);
+        for (k, ((x, xk), &e)) in d.xs.iter().zip(&xq).zip(&d.es).enumerate() {
+            let (win, o) = reference_step(&mut w, &x.map(i32::from), i32::from(e));
+            let f = net.forward(xk, &mut NoopMeter);
             assert_eq!(win, f.win(), "{name} step {k}: winner");
             let o_q: Vec<i32> = f.o_bits().iter().map(|&v| i32::from(v)).collect();
             assert_eq!(o.to_vec(), o_q, "{name} step {k}: outputs");
             let params = Params::new(ETA, T).expect("valid parameters");
-            net.update(&xq[k], f.win(), d.es[k], params, &mut NoopMeter)
+            net.update(xk, f.win(), e, params, &mut NoopMeter)
                 .expect("winner is an output");
         }
         let ours = net.weights().map(|row| row.map(|q| i32::from(q.to_bits())));

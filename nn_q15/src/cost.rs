@@ -626,11 +626,13 @@ impl Meter for NoopMeter {
 }
 
 /// A meter that charges H8/300H states per phase from [`OP_STATES`] and counts every primitive.
+///
+/// It keeps one count per (phase, primitive) pair, so a charge is a single addition; states are
+/// the counts weighted by [`OP_STATES`] when asked for.
 #[derive(Clone, Debug)]
 pub struct H8Meter {
     phase: Phase,
-    states: [u64; Phase::COUNT],
-    counts: [u64; Op::COUNT],
+    counts: [[u64; Op::COUNT]; Phase::COUNT],
 }
 
 impl Default for H8Meter {
@@ -645,33 +647,42 @@ impl H8Meter {
     pub const fn new() -> Self {
         Self {
             phase: Phase::Input,
-            states: [0; Phase::COUNT],
-            counts: [0; Op::COUNT],
+            counts: [[0; Op::COUNT]; Phase::COUNT],
         }
     }
 
     /// States charged to `phase` so far.
     #[must_use]
-    pub const fn states(&self, phase: Phase) -> u64 {
-        self.states[phase as usize]
+    pub fn states(&self, phase: Phase) -> u64 {
+        self.counts[phase as usize]
+            .iter()
+            .zip(OP_STATES)
+            .map(|(&n, s)| n * u64::from(s))
+            .sum()
     }
 
     /// States charged to every phase so far.
     #[must_use]
     pub fn total_states(&self) -> u64 {
-        self.states.iter().sum()
+        Phase::ALL.iter().map(|&p| self.states(p)).sum()
     }
 
-    /// How many times `op` was charged so far.
+    /// How many times `op` was charged so far, over all phases.
     #[must_use]
-    pub const fn count(&self, op: Op) -> u64 {
-        self.counts[op as usize]
+    pub fn count(&self, op: Op) -> u64 {
+        self.counts.iter().map(|per_op| per_op[op as usize]).sum()
+    }
+
+    /// How many times `op` was charged in `phase` so far.
+    #[must_use]
+    pub const fn count_in(&self, phase: Phase, op: Op) -> u64 {
+        self.counts[phase as usize][op as usize]
     }
 
     /// The states per phase so far, in [`Phase::ALL`] order.
     #[must_use]
-    pub const fn phase_states(&self) -> [u64; Phase::COUNT] {
-        self.states
+    pub fn phase_states(&self) -> [u64; Phase::COUNT] {
+        Phase::ALL.map(|p| self.states(p))
     }
 
     /// Forgets everything charged so far.
@@ -688,8 +699,7 @@ impl Meter for H8Meter {
     }
     #[inline(always)]
     fn charge(&mut self, op: Op, count: u32) {
-        self.states[self.phase as usize] += u64::from(OP_STATES[op as usize]) * u64::from(count);
-        self.counts[op as usize] += u64::from(count);
+        self.counts[self.phase as usize][op as usize] += u64::from(count);
     }
 }
 

@@ -171,7 +171,9 @@ pub enum UpdateKind {
 
 /// The forward pass on raw slices: `w` holds M rows of N weights, `x` N inputs.
 /// The caller guarantees `w.len() == x.len() * n_out`, `1 ≤ x.len() ≤ 256` and `2 ≤ n_out ≤ 4`.
-#[inline]
+// Always inlined: in `Network<N, M>` the lengths then become constants and the sums vectorise
+// with or without a meter.
+#[inline(always)]
 pub(crate) fn forward_core<Mt: Meter>(
     w: &[Q15],
     x: &[Q7],
@@ -183,7 +185,6 @@ pub(crate) fn forward_core<Mt: Meter>(
     let mut o = [0i16; MAX_OUTPUTS];
 
     meter.enter(Phase::Forward);
-    meter.charge(Op::CallFrame, 1);
 
     // Step 1: y_j = Σ_i w_ij · x_i, exact in i32.
     for (row, yj) in w.chunks_exact(n_in).zip(y.iter_mut()) {
@@ -193,14 +194,6 @@ pub(crate) fn forward_core<Mt: Meter>(
             .map(|(wi, xi)| i32::from(wi.to_bits()) * i32::from(xi.to_bits()))
             .sum();
     }
-    let (m_in, m_out) = (n_in as u32, n_out as u32);
-    meter.charge(Op::PtrInit, 2 + m_out);
-    meter.charge(Op::LoopInitB, 1);
-    meter.charge(Op::LoopInitW, m_out);
-    meter.charge(Op::AccClear, m_out);
-    meter.charge(Op::Mac, m_in * m_out);
-    meter.charge(Op::LoopIter, m_in * m_out + m_out);
-    meter.charge(Op::StoreL, m_out);
 
     // Steps 2 and 4: the maximum and the winner, ties to the lowest index.
     let ys = &y[..n_out];
@@ -214,39 +207,25 @@ pub(crate) fn forward_core<Mt: Meter>(
             new_max += 1;
         }
     }
-    meter.charge(Op::PtrInit, 1);
-    meter.charge(Op::LoadL, m_out);
-    meter.charge(Op::LoopInitB, 3);
-    meter.charge(Op::CmpBranch, m_out - 1);
-    meter.charge(Op::IndexInc, m_out - 1);
-    meter.charge(Op::LoopIter, m_out - 1);
-    meter.charge(Op::NewMax, new_max);
-    meter.charge(Op::StoreVarB, 1);
 
     // Step 3: the activation of Eq. 2.
-    meter.charge(Op::CmpImmBranch, 1);
-    meter.charge(Op::PtrInit, 2);
-    meter.charge(Op::LoopInitB, 1);
-    meter.charge(Op::LoadL, m_out);
-    meter.charge(Op::StoreW, m_out);
-    meter.charge(Op::LoopIter, m_out);
-    if max < ONE_Q22 {
-        let mut clamps = 0u32;
+    // What the scaling did, for the meter.
+    let mut plain_clamps = 0u32;
+    let (mut shift, mut divides, mut lows, mut highs) = (0u32, 0u32, 0u32, 0u32);
+    let plain = max < ONE_Q22;
+    if plain {
         for (oj, &yj) in o.iter_mut().zip(ys) {
             let v = yj >> 7;
             *oj = sat16(v);
             if Mt::ACTIVE {
-                clamps += u32::from(i32::from(*oj) != v);
+                plain_clamps += u32::from(i32::from(*oj) != v);
             }
         }
-        meter.charge(Op::Shr1, 7 * m_out);
-        meter.charge(Op::Sat16, m_out);
-        meter.charge(Op::SatClamp, clamps);
     } else {
         // Eq. 2's division by the largest sum, as a 32/16 DIVXS.W: bring m into [2^14, 2^15).
         let s = (i32::BITS - max.leading_zeros()) - 15;
+        shift = s;
         let m_s = max >> s;
-        let (mut divides, mut lows, mut highs) = (0u32, 0u32, 0u32);
         for (oj, &yj) in o.iter_mut().zip(ys) {
             let y_s = yj >> s;
             *oj = if y_s <= -m_s {
@@ -261,16 +240,21 @@ pub(crate) fn forward_core<Mt: Meter>(
                 ((y_s << 15) / m_s) as i16
             };
         }
-        meter.charge(Op::LoopInitB, 1);
-        meter.charge(Op::NormShiftStep, s);
-        meter.charge(Op::NormSetup, 1);
-        meter.charge(Op::RegOp, m_out);
-        meter.charge(Op::VarShiftStep, s * m_out);
-        meter.charge(Op::CmpBranch, m_out + divides + highs);
-        meter.charge(Op::Shl15, divides);
-        meter.charge(Op::Div, divides);
-        meter.charge(Op::Branch, divides + lows);
-        meter.charge(Op::ClampW, lows + highs);
+    }
+
+    if Mt::ACTIVE {
+        let tally = ForwardTally {
+            n_in: n_in as u32,
+            n_out: n_out as u32,
+            new_max,
+            plain,
+            plain_clamps,
+            shift,
+            divides,
+            lows,
+            highs,
+        };
+        charge_forward(meter, &tally);
     }
 
     ForwardOut {
@@ -281,10 +265,94 @@ pub(crate) fn forward_core<Mt: Meter>(
     }
 }
 
+/// What one forward pass did, as the meter needs it.
+struct ForwardTally {
+    n_in: u32,
+    n_out: u32,
+    new_max: u32,
+    plain: bool,
+    plain_clamps: u32,
+    shift: u32,
+    divides: u32,
+    lows: u32,
+    highs: u32,
+}
+
+/// Charges one forward pass: one charge per primitive, the routine of the [`crate::cost`] docs
+/// summed over its loops. Kept out of line so that the arithmetic compiles to the same code with
+/// every meter.
+#[inline(never)]
+fn charge_forward<Mt: Meter>(meter: &mut Mt, t: &ForwardTally) {
+    let (m_in, m_out) = (t.n_in, t.n_out);
+    meter.charge(Op::CallFrame, 1);
+    meter.charge(Op::PtrInit, 5 + m_out);
+    meter.charge(Op::LoopInitB, 5 + u32::from(!t.plain));
+    meter.charge(Op::LoopInitW, m_out);
+    meter.charge(Op::AccClear, m_out);
+    meter.charge(Op::Mac, m_in * m_out);
+    meter.charge(Op::LoopIter, m_in * m_out + 3 * m_out - 1);
+    meter.charge(Op::StoreL, m_out);
+    meter.charge(Op::LoadL, 2 * m_out);
+    meter.charge(Op::IndexInc, m_out - 1);
+    meter.charge(Op::NewMax, t.new_max);
+    meter.charge(Op::StoreVarB, 1);
+    meter.charge(Op::CmpImmBranch, 1);
+    meter.charge(Op::StoreW, m_out);
+    if t.plain {
+        meter.charge(Op::CmpBranch, m_out - 1);
+        meter.charge(Op::Shr1, 7 * m_out);
+        meter.charge(Op::Sat16, m_out);
+        meter.charge(Op::SatClamp, t.plain_clamps);
+    } else {
+        meter.charge(Op::CmpBranch, (m_out - 1) + m_out + t.divides + t.highs);
+        meter.charge(Op::NormShiftStep, t.shift);
+        meter.charge(Op::NormSetup, 1);
+        meter.charge(Op::RegOp, m_out);
+        meter.charge(Op::VarShiftStep, t.shift * m_out);
+        meter.charge(Op::Shl15, t.divides);
+        meter.charge(Op::Div, t.divides);
+        meter.charge(Op::Branch, t.divides + t.lows);
+        meter.charge(Op::ClampW, t.lows + t.highs);
+    }
+}
+
+/// Charges one update: the dead-zone test (load E and T, form |E|, compare) and, when it
+/// updates, σ·η (load η, branch on the sign, negate when E < 0), the Δ loop and the row loops.
+#[inline(never)]
+fn charge_update<Mt: Meter>(
+    meter: &mut Mt,
+    n_in: u32,
+    n_out: u32,
+    negative: bool,
+    clamps: Option<(u32, u32)>,
+) {
+    let negative = u32::from(negative);
+    meter.charge(Op::CallFrame, 1);
+    meter.charge(Op::AbsTest, 1);
+    meter.charge(Op::CmpBranchW, 1);
+    let Some((hi, lo)) = clamps else {
+        meter.charge(Op::LoadW, 2);
+        meter.charge(Op::RegOp, negative);
+        return;
+    };
+    meter.charge(Op::LoadW, 3);
+    meter.charge(Op::RegOp, 2 * negative);
+    meter.charge(Op::Branch, 2);
+    meter.charge(Op::PtrInit, 3);
+    meter.charge(Op::LoopInitW, 1);
+    meter.charge(Op::DeltaCompute, n_in);
+    meter.charge(Op::LoopIter, n_in + n_in * n_out);
+    meter.charge(Op::LoopInitB, 1);
+    meter.charge(Op::UpdateRow, n_out);
+    meter.charge(Op::WeightApply, n_in * n_out);
+    meter.charge(Op::WeightClampHi, hi);
+    meter.charge(Op::WeightClampLo, lo);
+}
+
 /// The update of SPEC §2.4 on raw slices, with `delta` as the scratch for σ·Δ_i.
 /// The caller guarantees `w.len() == x.len() * n_out` with `1 ≤ x.len() ≤ 256`,
 /// `delta.len() >= x.len()` and `win < n_out`.
-#[inline]
+#[inline(always)]
 pub(crate) fn update_core<Mt: Meter>(
     w: &mut [Q15],
     x: &[Q7],
@@ -297,13 +365,10 @@ pub(crate) fn update_core<Mt: Meter>(
     let n_in = x.len();
     let n_out = w.len() / n_in;
     meter.enter(Phase::Update);
-    meter.charge(Op::CallFrame, 1);
-    // |E| ≤ T? (E and T loaded, |E| formed, compared.)
-    meter.charge(Op::LoadW, 2);
-    meter.charge(Op::AbsTest, 1);
-    meter.charge(Op::RegOp, u32::from(e < 0));
-    meter.charge(Op::CmpBranchW, 1);
     if e.unsigned_abs() <= params.threshold.unsigned_abs() {
+        if Mt::ACTIVE {
+            charge_update(meter, n_in as u32, n_out as u32, e < 0, None);
+        }
         return UpdateKind::DeadZone;
     }
     let kind = if e > 0 {
@@ -317,42 +382,57 @@ pub(crate) fn update_core<Mt: Meter>(
     } else {
         -i32::from(params.eta)
     };
-    meter.charge(Op::LoadW, 1);
-    meter.charge(Op::Branch, 1);
-    meter.charge(Op::RegOp, u32::from(e < 0));
 
     let delta = &mut delta[..n_in];
     for (d, xi) in delta.iter_mut().zip(x) {
         // |σ·η·x| ≤ 32767 · 128, so the rounded quotient fits in an i16.
         *d = round_half_away_shr7(signed_eta * i32::from(xi.to_bits())) as i16;
     }
-    let (m_in, m_out) = (n_in as u32, n_out as u32);
-    meter.charge(Op::PtrInit, 2);
-    meter.charge(Op::LoopInitW, 1);
-    meter.charge(Op::DeltaCompute, m_in);
-    meter.charge(Op::LoopIter, m_in);
 
     let (mut clamp_hi, mut clamp_lo) = (0u32, 0u32);
     for (j, row) in w.chunks_exact_mut(n_in).enumerate() {
-        let sign: i32 = if j == win { 1 } else { -1 };
-        for (wi, &d) in row.iter_mut().zip(delta.iter()) {
-            let v = i32::from(wi.to_bits()) + sign * i32::from(d);
-            *wi = Q15::from_bits(sat16(v));
-            if Mt::ACTIVE {
-                clamp_hi += u32::from(v > i32::from(i16::MAX));
-                clamp_lo += u32::from(v < i32::from(i16::MIN));
-            }
+        // |Δ| ≤ 32767, so w ± Δ saturated in i16 is exactly sat16(w ± Δ) of SPEC §2.4: the
+        // winner's row adds, the others subtract, each a loop of saturating i16 arithmetic.
+        let (hi, lo) = if j == win {
+            apply_row::<Mt>(row, delta, true)
+        } else {
+            apply_row::<Mt>(row, delta, false)
+        };
+        clamp_hi += hi;
+        clamp_lo += lo;
+    }
+    if Mt::ACTIVE {
+        let clamps = Some((clamp_hi, clamp_lo));
+        charge_update(meter, n_in as u32, n_out as u32, e < 0, clamps);
+    }
+    kind
+}
+
+/// Applies `delta` to one row, adding when `up` (the winner's row) and subtracting otherwise,
+/// and, when the meter is active, counts the clamps at the top and at the bottom (in a
+/// separate pass, so that the update itself compiles to the same saturating i16 loop with every
+/// meter).
+#[inline(always)]
+fn apply_row<Mt: Meter>(row: &mut [Q15], delta: &[i16], up: bool) -> (u32, u32) {
+    let (mut hi, mut lo) = (0u32, 0u32);
+    if Mt::ACTIVE {
+        let dir = if up { 1 } else { -1 };
+        for (wi, &d) in row.iter().zip(delta) {
+            let v = i32::from(wi.to_bits()) + dir * i32::from(d);
+            hi += u32::from(v > i32::from(i16::MAX));
+            lo += u32::from(v < i32::from(i16::MIN));
         }
     }
-    meter.charge(Op::PtrInit, 1);
-    meter.charge(Op::LoopInitB, 1);
-    meter.charge(Op::UpdateRow, m_out);
-    meter.charge(Op::WeightApply, m_in * m_out);
-    meter.charge(Op::LoopIter, m_in * m_out);
-    meter.charge(Op::Branch, 1);
-    meter.charge(Op::WeightClampHi, clamp_hi);
-    meter.charge(Op::WeightClampLo, clamp_lo);
-    kind
+    if up {
+        for (wi, &d) in row.iter_mut().zip(delta) {
+            *wi = Q15::from_bits(wi.to_bits().saturating_add(d));
+        }
+    } else {
+        for (wi, &d) in row.iter_mut().zip(delta) {
+            *wi = Q15::from_bits(wi.to_bits().saturating_sub(d));
+        }
+    }
+    (hi, lo)
 }
 
 /// The forward pass on a runtime-shaped network (used by the replay, SPEC §2.6): `w` holds
