@@ -132,6 +132,42 @@ pub fn obb_overlap(a: &Obb, b: &Obb, threshold_m: f64) -> Option<Overlap> {
     Some(best)
 }
 
+/// Shortest distance between the outlines of two boxes, metres (0 if they touch or overlap):
+/// for separated convex polygons it is attained between a corner of one and an edge of the
+/// other.
+pub fn obb_distance(a: &Obb, b: &Obb) -> f64 {
+    if obb_overlap(a, b, 0.0).is_some() {
+        return 0.0;
+    }
+    let ca = a.corners();
+    let cb = b.corners();
+    let mut best = f64::INFINITY;
+    for (corners, edges) in [(&ca, &cb), (&cb, &ca)] {
+        for &p in corners.iter() {
+            for k in 0..4 {
+                let d = point_segment_distance(p, edges[k], edges[(k + 1) % 4]);
+                if d < best {
+                    best = d;
+                }
+            }
+        }
+    }
+    best
+}
+
+/// Distance from point `p` to the segment `a`–`b`.
+fn point_segment_distance(p: (f64, f64), a: (f64, f64), b: (f64, f64)) -> f64 {
+    let (ex, ey) = (b.0 - a.0, b.1 - a.1);
+    let (wx, wy) = (p.0 - a.0, p.1 - a.1);
+    let len2 = ex * ex + ey * ey;
+    let t = if len2 > 0.0 {
+        ((wx * ex + wy * ey) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (wx - t * ex).hypot(wy - t * ey)
+}
+
 /// Distance along a ray from `(ox, oy)` in unit direction `(dx, dy)` to the box, if it is hit
 /// within `max_t`. A ray starting inside the box hits at 0.
 #[inline]
@@ -296,6 +332,18 @@ mod tests {
         assert!(obb_overlap(&a, &touch, 0.0).is_none());
         // With a clearance threshold the near miss counts.
         assert!(obb_overlap(&a, &far, -0.01).is_some());
+    }
+
+    #[test]
+    fn distance_between_boxes() {
+        let a = Obb::new(0.0, 0.0, 0.0, 0.115, 0.09);
+        let b = Obb::new(0.5, 0.0, 0.0, 0.115, 0.09);
+        assert!((obb_distance(&a, &b) - 0.27).abs() < 1e-15);
+        // Corner to corner along the diagonal.
+        let c = Obb::new(0.33, 0.28, 0.0, 0.115, 0.09);
+        assert!((obb_distance(&a, &c) - 0.1f64.hypot(0.1)).abs() < 1e-15);
+        let d = Obb::new(0.2, 0.0, 1.0, 0.115, 0.09);
+        assert_eq!(obb_distance(&a, &d), 0.0);
     }
 
     #[test]

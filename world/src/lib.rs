@@ -96,8 +96,10 @@
 //!   in index order; the pushes run on one thread in index order. Results are bit-identical to
 //!   [`World::advance`] whatever the thread count.
 //! - **Corridor metric**: [`World::corridor_gaps_m`] gives the free gaps between neighbouring
-//!   bodies along the corridor (wall gaps excluded); [`World::corridor_gap_cv`] their
-//!   coefficient of variation (population standard deviation / mean).
+//!   robots along the corridor (sorted by centre x; gap = shortest distance between the two
+//!   outlines, which for robots facing along the corridor is face to face; the gaps to the end
+//!   walls are excluded); [`World::corridor_gap_cv`] their coefficient of variation
+//!   (population standard deviation / mean).
 
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]

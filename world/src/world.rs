@@ -6,7 +6,7 @@ use rayon::prelude::*;
 
 use crate::arena::{Arena, ArenaKind};
 use crate::error::WorldError;
-use crate::geometry::{Obb, arc_step, obb_overlap, ray_obb, ray_walls, side_of};
+use crate::geometry::{Obb, arc_step, obb_distance, obb_overlap, ray_obb, ray_walls, side_of};
 use crate::grid::Grid;
 use crate::motor::{Direction, LagCoefficients, MODE_BRAKE, MODE_COAST, MODE_DRIVE, WheelCommand};
 use crate::params::{MAX_ADVANCE_S, WorldParams};
@@ -1016,9 +1016,11 @@ impl World {
     // ----- corridor metric -----------------------------------------------------------------------
 
     /// The free gaps between neighbouring robots along the corridor, metres, in order along it:
-    /// robots sorted by centre x, gap k = left edge of robot k+1 minus right edge of robot k
-    /// (edges of each body's axis-aligned extent along x). The gaps to the end walls are not
-    /// included, so n robots give n − 1 gaps. Errors outside the corridor.
+    /// robots sorted by centre x (robots cannot pass each other in the corridor), gap k = the
+    /// shortest distance between the outlines of robots k and k+1 (0 when touching; for robots
+    /// facing along the corridor it is the distance between rear and front faces). The gaps
+    /// to the end walls are not included, so n robots give n − 1 gaps. Errors outside the
+    /// corridor.
     pub fn corridor_gaps_m(&self, out: &mut Vec<f64>) -> Result<(), WorldError> {
         if self.arena.kind() != ArenaKind::Corridor {
             return Err(WorldError::NotACorridor {
@@ -1030,9 +1032,7 @@ impl World {
         let mut order: Vec<usize> = (0..self.pose.len()).collect();
         order.sort_by(|&a, &b| self.pose[a].x.total_cmp(&self.pose[b].x).then(a.cmp(&b)));
         for w in order.windows(2) {
-            let (ea, _) = self.obb(w[0]).aabb_half_extents();
-            let (eb, _) = self.obb(w[1]).aabb_half_extents();
-            out.push((self.pose[w[1]].x - eb) - (self.pose[w[0]].x + ea));
+            out.push(obb_distance(&self.obb(w[0]), &self.obb(w[1])));
         }
         Ok(())
     }

@@ -1143,7 +1143,7 @@ fn corners_outline_the_body() {
 mod parry_check {
     use super::*;
     use parry2d::math::{Pose as PPose, Vector};
-    use parry2d::query::{Ray, RayCast, contact};
+    use parry2d::query::{Ray, RayCast, contact, distance};
     use parry2d::shape::Cuboid;
 
     fn ppose(b: &Obb) -> PPose {
@@ -1181,6 +1181,19 @@ mod parry_check {
                     prop_assert!(d.abs() < 1e-5 && pd.abs() < 1e-5, "ours {o:?} parry {c:?}");
                 }
             }
+        }
+
+                /// The distance between outlines equals parry2d's within f32 precision.
+        #[test]
+        fn obb_distance_agrees_with_parry(
+            bx in -0.8f64..0.8, by in -0.8f64..0.8, ta in -PI..PI, tb in -PI..PI,
+        ) {
+            let a = Obb::new(0.0, 0.0, ta, HX, HY);
+            let b = Obb::new(bx, by, tb, HX, HY);
+            let cub = Cuboid::new(Vector::new(HX as f32, HY as f32));
+            let theirs = f64::from(distance(&ppose(&a), &cub, &ppose(&b), &cub).unwrap().distance);
+            let ours = obb_distance(&a, &b);
+            prop_assert!((ours - theirs).abs() < 2e-6, "ours {ours} parry {theirs}");
         }
 
         /// Ray distances equal an independent f64 reference (intersection with the four edge
@@ -1342,5 +1355,42 @@ proptest! {
             let _ = w.set_pose(robot, pose(x, y, h));
         }
         assert_no_penetration(&w);
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// In the corridor (paper env. 1: forward and backward only, 0.60 s steps) robots never
+    /// penetrate, and never pass each other: two 180 mm bodies do not fit side by side in
+    /// 220 mm, so the order along the corridor is kept.
+    #[test]
+    fn corridor_robots_keep_their_order(seed in any::<u64>(), n in 2usize..9) {
+        let mut w = World::new(Arena::paper_corridor(), WorldParams::default(), n, seed).unwrap();
+        let order = |w: &World| {
+            let mut o: Vec<usize> = (0..w.robot_count()).collect();
+            o.sort_by(|&a, &b| w.pose[a].x.total_cmp(&w.pose[b].x));
+            o
+        };
+        let start = order(&w);
+        let mut rng = stream_rng(seed, 5, 5);
+        let mut bumps = 0;
+        for k in 0..6000 {
+            if k % 60 == 0 {
+                for r in 0..n {
+                    let b = if unit(&mut rng) < 0.5 { Behaviour::Forward } else { Behaviour::Backward };
+                    set_behaviour(&mut w, r, b);
+                }
+            }
+            w.advance(0.01).unwrap();
+            assert_no_penetration(&w);
+            bumps += (0..n).filter(|&r| w.bumpers[r] != 0).count();
+        }
+        prop_assert_eq!(order(&w), start);
+        prop_assert!(bumps > 0);
+        let mut gaps = Vec::new();
+        w.corridor_gaps_m(&mut gaps).unwrap();
+        prop_assert_eq!(gaps.len(), n - 1);
+        prop_assert!(gaps.iter().all(|&g| g >= 0.0));
     }
 }
