@@ -80,7 +80,7 @@
 //!   at least two bounding radii (2 × 146 mm) plus a 200 mm margin, enlarged to about one
 //!   robot per cell (≈ 1.04 m at the paper's density). From it come the candidate pairs
 //!   (bounding circles within the margin, from the 3 × 3 neighbouring cells) and the robots
-//!   within the margin of a wall. Like a Verlet list, grid and candidates are kept until some
+//!   whose bounding circle is within the margin of a wall. Like a Verlet list, grid and candidates are kept until some
 //!   robot has moved more than half the margin (100 mm, about 0.67 s at full speed) from where
 //!   it was filed, then rebuilt; no overlap can be missed in between. Rays visit the cells of
 //!   their bounding box padded by a body radius plus that drift. Cost grows linearly with the

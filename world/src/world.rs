@@ -543,8 +543,7 @@ impl World {
             pose,
             grid: &self.grid,
             reach2: reach * reach,
-            hx: self.hx,
-            hy: self.hy,
+            radius_m: self.radius_m,
             w: self.arena.width_m(),
             h: self.arena.height_m(),
         };
@@ -1206,24 +1205,22 @@ struct CandidateCtx<'a> {
     pose: &'a [BodyPose],
     grid: &'a Grid,
     reach2: f64,
-    hx: f64,
-    hy: f64,
+    radius_m: f64,
     w: f64,
     h: f64,
 }
 
 impl CandidateCtx<'_> {
-    /// Candidates for robots `lo..hi`: those within the margin of a wall, and pairs (i, j > i)
-    /// whose centres are within two bounding radii plus the margin.
+    /// Candidates for robots `lo..hi`: those whose bounding circle is within the margin of a
+    /// wall, and pairs (i, j > i) whose centres are within two bounding radii plus the margin.
     fn find(&self, lo: usize, hi: usize, out: &mut Candidates) {
         let nx = self.grid.nx();
         let ny = self.grid.ny();
         for i in lo..hi {
             let b = self.pose[i];
-            let (ac, as_) = (b.c.abs(), b.s.abs());
-            let ex = self.hx * ac + self.hy * as_ + BROAD_PHASE_MARGIN_M;
-            let ey = self.hx * as_ + self.hy * ac + BROAD_PHASE_MARGIN_M;
-            if b.x - ex < 0.0 || b.x + ex > self.w || b.y - ey < 0.0 || b.y + ey > self.h {
+            // By the bounding circle, so that turning cannot bring a body to a wall unseen.
+            let e = self.radius_m + BROAD_PHASE_MARGIN_M;
+            if b.x - e < 0.0 || b.x + e > self.w || b.y - e < 0.0 || b.y + e > self.h {
                 out.walls.push(i as u32);
             }
             let (cx, cy) = self.grid.cell_of(i);
