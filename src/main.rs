@@ -2,10 +2,13 @@
 //!
 //! Exit status: 0 on success; 2 for bad input (a malformed replay line, an unreadable input
 //! file, an option out of range, a usage error); 1 when the tool itself fails (an output that
-//! cannot be written).
+//! cannot be written). `h8swarm emu` exits with the program's own status when it halts, 124
+//! when `--max-states` runs out, 125 when the core stops on an error (undefined opcode, fetch
+//! outside ROM and RAM) and 126 when the program sleeps with nothing left to wake it.
 #![forbid(unsafe_code)]
 
 mod cost_report;
+mod emu_cmd;
 mod replay;
 
 use std::fs::File;
@@ -29,6 +32,23 @@ enum Command {
     Learn(LearnArgs),
     /// Measure the learner's H8/300H states per step and its RAM footprint (the default job).
     Cost(CostArgs),
+    /// Run an H8/300H program image (.mot) on the emulated H8/3052F, SCI1 as the console.
+    Emu(EmuArgs),
+}
+
+#[derive(Args, Debug)]
+struct EmuArgs {
+    /// The program: a Motorola S-record image (.mot).
+    image: String,
+    /// Stop after this many states (exit status 124).
+    #[arg(long, value_name = "N")]
+    max_states: Option<u64>,
+    /// Print every instruction, disassembled, with its address and states, on standard error.
+    #[arg(long)]
+    trace: bool,
+    /// Print instructions, states and emulated time as JSON on standard error at the end.
+    #[arg(long)]
+    stats: bool,
 }
 
 #[derive(Args, Debug)]
@@ -94,6 +114,8 @@ enum Failure {
     Input(anyhow::Error),
     /// The tool failed: exit status 1.
     Tool(anyhow::Error),
+    /// An emulated program ended with this exit status (already reported).
+    Program(u8),
 }
 
 fn main() -> ExitCode {
@@ -101,10 +123,14 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Some(Command::Learn(args)) => learn(&args),
         Some(Command::Cost(args)) => cost(&args),
+        Some(Command::Emu(args)) => {
+            emu_cmd::run(&args.image, args.max_states, args.trace, args.stats)
+        }
         None => cost(&CostArgs::default()),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        Err(Failure::Program(status)) => ExitCode::from(status),
         Err(Failure::Input(e)) => {
             eprintln!("error: {e:#}");
             ExitCode::from(2)

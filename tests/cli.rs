@@ -226,3 +226,72 @@ fn cost_summary_reports_phases_and_ram() {
     assert!(default.status.success());
     assert!(String::from_utf8_lossy(&default.stdout).contains("worst step"));
 }
+
+#[test]
+fn emu_runs_a_differential_program_with_its_console_and_status() {
+    let out = h8swarm(&["emu", "emu/tests/programs/switch.mot", "--stats"], None);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let expected = std::fs::read(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/emu/tests/programs/switch.expected"
+    ))
+    .expect("the expected output is committed");
+    assert_eq!(out.stdout, expected);
+    let stats: Value = serde_json::from_str(
+        String::from_utf8_lossy(&out.stderr)
+            .lines()
+            .last()
+            .expect("a stats line"),
+    )
+    .expect("stats are JSON");
+    assert_eq!(stats["outcome"], "halted");
+    assert!(
+        stats["states"].as_u64().expect("states")
+            > stats["instructions"].as_u64().expect("instructions")
+    );
+}
+
+#[test]
+fn emu_trace_budget_and_bad_images_have_their_exit_statuses() {
+    let out = h8swarm(
+        &[
+            "emu",
+            "emu/tests/programs/arith.mot",
+            "--trace",
+            "--max-states",
+            "200",
+        ],
+        None,
+    );
+    assert_eq!(out.status.code(), Some(124));
+    let trace = String::from_utf8_lossy(&out.stderr);
+    assert!(trace.starts_with("0000f4: mov.l #0xffff10,er7"), "{trace}");
+    assert!(trace.contains("6 states"));
+
+    let dir = std::env::temp_dir().join(format!("h8swarm-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    // Reset vector pointing at H'100000, outside ROM and RAM: the first fetch is refused.
+    let outside = dir.join("outside.mot");
+    std::fs::write(&outside, "S107000000100000E8\nS9030000FC\n").expect("write");
+    let out = h8swarm(&["emu", outside.to_str().expect("utf-8 path")], None);
+    assert_eq!(out.status.code(), Some(125));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("100000"), "{stderr}");
+
+    let corrupt = dir.join("corrupt.mot");
+    std::fs::write(&corrupt, "S107000000100000E9\n").expect("write");
+    let out = h8swarm(&["emu", corrupt.to_str().expect("utf-8 path")], None);
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("line 1"), "{stderr}");
+    assert!(!stderr.contains("panicked"));
+
+    let out = h8swarm(&["emu", "no/such/image.mot"], None);
+    assert_eq!(out.status.code(), Some(2));
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -116,17 +116,18 @@ fn json_string(s: &str) -> String {
     out
 }
 
-/// Why a run could not start or could not write its output.
+/// Why a run could not start or could not write its output. The message names the stage; the
+/// cause is the error's `source()` (print the chain, as `anyhow`'s `{:#}` does).
 #[derive(Debug, thiserror::Error)]
 pub enum RunError {
     /// The image is not a valid S-record file.
-    #[error("bad image: {0}")]
+    #[error("bad image")]
     Srec(#[from] SrecError),
     /// The image does not fit the flash.
-    #[error("cannot load image: {0}")]
+    #[error("cannot load image")]
     Load(#[from] LoadError),
     /// Writing the console or the trace failed.
-    #[error("writing output failed: {0}")]
+    #[error("writing output failed")]
     Io(#[from] std::io::Error),
 }
 
