@@ -572,6 +572,130 @@ const fn op_states_table() -> [u32; Op::COUNT] {
 /// States of every [`Op`], indexed by `op as usize`, computed from [`OP_TABLE`].
 pub const OP_STATES: [u32; Op::COUNT] = op_states_table();
 
+/// A routine of the H8 learner as code: how many times each primitive's instruction sequence
+/// appears in its text (not how often it runs), plus instructions on paths no primitive covers.
+/// Its size is the ROM estimate of the routine.
+#[derive(Clone, Copy, Debug)]
+pub struct Routine {
+    /// The routine's name.
+    pub name: &'static str,
+    /// (primitive, number of places its sequence appears in the code).
+    pub code: &'static [(Op, u32)],
+    /// Instructions of alternative paths that no primitive's sequence lists.
+    pub extra: &'static [Insn],
+}
+
+impl Routine {
+    /// Estimated code size in bytes.
+    #[must_use]
+    pub const fn bytes(&self) -> u32 {
+        let mut total = 0;
+        let mut i = 0;
+        while i < self.code.len() {
+            total += self.code[i].0.spec().bytes() * self.code[i].1;
+            i += 1;
+        }
+        let mut k = 0;
+        while k < self.extra.len() {
+            total += self.extra[k].bytes();
+            k += 1;
+        }
+        total
+    }
+}
+
+/// The learner's three routines as code, following the routine sketched in the module docs
+/// (the callee half of [`Op::CallFrame`], pushes, pops and RTS, is counted with the callee).
+pub const LEARNER_ROUTINES: [Routine; 3] = [
+    Routine {
+        name: "learner input (D, E, input vector)",
+        code: &[
+            (Op::CallFrame, 1),
+            (Op::PtrInit, 7),
+            (Op::AccClear, 1),
+            (Op::LoopInitB, 4),
+            (Op::SumIn, 1),
+            (Op::LoopIter, 3),
+            (Op::FlagTest, 1),
+            (Op::LoadW, 1),
+            (Op::RegOp, 2),
+            (Op::StoreVarW, 1),
+            (Op::HistoryShift, 1),
+            (Op::ProximityIn, 1),
+            (Op::OutputIn, 1),
+            (Op::EvalIn, 1),
+            (Op::ClampW, 2),
+            (Op::BiasIn, 1),
+        ],
+        extra: &[],
+    },
+    Routine {
+        name: "learner update",
+        code: &[
+            (Op::CallFrame, 1),
+            (Op::LoadW, 3),
+            (Op::AbsTest, 1),
+            (Op::RegOp, 2),
+            (Op::CmpBranchW, 1),
+            (Op::Branch, 2),
+            (Op::PtrInit, 3),
+            (Op::LoopInitW, 1),
+            (Op::DeltaCompute, 1),
+            (Op::LoopIter, 3),
+            (Op::LoopInitB, 1),
+            (Op::UpdateRow, 1),
+            (Op::WeightApply, 2),
+            (Op::WeightClampHi, 2),
+            (Op::WeightClampLo, 2),
+        ],
+        // The negative-product path of the Δ computation: NEG.L, ADD.L #64, SHLR.L ×7, NEG.L.
+        extra: &[
+            Insn::Reg,
+            Insn::ImmL,
+            Insn::Reg,
+            Insn::Reg,
+            Insn::Reg,
+            Insn::Reg,
+            Insn::Reg,
+            Insn::Reg,
+            Insn::Reg,
+            Insn::Reg,
+        ],
+    },
+    Routine {
+        name: "learner forward pass",
+        code: &[
+            (Op::CallFrame, 1),
+            (Op::PtrInit, 8),
+            (Op::LoopInitB, 7),
+            (Op::LoopInitW, 1),
+            (Op::AccClear, 1),
+            (Op::Mac, 1),
+            (Op::LoopIter, 5),
+            (Op::StoreL, 1),
+            (Op::LoadL, 4),
+            (Op::CmpBranch, 3),
+            (Op::NewMax, 1),
+            (Op::IndexInc, 1),
+            (Op::StoreVarB, 1),
+            (Op::CmpImmBranch, 1),
+            (Op::Shr1, 7),
+            (Op::Sat16, 1),
+            (Op::SatClamp, 2),
+            (Op::StoreW, 2),
+            (Op::NormShiftStep, 1),
+            (Op::NormSetup, 1),
+            (Op::RegOp, 1),
+            (Op::VarShiftStep, 1),
+            (Op::Shl15, 1),
+            (Op::Div, 1),
+            (Op::Branch, 2),
+            (Op::ClampW, 2),
+        ],
+        extra: &[],
+    },
+];
+
 /// The phases of a learner step, in the order the firmware runs them (SPEC §3.5).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(u8)]
@@ -736,6 +860,21 @@ mod tests {
         // A branch fetches its own word and then refills the prefetch queue at the target
         // (taken) or the next word (not taken): two fetches either way.
         assert_eq!(Insn::Bcc8.states(), 2 * Insn::Bcc8.bytes());
+    }
+
+    #[test]
+    fn routine_sizes_add_up_from_the_sequences() {
+        // The forward routine holds one multiply-accumulate sequence (12 bytes: two 2-byte
+        // loads, EXTS, a 4-byte MULXS.W, ADD.L) among everything else.
+        assert_eq!(Op::Mac.spec().bytes(), 2 + 2 + 2 + 4 + 2);
+        for r in LEARNER_ROUTINES {
+            assert!(
+                r.bytes() > 100 && r.bytes() < 1000,
+                "{}: {}",
+                r.name,
+                r.bytes()
+            );
+        }
     }
 
     #[test]

@@ -22,6 +22,7 @@ pub const MAX_HISTORY: usize = 8;
 pub struct InputLayout {
     history: u8,
     bias: bool,
+    spare: u16,
 }
 
 impl Default for InputLayout {
@@ -35,6 +36,7 @@ impl InputLayout {
     pub const DEFAULT: InputLayout = InputLayout {
         history: 1,
         bias: false,
+        spare: 0,
     };
 
     /// A layout with `history` delayed copies of the proximities and an optional bias input.
@@ -48,7 +50,20 @@ impl InputLayout {
         Ok(InputLayout {
             history: history as u8,
             bias,
+            spare: 0,
         })
+    }
+
+    /// The same layout with `spare` inputs held at 0 after the others (for what-if studies).
+    #[must_use]
+    pub const fn with_spare(self, spare: u16) -> InputLayout {
+        InputLayout { spare, ..self }
+    }
+
+    /// Number of spare inputs.
+    #[must_use]
+    pub const fn spare(self) -> usize {
+        self.spare as usize
     }
 
     /// The history depth H.
@@ -63,10 +78,10 @@ impl InputLayout {
         self.bias
     }
 
-    /// Number of inputs N for `n_out` behaviours: `4·(1 + H) + M + 1 (+ 1 with bias)`.
+    /// Number of inputs N for `n_out` behaviours: `4·(1 + H) + M + 1 (+ 1 with bias) (+ spare)`.
     #[must_use]
     pub const fn n_inputs(self, n_out: usize) -> usize {
-        SENSORS * (1 + self.history as usize) + n_out + 1 + self.bias as usize
+        SENSORS * (1 + self.history as usize) + n_out + 1 + self.bias as usize + self.spare as usize
     }
 
     /// Index of the first past output in the vector.
@@ -90,5 +105,6 @@ mod tests {
             InputLayout::new(9, false),
             Err(ConfigError::History { got: 9 })
         );
+        assert_eq!(InputLayout::DEFAULT.with_spare(243).n_inputs(4), 256);
     }
 }
