@@ -1,0 +1,222 @@
+//! How the Rust controller pays for what it does on the emulated MCU.
+//!
+//! The controller is a program running on the H8/3052F, written in Rust instead of H8 code. It
+//! reaches the hardware only through [`Bus`] register reads and writes, each charged by the area
+//! it touches (3 states per byte of on-chip I/O, SPEC §4.1); the instruction fetches of the
+//! instructions that make those accesses are charged as ROM fetch cycles (2 states per word);
+//! register-only code is charged from its instruction sequence ([`nn_q15::cost::Insn`]); the
+//! learner's arithmetic is charged from `nn_q15`'s H8 meter. Between charges the controller
+//! takes the tick interrupt when it is pending, as the chip would with interrupts enabled, and
+//! keeps the states spent in it apart so that every phase is measured without it.
+
+use eeprom::I2cPins;
+use nn_q15::cost::Insn;
+
+use super::regs::{IMA, ITU0, P4DDR, P4DR, SCL_BIT, SDA_BIT, TSR, VECTOR_IMIA0};
+use crate::bus::Bus;
+use crate::cpu::timing::{N_INTERRUPT_INTERNAL, N_PRIORITY_DECISION_INTERNAL};
+use crate::memmap::{RAM_ACCESS_STATES, ROM_ACCESS_STATES};
+
+/// States of one instruction-fetch cycle from the on-chip flash (SPEC §4.1: 2 states, 16-bit).
+pub const FETCH_STATES: u32 = ROM_ACCESS_STATES;
+
+/// Interrupt entry for an on-chip source, as the H8/300H core charges it (H8/3052F hardware
+/// manual Table 5-5): priority decision, the prefetch at the return address, PC and CCR pushed
+/// (two word writes to RAM), the vector read (two words from flash), the prefetch of the
+/// handler, and the internal states after it.
+pub const INTERRUPT_ENTRY_STATES: u32 = N_PRIORITY_DECISION_INTERNAL
+    + FETCH_STATES
+    + 2 * RAM_ACCESS_STATES
+    + 2 * ROM_ACCESS_STATES
+    + FETCH_STATES
+    + N_INTERRUPT_INTERNAL;
+
+/// States of RTE (SPEC §4.2).
+pub const RTE_STATES: u32 = 10;
+/// States of SLEEP (SPEC §4.2).
+pub const SLEEP_STATES: u32 = 2;
+
+/// Sum of the states of an instruction sequence (on-chip operands, SPEC §4.2).
+#[must_use]
+pub const fn states_of(insns: &[Insn]) -> u32 {
+    let mut total = 0;
+    let mut i = 0;
+    while i < insns.len() {
+        total += insns[i].states();
+        i += 1;
+    }
+    total
+}
+
+/// The tick interrupt's handler body after entry: save ER0, read TSR0 (IMFA = 1), clear IMFA,
+/// write TSR0 back, increment the 32-bit tick counter in RAM, restore ER0; RTE follows.
+/// (`PUSH.L ER0 ; MOV.B @TSR0:8,R0L ; BCLR #0,R0L ; MOV.B R0L,@TSR0:8 ; MOV.L @TICKS:16,ER0 ;
+/// INC.L #1,ER0 ; MOV.L ER0,@TICKS:16 ; POP.L ER0 ; RTE`; the two TSR0 accesses go over the bus.)
+const ISR_REGISTER_CODE: [Insn; 6] = [
+    Insn::PushPopL,
+    Insn::Reg,
+    Insn::MovLAbs16,
+    Insn::Reg,
+    Insn::MovLAbs16,
+    Insn::PushPopL,
+];
+
+/// The firmware's view of the MCU while it runs: the bus, whether interrupts are enabled, the
+/// tick counter the interrupt handler keeps, and the states spent in the handler so far.
+pub struct Fw<'a, B: Bus> {
+    /// The MCU.
+    pub bus: &'a mut B,
+    /// CCR.I = 0: the tick interrupt is taken when pending.
+    pub interrupts_enabled: bool,
+    /// The tick counter (a 32-bit variable in RAM on the chip).
+    pub ticks: &'a mut u64,
+    /// States spent in the tick handler (entry to RTE) since the counter was last reset.
+    pub isr_states: u64,
+}
+
+impl<'a, B: Bus> Fw<'a, B> {
+    /// A view of `bus` with the tick counter `ticks`.
+    pub fn new(bus: &'a mut B, ticks: &'a mut u64, interrupts_enabled: bool) -> Self {
+        Self {
+            bus,
+            interrupts_enabled,
+            ticks,
+            isr_states: 0,
+        }
+    }
+
+    /// The MCU clock.
+    pub fn now(&self) -> u64 {
+        self.bus.now()
+    }
+
+    /// Runs register-only code (no I/O access), then takes a pending tick.
+    pub fn code(&mut self, insns: &[Insn]) {
+        self.bus.internal(states_of(insns));
+        self.service();
+    }
+
+    /// Lets `states` states of register and RAM work pass (the learner's metered arithmetic),
+    /// then takes a pending tick.
+    pub fn lump(&mut self, states: u64) {
+        let mut left = states;
+        while left > 0 {
+            let chunk = u32::try_from(left).unwrap_or(u32::MAX);
+            self.bus.internal(chunk);
+            left -= u64::from(chunk);
+        }
+        self.service();
+    }
+
+    /// `MOV.B @aa:8,R0L`: one fetch, one byte read.
+    pub fn read8(&mut self, addr: u32) -> u8 {
+        self.bus.internal(FETCH_STATES);
+        let v = self.bus.read8(addr);
+        self.service();
+        v
+    }
+
+    /// `MOV.B R0L,@aa:8`: one fetch, one byte write.
+    pub fn write8(&mut self, addr: u32, value: u8) {
+        self.bus.internal(FETCH_STATES);
+        self.bus.write8(addr, value);
+        self.service();
+    }
+
+    /// `MOV.W R0,@aa:16`: two fetches, one word write.
+    pub fn write16(&mut self, addr: u32, value: u16) {
+        self.bus.internal(2 * FETCH_STATES);
+        self.bus.write16(addr, value);
+        self.service();
+    }
+
+    /// Takes the tick interrupt if interrupts are enabled and it is pending.
+    pub fn service(&mut self) {
+        if self.interrupts_enabled && self.bus.pending_irq() == Some(VECTOR_IMIA0) {
+            self.tick_handler();
+        }
+    }
+
+    /// Interrupt entry, the handler and RTE; counts one tick.
+    pub fn tick_handler(&mut self) {
+        let t0 = self.bus.now();
+        self.bus.internal(INTERRUPT_ENTRY_STATES);
+        // PUSH.L ER0, then MOV.B @TSR0:8,R0L (IMFA reads 1) ; BCLR #0,R0L ; MOV.B R0L,@TSR0:8
+        // clears it (the chip's read-1-then-write-0 rule).
+        self.bus.internal(states_of(&ISR_REGISTER_CODE[..1]));
+        self.bus.internal(FETCH_STATES);
+        let tsr = self.bus.read8(ITU0 + TSR);
+        self.bus.internal(states_of(&ISR_REGISTER_CODE[1..2]));
+        self.bus.internal(FETCH_STATES);
+        self.bus.write8(ITU0 + TSR, tsr & !IMA);
+        self.bus.internal(states_of(&ISR_REGISTER_CODE[2..]));
+        self.bus.internal(RTE_STATES);
+        *self.ticks += 1;
+        self.isr_states += self.bus.now() - t0;
+    }
+}
+
+/// Port 4 as the I²C pins (SPEC §3.6): a line is pulled low by setting its DDR bit (DR bits 7
+/// and 6 stay 0) and released by clearing it; the DDR is write-only, so the firmware keeps a
+/// shadow in a register and writes it whole. A pin operation is `BSET/BCLR #n,R2L ;
+/// MOV.B R2L,@P4DDR:8` (2 + 2 + 3 = 7 states, the edge at the end of the write); reading SDA is
+/// `MOV.B @P4DR:8,R0L ; BTST #7,R0L` (2 + 3 + 2 = 7). The master's waits are the firmware's delay
+/// loops; the shifts and branches that pick each bit run inside them.
+pub struct FwPins<'f, 'a, B: Bus> {
+    /// The firmware's view of the MCU.
+    pub fw: &'f mut Fw<'a, B>,
+    /// The P4DDR shadow.
+    pub shadow: &'f mut u8,
+}
+
+/// States of one I²C pin operation (see [`FwPins`]).
+pub const PIN_OP_STATES: u64 = 7;
+
+impl<B: Bus> FwPins<'_, '_, B> {
+    fn set_ddr(&mut self, bit: u8, pull: bool) {
+        if pull {
+            *self.shadow |= bit;
+        } else {
+            *self.shadow &= !bit;
+        }
+        self.fw.bus.internal(states_of(&[Insn::Reg]));
+        self.fw.write8(P4DDR, *self.shadow);
+    }
+}
+
+impl<B: Bus> I2cPins for FwPins<'_, '_, B> {
+    fn scl_low(&mut self) {
+        self.set_ddr(SCL_BIT, true);
+    }
+    fn scl_release(&mut self) {
+        self.set_ddr(SCL_BIT, false);
+    }
+    fn sda_low(&mut self) {
+        self.set_ddr(SDA_BIT, true);
+    }
+    fn sda_release(&mut self) {
+        self.set_ddr(SDA_BIT, false);
+    }
+    fn sda_is_high(&mut self) -> bool {
+        let v = self.fw.read8(P4DR);
+        self.fw.code(&[Insn::Reg]);
+        v & SDA_BIT != 0
+    }
+    fn wait_states(&mut self, states: u64) {
+        self.fw.lump(states);
+    }
+    fn op_states(&self) -> u64 {
+        PIN_OP_STATES
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn interrupt_entry_is_the_manuals_17_states() {
+        assert_eq!(INTERRUPT_ENTRY_STATES, 17);
+        assert_eq!(states_of(&[Insn::MulxsW, Insn::Reg]), 26);
+    }
+}

@@ -1,0 +1,870 @@
+//! The robot controller: the program the H8/3052F runs, written in Rust, running on the
+//! emulated MCU through its registers.
+//!
+//! # What it does (SPEC §3.5)
+//! At boot it sets up the ports, the ITU (ITU0 as a 10 ms tick interrupt, ITU1 and ITU2 as the
+//! motors' PWM) and the I²C lines, then restores the newest valid record from the two EEPROMs
+//! or, if there is none, draws fresh weights with a seeded xorshift32 (uniform in ±0.5). Then it
+//! sleeps; every tick interrupt counts a tick, and every `step_period_s / 10 ms` ticks it runs a
+//! step:
+//! 1. **A/D**: a scan of AN0–AN3 (134 states per conversion, CKS = 1), polling ADF, then the
+//!    four 8-bit codes through the du table (SPEC §3.3) into the proximities p;
+//! 2. **learner**: D and E(t−1), the update, the input vector and the forward pass
+//!    (`nn_q15`, charged from its H8 meter, phases `input`, `update`, `forward`);
+//! 3. **motors**: the winner's row of the behaviour table into GRB1 and GRB2 (PWM duty) and the
+//!    H-bridge direction bits on port B;
+//! 4. **save** every `save_every_steps` steps: the weights as an A/B record on the EEPROMs
+//!    (`eeprom::persist`), bit-banged on port 4 with ACK polling during each write cycle;
+//! 5. back to SLEEP until the next step's tick.
+//!
+//! Every register access goes through the bus and is charged by area; instruction fetches and
+//! register-only code are charged from their instruction sequences ([`fw`]); the learner's
+//! arithmetic from `nn_q15`'s H8 meter. The tick interrupt is taken whenever it is pending
+//! between two charges (interrupts are enabled after boot), and its states are reported apart.
+//!
+//! # Choices where the spec is silent
+//! - Tick 10 ms (ITU0, φ/8, compare match A clears the counter); the step period must be a
+//!   whole number of ticks (0.45 s = 45, 0.60 s = 60). The first step comes with the first tick
+//!   after boot.
+//! - PWM: ITU1 (left) and ITU2 (right) in PWM mode at φ/8 with GRA = 1249: a 400 µs period
+//!   (2.5 kHz at 25 MHz); duty v = 1250 counts (GRB = 1249), 0.3 v = 375 counts (GRB = 374).
+//!   Direction: PB0/PB1 = IN1/IN2 of the left H-bridge, PB2/PB3 of the right (H/L forward,
+//!   L/H reverse).
+//! - The sample is taken at the step's tick: each sensor's held value dates from its latest
+//!   refresh, at most one sensor period (≤ 47.9 ms) earlier, while the robot was still running
+//!   the previous behaviour.
+//! - The record's payload is the weight matrix as the H8 holds it: row by row, big-endian i16.
+
+pub mod code;
+pub mod fw;
+pub mod regs;
+
+use eeprom::persist::{Persistence, Record, RecordLayout};
+use eeprom::{I2cMaster, MasterTiming};
+use nn_q15::cost::Insn;
+use nn_q15::{
+    Behaviour, DynLearner, H8Meter, InputLayout, Params, Phase, Q15, ShapeError, UpdateKind,
+    ram_items,
+};
+
+use crate::bus::Bus;
+use crate::ram::{RamMap, RamOverflow};
+use fw::{FETCH_STATES, Fw, FwPins, SLEEP_STATES, states_of};
+use regs::*;
+
+/// The tick period: 10 ms.
+pub const TICK_S: f64 = 0.010;
+/// PWM period in ITU counts at φ/8 (GRA + 1): 1250 counts, 400 µs at 25 MHz.
+pub const PWM_PERIOD_COUNTS: u16 = 1250;
+/// Lowest φ the H8/3052F runs at (hardware manual, electrical characteristics: 2 MHz).
+pub const CLOCK_MIN_HZ: u32 = 2_000_000;
+/// Highest φ of the H8/3052F (hardware manual: 25 MHz; the AKI board's crystal, SPEC §4.1).
+pub const CLOCK_MAX_HZ: u32 = 25_000_000;
+/// Longest step period accepted (10 minutes).
+pub const MAX_STEP_PERIOD_S: f64 = 600.0;
+/// Amplitude of the fresh random weights: uniform in ±0.5 (±16384 in Q15).
+pub const INITIAL_WEIGHT_AMPLITUDE: i16 = 16384;
+/// Most ACK polls per page write before the save gives up (well past a 5 ms write cycle).
+pub const MAX_POLLS: u32 = 2000;
+
+/// States of `MOV.B @(d:24,ERs),Rd` (SPEC §4.2: 10; the du table lookup in flash).
+const MOVB_DISP24_STATES: u32 = 10;
+/// States of JSR @aa:24 and RTS (SPEC §4.2: 10 each).
+const CALL_RETURN_STATES: u32 = 20;
+
+/// How the controller is set up.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ControllerConfig {
+    /// The MCU clock φ in Hz (2–25 MHz).
+    pub clock_hz: u32,
+    /// Enabled behaviours M (2: forward, backward; 4: all).
+    pub behaviours: usize,
+    /// History depth, bias and spare inputs.
+    pub layout: InputLayout,
+    /// η and T.
+    pub params: Params,
+    /// One record every this many steps (≥ 1).
+    pub save_every_steps: u32,
+    /// Step period in seconds: a whole number of 10 ms ticks.
+    pub step_period_s: f64,
+    /// Seed of the fresh random weights (used when no record is restored).
+    pub weight_seed: u64,
+}
+
+impl ControllerConfig {
+    /// The arena's controller (paper env. 2): four behaviours, η = 0.001, T = 10, 0.45 s,
+    /// one record every 20 steps, φ = 25 MHz.
+    #[must_use]
+    pub fn arena(weight_seed: u64) -> Self {
+        Self {
+            clock_hz: CLOCK_MAX_HZ,
+            behaviours: 4,
+            layout: InputLayout::DEFAULT,
+            params: Params::ARENA,
+            save_every_steps: eeprom::persist::DEFAULT_SAVE_EVERY_STEPS,
+            step_period_s: 0.45,
+            weight_seed,
+        }
+    }
+
+    /// The corridor's controller (paper env. 1): forward and backward, η = 0.1, T = 10, 0.60 s.
+    #[must_use]
+    pub fn corridor(weight_seed: u64) -> Self {
+        Self {
+            behaviours: 2,
+            params: Params::CORRIDOR,
+            step_period_s: 0.60,
+            ..Self::arena(weight_seed)
+        }
+    }
+
+    /// Number of inputs N.
+    #[must_use]
+    pub fn n_inputs(&self) -> usize {
+        self.layout.n_inputs(self.behaviours)
+    }
+}
+
+/// A controller that cannot be built or cannot run.
+#[derive(Debug, thiserror::Error)]
+pub enum ControllerError {
+    /// A configuration value out of range.
+    #[error("{field} = {value}: {valid}")]
+    Config {
+        /// Which setting.
+        field: &'static str,
+        /// Its value as given.
+        value: String,
+        /// What would be valid.
+        valid: String,
+    },
+    /// The controller's state does not fit the on-chip RAM.
+    #[error(transparent)]
+    Ram(#[from] RamOverflow),
+    /// The network shape is outside the learner's bounds.
+    #[error("the network cannot be built: {0}")]
+    Shape(#[from] ShapeError),
+    /// The EEPROM record layout or a save failed.
+    #[error("EEPROM: {0}")]
+    Persist(#[from] eeprom::PersistError),
+    /// The I²C master timing could not be set up for this clock.
+    #[error("I2C timing: {0}")]
+    I2c(#[from] eeprom::EepromError),
+    /// SLEEP returned without the tick interrupt pending.
+    #[error("SLEEP at state {now} woke without the tick interrupt (ITU0 compare match A) pending")]
+    NoTick {
+        /// The clock when it happened.
+        now: u64,
+    },
+}
+
+/// States of one step by phase, excluding the tick interrupts taken during it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PhaseStates {
+    /// A/D scan, du lookup.
+    pub adc: u64,
+    /// The learner's input phase (D, E, input vector).
+    pub input: u64,
+    /// The learner's update.
+    pub update: u64,
+    /// The learner's forward pass.
+    pub forward: u64,
+    /// Motor set-up.
+    pub motors: u64,
+    /// The EEPROM save (0 when none was due).
+    pub save: u64,
+    /// Tick interrupts taken during the step (entry to RTE).
+    pub isr: u64,
+}
+
+impl PhaseStates {
+    /// The step's own work: every phase but the interrupts.
+    #[must_use]
+    pub const fn work(&self) -> u64 {
+        self.adc + self.input + self.update + self.forward + self.motors + self.save
+    }
+}
+
+/// What one save did.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SaveSummary {
+    /// The record's sequence number.
+    pub sequence: u32,
+    /// The chip written (0x50 or 0x51).
+    pub chip: u8,
+    /// Pages written (body pages, then the commit page).
+    pub pages: usize,
+    /// ACK polls in total.
+    pub polls: u32,
+    /// Record bytes sent.
+    pub record_bytes: usize,
+}
+
+/// What one step did.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct StepReport {
+    /// The step's index from boot (0 = first step).
+    pub step: u64,
+    /// The clock when the step began.
+    pub start_states: u64,
+    /// The proximities read (du).
+    pub p: [u8; 4],
+    /// D(t).
+    pub d: i16,
+    /// E(t−1).
+    pub e: i16,
+    /// The update's branch (None at the first step).
+    pub update: Option<UpdateKind>,
+    /// The behaviour chosen.
+    pub behaviour: Behaviour,
+    /// States by phase.
+    pub phases: PhaseStates,
+    /// The save, when one was due.
+    pub saved: Option<SaveSummary>,
+}
+
+/// What boot did.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct BootReport {
+    /// The sequence number of the restored record, or None (fresh random weights).
+    pub restored: Option<u32>,
+    /// States from reset to the end of boot.
+    pub states: u64,
+}
+
+/// What the sleep between two steps did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SleepReport {
+    /// Tick interrupts taken while asleep.
+    pub ticks: u64,
+    /// States the CPU was busy while "asleep" (SLEEP, interrupt entry, handler, main loop).
+    pub busy_states: u64,
+    /// States elapsed in all.
+    pub elapsed_states: u64,
+}
+
+/// The controller: configuration, learner, RAM placement and the firmware's variables.
+#[derive(Clone, Debug)]
+pub struct Controller {
+    cfg: ControllerConfig,
+    learner: DynLearner,
+    ram: RamMap,
+    persistence: Persistence,
+    timing: MasterTiming,
+    p4_shadow: u8,
+    ticks: u64,
+    next_step_tick: u64,
+    ticks_per_step: u64,
+    tick_counts: u16,
+    steps: u64,
+    next_sequence: u32,
+    booted: bool,
+}
+
+fn config_error(
+    field: &'static str,
+    value: impl ToString,
+    valid: impl Into<String>,
+) -> ControllerError {
+    ControllerError::Config {
+        field,
+        value: value.to_string(),
+        valid: valid.into(),
+    }
+}
+
+impl Controller {
+    /// Checks the configuration, places the controller's state in the on-chip RAM and builds
+    /// the learner (its weights are set at boot).
+    ///
+    /// # Errors
+    /// [`ControllerError::Config`] for a value out of range, [`ControllerError::Ram`] naming the
+    /// item that overflows the 8 KB, [`ControllerError::Shape`] for a network beyond the
+    /// learner's no-overflow bound.
+    pub fn new(cfg: ControllerConfig) -> Result<Self, ControllerError> {
+        if !(CLOCK_MIN_HZ..=CLOCK_MAX_HZ).contains(&cfg.clock_hz) {
+            return Err(config_error(
+                "clock_hz",
+                cfg.clock_hz,
+                format!("the H8/3052F runs at {CLOCK_MIN_HZ} to {CLOCK_MAX_HZ} Hz (2 to 25 MHz)"),
+            ));
+        }
+        if !(2..=4).contains(&cfg.behaviours) {
+            return Err(config_error(
+                "behaviours",
+                cfg.behaviours,
+                "2 (forward, backward) to 4 (all four behaviours)",
+            ));
+        }
+        if cfg.save_every_steps == 0 {
+            return Err(config_error(
+                "save_every_steps",
+                0,
+                "at least 1 (one record every S steps)",
+            ));
+        }
+        let ticks = cfg.step_period_s / TICK_S;
+        if !(cfg.step_period_s.is_finite()
+            && cfg.step_period_s >= TICK_S
+            && cfg.step_period_s <= MAX_STEP_PERIOD_S
+            && (ticks - ticks.round()).abs() < 1e-9)
+        {
+            return Err(config_error(
+                "step_period_s",
+                cfg.step_period_s,
+                format!(
+                    "a whole number of 10 ms ticks from {TICK_S} to {MAX_STEP_PERIOD_S} s (0.45 and 0.60 are the paper's)"
+                ),
+            ));
+        }
+        let tick_counts = (TICK_S * f64::from(cfg.clock_hz) / PRESCALE as f64).round();
+        // 2–25 MHz gives 2 500 to 31 250 counts: always a 16-bit GRA.
+        let tick_counts = tick_counts as u16;
+
+        let n_in = cfg.n_inputs();
+        let n_out = cfg.behaviours;
+        let ram = Self::place_ram(n_in, n_out)?;
+        let layout = RecordLayout::new(0, u16::try_from(2 * n_in * n_out).unwrap_or(u16::MAX))?;
+        let persistence = Persistence::new(layout, MAX_POLLS)?;
+        let learner = DynLearner::new(
+            n_out,
+            cfg.layout,
+            cfg.params,
+            &vec![Q15::ZERO; n_in.min(nn_q15::MAX_INPUTS) * n_out],
+        )?;
+        let timing = MasterTiming::fast_mode(cfg.clock_hz)?;
+        Ok(Self {
+            ticks_per_step: ticks.round() as u64,
+            tick_counts,
+            cfg,
+            learner,
+            ram,
+            persistence,
+            timing,
+            p4_shadow: 0,
+            ticks: 0,
+            next_step_tick: 1,
+            steps: 0,
+            next_sequence: 0,
+            booted: false,
+        })
+    }
+
+    /// The RAM items of a controller with N inputs and M outputs, placed.
+    ///
+    /// # Errors
+    /// [`RamOverflow`] naming the first item that does not fit.
+    pub fn place_ram(n_in: usize, n_out: usize) -> Result<RamMap, RamOverflow> {
+        let mut ram = RamMap::new();
+        for item in ram_items(n_in, n_out) {
+            ram.place(item.name, item.bytes)?;
+        }
+        ram.place("proximities p (u8 x 4)", 4)?;
+        ram.place("tick counter, next step tick, step counter (u32 each)", 12)?;
+        ram.place("record sequence (u32), save countdown (u16)", 6)?;
+        ram.place("EEPROM page buffer (64 bytes)", 64)?;
+        ram.place("EEPROM commit block", eeprom::persist::COMMIT_BYTES as u32)?;
+        ram.place("xorshift32 state (u32)", 4)?;
+        ram.place(
+            "stack (deepest call chain + tick interrupt)",
+            code::stack_bytes(),
+        )?;
+        Ok(ram)
+    }
+
+    /// The configuration.
+    #[must_use]
+    pub fn config(&self) -> &ControllerConfig {
+        &self.cfg
+    }
+
+    /// The RAM placement.
+    #[must_use]
+    pub fn ram(&self) -> &RamMap {
+        &self.ram
+    }
+
+    /// The learner (its weights, shape and parameters).
+    #[must_use]
+    pub fn learner(&self) -> &DynLearner {
+        &self.learner
+    }
+
+    /// Changes the learning parameters (η = 0 freezes learning).
+    pub fn set_params(&mut self, params: Params) {
+        self.learner.set_params(params);
+    }
+
+    /// Ticks per step.
+    #[must_use]
+    pub const fn ticks_per_step(&self) -> u64 {
+        self.ticks_per_step
+    }
+
+    /// Steps run since boot.
+    #[must_use]
+    pub const fn steps(&self) -> u64 {
+        self.steps
+    }
+
+    /// EEPROM bytes written per save (record bytes on the wire).
+    #[must_use]
+    pub fn bytes_per_save(&self) -> usize {
+        self.persistence
+            .layout()
+            .bytes_per_save(self.weight_bytes())
+    }
+
+    /// EEPROM pages written per save.
+    #[must_use]
+    pub fn pages_per_save(&self) -> usize {
+        self.persistence
+            .layout()
+            .pages_per_record(self.weight_bytes())
+    }
+
+    fn weight_bytes(&self) -> usize {
+        2 * self.learner.weights().len()
+    }
+
+    /// Boots on `bus` (the MCU after reset or after a power cut): sets up the hardware,
+    /// restores the newest valid record or draws fresh weights, enables interrupts. The first
+    /// step comes with the first tick.
+    ///
+    /// # Errors
+    /// None from the hardware model today; kept fallible for the bus errors of later boards.
+    pub fn boot<B: Bus>(&mut self, bus: &mut B) -> Result<BootReport, ControllerError> {
+        let t0 = bus.now();
+        self.ticks = 0;
+        self.next_step_tick = 1;
+        self.steps = 0;
+        self.p4_shadow = 0;
+        self.learner.restart();
+        let mut ticks = 0u64;
+        let restored = {
+            let mut fw = Fw::new(bus, &mut ticks, false);
+            // Stack pointer, ports: P4DR = 0 and P4DDR = 0 (both I2C lines released, ready to be
+            // pulled by DDR); port B bits 0-3 outputs, H-bridges coasting.
+            fw.code(&[Insn::ImmL, Insn::Reg]);
+            fw.write8(P4DR, 0);
+            fw.write8(P4DDR, 0);
+            fw.write8(PBDR, 0);
+            fw.code(&[Insn::Reg]);
+            fw.write8(PBDDR, 0x0F);
+            // ITU0: 10 ms tick; ITU1/2: PWM at φ/8, coasting duty; start all three.
+            fw.code(&[Insn::Reg]);
+            fw.write8(ITU0 + TCR, TCR_CLEAR_ON_GRA_PHI8);
+            fw.write8(ITU1 + TCR, TCR_CLEAR_ON_GRA_PHI8);
+            fw.write8(ITU2 + TCR, TCR_CLEAR_ON_GRA_PHI8);
+            fw.code(&[Insn::ImmW]);
+            fw.write16(ITU0 + GRA, self.tick_counts - 1);
+            fw.code(&[Insn::ImmW]);
+            fw.write16(ITU1 + GRA, PWM_PERIOD_COUNTS - 1);
+            fw.write16(ITU2 + GRA, PWM_PERIOD_COUNTS - 1);
+            fw.write16(ITU1 + GRB, PWM_PERIOD_COUNTS - 1);
+            fw.write16(ITU2 + GRB, PWM_PERIOD_COUNTS - 1);
+            fw.code(&[Insn::Reg]);
+            fw.write8(ITU0 + TIER, IMA);
+            fw.code(&[Insn::Reg]);
+            fw.write8(TMDR, 0b0000_0110);
+            fw.code(&[Insn::Reg]);
+            fw.write8(TSTR, 0b0000_0111);
+            fw.code(&[Insn::Reg, Insn::MovLAbs16, Insn::MovLAbs16, Insn::MovLAbs16]);
+
+            // Restore the newest valid record, if its size matches this network.
+            let expected = self.weight_bytes();
+            let recovery = {
+                let mut pins = FwPins {
+                    fw: &mut fw,
+                    shadow: &mut self.p4_shadow,
+                };
+                let mut master = I2cMaster::new(&mut pins, self.timing);
+                master.init();
+                let _ = master.bus_clear();
+                self.persistence.recover(&mut master)
+            };
+            fw.code(&[Insn::JsrAbs24, Insn::Rts]);
+            let usable = recovery
+                .newest
+                .as_ref()
+                .filter(|r| r.payload.len() == expected);
+            // The firmware checks the commit blocks and the body it read with CRC-16.
+            let checked: usize = 2 * eeprom::persist::COMMIT_BYTES
+                + recovery.newest.as_ref().map_or(0, |r| r.payload.len());
+            fw.lump(crc16_states_estimate(checked));
+            match usable {
+                Some(record) => {
+                    let weights: Vec<Q15> = record
+                        .payload
+                        .chunks_exact(2)
+                        .map(|b| Q15::from_bits(i16::from_be_bytes([b[0], b[1]])))
+                        .collect();
+                    // Lengths match by the filter above.
+                    let _ = self.learner.set_weights(&weights);
+                    self.next_sequence = record.sequence.wrapping_add(1);
+                    Some(record.sequence)
+                }
+                None => {
+                    let weights = fresh_weights(self.cfg.weight_seed, self.learner.weights().len());
+                    fw.lump(XORSHIFT_WEIGHT_STATES * weights.len() as u64);
+                    let _ = self.learner.set_weights(&weights);
+                    self.next_sequence = recovery.next_sequence();
+                    None
+                }
+            }
+        };
+        // ANDC #H'7F,CCR: interrupts on.
+        bus.internal(FETCH_STATES);
+        self.ticks = ticks;
+        self.booted = true;
+        Ok(BootReport {
+            restored,
+            states: bus.now() - t0,
+        })
+    }
+
+    /// Sleeps until the next step is due: SLEEP, the tick interrupt, the main loop's check,
+    /// again and again.
+    ///
+    /// # Errors
+    /// [`ControllerError::NoTick`] when SLEEP wakes without the tick pending (the ITU was
+    /// stopped or reprogrammed behind the controller's back).
+    pub fn sleep_until_step<B: Bus>(
+        &mut self,
+        bus: &mut B,
+    ) -> Result<SleepReport, ControllerError> {
+        let t0 = bus.now();
+        let mut report = SleepReport::default();
+        let tick_states = u64::from(self.tick_counts) * PRESCALE;
+        let mut ticks = self.ticks;
+        {
+            let mut fw = Fw::new(bus, &mut ticks, true);
+            while *fw.ticks < self.next_step_tick {
+                fw.bus.internal(SLEEP_STATES);
+                let asleep_from = fw.bus.now();
+                let deadline = asleep_from + 2 * tick_states;
+                if !fw.bus.sleep_until_irq(deadline) || fw.bus.pending_irq() != Some(VECTOR_IMIA0) {
+                    return Err(ControllerError::NoTick { now: fw.bus.now() });
+                }
+                let slept = fw.bus.now() - asleep_from;
+                fw.tick_handler();
+                report.ticks += 1;
+                // Main loop: MOV.L @TICKS:16,ER0 ; MOV.L @NEXT:16,ER1 ; CMP.L ; BLO.
+                fw.code(&[Insn::MovLAbs16, Insn::MovLAbs16, Insn::Reg, Insn::Bcc8]);
+                report.busy_states += fw.bus.now() - asleep_from - slept + u64::from(SLEEP_STATES);
+            }
+        }
+        self.ticks = ticks;
+        self.next_step_tick += self.ticks_per_step;
+        report.elapsed_states = bus.now() - t0;
+        Ok(report)
+    }
+
+    /// Runs one step now (call it after [`Self::sleep_until_step`]).
+    ///
+    /// # Errors
+    /// [`ControllerError::Persist`] when a due save fails on the bus (a chip that never
+    /// answers, say).
+    pub fn step<B: Bus>(&mut self, bus: &mut B) -> Result<StepReport, ControllerError> {
+        let start_states = bus.now();
+        let mut ticks = self.ticks;
+        let mut phases = PhaseStates::default();
+        let step = self.steps;
+        let due = (step + 1).is_multiple_of(u64::from(self.cfg.save_every_steps));
+        let (p, out, saved) = {
+            let mut fw = Fw::new(bus, &mut ticks, true);
+            // Main loop: advance NEXT, call the A/D routine.
+            fw.code(&[Insn::ImmL, Insn::MovLAbs16]);
+
+            // 1. A/D: scan AN0-AN3 once, poll ADF, stop, read and linearise.
+            let t = Mark::new(&fw);
+            fw.bus.internal(CALL_RETURN_STATES / 2);
+            fw.code(&[Insn::Reg]);
+            fw.write8(ADCSR, ADCSR_ADST | ADCSR_SCAN | ADCSR_CKS | 3);
+            loop {
+                let v = fw.read8(ADCSR);
+                fw.code(&[Insn::Bcc8]);
+                if v & ADCSR_ADF != 0 {
+                    break;
+                }
+            }
+            fw.code(&[Insn::Reg]);
+            fw.write8(ADCSR, ADCSR_SCAN | ADCSR_CKS | 3);
+            let mut p = [0u8; 4];
+            for (k, pk) in p.iter_mut().enumerate() {
+                let code8 = fw.read8(ADDRAH + 2 * k as u32);
+                fw.bus
+                    .internal(states_of(&[Insn::Reg, Insn::Reg]) + MOVB_DISP24_STATES);
+                fw.code(&[Insn::MovBwAbs16]);
+                *pk = sensors::DU_TABLE[usize::from(code8)];
+            }
+            fw.bus.internal(CALL_RETURN_STATES / 2);
+            phases.adc = t.done(&fw);
+
+            // 2. The learner, charged phase by phase from its meter.
+            let mut meter = H8Meter::new();
+            let out = self.learner.step(&p, &mut meter);
+            for (phase, slot) in [
+                (Phase::Input, &mut phases.input),
+                (Phase::Update, &mut phases.update),
+                (Phase::Forward, &mut phases.forward),
+            ] {
+                let t = Mark::new(&fw);
+                fw.bus.internal(CALL_RETURN_STATES / 2);
+                fw.lump(meter.states(phase));
+                *slot = t.done(&fw);
+            }
+
+            // 3. Motors: the behaviour table's row into GRB1, GRB2 and port B.
+            let t = Mark::new(&fw);
+            fw.bus.internal(CALL_RETURN_STATES / 2);
+            fw.code(&[
+                Insn::MovBwAbs16,
+                Insn::Reg,
+                Insn::Reg,
+                Insn::Reg,
+                Insn::Reg,
+                Insn::Reg,
+                Insn::ImmL,
+                Insn::Reg,
+                Insn::MovBwPostInc,
+            ]);
+            let (left, right, dir) = motor_row(out.behaviour);
+            fw.write16(ITU1 + GRB, left);
+            fw.code(&[Insn::MovBwPostInc]);
+            fw.write16(ITU2 + GRB, right);
+            fw.code(&[Insn::MovBwInd]);
+            fw.write8(PBDR, dir);
+            fw.code(&[Insn::Rts]);
+            phases.motors = t.done(&fw);
+
+            // 4. The save, when due.
+            fw.code(&[Insn::MovBwAbs16, Insn::Reg, Insn::Bcc8]);
+            let saved = if due {
+                let t = Mark::new(&fw);
+                let s = self.save(&mut fw)?;
+                phases.save = t.done(&fw);
+                Some(s)
+            } else {
+                None
+            };
+            fw.code(&[Insn::MovBwAbs16, Insn::Bcc8]);
+            phases.isr = fw.isr_states;
+            (p, out, saved)
+        };
+        self.ticks = ticks;
+        self.steps += 1;
+        Ok(StepReport {
+            step,
+            start_states,
+            p,
+            d: out.d,
+            e: out.e,
+            update: out.update,
+            behaviour: out.behaviour,
+            phases,
+            saved,
+        })
+    }
+
+    /// Writes the weights as the next A/B record.
+    fn save<B: Bus>(&mut self, fw: &mut Fw<'_, B>) -> Result<SaveSummary, ControllerError> {
+        let payload: Vec<u8> = self
+            .learner
+            .weights()
+            .iter()
+            .flat_map(|w| w.to_bits().to_be_bytes())
+            .collect();
+        let record = Record {
+            sequence: self.next_sequence,
+            payload,
+        };
+        // The firmware builds the pages in its page buffer (EEPMOV.B from the weights) and
+        // computes the two CRCs over what it sends.
+        let (commit, body) = self.persistence.layout().encode(&record)?;
+        fw.bus.internal(CALL_RETURN_STATES);
+        let pages = body.len().div_ceil(64);
+        fw.lump(pages as u64 * (14 + 8) + 4 * body.len() as u64 + 7 * 6);
+        fw.lump(crc16_states(&body[..body.len() - 2]) + crc16_states(&commit[..commit.len() - 2]));
+        let report = {
+            let mut pins = FwPins {
+                fw,
+                shadow: &mut self.p4_shadow,
+            };
+            let mut master = I2cMaster::new(&mut pins, self.timing);
+            self.persistence.save(&mut master, &record)?
+        };
+        fw.code(&[Insn::MovLAbs16, Insn::Reg, Insn::MovLAbs16]);
+        self.next_sequence = self.next_sequence.wrapping_add(1);
+        Ok(SaveSummary {
+            sequence: report.sequence,
+            chip: report.chip,
+            pages: report.pages_written,
+            polls: report.polls_per_page.iter().sum(),
+            record_bytes: report.record_bytes,
+        })
+    }
+}
+
+/// Measures a phase: the clock and the interrupt states at its start.
+struct Mark {
+    t0: u64,
+    isr0: u64,
+}
+
+impl Mark {
+    fn new<B: Bus>(fw: &Fw<'_, B>) -> Self {
+        Self {
+            t0: fw.now(),
+            isr0: fw.isr_states,
+        }
+    }
+
+    /// States of the phase, interrupts excluded.
+    fn done<B: Bus>(&self, fw: &Fw<'_, B>) -> u64 {
+        (fw.now() - self.t0) - (fw.isr_states - self.isr0)
+    }
+}
+
+/// GRB1, GRB2 and the port-B direction bits for a behaviour (SPEC §3.5: forward (v, v),
+/// backward (−v, −v), turn-left-forward (0.3 v, v), turn-right-forward (v, 0.3 v)).
+#[must_use]
+pub fn motor_row(b: Behaviour) -> (u16, u16, u8) {
+    const FULL: u16 = PWM_PERIOD_COUNTS - 1;
+    // 0.3 v: 375 of 1250 counts high.
+    const SLOW: u16 = (PWM_PERIOD_COUNTS * 3).div_ceil(10) - 1;
+    const LEFT_FWD: u8 = 0b0001;
+    const LEFT_REV: u8 = 0b0010;
+    const RIGHT_FWD: u8 = 0b0100;
+    const RIGHT_REV: u8 = 0b1000;
+    match b {
+        Behaviour::Forward => (FULL, FULL, LEFT_FWD | RIGHT_FWD),
+        Behaviour::Backward => (FULL, FULL, LEFT_REV | RIGHT_REV),
+        Behaviour::TurnLeftForward => (SLOW, FULL, LEFT_FWD | RIGHT_FWD),
+        Behaviour::TurnRightForward => (FULL, SLOW, LEFT_FWD | RIGHT_FWD),
+    }
+}
+
+/// States of one fresh weight from xorshift32 (the routine in [`code`]): three shift-and-XOR
+/// rounds (13, 17 and 5 one-bit shifts of a long), the 15-bit extraction (17 shifts), the
+/// offset, the store and the loop: (13 + 17 + 5 + 17) · 2 + 3 · (2 + 2) + 2 + 2 + 4 + 4 + 2 + 6.
+pub const XORSHIFT_WEIGHT_STATES: u64 =
+    (13 + 17 + 5 + 17) * 2 + 3 * (2 + 2) + 2 + 2 + 4 + 4 + 2 + 6;
+
+/// Fresh weights: xorshift32 (13, 17, 5) seeded from `seed`, each weight the top 15 bits less
+/// 2^14, so uniform in [−16384, 16383] (±0.5).
+#[must_use]
+pub fn fresh_weights(seed: u64, n: usize) -> Vec<Q15> {
+    // Fold the 64-bit seed and keep the state non-zero (xorshift's one forbidden state).
+    let mut x = ((seed ^ (seed >> 32)) as u32) | 1;
+    (0..n)
+        .map(|_| {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            Q15::from_bits(((x >> 17) as i32 - i32::from(INITIAL_WEIGHT_AMPLITUDE)) as i16)
+        })
+        .collect()
+}
+
+/// States of the bitwise CRC-16/CCITT-FALSE routine in [`code`] over `bytes`: per byte the
+/// load, the XOR into the high byte and the bit counter (6 + 2 + 2), per bit the shift, the
+/// branch, the counter and the loop (2 + 4 + 2 + 4), plus 4 for each XOR with the polynomial,
+/// plus the byte loop (2 + 4).
+#[must_use]
+pub fn crc16_states(bytes: &[u8]) -> u64 {
+    let mut crc: u16 = 0xFFFF;
+    let mut xors = 0u64;
+    for &b in bytes {
+        crc ^= u16::from(b) << 8;
+        for _ in 0..8 {
+            if crc & 0x8000 != 0 {
+                crc = (crc << 1) ^ 0x1021;
+                xors += 1;
+            } else {
+                crc <<= 1;
+            }
+        }
+    }
+    bytes.len() as u64 * (10 + 8 * 12 + 6) + 4 * xors + 4
+}
+
+/// The CRC routine's states for `n` bytes whose contents are not at hand (half the bits XOR the
+/// polynomial on average): used for what recovery reads.
+#[must_use]
+pub fn crc16_states_estimate(n: usize) -> u64 {
+    n as u64 * (10 + 8 * 12 + 6 + 4 * 4) + 4
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn config_errors_name_the_setting() {
+        let mut cfg = ControllerConfig::arena(1);
+        cfg.clock_hz = 0;
+        let e = Controller::new(cfg).unwrap_err().to_string();
+        assert!(e.starts_with("clock_hz = 0"), "{e}");
+        let mut cfg = ControllerConfig::arena(1);
+        cfg.save_every_steps = 0;
+        assert!(
+            Controller::new(cfg)
+                .unwrap_err()
+                .to_string()
+                .contains("save_every_steps")
+        );
+        let mut cfg = ControllerConfig::arena(1);
+        cfg.step_period_s = 0.455;
+        assert!(
+            Controller::new(cfg)
+                .unwrap_err()
+                .to_string()
+                .contains("whole number of 10 ms")
+        );
+        let mut cfg = ControllerConfig::arena(1);
+        cfg.behaviours = 5;
+        assert!(
+            Controller::new(cfg)
+                .unwrap_err()
+                .to_string()
+                .contains("behaviours = 5")
+        );
+    }
+
+    #[test]
+    fn a_network_too_large_for_the_ram_names_the_item() {
+        let mut cfg = ControllerConfig::arena(1);
+        cfg.layout = InputLayout::DEFAULT.with_spare(1200);
+        match Controller::new(cfg) {
+            Err(ControllerError::Ram(o)) => {
+                assert_eq!(o.item, "weights w (i16, N x M)");
+                assert!(o.over_by > 0);
+            }
+            other => panic!("expected a RAM overflow, got {other:?}"),
+        }
+        // Fits the RAM but not the learner's no-overflow bound.
+        let mut cfg = ControllerConfig::arena(1);
+        cfg.layout = InputLayout::DEFAULT.with_spare(300);
+        assert!(matches!(
+            Controller::new(cfg),
+            Err(ControllerError::Shape(_))
+        ));
+    }
+
+    #[test]
+    fn motor_rows_follow_the_behaviours() {
+        assert_eq!(motor_row(Behaviour::Forward), (1249, 1249, 0b0101));
+        assert_eq!(motor_row(Behaviour::Backward), (1249, 1249, 0b1010));
+        assert_eq!(motor_row(Behaviour::TurnLeftForward), (374, 1249, 0b0101));
+        assert_eq!(motor_row(Behaviour::TurnRightForward), (1249, 374, 0b0101));
+    }
+
+    #[test]
+    fn fresh_weights_are_seeded_and_within_half() {
+        let a = fresh_weights(7, 52);
+        assert_eq!(a, fresh_weights(7, 52));
+        assert_ne!(a, fresh_weights(8, 52));
+        assert!(a.iter().all(|w| (-16384..16384).contains(&w.to_bits())));
+    }
+}
