@@ -1,7 +1,8 @@
 //! Running a program image on the core: the API behind `h8swarm emu`.
 //!
-//! [`run_image`] parses a `.mot` image, loads it into a [`Machine`] (512 KB flash, 8 KB RAM,
-//! SCI1 as console), resets the CPU through vector 0 and runs it until the program halts
+//! [`run_image`] parses a `.mot` image, loads it into a [`Machine`] — the same [`Mcu`] the
+//! robot's controller runs on (flash, RAM, SCI1 as console, ITU, A/D, ports, interrupt
+//! controller, EEPROMs on port 4) with a [`NullBoard`](crate::mcu::NullBoard) outside it — resets the CPU through vector 0 and runs it until the program halts
 //! (SLEEP with CCR.I = 1 and no NMI pending; exit status = low byte of R0, SPEC §7), the state
 //! budget runs out, or the core stops on an error (undefined opcode, fetch outside ROM/RAM).
 //! Bytes the program transmits on SCI1 go to the console writer as they leave TDR; the
@@ -15,6 +16,7 @@ use crate::bus::Bus;
 use crate::cpu::disasm::format_instr;
 use crate::cpu::{Cpu, CpuError, Event};
 use crate::machine::{LoadError, Machine};
+use crate::mcu::{Board, Mcu};
 use crate::srec::{self, SrecError};
 
 /// The system clock φ of the AKI-H8/3052F board: 25 MHz, 1 state = 40 ns (SPEC §4.1).
@@ -167,6 +169,21 @@ pub fn run_machine(
     machine: &mut Machine,
     options: &RunOptions,
     console: &mut dyn Write,
+    trace: Option<&mut dyn Write>,
+) -> std::io::Result<RunReport> {
+    run_mcu(cpu, machine.mcu_mut(), options, console, trace)
+}
+
+/// [`run_machine`] on any [`Mcu`], whatever board is outside it (a [`NullBoard`](crate::mcu::NullBoard) for
+/// `h8swarm emu`, the robot for machine-code controllers). `emulated_seconds` uses the MCU's φ.
+///
+/// # Errors
+/// Only I/O errors of the writers.
+pub fn run_mcu<B: Board>(
+    cpu: &mut Cpu,
+    machine: &mut Mcu<B>,
+    options: &RunOptions,
+    console: &mut dyn Write,
     mut trace: Option<&mut dyn Write>,
 ) -> std::io::Result<RunReport> {
     let deadline = options.max_states.unwrap_or(u64::MAX);
@@ -239,7 +256,7 @@ pub fn run_machine(
         stats: RunStats {
             instructions: cpu.instructions() - start_instructions,
             states,
-            emulated_seconds: states as f64 / PHI_HZ as f64,
+            emulated_seconds: states as f64 / f64::from(machine.clock_hz()),
             interrupts,
             console_bytes: machine.sci().bytes_sent(),
         },

@@ -1,0 +1,892 @@
+//! The H8/3052F as one chip: clock, flash, RAM, the peripherals and the robot's I²C EEPROMs on
+//! port 4, behind the [`Bus`] every program (the Rust controller or machine code on the
+//! H8/300H core) talks through.
+//!
+//! # Memory
+//! A swarm holds thousands of MCUs and the Rust controller never touches ROM or RAM contents,
+//! so memory is allocated only when used:
+//! - the 512 KB flash exists only once an image is loaded ([`Mcu::load_image`]) or poked;
+//!   reads of an empty flash return H'FF (erased flash);
+//! - the 8 KB RAM is allocated on the first write (bus or [`Mcu::poke`]); reads of untouched
+//!   RAM return 0.
+//!
+//! An `Mcu` without image and RAM holds a few hundred bytes plus its two EEPROM chips.
+//!
+//! # Peripherals and time
+//! The clock counts states since reset; every bus access advances it by the states of the
+//! area it touches ([`crate::memmap`]) before it takes effect. Word accesses to the ITU's
+//! 16-bit registers take one 3-state cycle ([`itu::ITU_WORD_ACCESS_STATES`]); other I/O word
+//! accesses take two byte cycles, upper byte first. Peripherals are synchronised lazily: each
+//! keeps the time it was last brought up to date and catches up, in O(1), when accessed, when
+//! the clock is fast-forwarded ([`Bus::sleep_until_irq`], [`Mcu::advance_to`]) or on
+//! [`Mcu::sync`]. The pending interrupt is cached until the next I/O access or the next
+//! instant a source can raise a request, so [`Bus::pending_irq`], called by the core before
+//! every instruction, is one comparison in the common case.
+//!
+//! The board (the robot outside the chip, [`Board`]) is asked for analog inputs with each
+//! conversion's sampling instant — at the latest when the MCU is next synchronised (an A/D
+//! access, the end of a sleep, [`Mcu::sync`], [`Mcu::advance_to`]) — and for the port-2 pins
+//! at each P2DR read. A board must answer for any instant not earlier than one it was already
+//! asked about and not later than the MCU clock.
+//!
+//! # I²C on port 4
+//! SDA = P4.7, SCL = P4.6 (SPEC §3.6): a line is pulled low while its DDR bit is 1 with DR = 0
+//! and released otherwise (a 1 in DR with DDR = 1 would drive the line high; it is treated as
+//! a release, since only the master could then pull it). Every write to P4DDR, P4DR or P4PCR
+//! passes the new pulls to the bus at the instant of the write; P4DR reads return the bus
+//! lines at the instant of the read (input bits, through the pull-up rule of
+//! [`crate::periph::ports`]). The chips' own events (end of a write cycle) are applied lazily
+//! by the bus.
+//!
+//! # Other registers
+//! SYSCR (H'FFFFF2) reads back what was written (reset H'0B). Registers of modules not
+//! modelled (DMAC, watchdog, SCI0, TPC, ports 1, 3, 5, 6, 7, 8, 9, the bus controller, the IRQ
+//! registers) read 0 and ignore writes.
+
+use std::cell::Cell;
+
+use eeprom::{DeviceConfig, EepromError, I2cBus, PowerCutOutcome};
+
+use crate::bus::Bus;
+use crate::memmap::{
+    ADDRESS_MASK, Area, IO_ACCESS_STATES, RAM_BYTES, RAM_START, ROM_BYTES, ROM_END,
+};
+use crate::periph::adc::{self, Adc};
+use crate::periph::intc::{self, Intc};
+use crate::periph::itu::{self, Itu};
+use crate::periph::ports::{self, Port};
+use crate::periph::sci::{self, Sci};
+use crate::srec::SrecImage;
+use crate::wiring::{
+    ITU_MOTOR_LEFT, ITU_MOTOR_RIGHT, MotorDrive, MotorPins, P4_SCL, P4_SDA, PA_TIOCA0, PA_TIOCA1,
+    PA_TIOCA2, PB_LEFT_IN1, PB_LEFT_IN2, PB_RIGHT_IN1, PB_RIGHT_IN2, PB_TIOCA3, PB_TIOCA4,
+    PwmOutput,
+};
+
+/// The clock φ of the AKI-H8/3052F board: 25 MHz, 1 state = 40 ns (SPEC §4.1).
+pub const DEFAULT_CLOCK_HZ: u32 = 25_000_000;
+/// Lowest φ accepted: 2 MHz (H8/3052F hardware manual, electrical characteristics: operating
+/// frequency 2–25 MHz).
+pub const MIN_CLOCK_HZ: u32 = 2_000_000;
+/// Highest φ accepted: 25 MHz (same table; also the top of the EEPROM model's clock range).
+pub const MAX_CLOCK_HZ: u32 = 25_000_000;
+
+/// Address of SYSCR, the system control register (SPEC §4.1: H'FFFFF2).
+pub const SYSCR: u32 = 0xFF_FFF2;
+/// Reset value of SYSCR in this model: H'0B (UE = 1, RAME = 1, STS = 000, SSBY = 0).
+pub const SYSCR_RESET: u8 = 0x0B;
+
+/// Index masks of the flash and RAM arrays (both sizes are powers of two).
+const ROM_INDEX_MASK: usize = ROM_BYTES as usize - 1;
+const RAM_INDEX_MASK: usize = RAM_BYTES as usize - 1;
+
+/// The robot outside the chip, as the MCU's input pins see it.
+pub trait Board {
+    /// Volts on analog input ANn at `now_states` (called at each conversion's sampling instant).
+    fn analog_volts(&mut self, channel: u8, now_states: u64) -> f64;
+    /// Levels of the port-2 input pins (bit n = P2.n) at `now_states`: 0 where something pulls
+    /// the pin low (a pressed bumper), 1 where nothing does — such a pin reads high only with
+    /// its on-chip pull-up enabled (P2PCR), as `sensors::port2_pins` assumes.
+    fn port2_pins(&mut self, now_states: u64) -> u8;
+}
+
+/// A board with nothing connected: every analog input at 0 V, every port-2 pin released
+/// (high with its pull-up). What `h8swarm emu` runs machine code with.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct NullBoard;
+
+impl Board for NullBoard {
+    fn analog_volts(&mut self, _channel: u8, _now_states: u64) -> f64 {
+        0.0
+    }
+
+    fn port2_pins(&mut self, _now_states: u64) -> u8 {
+        0xFF
+    }
+}
+
+/// How to build an [`Mcu`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct McuConfig {
+    /// The system clock φ in Hz ([`MIN_CLOCK_HZ`]..=[`MAX_CLOCK_HZ`]; default 25 MHz). The MCU
+    /// counts states; φ converts them to seconds and sets the EEPROMs' timing.
+    pub clock_hz: u32,
+    /// Seed of the two EEPROMs' random streams (write-cycle times, power-cut corruption,
+    /// wear).
+    pub eeprom_seed: u64,
+}
+
+impl Default for McuConfig {
+    fn default() -> Self {
+        McuConfig {
+            clock_hz: DEFAULT_CLOCK_HZ,
+            eeprom_seed: 0,
+        }
+    }
+}
+
+/// Why an MCU cannot be built or its EEPROMs cannot be switched.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum McuError {
+    /// φ outside what the chip runs at.
+    #[error(
+        "clock φ = {clock_hz} Hz is outside the H8/3052F's operating range {min}..={max} Hz",
+        min = MIN_CLOCK_HZ,
+        max = MAX_CLOCK_HZ
+    )]
+    InvalidClock {
+        /// The rejected value.
+        clock_hz: u32,
+    },
+    /// The EEPROM bus refused an operation.
+    #[error("EEPROM bus on port 4")]
+    Eeprom(#[from] EepromError),
+}
+
+/// Why an image cannot be loaded into the flash.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum LoadError {
+    /// Data outside the on-chip flash.
+    #[error(
+        "image data at H'{address:06X}..H'{end:06X} lies outside the on-chip flash H'000000-H'{rom_end:06X}; an S-record image may only load flash",
+        end = .address.wrapping_add(*.len as u32).wrapping_sub(1),
+        rom_end = ROM_END
+    )]
+    OutsideFlash {
+        /// First address of the offending chunk.
+        address: u32,
+        /// Its length in bytes.
+        len: usize,
+    },
+    /// No data at all.
+    #[error("the image holds no data records")]
+    Empty,
+}
+
+/// The H8/3052F with its board and the robot's EEPROM bus.
+#[derive(Clone, Debug)]
+pub struct Mcu<B: Board> {
+    now: u64,
+    clock_hz: u32,
+    rom: Option<Box<[u8; ROM_BYTES as usize]>>,
+    ram: Option<Box<[u8; RAM_BYTES as usize]>>,
+    sci: Sci,
+    itu: Itu,
+    adc: Adc,
+    intc: Intc,
+    p2: Port,
+    p4: Port,
+    pa: Port,
+    pb: Port,
+    syscr: u8,
+    i2c: I2cBus,
+    board: B,
+    /// The winning interrupt request as of the last computation.
+    irq_cached: Cell<Option<u8>>,
+    /// The cached request is valid while `now` is below this.
+    irq_valid_until: Cell<u64>,
+}
+
+impl<B: Board> Mcu<B> {
+    /// An MCU after reset with `board` outside it and the robot's two 24LC256 (0x50, 0x51) on
+    /// port 4, their streams seeded from `config.eeprom_seed`.
+    ///
+    /// # Errors
+    /// [`McuError::InvalidClock`] if `config.clock_hz` is outside
+    /// [`MIN_CLOCK_HZ`]..=[`MAX_CLOCK_HZ`]; [`McuError::Eeprom`] if the EEPROM model refuses.
+    pub fn new(config: McuConfig, board: B) -> Result<Self, McuError> {
+        if !(MIN_CLOCK_HZ..=MAX_CLOCK_HZ).contains(&config.clock_hz) {
+            return Err(McuError::InvalidClock {
+                clock_hz: config.clock_hz,
+            });
+        }
+        // I2cBus::robot(seed) with the chips counting in this MCU's φ.
+        let chip = DeviceConfig {
+            clock_hz: config.clock_hz,
+            ..DeviceConfig::new(eeprom::CHIP_A, config.eeprom_seed)
+        };
+        let i2c = I2cBus::with_chips(&[eeprom::CHIP_A, eeprom::CHIP_B], &chip)?;
+        Ok(Mcu {
+            now: 0,
+            clock_hz: config.clock_hz,
+            rom: None,
+            ram: None,
+            sci: Sci::new(),
+            itu: Itu::new(),
+            adc: Adc::new(),
+            intc: Intc::new(),
+            p2: Port::new(),
+            p4: Port::new(),
+            pa: Port::new(),
+            pb: Port::new(),
+            syscr: SYSCR_RESET,
+            i2c,
+            board,
+            irq_cached: Cell::new(None),
+            irq_valid_until: Cell::new(0),
+        })
+    }
+
+    /// The board outside the chip.
+    #[must_use]
+    pub fn board(&self) -> &B {
+        &self.board
+    }
+
+    /// The board, mutably (the world updates what the sensors see).
+    pub fn board_mut(&mut self) -> &mut B {
+        &mut self.board
+    }
+
+    /// The I²C bus with the two EEPROMs.
+    #[must_use]
+    pub fn i2c(&self) -> &I2cBus {
+        &self.i2c
+    }
+
+    /// The I²C bus, mutably (back-door loads and reads of the chips). Keep its time calls at
+    /// or after [`Bus::now`].
+    pub fn i2c_mut(&mut self) -> &mut I2cBus {
+        &mut self.i2c
+    }
+
+    /// φ in Hz.
+    #[must_use]
+    pub const fn clock_hz(&self) -> u32 {
+        self.clock_hz
+    }
+
+    /// SCI1 (the console).
+    #[must_use]
+    pub fn sci(&self) -> &Sci {
+        &self.sci
+    }
+
+    /// SCI1, mutably (to collect console output).
+    pub fn sci_mut(&mut self) -> &mut Sci {
+        self.invalidate_irq();
+        &mut self.sci
+    }
+
+    /// The ITU (read-only view; use the bus to program it).
+    #[must_use]
+    pub fn itu(&self) -> &Itu {
+        &self.itu
+    }
+
+    /// The A/D converter (read-only view).
+    #[must_use]
+    pub fn adc(&self) -> &Adc {
+        &self.adc
+    }
+
+    /// The interrupt controller (read-only view).
+    #[must_use]
+    pub fn intc(&self) -> &Intc {
+        &self.intc
+    }
+
+    /// Whether the flash holds an image (or poked bytes).
+    #[must_use]
+    pub fn has_flash(&self) -> bool {
+        self.rom.is_some()
+    }
+
+    /// Whether the RAM has been written since reset or the last power cut.
+    #[must_use]
+    pub fn has_ram(&self) -> bool {
+        self.ram.is_some()
+    }
+
+    fn rom_mut(&mut self) -> &mut [u8; ROM_BYTES as usize] {
+        self.rom.get_or_insert_with(new_erased_flash)
+    }
+
+    #[inline]
+    fn ram_mut(&mut self) -> &mut [u8; RAM_BYTES as usize] {
+        self.ram.get_or_insert_with(new_zeroed_ram)
+    }
+
+    /// Programs `image` into the flash (nothing is written if any chunk lies outside it). The
+    /// flash is allocated, erased (H'FF), on the first load.
+    ///
+    /// # Errors
+    /// [`LoadError`] if the image has data outside the flash or none at all.
+    pub fn load_image(&mut self, image: &SrecImage) -> Result<(), LoadError> {
+        if image.data_len() == 0 {
+            return Err(LoadError::Empty);
+        }
+        for c in &image.chunks {
+            let end = u64::from(c.address) + c.data.len() as u64;
+            if end > u64::from(ROM_BYTES) {
+                return Err(LoadError::OutsideFlash {
+                    address: c.address,
+                    len: c.data.len(),
+                });
+            }
+        }
+        let rom = self.rom_mut();
+        for c in &image.chunks {
+            let a = c.address as usize;
+            rom[a..a + c.data.len()].copy_from_slice(&c.data);
+        }
+        Ok(())
+    }
+
+    /// Writes bytes into flash or RAM directly (no bus cycle, no time): test set-up. Bytes at
+    /// addresses outside flash and RAM are ignored.
+    pub fn poke(&mut self, addr: u32, bytes: &[u8]) {
+        for (i, &b) in bytes.iter().enumerate() {
+            let a = addr.wrapping_add(i as u32) & ADDRESS_MASK;
+            match Area::of(a) {
+                Area::Rom => self.rom_mut()[a as usize & ROM_INDEX_MASK] = b,
+                Area::Ram => self.ram_mut()[(a - RAM_START) as usize & RAM_INDEX_MASK] = b,
+                _ => {}
+            }
+        }
+    }
+
+    /// Reads a byte of flash or RAM directly (no bus cycle, no time); other areas read H'FF.
+    #[must_use]
+    pub fn peek(&self, addr: u32) -> u8 {
+        let a = addr & ADDRESS_MASK;
+        match Area::of(a) {
+            Area::Rom => self.rom_byte(a),
+            Area::Ram => self.ram_byte(a),
+            _ => 0xff,
+        }
+    }
+
+    #[inline]
+    fn rom_byte(&self, a: u32) -> u8 {
+        match &self.rom {
+            Some(r) => r[a as usize & ROM_INDEX_MASK],
+            None => 0xff,
+        }
+    }
+
+    #[inline]
+    fn ram_byte(&self, a: u32) -> u8 {
+        match &self.ram {
+            Some(r) => r[(a.wrapping_sub(RAM_START)) as usize & RAM_INDEX_MASK],
+            None => 0,
+        }
+    }
+
+    /// Lets the clock run to `t_states` (if later) without bus cycles, then synchronises every
+    /// peripheral (the board is sampled for conversions that ended).
+    pub fn advance_to(&mut self, t_states: u64) {
+        if t_states > self.now {
+            self.now = t_states;
+        }
+        self.sync();
+    }
+
+    /// Brings every peripheral and the EEPROM bus up to the current clock.
+    pub fn sync(&mut self) {
+        let now = self.now;
+        self.itu.sync(now);
+        self.sync_adc();
+        self.sci.sync(now);
+        // Time never goes back here (max), so the bus cannot refuse.
+        let _ = self.i2c.advance_to(now.max(self.i2c.now()));
+        self.invalidate_irq();
+    }
+
+    /// The earliest state after now at which a peripheral next needs attention (an ITU compare
+    /// match or overflow, an A/D sampling instant or conversion end, an SCI frame end, an
+    /// EEPROM write cycle end), if any.
+    #[must_use]
+    pub fn next_event(&self) -> Option<u64> {
+        let now = self.now;
+        [
+            self.itu.next_event(now),
+            self.adc.next_event(now),
+            self.sci.next_irq_time(now),
+            self.i2c.next_event_states().filter(|&t| t > now),
+        ]
+        .into_iter()
+        .flatten()
+        .min()
+    }
+
+    /// The earliest state after now at which an enabled interrupt request appears.
+    fn next_irq_time(&self) -> Option<u64> {
+        let now = self.now;
+        [
+            self.itu.next_irq_time(now),
+            self.adc.next_irq_time(now),
+            if self.sci_requests(now) == 0 {
+                self.sci.next_irq_time(now)
+            } else {
+                None
+            },
+        ]
+        .into_iter()
+        .flatten()
+        .min()
+    }
+
+    /// The motor driver inputs now (ITU1/ITU2 PWM on TIOCA1/TIOCA2, IN1/IN2 on PB0–PB3).
+    pub fn motors(&mut self) -> MotorPins {
+        let pb = self.pb_pins();
+        MotorPins {
+            left: self.motor_drive(ITU_MOTOR_LEFT, PA_TIOCA1, pb, PB_LEFT_IN1, PB_LEFT_IN2),
+            right: self.motor_drive(ITU_MOTOR_RIGHT, PA_TIOCA2, pb, PB_RIGHT_IN1, PB_RIGHT_IN2),
+        }
+    }
+
+    fn motor_drive(&mut self, ch: usize, pa_bit: u8, pb: u8, in1: u8, in2: u8) -> MotorDrive {
+        let (itu_level, drives) = self.itu.tioca(ch, self.now);
+        let level = if drives {
+            itu_level
+        } else {
+            self.pa.output_levels() & pa_bit != 0
+        };
+        let wave = if drives && self.itu.running(ch) {
+            self.itu.pwm(ch, level)
+        } else {
+            None
+        };
+        MotorDrive {
+            pwm: PwmOutput {
+                running: wave.is_some(),
+                level,
+                period_states: wave.map_or(0, |w| w.period_states),
+                high_states: wave.map_or(0, |w| w.high_states),
+            },
+            in1: pb & in1 != 0,
+            in2: pb & in2 != 0,
+        }
+    }
+
+    /// Cuts the robot's power now: the EEPROMs lose power (a write cycle under way is
+    /// corrupted as the `eeprom` crate models it), the RAM loses its contents and every
+    /// peripheral returns to its reset state (ports released). The flash keeps its image. The
+    /// clock keeps running. Returns each chip's outcome (0x50, then 0x51).
+    ///
+    /// # Errors
+    /// [`McuError::Eeprom`] if the bus refuses (it cannot, as time never goes back here).
+    pub fn power_cut(&mut self) -> Result<Vec<PowerCutOutcome>, McuError> {
+        let t = self.now.max(self.i2c.now());
+        let outcomes = self.i2c.power_cut(t)?;
+        self.reset_peripherals();
+        self.ram = None;
+        Ok(outcomes)
+    }
+
+    /// Powers the robot on at `at_states` (the clock jumps there if it is later): the
+    /// EEPROMs power up, the peripherals are in their reset state. The caller resets the CPU
+    /// (or restarts the controller program).
+    ///
+    /// # Errors
+    /// [`McuError::Eeprom`] if the bus refuses (it cannot, as time never goes back here).
+    pub fn power_on(&mut self, at_states: u64) -> Result<(), McuError> {
+        self.now = self.now.max(at_states);
+        let t = self.now.max(self.i2c.now());
+        self.i2c.power_on(t)?;
+        self.reset_peripherals();
+        Ok(())
+    }
+
+    fn reset_peripherals(&mut self) {
+        self.sci = Sci::new();
+        self.itu = Itu::new();
+        self.adc = Adc::new();
+        self.intc = Intc::new();
+        self.p2 = Port::new();
+        self.p4 = Port::new();
+        self.pa = Port::new();
+        self.pb = Port::new();
+        self.syscr = SYSCR_RESET;
+        self.invalidate_irq();
+    }
+
+    #[inline]
+    fn invalidate_irq(&self) {
+        self.irq_valid_until.set(0);
+    }
+
+    fn sync_adc(&mut self) {
+        let now = self.now;
+        let board = &mut self.board;
+        self.adc.sync(now, &mut |ch, t| board.analog_volts(ch, t));
+    }
+
+    #[inline]
+    fn sci_requests(&self, now: u64) -> u64 {
+        self.sci.pending_irq(now).map_or(0, |v| 1u64 << v)
+    }
+
+    /// Recomputes the pending interrupt and how long it stays valid.
+    #[cold]
+    fn refresh_irq(&self) -> Option<u8> {
+        let now = self.now;
+        let requests = self.itu.requests(now) | self.adc.requests(now) | self.sci_requests(now);
+        let winner = self.intc.choose(requests);
+        let valid_until = match self.next_irq_time() {
+            Some(t) if t > now => t,
+            Some(_) => now, // recompute at every call until something changes
+            None => u64::MAX,
+        };
+        self.irq_cached.set(winner);
+        self.irq_valid_until.set(valid_until);
+        winner
+    }
+
+    /// Pin levels of port A: ITU-driven TIOCA0–2 (PA2, PA4, PA6), else the output latch; input
+    /// pins with nothing connected float and read 0 (port A has no pull-ups).
+    fn pa_pins(&mut self) -> u8 {
+        let mut pins = self.pa.output_levels();
+        for (ch, bit) in [(0, PA_TIOCA0), (1, PA_TIOCA1), (2, PA_TIOCA2)] {
+            let (level, drives) = self.itu.tioca(ch, self.now);
+            if drives {
+                pins = (pins & !bit) | if level { bit } else { 0 };
+            }
+        }
+        pins
+    }
+
+    /// Pin levels of port B: ITU-driven TIOCA3/TIOCA4 (PB0, PB2), else the output latch.
+    fn pb_pins(&mut self) -> u8 {
+        let mut pins = self.pb.output_levels();
+        for (ch, bit) in [(3, PB_TIOCA3), (4, PB_TIOCA4)] {
+            let (level, drives) = self.itu.tioca(ch, self.now);
+            if drives {
+                pins = (pins & !bit) | if level { bit } else { 0 };
+            }
+        }
+        pins
+    }
+
+    /// Levels of port 4's input pins: SDA/SCL from the bus, the rest unconnected; a released
+    /// pin reads high only through its pull-up.
+    fn p4_inputs(&mut self) -> u8 {
+        let t = self.now.max(self.i2c.now());
+        let released = match self.i2c.lines(t) {
+            Ok(l) => {
+                !(P4_SDA | P4_SCL) | if l.sda { P4_SDA } else { 0 } | if l.scl { P4_SCL } else { 0 }
+            }
+            // Cannot happen (time never goes back here); read the lines as released.
+            Err(_) => 0xFF,
+        };
+        self.p4.open_drain_levels(released)
+    }
+
+    /// Passes port 4's pulls on SDA/SCL to the bus at the current instant.
+    fn update_i2c(&mut self) {
+        let low = self.p4.driven_low();
+        let scl_low = low & P4_SCL != 0;
+        let sda_low = low & P4_SDA != 0;
+        if self.i2c.master_pulls() != (scl_low, sda_low) {
+            let t = self.now.max(self.i2c.now());
+            // Cannot fail: time never goes back here.
+            let _ = self.i2c.set_master(t, scl_low, sda_low);
+        }
+    }
+
+    fn io_read8(&mut self, a: u32) -> u8 {
+        self.invalidate_irq();
+        let now = self.now;
+        match a {
+            itu::ITU_FIRST..=itu::ITU_LAST => self.itu.read(a, now),
+            sci::SCI1_SMR..=sci::SCI1_RDR => self.sci.read(a, now),
+            ports::P2DDR | ports::P4DDR | ports::PADDR | ports::PBDDR => ports::DDR_READ_VALUE,
+            ports::P2DR => {
+                let released = self.board.port2_pins(now);
+                self.p2.read_dr(self.p2.open_drain_levels(released))
+            }
+            ports::P4DR => {
+                let inputs = self.p4_inputs();
+                self.p4.read_dr(inputs)
+            }
+            ports::PADR => {
+                let pins = self.pa_pins();
+                self.pa.read_dr(pins)
+            }
+            ports::PBDR => {
+                let pins = self.pb_pins();
+                self.pb.read_dr(pins)
+            }
+            ports::P2PCR => self.p2.pcr,
+            ports::P4PCR => self.p4.pcr,
+            adc::ADDRA..=adc::ADCR => {
+                self.sync_adc();
+                self.adc.read(a)
+            }
+            SYSCR => self.syscr,
+            intc::IPRA | intc::IPRB => self.intc.read(a),
+            _ => 0,
+        }
+    }
+
+    fn io_write8(&mut self, a: u32, v: u8) {
+        self.invalidate_irq();
+        let now = self.now;
+        match a {
+            itu::ITU_FIRST..=itu::ITU_LAST => self.itu.write(a, v, now),
+            sci::SCI1_SMR..=sci::SCI1_RDR => self.sci.write(a, v, now),
+            ports::P2DDR => self.p2.ddr = v,
+            ports::P2DR => self.p2.dr = v,
+            ports::P2PCR => self.p2.pcr = v,
+            ports::P4DDR => {
+                self.p4.ddr = v;
+                self.update_i2c();
+            }
+            ports::P4DR => {
+                self.p4.dr = v;
+                self.update_i2c();
+            }
+            ports::P4PCR => self.p4.pcr = v,
+            ports::PADDR => self.pa.ddr = v,
+            ports::PADR => self.pa.dr = v,
+            ports::PBDDR => self.pb.ddr = v,
+            ports::PBDR => self.pb.dr = v,
+            adc::ADDRA..=adc::ADCR => {
+                self.sync_adc();
+                self.adc.write(a, v, now);
+            }
+            SYSCR => self.syscr = v,
+            intc::IPRA | intc::IPRB => self.intc.write(a, v),
+            _ => {}
+        }
+    }
+}
+
+#[cold]
+fn new_erased_flash() -> Box<[u8; ROM_BYTES as usize]> {
+    let v = vec![0xffu8; ROM_BYTES as usize].into_boxed_slice();
+    match v.try_into() {
+        Ok(b) => b,
+        // The length is ROM_BYTES by construction.
+        Err(_) => unreachable!(),
+    }
+}
+
+#[cold]
+fn new_zeroed_ram() -> Box<[u8; RAM_BYTES as usize]> {
+    Box::new([0u8; RAM_BYTES as usize])
+}
+
+impl<B: Board> Bus for Mcu<B> {
+    #[inline]
+    fn now(&self) -> u64 {
+        self.now
+    }
+
+    #[inline]
+    fn read8(&mut self, addr: u32) -> u8 {
+        let a = addr & ADDRESS_MASK;
+        let area = Area::of(a);
+        self.now += u64::from(area.byte_states());
+        match area {
+            Area::Rom => self.rom_byte(a),
+            Area::Ram => self.ram_byte(a),
+            Area::Io => self.io_read8(a),
+            Area::Unmapped => 0xff,
+        }
+    }
+
+    #[inline]
+    fn read16(&mut self, addr: u32) -> u16 {
+        let a = addr & ADDRESS_MASK & !1;
+        match Area::of(a) {
+            Area::Rom => {
+                self.now += u64::from(Area::Rom.word_states());
+                match &self.rom {
+                    Some(r) => {
+                        let i = a as usize & ROM_INDEX_MASK & !1;
+                        u16::from_be_bytes([r[i], r[i | 1]])
+                    }
+                    None => 0xffff,
+                }
+            }
+            Area::Ram => {
+                self.now += u64::from(Area::Ram.word_states());
+                match &self.ram {
+                    Some(r) => {
+                        let i = (a - RAM_START) as usize & RAM_INDEX_MASK & !1;
+                        u16::from_be_bytes([r[i], r[i | 1]])
+                    }
+                    None => 0,
+                }
+            }
+            Area::Io => {
+                if itu::is_word_register(a) {
+                    // One cycle on the ITU's 16-bit internal bus.
+                    self.now += u64::from(itu::ITU_WORD_ACCESS_STATES);
+                    let hi = self.io_read8(a);
+                    let lo = self.io_read8(a + 1);
+                    u16::from_be_bytes([hi, lo])
+                } else {
+                    // Two byte cycles on the 8-bit bus, upper byte first.
+                    self.now += u64::from(IO_ACCESS_STATES);
+                    let hi = self.io_read8(a);
+                    self.now += u64::from(IO_ACCESS_STATES);
+                    let lo = self.io_read8(a + 1);
+                    u16::from_be_bytes([hi, lo])
+                }
+            }
+            Area::Unmapped => {
+                self.now += u64::from(Area::Unmapped.word_states());
+                0xffff
+            }
+        }
+    }
+
+    #[inline]
+    fn write8(&mut self, addr: u32, value: u8) {
+        let a = addr & ADDRESS_MASK;
+        let area = Area::of(a);
+        self.now += u64::from(area.byte_states());
+        match area {
+            Area::Ram => self.ram_mut()[(a - RAM_START) as usize & RAM_INDEX_MASK] = value,
+            Area::Io => self.io_write8(a, value),
+            // Flash is not writable through the bus; nothing answers unmapped addresses.
+            Area::Rom | Area::Unmapped => {}
+        }
+    }
+
+    #[inline]
+    fn write16(&mut self, addr: u32, value: u16) {
+        let a = addr & ADDRESS_MASK & !1;
+        let [hi, lo] = value.to_be_bytes();
+        match Area::of(a) {
+            Area::Ram => {
+                self.now += u64::from(Area::Ram.word_states());
+                let i = (a - RAM_START) as usize & RAM_INDEX_MASK & !1;
+                let r = self.ram_mut();
+                r[i] = hi;
+                r[i | 1] = lo;
+            }
+            Area::Io => {
+                if itu::is_word_register(a) {
+                    self.now += u64::from(itu::ITU_WORD_ACCESS_STATES);
+                    self.io_write8(a, hi);
+                    self.io_write8(a + 1, lo);
+                } else {
+                    self.now += u64::from(IO_ACCESS_STATES);
+                    self.io_write8(a, hi);
+                    self.now += u64::from(IO_ACCESS_STATES);
+                    self.io_write8(a + 1, lo);
+                }
+            }
+            area @ (Area::Rom | Area::Unmapped) => self.now += u64::from(area.word_states()),
+        }
+    }
+
+    #[inline]
+    fn internal(&mut self, states: u32) {
+        self.now += u64::from(states);
+    }
+
+    #[inline]
+    fn pending_irq(&self) -> Option<u8> {
+        if self.now < self.irq_valid_until.get() {
+            self.irq_cached.get()
+        } else {
+            self.refresh_irq()
+        }
+    }
+
+    fn sleep_until_irq(&mut self, deadline: u64) -> bool {
+        if self.pending_irq().is_some() {
+            return true;
+        }
+        match self.next_irq_time() {
+            Some(t) if t <= deadline => {
+                self.now = self.now.max(t);
+                self.sync();
+                self.pending_irq().is_some()
+            }
+            _ => {
+                if deadline != u64::MAX {
+                    self.now = self.now.max(deadline);
+                    self.sync();
+                }
+                false
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn mcu() -> Mcu<NullBoard> {
+        Mcu::new(McuConfig::default(), NullBoard).unwrap()
+    }
+
+    #[test]
+    fn clock_out_of_range_is_an_error() {
+        for hz in [0, MIN_CLOCK_HZ - 1, MAX_CLOCK_HZ + 1] {
+            let e = Mcu::new(
+                McuConfig {
+                    clock_hz: hz,
+                    eeprom_seed: 1,
+                },
+                NullBoard,
+            )
+            .unwrap_err();
+            assert_eq!(e, McuError::InvalidClock { clock_hz: hz });
+            assert!(e.to_string().contains("2000000..=25000000"), "{e}");
+        }
+        let m = Mcu::new(
+            McuConfig {
+                clock_hz: 16_000_000,
+                eeprom_seed: 1,
+            },
+            NullBoard,
+        )
+        .unwrap();
+        assert_eq!(m.clock_hz(), 16_000_000);
+        assert_eq!(m.i2c().devices()[0].clock().hz(), 16_000_000);
+    }
+
+    #[test]
+    fn memory_is_allocated_lazily() {
+        let mut m = mcu();
+        assert!(!m.has_flash() && !m.has_ram());
+        assert_eq!(m.read16(0x100), 0xFFFF);
+        assert_eq!(m.read8(RAM_START + 10), 0);
+        assert!(!m.has_flash() && !m.has_ram());
+        m.write16(RAM_START + 10, 0x1234);
+        assert!(m.has_ram());
+        assert_eq!(m.read16(RAM_START + 10), 0x1234);
+        // Flash is not writable through the bus.
+        m.write8(0x100, 0);
+        assert!(!m.has_flash());
+        m.poke(0x100, &[1, 2]);
+        assert!(m.has_flash());
+        assert_eq!(m.read16(0x100), 0x0102);
+        assert_eq!(m.peek(0x102), 0xFF);
+    }
+
+    #[test]
+    fn io_words_cost_two_cycles_but_itu_words_one() {
+        let mut m = mcu();
+        let t = m.now();
+        m.read16(adc::ADDRA);
+        assert_eq!(m.now() - t, 6);
+        let t = m.now();
+        m.read16(0xFF_FF68); // TCNT0
+        assert_eq!(m.now() - t, 3);
+        let t = m.now();
+        m.write16(0xFF_FF6A, 0x1234); // GRA0
+        assert_eq!(m.now() - t, 3);
+        assert_eq!(m.read16(0xFF_FF6A), 0x1234);
+        let t = m.now();
+        m.read8(itu::TSTR);
+        assert_eq!(m.now() - t, 3);
+    }
+
+    #[test]
+    fn syscr_and_unmodelled_registers() {
+        let mut m = mcu();
+        assert_eq!(m.read8(SYSCR), SYSCR_RESET);
+        m.write8(SYSCR, 0x09);
+        assert_eq!(m.read8(SYSCR), 0x09);
+        assert_eq!(m.read8(0xFF_FFC0), 0); // P1DDR: not modelled
+    }
+}

@@ -1,0 +1,143 @@
+//! The I/O ports the robot uses: port 2 (bumpers), port 4 (the bit-banged I²C bus), port A
+//! (ITU outputs TIOCA1/TIOCA2 to the motor drivers) and port B (H-bridge direction inputs)
+//! (H8/3052F hardware manual, section 9 "I/O Ports"; addresses from appendix B).
+//!
+//! Each port has a data direction register (DDR: 1 = output), a data register (DR, the output
+//! latch) and, for ports 2 and 4, an input pull-up control register (PCR). Behaviour modelled:
+//!
+//! - **DDRs are write-only.** The manual: a DDR cannot be read; a read returns 1 in every bit.
+//!   So reading PnDDR returns [`DDR_READ_VALUE`] (H'FF) whatever was written — firmware keeps a
+//!   shadow copy (SPEC §3.6).
+//! - **DR reads** return the DR latch for output bits (DDR = 1) and the pin level for input
+//!   bits (DDR = 0).
+//! - **Pull-ups** (P2PCR, P4PCR): an input pin with its PCR bit set is pulled high by the
+//!   on-chip MOS pull-up; a pin that nothing drives and nothing pulls up *floats*. A floating
+//!   input is undefined on the chip; here it reads 0 (a deterministic stand-in), so firmware
+//!   that forgets to enable the pull-ups it needs (bumpers, I²C) misreads as it would on the
+//!   robot. The pull-up is off for output bits, as on the chip. Ports A and B have no
+//!   pull-ups.
+//! - Pins driven by a peripheral (TIOCA outputs of the ITU) read their peripheral level; the
+//!   MCU computes those levels ([`crate::mcu`]).
+
+/// Address of P2DDR, port 2 data direction register (write-only; SPEC §4.1: H'FFFFC1).
+pub const P2DDR: u32 = 0xFF_FFC1;
+/// Address of P2DR, port 2 data register (SPEC §4.1: H'FFFFC3).
+pub const P2DR: u32 = 0xFF_FFC3;
+/// Address of P2PCR, port 2 input pull-up control register (H'FFFFD8).
+pub const P2PCR: u32 = 0xFF_FFD8;
+/// Address of P4DDR, port 4 data direction register (write-only; SPEC §4.1: H'FFFFC5).
+pub const P4DDR: u32 = 0xFF_FFC5;
+/// Address of P4DR, port 4 data register (SPEC §4.1: H'FFFFC7).
+pub const P4DR: u32 = 0xFF_FFC7;
+/// Address of P4PCR, port 4 input pull-up control register (SPEC §4.1: H'FFFFDA).
+pub const P4PCR: u32 = 0xFF_FFDA;
+/// Address of PADDR, port A data direction register (write-only; H8/3052F manual appendix B:
+/// H'FFFFD1).
+pub const PADDR: u32 = 0xFF_FFD1;
+/// Address of PADR, port A data register (H'FFFFD3).
+pub const PADR: u32 = 0xFF_FFD3;
+/// Address of PBDDR, port B data direction register (write-only; H'FFFFD4).
+pub const PBDDR: u32 = 0xFF_FFD4;
+/// Address of PBDR, port B data register (H'FFFFD6).
+pub const PBDR: u32 = 0xFF_FFD6;
+
+/// What a read of a write-only DDR returns: every bit 1 (H8/3052F manual, port sections: "DDR
+/// is a write-only register ... all bits are read as 1").
+pub const DDR_READ_VALUE: u8 = 0xFF;
+/// Reset value of DDR, DR and PCR of ports 2, 4, A and B: H'00 (all inputs, latches 0,
+/// pull-ups off) in single-chip mode.
+pub const PORT_RESET: u8 = 0x00;
+
+/// One 8-bit port: DDR, DR latch and PCR.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Port {
+    /// Data direction register (1 = output).
+    pub ddr: u8,
+    /// Data register (output latch).
+    pub dr: u8,
+    /// Input pull-up control register (ports 2 and 4; always 0 for the others).
+    pub pcr: u8,
+}
+
+impl Port {
+    /// A port after reset.
+    #[must_use]
+    pub const fn new() -> Self {
+        Port {
+            ddr: PORT_RESET,
+            dr: PORT_RESET,
+            pcr: PORT_RESET,
+        }
+    }
+
+    /// The input pins whose on-chip pull-up is on (PCR = 1 and DDR = 0).
+    #[inline]
+    #[must_use]
+    pub const fn pulled_up(&self) -> u8 {
+        self.pcr & !self.ddr
+    }
+
+    /// Levels of input pins that are either pulled low from outside or released: bit = 1
+    /// where nothing outside pulls the pin low. A released pin reads high only through its
+    /// pull-up; otherwise it floats and reads 0 (see the module docs).
+    #[inline]
+    #[must_use]
+    pub const fn open_drain_levels(&self, released: u8) -> u8 {
+        released & self.pulled_up()
+    }
+
+    /// What a DR read returns given the levels of the input pins: the latch for output bits,
+    /// the pin for input bits.
+    #[inline]
+    #[must_use]
+    pub const fn read_dr(&self, input_levels: u8) -> u8 {
+        (self.dr & self.ddr) | (input_levels & !self.ddr)
+    }
+
+    /// Pins that drive a low level (output bits whose latch is 0): what pulls an open-drain
+    /// line low when DDR is set with DR = 0 (SPEC §3.6).
+    #[inline]
+    #[must_use]
+    pub const fn driven_low(&self) -> u8 {
+        self.ddr & !self.dr
+    }
+
+    /// Levels the port drives on its output pins (input bits read 0 here).
+    #[inline]
+    #[must_use]
+    pub const fn output_levels(&self) -> u8 {
+        self.ddr & self.dr
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dr_reads_latch_for_outputs_and_pins_for_inputs() {
+        let p = Port {
+            ddr: 0xF0,
+            dr: 0xA5,
+            pcr: 0,
+        };
+        assert_eq!(p.read_dr(0x0F), 0xAF);
+        assert_eq!(p.read_dr(0x00), 0xA0);
+        assert_eq!(p.output_levels(), 0xA0);
+        assert_eq!(p.driven_low(), 0x50);
+    }
+
+    #[test]
+    fn released_inputs_need_their_pull_up() {
+        let p = Port {
+            ddr: 0x01,
+            dr: 0,
+            pcr: 0x0F,
+        };
+        // Bit 0 is an output (pull-up off), bits 1–3 pulled up, bits 4–7 float.
+        assert_eq!(p.pulled_up(), 0x0E);
+        assert_eq!(p.open_drain_levels(0xFF), 0x0E);
+        // Bit 2 pulled low from outside.
+        assert_eq!(p.open_drain_levels(0xFB), 0x0A);
+    }
+}
