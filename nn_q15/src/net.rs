@@ -409,18 +409,36 @@ pub(crate) fn update_core<Mt: Meter>(
 }
 
 /// Applies `delta` to one row, adding when `up` (the winner's row) and subtracting otherwise,
-/// and, when the meter is active, counts the clamps at the top and at the bottom (in a
-/// separate pass, so that the update itself compiles to the same saturating i16 loop with every
-/// meter).
+/// and, when the meter is active, counts the clamps at the top and at the bottom.
+///
+/// The counting runs on blocks of 16 lanes padded with zeros (a zero lane never clamps), so its
+/// loop has a fixed trip count and vectorises even for short rows such as the default 13; a
+/// clamp is a lane whose saturating result differs from the wrapping one, at the top when the
+/// change was upward.
 #[inline(always)]
 fn apply_row<Mt: Meter>(row: &mut [Q15], delta: &[i16], up: bool) -> (u32, u32) {
     let (mut hi, mut lo) = (0u32, 0u32);
     if Mt::ACTIVE {
-        let dir = if up { 1 } else { -1 };
-        for (wi, &d) in row.iter().zip(delta) {
-            let v = i32::from(wi.to_bits()) + dir * i32::from(d);
-            hi += u32::from(v > i32::from(i16::MAX));
-            lo += u32::from(v < i32::from(i16::MIN));
+        for (wc, dc) in row.chunks(16).zip(delta.chunks(16)) {
+            let (mut w, mut d) = ([0i16; 16], [0i16; 16]);
+            for (wk, x) in w.iter_mut().zip(wc) {
+                *wk = x.to_bits();
+            }
+            d[..dc.len()].copy_from_slice(dc);
+            if !up {
+                for dk in &mut d {
+                    *dk = dk.wrapping_neg();
+                }
+            }
+            let (mut h, mut l) = (0u16, 0u16);
+            for k in 0..16 {
+                let clamped = u16::from(w[k].saturating_add(d[k]) != w[k].wrapping_add(d[k]));
+                let upward = u16::from(d[k] > 0);
+                h += clamped & upward;
+                l += clamped & (upward ^ 1);
+            }
+            hi += u32::from(h);
+            lo += u32::from(l);
         }
     }
     if up {
