@@ -193,6 +193,8 @@ impl Orbit {
     #[inline]
     fn hits(&self, x: u64, n: u64) -> (u64, u64) {
         match self.first_hit(x) {
+            // A value outside the cycle is passed once, on the way to the first wrap.
+            Some(f) if f <= n && x >= self.cycle => (1, f),
             Some(f) if f <= n => {
                 let count = 1 + (n - f) / self.cycle;
                 (count, f + (count - 1) * self.cycle)
