@@ -178,9 +178,9 @@ fn flags_clear_by_reading_one_then_writing_zero() {
 #[test]
 fn each_channel_requests_its_own_vectors() {
     let mut m = mcu();
-    for ch in 0..5 {
+    for (ch, base) in CHANNEL_BASE.into_iter().enumerate() {
         setup(&mut m, ch, 0x20, 9, 4);
-        m.write8(CHANNEL_BASE[ch] + OFF_TIER, IMFB);
+        m.write8(base + OFF_TIER, IMFB);
     }
     m.write8(TSTR, 0x10); // only ITU4
     m.internal(20);
