@@ -9,6 +9,7 @@
 
 mod cost_report;
 mod emu_cmd;
+mod fit_cmd;
 mod replay;
 
 use std::fs::File;
@@ -34,6 +35,9 @@ enum Command {
     Cost(CostArgs),
     /// Run an H8/300H program image (.mot) on the emulated H8/3052F, SCI1 as the console.
     Emu(EmuArgs),
+    /// Does the learner fit the H8/3052F? RAM, ROM, states per phase, EEPROM, measured on the
+    /// emulated MCU (SPEC §6).
+    Fit(fit_cmd::FitArgs),
 }
 
 #[derive(Args, Debug)]
@@ -126,6 +130,7 @@ fn main() -> ExitCode {
         Some(Command::Emu(args)) => {
             emu_cmd::run(&args.image, args.max_states, args.trace, args.stats)
         }
+        Some(Command::Fit(args)) => fit(&args),
         None => cost(&CostArgs::default()),
     };
     match result {
@@ -201,6 +206,14 @@ fn cost(args: &CostArgs) -> Result<(), Failure> {
     } else {
         cost_report::render(&report)
     };
+    io::stdout()
+        .lock()
+        .write_all(text.as_bytes())
+        .or_else(write_failure)
+}
+
+fn fit(args: &fit_cmd::FitArgs) -> Result<(), Failure> {
+    let text = fit_cmd::run(args).map_err(Failure::Input)?;
     io::stdout()
         .lock()
         .write_all(text.as_bytes())

@@ -51,11 +51,14 @@
 #![deny(missing_docs)]
 
 pub mod bus;
+pub mod controller;
 pub mod cpu;
+pub mod fit;
 pub mod machine;
 pub mod mcu;
 pub mod memmap;
 pub mod periph;
+pub mod ram;
 pub mod run;
 pub mod srec;
 pub mod wiring;

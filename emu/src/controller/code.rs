@@ -40,6 +40,8 @@ pub const CONTROLLER_ROUTINES: &[Routine] = &[
             ("MOV.B R0L,@P4DR:8", 2),
             ("MOV.B R0L,@P4DDR:8", 2),
             ("MOV.B R0L,@PBDR:8", 2),
+            ("MOV.B #H'C0,R0L", 2),
+            ("MOV.B R0L,@P4PCR:8", 2),
             ("MOV.B #H'0F,R0L", 2),
             ("MOV.B R0L,@PBDDR:8", 2),
             ("MOV.B #H'23,R0L", 2),

@@ -444,10 +444,13 @@ impl Controller {
         let restored = {
             let mut fw = Fw::new(bus, &mut ticks, false);
             // Stack pointer, ports: P4DR = 0 and P4DDR = 0 (both I2C lines released, ready to be
-            // pulled by DDR); port B bits 0-3 outputs, H-bridges coasting.
+            // pulled by DDR) with the SDA/SCL pull-ups on; port B bits 0-3 outputs,
+            // H-bridges coasting.
             fw.code(&[Insn::ImmL, Insn::Reg]);
             fw.write8(P4DR, 0);
             fw.write8(P4DDR, 0);
+            fw.code(&[Insn::Reg]);
+            fw.write8(P4PCR, SDA_BIT | SCL_BIT);
             fw.write8(PBDR, 0);
             fw.code(&[Insn::Reg]);
             fw.write8(PBDDR, 0x0F);

@@ -49,6 +49,9 @@ pub const VECTOR_IMIA0: u8 = 24;
 pub const P4DDR: u32 = 0xFF_FFC5;
 /// Port 4 data register (SPEC §4.1: H'FFFFC7).
 pub const P4DR: u32 = 0xFF_FFC7;
+/// Port 4 input pull-up control register (SPEC §4.1: H'FFFFDA); bits 7 and 6 turn on the
+/// pull-ups of SDA and SCL, which are the only thing that takes a released line high.
+pub const P4PCR: u32 = 0xFF_FFDA;
 /// Port B data direction register (write-only).
 pub const PBDDR: u32 = 0xFF_FFD4;
 /// Port B data register.

@@ -1,0 +1,255 @@
+//! The controller on the emulated MCU: boot, the tick, steps within bounds derived here from
+//! SPEC §4.2, saves and their restore, a power cut in the middle of a save, determinism.
+
+use emu::bus::Bus;
+use emu::controller::{Controller, ControllerConfig, StepReport};
+use emu::mcu::{Board, Mcu, McuConfig};
+use nn_q15::Q15;
+
+/// A board whose four sensors read voltages that change with time (so the learner sees
+/// rewards, punishments and dead zones).
+struct Wave;
+
+impl Board for Wave {
+    fn analog_volts(&mut self, channel: u8, now: u64) -> f64 {
+        let t = now as f64 / 25e6;
+        1.4 + 1.1 * (t * (0.7 + 0.3 * f64::from(channel))).sin()
+    }
+    fn port2_pins(&mut self, _now: u64) -> u8 {
+        0xFF
+    }
+}
+
+fn mcu(seed: u64) -> Mcu<Wave> {
+    Mcu::new(
+        McuConfig {
+            clock_hz: 25_000_000,
+            eeprom_seed: seed,
+        },
+        Wave,
+    )
+    .expect("a valid MCU")
+}
+
+fn run(c: &mut Controller, m: &mut Mcu<Wave>, steps: u32) -> Vec<StepReport> {
+    (0..steps)
+        .map(|_| {
+            c.sleep_until_step(m).expect("the tick wakes the CPU");
+            c.step(m).expect("the step runs")
+        })
+        .collect()
+}
+
+#[test]
+fn steps_come_every_45_ticks_of_10_ms() {
+    let mut m = mcu(1);
+    let mut c = Controller::new(ControllerConfig::arena(7)).expect("valid");
+    c.boot(&mut m).expect("boots");
+    let r = run(&mut c, &mut m, 4);
+    let tick = 31_250 * 8; // 10 ms at φ/8, 25 MHz
+    for w in r.windows(2) {
+        let gap = w[1].start_states - w[0].start_states;
+        // The next step starts 45 ticks later, give or take the difference of where each step
+        // began inside its tick handler's aftermath (well under a tick).
+        assert!(gap.abs_diff(45 * tick) < 1_000, "{gap}");
+    }
+    assert_eq!(c.ticks_per_step(), 45);
+}
+
+/// States of the forward pass of a 13 × 4 network, bounded from SPEC §4.2 alone: each
+/// multiply-accumulate is two post-increment loads (6 + 6), EXTS (2), MULXS.W (24) and ADD.L
+/// (2), and each loop iteration at least a decrement (2) and a branch (4); the rest of the
+/// routine (row set-up, the argmax, the scaling of 4 outputs, its call and return) is at most
+/// 4 × 200 states even on its slowest path (a normalising shift of up to 17 places per output).
+const MAC_13X4_MIN: u64 = 52 * (6 + 6 + 2 + 24 + 2 + 2 + 4);
+const FORWARD_13X4_MAX: u64 = MAC_13X4_MIN + 4 * 200 + 17 * 14 + 4 * 17 * 8;
+
+/// The A/D phase: four conversions of 134 states (CKS = 1, SPEC §3.2) at least; at most those
+/// plus one more poll of ADF (MOV.B @aa:8 = 2 + 3 states, BPL = 4), the start and stop writes,
+/// four result reads (2 + 3) with the du lookup (EXTU ×2, MOV.B @(d:24) = 10) and the store
+/// (MOV.B @aa:16 = 6), and the call and return (10 + 10).
+const ADC_MIN: u64 = 4 * 134;
+const ADC_MAX: u64 = 4 * 134 + 9 + 2 * (2 + 2 + 3) + 4 * (5 + 4 + 10 + 6) + 20;
+
+#[test]
+fn the_step_lies_within_bounds_derived_from_the_instruction_states() {
+    let mut m = mcu(2);
+    let mut c = Controller::new(ControllerConfig::arena(3)).expect("valid");
+    c.boot(&mut m).expect("boots");
+    for r in run(&mut c, &mut m, 100) {
+        let p = r.phases;
+        assert!((ADC_MIN..=ADC_MAX).contains(&p.adc), "A/D {}", p.adc);
+        assert!(
+            (MAC_13X4_MIN..=FORWARD_13X4_MAX).contains(&p.forward),
+            "forward {}",
+            p.forward
+        );
+        // The update: nothing but its test in the dead zone, else 13 Δ (MULXS.W and the
+        // rounding, 74 states each) and 52 weight changes (28 states each) at least.
+        if matches!(
+            r.update,
+            Some(nn_q15::UpdateKind::Reward | nn_q15::UpdateKind::Punish)
+        ) {
+            assert!(p.update >= 13 * 74 + 52 * 28, "update {}", p.update);
+            assert!(
+                p.update <= 13 * 74 + 52 * (28 + 12) + 4 * 30 + 300,
+                "update {}",
+                p.update
+            );
+        } else {
+            assert!(p.update <= 150, "dead-zone update {}", p.update);
+        }
+        // Motors: two word writes to the ITU (2 fetches + 6 states over the 8-bit bus) and one
+        // byte write to port B (2 + 3) at least.
+        assert!(p.motors >= 2 * (4 + 6) + 5, "motors {}", p.motors);
+        if r.saved.is_some() {
+            // Three pages, each followed by a 3-5 ms write cycle polled to its end: at least
+            // 9 ms (225 000 states), at most 3 × (5 ms + one poll) plus the transfers.
+            assert!((225_000..=600_000).contains(&p.save), "save {}", p.save);
+        } else {
+            assert_eq!(p.save, 0);
+        }
+    }
+}
+
+#[test]
+fn saves_write_records_that_a_reboot_restores() {
+    let mut m = mcu(1);
+    let mut c = Controller::new(ControllerConfig::arena(7)).expect("valid");
+    assert_eq!(c.boot(&mut m).expect("boots").restored, None);
+    let reports = run(&mut c, &mut m, 40);
+    let saves: Vec<_> = reports.iter().filter_map(|r| r.saved.clone()).collect();
+    assert_eq!(saves.len(), 2, "one record every 20 steps");
+    assert_eq!((saves[0].sequence, saves[0].chip), (0, 0x50));
+    assert_eq!((saves[1].sequence, saves[1].chip), (1, 0x51));
+    assert!(
+        saves.iter().all(|s| s.pages == 3 && s.polls > 100),
+        "{saves:?}"
+    );
+    let weights = c.learner().weights().to_vec();
+    let mut again = Controller::new(ControllerConfig::arena(99)).expect("valid");
+    assert_eq!(again.boot(&mut m).expect("boots").restored, Some(1));
+    assert_eq!(again.learner().weights(), &weights[..]);
+}
+
+/// Delegates to an MCU and cuts the robot's power once the clock passes `cut_at`.
+struct CutAt<'a> {
+    mcu: &'a mut Mcu<Wave>,
+    cut_at: u64,
+    cut: bool,
+}
+
+impl CutAt<'_> {
+    fn check(&mut self) {
+        if !self.cut && self.mcu.now() >= self.cut_at {
+            self.mcu.power_cut().expect("power cut");
+            self.cut = true;
+        }
+    }
+}
+
+impl Bus for CutAt<'_> {
+    fn now(&self) -> u64 {
+        self.mcu.now()
+    }
+    fn read8(&mut self, addr: u32) -> u8 {
+        let v = self.mcu.read8(addr);
+        self.check();
+        v
+    }
+    fn read16(&mut self, addr: u32) -> u16 {
+        let v = self.mcu.read16(addr);
+        self.check();
+        v
+    }
+    fn write8(&mut self, addr: u32, value: u8) {
+        self.mcu.write8(addr, value);
+        self.check();
+    }
+    fn write16(&mut self, addr: u32, value: u16) {
+        self.mcu.write16(addr, value);
+        self.check();
+    }
+    fn internal(&mut self, states: u32) {
+        self.mcu.internal(states);
+        self.check();
+    }
+    fn pending_irq(&self) -> Option<u8> {
+        self.mcu.pending_irq()
+    }
+    fn sleep_until_irq(&mut self, deadline: u64) -> bool {
+        self.mcu.sleep_until_irq(deadline)
+    }
+}
+
+#[test]
+fn a_power_cut_in_the_middle_of_a_save_leaves_the_last_committed_weights() {
+    // Find when the second save (sequence 1, on chip 0x51) runs in an uninterrupted twin.
+    let twin = {
+        let mut m = mcu(5);
+        let mut c = Controller::new(ControllerConfig::arena(11)).expect("valid");
+        c.boot(&mut m).expect("boots");
+        run(&mut c, &mut m, 40)
+    };
+    let second = twin
+        .iter()
+        .filter(|r| r.saved.is_some())
+        .nth(1)
+        .expect("two saves");
+    let save_start = second.start_states
+        + second.phases.adc
+        + second.phases.input
+        + second.phases.update
+        + second.phases.forward
+        + second.phases.motors;
+    // Cut at several instants inside that save: during the first page, the polling, the
+    // commit page.
+    for frac in [0.05, 0.3, 0.55, 0.8, 0.97] {
+        let mut m = mcu(5);
+        let mut c = Controller::new(ControllerConfig::arena(11)).expect("valid");
+        c.boot(&mut m).expect("boots");
+        let mut committed: Vec<Q15> = Vec::new();
+        for _ in 0..39 {
+            c.sleep_until_step(&mut m).expect("ticks");
+            let r = c.step(&mut m).expect("steps");
+            if r.saved.is_some() {
+                committed = c.learner().weights().to_vec();
+            }
+        }
+        assert_eq!(committed.len(), 52, "the first save happened");
+        c.sleep_until_step(&mut m).expect("ticks");
+        let cut_at = save_start + (second.phases.save as f64 * frac) as u64;
+        {
+            let mut bus = CutAt {
+                mcu: &mut m,
+                cut_at,
+                cut: false,
+            };
+            // On the robot the CPU dies with the cut; the emulation runs the rest of the step's
+            // code against a reset MCU and powered-off chips, so its outcome means nothing.
+            let _ = c.step(&mut bus);
+            assert!(bus.cut, "the cut happened at {frac}");
+        }
+        let now = m.now();
+        m.power_on(now + 25_000_000).expect("power on");
+        let mut rebooted = Controller::new(ControllerConfig::arena(12)).expect("valid");
+        let boot = rebooted.boot(&mut m).expect("boots");
+        assert_eq!(boot.restored, Some(0), "cut at {frac} of the save");
+        assert_eq!(
+            rebooted.learner().weights(),
+            &committed[..],
+            "cut at {frac}"
+        );
+    }
+}
+
+#[test]
+fn same_seeds_same_steps() {
+    let go = || {
+        let mut m = mcu(9);
+        let mut c = Controller::new(ControllerConfig::corridor(4)).expect("valid");
+        c.boot(&mut m).expect("boots");
+        (run(&mut c, &mut m, 50), m.now())
+    };
+    assert_eq!(go(), go());
+}

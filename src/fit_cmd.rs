@@ -1,0 +1,310 @@
+//! `h8swarm fit`: the verdict of SPEC §6 for the default network and the paper's two settings,
+//! what-ifs, and the largest network within a CPU budget, all measured by running the
+//! controller on the emulated H8/3052F (`emu::fit`).
+
+use std::fmt::Write as _;
+
+use anyhow::{Context, Result, bail};
+use clap::{Args, ValueEnum};
+use emu::controller::ControllerConfig;
+use emu::fit::{FitConfig, FitReport, largest_fitting, measure};
+use nn_q15::InputLayout;
+use serde::Serialize;
+
+/// Which of the paper's settings to start from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Setting {
+    /// Paper env. 2: four behaviours, η = 0.001, 0.45 s steps (the default network).
+    Arena,
+    /// Paper env. 1: forward and backward, η = 0.1, 0.60 s steps.
+    Corridor,
+}
+
+/// Options of `h8swarm fit`.
+#[derive(Args, Debug, Default)]
+pub struct FitArgs {
+    /// Start from this setting (default: report both, arena first; with a what-if, arena).
+    #[arg(long, value_enum)]
+    pub setting: Option<Setting>,
+    /// What-if: the network has N inputs (the layout's own inputs plus spare inputs held at 0).
+    #[arg(long, value_name = "N")]
+    pub inputs: Option<usize>,
+    /// What-if: history depth H (0 to 8).
+    #[arg(long, value_name = "H")]
+    pub history: Option<usize>,
+    /// What-if: enabled behaviours M (2 to 4).
+    #[arg(long, value_name = "M")]
+    pub outputs: Option<usize>,
+    /// What-if: one EEPROM record every S steps.
+    #[arg(long, value_name = "S")]
+    pub save_every: Option<u32>,
+    /// What-if: add the bias input.
+    #[arg(long)]
+    pub bias: bool,
+    /// What-if: the step period in seconds (a whole number of 10 ms ticks).
+    #[arg(long, value_name = "SECONDS")]
+    pub step_period_s: Option<f64>,
+    /// What-if: the MCU clock φ in Hz (2 000 000 to 25 000 000).
+    #[arg(long, value_name = "HZ")]
+    pub clock_hz: Option<u32>,
+    /// Also find the largest network (by inputs) whose worst step stays within this share of
+    /// the step period, e.g. `5%` or `5`.
+    #[arg(long, value_name = "PERCENT")]
+    pub cpu_budget: Option<String>,
+    /// Steps to run for each measurement.
+    #[arg(long, default_value_t = 400)]
+    pub steps: u32,
+    /// Seed of the sensors, their distances and the initial weights.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Print the reports as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+impl FitArgs {
+    fn what_if(&self) -> bool {
+        self.inputs.is_some()
+            || self.history.is_some()
+            || self.outputs.is_some()
+            || self.save_every.is_some()
+            || self.bias
+            || self.step_period_s.is_some()
+            || self.clock_hz.is_some()
+    }
+}
+
+#[derive(Serialize)]
+struct JsonOut<'a> {
+    reports: &'a [(String, FitReport)],
+    #[serde(skip_serializing_if = "Option::is_none")]
+    largest: Option<&'a LargestOut>,
+}
+
+#[derive(Serialize)]
+struct LargestOut {
+    cpu_budget_percent: f64,
+    report: Option<FitReport>,
+}
+
+fn base_config(setting: Setting, seed: u64) -> ControllerConfig {
+    match setting {
+        Setting::Arena => ControllerConfig::arena(seed),
+        Setting::Corridor => ControllerConfig::corridor(seed),
+    }
+}
+
+fn apply_what_ifs(mut cfg: ControllerConfig, a: &FitArgs) -> Result<ControllerConfig> {
+    if let Some(m) = a.outputs {
+        if !(2..=4).contains(&m) {
+            bail!("--outputs {m}: valid is 2 (forward, backward) to 4 (all four behaviours)");
+        }
+        cfg.behaviours = m;
+    }
+    let history = a.history.unwrap_or(cfg.layout.history());
+    let mut layout = InputLayout::new(history, a.bias || cfg.layout.bias())
+        .with_context(|| format!("--history {history}"))?;
+    if let Some(n) = a.inputs {
+        let own = layout.n_inputs(cfg.behaviours);
+        if n < own {
+            bail!(
+                "--inputs {n}: this layout already has {own} inputs (4 proximities x (1 + history), the outputs, E{}); give at least {own}",
+                if layout.bias() { ", bias" } else { "" }
+            );
+        }
+        let spare =
+            u16::try_from(n - own).with_context(|| format!("--inputs {n}: far too many inputs"))?;
+        layout = layout.with_spare(spare);
+    }
+    cfg.layout = layout;
+    if let Some(s) = a.save_every {
+        cfg.save_every_steps = s;
+    }
+    if let Some(p) = a.step_period_s {
+        cfg.step_period_s = p;
+    }
+    if let Some(hz) = a.clock_hz {
+        cfg.clock_hz = hz;
+    }
+    Ok(cfg)
+}
+
+fn parse_budget(text: &str) -> Result<f64> {
+    let t = text.trim().trim_end_matches('%').trim();
+    let v: f64 = t
+        .parse()
+        .with_context(|| format!("--cpu-budget {text}: give a percentage such as 5% or 5"))?;
+    if !(v > 0.0 && v <= 100.0) {
+        bail!("--cpu-budget {text}: valid is more than 0 and at most 100 percent");
+    }
+    Ok(v)
+}
+
+/// Runs `h8swarm fit`; returns the text to print.
+///
+/// # Errors
+/// Bad options or an impossible configuration, with what would be valid.
+pub fn run(a: &FitArgs) -> Result<String> {
+    if a.steps == 0 {
+        bail!("--steps must be at least 1");
+    }
+    let budget = a.cpu_budget.as_deref().map(parse_budget).transpose()?;
+    let settings: Vec<Setting> = match (a.setting, a.what_if()) {
+        (Some(s), _) => vec![s],
+        (None, true) => vec![Setting::Arena],
+        (None, false) => vec![Setting::Arena, Setting::Corridor],
+    };
+    let mut reports = Vec::new();
+    for setting in &settings {
+        let cfg = apply_what_ifs(base_config(*setting, a.seed), a)?;
+        let fit = FitConfig {
+            controller: cfg,
+            steps: a.steps,
+            seed: a.seed,
+        };
+        let report = measure(&fit).map_err(anyhow::Error::new)?;
+        let name = match (setting, a.what_if()) {
+            (Setting::Arena, false) => "arena (paper env. 2; the default network)".to_string(),
+            (Setting::Corridor, false) => "corridor (paper env. 1)".to_string(),
+            (Setting::Arena, true) => "what-if, from the arena's settings".to_string(),
+            (Setting::Corridor, true) => "what-if, from the corridor's settings".to_string(),
+        };
+        reports.push((name, report));
+    }
+    let largest = match budget {
+        Some(pct) => {
+            let cfg = apply_what_ifs(base_config(settings[0], a.seed), a)?;
+            let fit = FitConfig {
+                controller: cfg,
+                steps: a.steps,
+                seed: a.seed,
+            };
+            Some(LargestOut {
+                cpu_budget_percent: pct,
+                report: largest_fitting(&fit, pct).map_err(anyhow::Error::new)?,
+            })
+        }
+        None => None,
+    };
+    if a.json {
+        let out = JsonOut {
+            reports: &reports,
+            largest: largest.as_ref(),
+        };
+        return Ok(serde_json::to_string_pretty(&out)? + "\n");
+    }
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "h8swarm fit: does the learner fit the H8/3052F? Measured on the emulated MCU over {} steps (seed {}).",
+        a.steps, a.seed
+    );
+    for (name, r) in &reports {
+        let _ = writeln!(s);
+        render(&mut s, name, r);
+    }
+    if let Some(l) = &largest {
+        let _ = writeln!(s);
+        match &l.report {
+            Some(r) => {
+                let _ = writeln!(
+                    s,
+                    "largest network within a {} % CPU budget: {} inputs x {} outputs ({} spare inputs), worst step {:.2} %, RAM {} B",
+                    l.cpu_budget_percent, r.n_in, r.n_out, r.spare, r.cpu_worst_percent, r.ram_used
+                );
+                if r.n_in == nn_q15::MAX_INPUTS {
+                    let _ = writeln!(
+                        s,
+                        "  (that is the learner's no-overflow bound of {} inputs: the budget would allow more)",
+                        nn_q15::MAX_INPUTS
+                    );
+                }
+            }
+            None => {
+                let _ = writeln!(
+                    s,
+                    "no network fits a {} % CPU budget: even the base network's worst step exceeds it",
+                    l.cpu_budget_percent
+                );
+            }
+        }
+    }
+    Ok(s)
+}
+
+fn render(s: &mut String, name: &str, r: &FitReport) {
+    let us = |states: f64| states / f64::from(r.clock_hz) * 1e6;
+    let _ = writeln!(s, "== {name}");
+    let _ = writeln!(
+        s,
+        "network {} inputs x {} outputs (history {}, bias {}, {} spare), eta {} (Q15), T {}, a record every {} steps, step {} s, phi {} MHz",
+        r.n_in,
+        r.n_out,
+        r.history,
+        if r.bias { "on" } else { "off" },
+        r.spare,
+        r.eta,
+        r.threshold,
+        r.save_every_steps,
+        r.step_period_s,
+        f64::from(r.clock_hz) / 1e6
+    );
+    let _ = writeln!(
+        s,
+        "{:<30} {:>12} {:>12} {:>10}",
+        "states per step", "max", "mean", "max µs"
+    );
+    for p in &r.phases {
+        let _ = writeln!(
+            s,
+            "{:<30} {:>12} {:>12.1} {:>10.1}",
+            p.phase, p.states.max, p.states.mean, p.max_us
+        );
+    }
+    let _ = writeln!(
+        s,
+        "{:<30} {:>12} {:>12.1} {:>10.1}",
+        "busy per step (with ticks)",
+        r.busy_per_step.max,
+        r.busy_per_step.mean,
+        us(r.busy_per_step.max as f64)
+    );
+    let _ = writeln!(
+        s,
+        "CPU: {:.3} % of the step period on average, {:.2} % in the worst step (a save); boot {} states",
+        r.cpu_mean_percent, r.cpu_worst_percent, r.boot_states
+    );
+    let _ = writeln!(s, "RAM (bytes, placed from H'FFDF10):");
+    for m in &r.ram {
+        let _ = writeln!(s, "  H'{:06X} {:>6}  {}", m.addr, m.bytes, m.item);
+    }
+    let _ = writeln!(
+        s,
+        "  total {} of 8192 ({:.1} %)",
+        r.ram_used,
+        f64::from(r.ram_used) / 8192.0 * 100.0
+    );
+    let _ = writeln!(s, "ROM estimate (bytes):");
+    for m in &r.rom {
+        let _ = writeln!(s, "  {:>6}  {}", m.bytes, m.item);
+    }
+    let _ = writeln!(
+        s,
+        "  total {} of 524288 ({:.2} %)",
+        r.rom_used,
+        f64::from(r.rom_used) / 524_288.0 * 100.0
+    );
+    let e = &r.eeprom;
+    let _ = writeln!(
+        s,
+        "EEPROM: {} bytes on {} pages per save, {:.0} saves/h, {:.0} writes/h on each record page, endurance lifetime {:.0} h; slowest save {} states ({:.1} ms)",
+        e.bytes_per_save,
+        e.pages_per_save,
+        e.saves_per_hour,
+        e.page_writes_per_hour,
+        e.lifetime_hours,
+        e.save_max_states,
+        us(e.save_max_states as f64) / 1000.0
+    );
+    let _ = writeln!(s, "verdict: {}", r.verdict);
+}
