@@ -288,12 +288,8 @@ impl Adc {
         if self.adf_at(now) {
             return None;
         }
-        let mut k = r.round_end_from(r.done);
-        // Rounds that ended by `now` are counted in adf_at; the next is after now.
-        while r.end(k) <= now {
-            k += r.channels;
-        }
-        Some(r.end(k))
+        // ADF clear at `now` means the round under way has not ended yet.
+        Some(r.end(r.round_end_from(r.done)))
     }
 
     /// The earliest state after `now` at which ADI becomes requested, if it will.
