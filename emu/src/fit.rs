@@ -357,22 +357,38 @@ fn spread_of(values: &[u64]) -> Spread {
     }
 }
 
+/// Which CPU share a budget limits.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Budget {
+    /// The mean share over the steps (the CPU load, saves amortised).
+    Mean,
+    /// The share of the worst step (a step with a save: the step must still end well inside
+    /// its period).
+    WorstStep,
+}
+
 /// The largest network (inputs N, by spare inputs on top of `base`'s layout) that fits the RAM
-/// and keeps the worst step within `cpu_budget_percent` of the step period, measured by running
-/// each candidate; None when even `base` does not. The search is a bisection over N up to the
-/// learner's bound (256 inputs), each probe a full [`measure`].
+/// and keeps the `budget` CPU share within `cpu_budget_percent` of the step period, measured by
+/// running each candidate; None when even `base` does not. The search is a bisection over N up
+/// to the learner's bound (256 inputs), each probe a full [`measure`].
 ///
 /// # Errors
 /// [`ControllerError`] for an impossible base configuration.
 pub fn largest_fitting(
     base: &FitConfig,
     cpu_budget_percent: f64,
+    budget: Budget,
 ) -> Result<Option<FitReport>, ControllerError> {
     let fits = |spare: usize| -> Result<Option<FitReport>, ControllerError> {
         let mut cfg = base.clone();
         cfg.controller.layout = base.controller.layout.with_spare(spare as u16);
+        let share = |r: &FitReport| match budget {
+            Budget::Mean => r.cpu_mean_percent,
+            Budget::WorstStep => r.cpu_worst_percent,
+        };
         match measure(&cfg) {
-            Ok(r) if r.fits && r.cpu_worst_percent <= cpu_budget_percent => Ok(Some(r)),
+            Ok(r) if r.fits && share(&r) <= cpu_budget_percent => Ok(Some(r)),
             Ok(_) | Err(ControllerError::Ram(_)) | Err(ControllerError::Shape(_)) => Ok(None),
             Err(e) => Err(e),
         }

@@ -142,13 +142,13 @@ pub enum ControllerError {
     #[error(transparent)]
     Ram(#[from] RamOverflow),
     /// The network shape is outside the learner's bounds.
-    #[error("the network cannot be built: {0}")]
+    #[error("the network cannot be built")]
     Shape(#[from] ShapeError),
     /// The EEPROM record layout or a save failed.
-    #[error("EEPROM: {0}")]
+    #[error("EEPROM record")]
     Persist(#[from] eeprom::PersistError),
     /// The I²C master timing could not be set up for this clock.
-    #[error("I2C timing: {0}")]
+    #[error("I2C timing")]
     I2c(#[from] eeprom::EepromError),
     /// SLEEP returned without the tick interrupt pending.
     #[error("SLEEP at state {now} woke without the tick interrupt (ITU0 compare match A) pending")]

@@ -1,0 +1,75 @@
+//! One controller step on the emulated MCU (host time), next to the emulated states it takes.
+//!
+//! `step_without_save`: a whole step period of the arena's controller as the swarm runs it: the
+//! sleep through 45 ticks, then the A/D scan, the learner (13 × 4), the motors; saves are
+//! switched off (one record every 1 000 000 steps) so that every iteration does the same work.
+//! `save`: one A/B record of the 13 × 4 weights through the bit-banged I²C with ACK polling.
+//! The emulated states of each are printed once before timing.
+
+use std::hint::black_box;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use emu::bus::Bus;
+use emu::controller::{Controller, ControllerConfig};
+use emu::mcu::{Board, Mcu, McuConfig};
+
+struct Wave;
+
+impl Board for Wave {
+    fn analog_volts(&mut self, channel: u8, now: u64) -> f64 {
+        let t = now as f64 / 25e6;
+        1.4 + 1.1 * (t * (0.7 + 0.3 * f64::from(channel))).sin()
+    }
+    fn port2_pins(&mut self, _now: u64) -> u8 {
+        0xFF
+    }
+}
+
+fn setup(save_every_steps: u32) -> (Controller, Mcu<Wave>) {
+    let mut cfg = ControllerConfig::arena(1);
+    cfg.save_every_steps = save_every_steps;
+    let mut c = Controller::new(cfg).expect("valid controller");
+    let mut m = Mcu::new(McuConfig::default(), Wave).expect("valid MCU");
+    c.boot(&mut m).expect("boots");
+    (c, m)
+}
+
+fn benches(c: &mut Criterion) {
+    let mut group = c.benchmark_group("controller");
+    {
+        let (mut ctl, mut m) = setup(1_000_000);
+        let t0 = m.now();
+        ctl.sleep_until_step(&mut m).expect("tick");
+        let r = ctl.step(&mut m).expect("step");
+        eprintln!(
+            "controller/step_without_save: {} emulated states per step period ({} busy in the step)",
+            m.now() - t0,
+            r.phases.work()
+        );
+        group.bench_function("step_without_save", |b| {
+            b.iter(|| {
+                ctl.sleep_until_step(&mut m).expect("tick");
+                black_box(ctl.step(&mut m).expect("step"))
+            });
+        });
+    }
+    {
+        let (mut ctl, mut m) = setup(1);
+        ctl.sleep_until_step(&mut m).expect("tick");
+        let r = ctl.step(&mut m).expect("step");
+        eprintln!(
+            "controller/save: {} emulated states per save ({:?})",
+            r.phases.save, r.saved
+        );
+        group.bench_function("step_with_save", |b| {
+            b.iter(|| {
+                ctl.sleep_until_step(&mut m).expect("tick");
+                black_box(ctl.step(&mut m).expect("step"))
+            });
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(controller, benches);
+criterion_main!(controller);
