@@ -179,5 +179,8 @@ fn bad_images_are_errors() {
     let e = run_image(text.as_bytes(), &RunOptions::default(), &mut console, None).unwrap_err();
     assert!(matches!(e, RunError::Load(_)), "{e}");
     let cause = std::error::Error::source(&e).map(ToString::to_string);
-    assert!(cause.as_deref().is_some_and(|c| c.contains("H'FFE000")), "{cause:?}");
+    assert!(
+        cause.as_deref().is_some_and(|c| c.contains("H'FFE000")),
+        "{cause:?}"
+    );
 }
