@@ -253,3 +253,27 @@ fn same_seeds_same_steps() {
     };
     assert_eq!(go(), go());
 }
+
+#[test]
+fn fast_forward_gives_identical_steps_sleeps_and_clock() {
+    let go = |fast: bool| {
+        let mut m = mcu(3);
+        let mut cfg = ControllerConfig::arena(5);
+        cfg.fast_forward = fast;
+        cfg.save_every_steps = 7;
+        let mut c = Controller::new(cfg).expect("valid");
+        c.boot(&mut m).expect("boots");
+        let mut log = Vec::new();
+        for _ in 0..60 {
+            let s = c.sleep_until_step(&mut m).expect("ticks");
+            let r = c.step(&mut m).expect("steps");
+            log.push((s, r, m.now()));
+        }
+        log
+    };
+    let (slow, fast) = (go(false), go(true));
+    assert_eq!(slow.len(), fast.len());
+    for (k, (a, b)) in slow.iter().zip(&fast).enumerate() {
+        assert_eq!(a, b, "step {k}");
+    }
+}

@@ -72,6 +72,11 @@ pub struct Fw<'a, B: Bus> {
     pub ticks: &'a mut u64,
     /// States spent in the tick handler (entry to RTE) since the counter was last reset.
     pub isr_states: u64,
+    /// When the next tick is due, if known: the interrupt controller is only asked from then
+    /// on (an emulation shortcut with identical results: the tick cannot be pending earlier).
+    pub next_tick_at: Option<u64>,
+    /// The tick period in states (to predict the next tick after one is taken).
+    pub tick_period: u64,
 }
 
 impl<'a, B: Bus> Fw<'a, B> {
@@ -82,6 +87,8 @@ impl<'a, B: Bus> Fw<'a, B> {
             interrupts_enabled,
             ticks,
             isr_states: 0,
+            next_tick_at: None,
+            tick_period: 0,
         }
     }
 
@@ -99,13 +106,18 @@ impl<'a, B: Bus> Fw<'a, B> {
     /// Lets `states` states of register and RAM work pass (the learner's metered arithmetic),
     /// then takes a pending tick.
     pub fn lump(&mut self, states: u64) {
+        self.idle(states);
+        self.service();
+    }
+
+    /// Lets `states` states pass without taking the tick (the CPU asleep).
+    pub fn idle(&mut self, states: u64) {
         let mut left = states;
         while left > 0 {
             let chunk = u32::try_from(left).unwrap_or(u32::MAX);
             self.bus.internal(chunk);
             left -= u64::from(chunk);
         }
-        self.service();
     }
 
     /// `MOV.B @aa:8,R0L`: one fetch, one byte read.
@@ -132,7 +144,15 @@ impl<'a, B: Bus> Fw<'a, B> {
 
     /// Takes the tick interrupt if interrupts are enabled and it is pending.
     pub fn service(&mut self) {
-        if self.interrupts_enabled && self.bus.pending_irq() == Some(VECTOR_IMIA0) {
+        if !self.interrupts_enabled {
+            return;
+        }
+        if let Some(due) = self.next_tick_at {
+            if self.bus.now() < due {
+                return;
+            }
+        }
+        if self.bus.pending_irq() == Some(VECTOR_IMIA0) {
             self.tick_handler();
         }
     }
@@ -153,6 +173,9 @@ impl<'a, B: Bus> Fw<'a, B> {
         self.bus.internal(RTE_STATES);
         *self.ticks += 1;
         self.isr_states += self.bus.now() - t0;
+        if let Some(due) = self.next_tick_at.as_mut() {
+            *due += self.tick_period;
+        }
     }
 }
 

@@ -89,6 +89,11 @@ pub struct ControllerConfig {
     pub step_period_s: f64,
     /// Seed of the fresh random weights (used when no record is restored).
     pub weight_seed: u64,
+    /// Emulation shortcuts with identical results (tested): while asleep between two steps,
+    /// only the first and the last tick interrupt are emulated register by register and the
+    /// identical ones in between are charged as such; and the interrupt controller is only
+    /// asked once a tick is due.
+    pub fast_forward: bool,
 }
 
 impl ControllerConfig {
@@ -104,6 +109,7 @@ impl ControllerConfig {
             save_every_steps: eeprom::persist::DEFAULT_SAVE_EVERY_STEPS,
             step_period_s: 0.45,
             weight_seed,
+            fast_forward: true,
         }
     }
 
@@ -259,6 +265,8 @@ pub struct Controller {
     steps: u64,
     next_sequence: u32,
     booted: bool,
+    /// The next tick's instant, once known (see [`ControllerConfig::fast_forward`]).
+    next_tick_at: Option<u64>,
 }
 
 fn config_error(
@@ -347,6 +355,7 @@ impl Controller {
             steps: 0,
             next_sequence: 0,
             booted: false,
+            next_tick_at: None,
         })
     }
 
@@ -439,6 +448,7 @@ impl Controller {
         self.next_step_tick = 1;
         self.steps = 0;
         self.p4_shadow = 0;
+        self.next_tick_at = None;
         self.learner.restart();
         let mut ticks = 0u64;
         let restored = {
@@ -538,25 +548,52 @@ impl Controller {
     ) -> Result<SleepReport, ControllerError> {
         let t0 = bus.now();
         let mut report = SleepReport::default();
-        let tick_states = u64::from(self.tick_counts) * PRESCALE;
+        let period = u64::from(self.tick_counts) * PRESCALE;
         let mut ticks = self.ticks;
+        let fast = self.cfg.fast_forward;
+        let mut next_tick_at = self.next_tick_at;
         {
             let mut fw = Fw::new(bus, &mut ticks, true);
+            fw.tick_period = period;
             while *fw.ticks < self.next_step_tick {
                 fw.bus.internal(SLEEP_STATES);
                 let asleep_from = fw.bus.now();
-                let deadline = asleep_from + 2 * tick_states;
+                let deadline = asleep_from + 2 * period;
                 if !fw.bus.sleep_until_irq(deadline) || fw.bus.pending_irq() != Some(VECTOR_IMIA0) {
                     return Err(ControllerError::NoTick { now: fw.bus.now() });
                 }
-                let slept = fw.bus.now() - asleep_from;
+                // Woken at the tick's instant: from here on its successors' are known.
+                let tick_at = fw.bus.now();
+                let slept = tick_at - asleep_from;
+                fw.next_tick_at = fast.then_some(tick_at);
                 fw.tick_handler();
                 report.ticks += 1;
                 // Main loop: MOV.L @TICKS:16,ER0 ; MOV.L @NEXT:16,ER1 ; CMP.L ; BLO.
                 fw.code(&[Insn::MovLAbs16, Insn::MovLAbs16, Insn::Reg, Insn::Bcc8]);
-                report.busy_states += fw.bus.now() - asleep_from - slept + u64::from(SLEEP_STATES);
+                let busy = fw.bus.now() - asleep_from - slept + u64::from(SLEEP_STATES);
+                report.busy_states += busy;
+                let left = self.next_step_tick.saturating_sub(*fw.ticks);
+                if fast && left >= 2 {
+                    // The ticks between this one and the last are identical: SLEEP, entry,
+                    // handler (TSR0 read with IMFA = 1 and cleared), RTE, the main loop. Charge
+                    // them as such and wake for real at the last one, whose IMFA is pending.
+                    let skipped = left - 1;
+                    let last_at = tick_at + left * period;
+                    *fw.ticks += skipped;
+                    report.ticks += skipped;
+                    report.busy_states += skipped * busy;
+                    fw.bus.internal(SLEEP_STATES);
+                    fw.idle(last_at - fw.bus.now());
+                    fw.next_tick_at = Some(last_at);
+                    fw.tick_handler();
+                    report.ticks += 1;
+                    fw.code(&[Insn::MovLAbs16, Insn::MovLAbs16, Insn::Reg, Insn::Bcc8]);
+                    report.busy_states += busy;
+                }
             }
+            next_tick_at = fw.next_tick_at.or(next_tick_at);
         }
+        self.next_tick_at = if fast { next_tick_at } else { None };
         self.ticks = ticks;
         self.next_step_tick += self.ticks_per_step;
         report.elapsed_states = bus.now() - t0;
@@ -574,8 +611,12 @@ impl Controller {
         let mut phases = PhaseStates::default();
         let step = self.steps;
         let due = (step + 1).is_multiple_of(u64::from(self.cfg.save_every_steps));
+        let tick_period = u64::from(self.tick_counts) * PRESCALE;
+        let mut next_tick_at = self.next_tick_at;
         let (p, out, saved) = {
             let mut fw = Fw::new(bus, &mut ticks, true);
+            fw.tick_period = tick_period;
+            fw.next_tick_at = next_tick_at;
             // Main loop: advance NEXT, call the A/D routine.
             fw.code(&[Insn::ImmL, Insn::MovLAbs16]);
 
@@ -653,8 +694,10 @@ impl Controller {
             };
             fw.code(&[Insn::MovBwAbs16, Insn::Bcc8]);
             phases.isr = fw.isr_states;
+            next_tick_at = fw.next_tick_at;
             (p, out, saved)
         };
+        self.next_tick_at = next_tick_at;
         self.ticks = ticks;
         self.steps += 1;
         Ok(StepReport {
