@@ -147,10 +147,8 @@ impl<'a, B: Bus> Fw<'a, B> {
         if !self.interrupts_enabled {
             return;
         }
-        if let Some(due) = self.next_tick_at {
-            if self.bus.now() < due {
-                return;
-            }
+        if self.next_tick_at.is_some_and(|due| self.bus.now() < due) {
+            return;
         }
         if self.bus.pending_irq() == Some(VECTOR_IMIA0) {
             self.tick_handler();
