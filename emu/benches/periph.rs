@@ -110,6 +110,20 @@ fn accesses(c: &mut Criterion) {
             }
         });
     });
+    let mut m = robot_mcu();
+    group.bench_function("tier_write8_then_pending_irq", |b| {
+        // A write invalidates the cached interrupt decision: this is the cost of recomputing
+        // it (three running ITU channels, the A/D scan, SCI1).
+        let tier1 = CHANNEL_BASE[1] + OFF_TIER;
+        b.iter(|| {
+            let mut n = 0u32;
+            for _ in 0..ACCESSES {
+                m.write8(black_box(tier1), 0);
+                n += u32::from(m.pending_irq().is_some());
+            }
+            n
+        });
+    });
     let m = robot_mcu();
     group.bench_function("pending_irq_cached", |b| {
         b.iter(|| {

@@ -19,8 +19,8 @@
 //! accesses take two byte cycles, upper byte first. Peripherals are synchronised lazily: each
 //! keeps the time it was last brought up to date and catches up, in O(1), when accessed, when
 //! the clock is fast-forwarded ([`Bus::sleep_until_irq`], [`Mcu::advance_to`]) or on
-//! [`Mcu::sync`]. The pending interrupt is cached until the next I/O access or the next
-//! instant a source can raise a request, so [`Bus::pending_irq`], called by the core before
+//! [`Mcu::sync`]. The pending interrupt is cached until the next write to an interrupt source
+//! or priority register, or the next instant a source can raise a request, so [`Bus::pending_irq`], called by the core before
 //! every instruction, is one comparison in the common case.
 //!
 //! The board (the robot outside the chip, [`Board`]) is asked for analog inputs with each
@@ -586,7 +586,8 @@ impl<B: Board> Mcu<B> {
     }
 
     fn io_read8(&mut self, a: u32) -> u8 {
-        self.invalidate_irq();
+        // Reads catch peripherals up but change no request (flags clear only by writes), so
+        // the cached interrupt decision stays valid.
         let now = self.now;
         match a {
             itu::ITU_FIRST..=itu::ITU_LAST => self.itu.read(a, now),
@@ -621,11 +622,18 @@ impl<B: Board> Mcu<B> {
     }
 
     fn io_write8(&mut self, a: u32, v: u8) {
-        self.invalidate_irq();
         let now = self.now;
+        // Writes to the interrupt sources and to the priority registers change the pending
+        // interrupt; port writes (I²C bit-banging, motor direction) cannot.
         match a {
-            itu::ITU_FIRST..=itu::ITU_LAST => self.itu.write(a, v, now),
-            sci::SCI1_SMR..=sci::SCI1_RDR => self.sci.write(a, v, now),
+            itu::ITU_FIRST..=itu::ITU_LAST => {
+                self.invalidate_irq();
+                self.itu.write(a, v, now);
+            }
+            sci::SCI1_SMR..=sci::SCI1_RDR => {
+                self.invalidate_irq();
+                self.sci.write(a, v, now);
+            }
             ports::P2DDR => self.p2.ddr = v,
             ports::P2DR => self.p2.dr = v,
             ports::P2PCR => self.p2.pcr = v,
@@ -643,11 +651,15 @@ impl<B: Board> Mcu<B> {
             ports::PBDDR => self.pb.ddr = v,
             ports::PBDR => self.pb.dr = v,
             adc::ADDRA..=adc::ADCR => {
+                self.invalidate_irq();
                 self.sync_adc();
                 self.adc.write(a, v, now);
             }
             SYSCR => self.syscr = v,
-            intc::IPRA | intc::IPRB => self.intc.write(a, v),
+            intc::IPRA | intc::IPRB => {
+                self.invalidate_irq();
+                self.intc.write(a, v);
+            }
             _ => {}
         }
     }

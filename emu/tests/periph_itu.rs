@@ -378,3 +378,48 @@ proptest! {
         prop_assert_eq!(wave.high_states, high);
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(300))]
+
+    /// As above, with register writes while the counter runs (GRA, GRB or TCNT rewritten at
+    /// access instants, as firmware changing the PWM duty does).
+    #[test]
+    fn lazy_counter_matches_the_model_across_register_writes(
+        cfg in cfg_strategy(),
+        steps in prop::collection::vec((1u64..2500, 0u8..4, any::<u16>()), 1..16),
+    ) {
+        let base = CHANNEL_BASE[3];
+        let mut itu = Itu::new();
+        let mut cfg = cfg;
+        itu.write(base + OFF_TCR, (cfg.cclr << 5) | cfg.shift as u8, 0);
+        itu.write(base + OFF_TIOR, cfg.ioa, 0);
+        let put16 = |itu: &mut Itu, off: u32, v: u16, t: u64| {
+            itu.write(base + off, (v >> 8) as u8, t);
+            itu.write(base + off + 1, v as u8, t);
+        };
+        put16(&mut itu, OFF_GRA, cfg.gra, 0);
+        put16(&mut itu, OFF_GRB, cfg.grb, 0);
+        put16(&mut itu, OFF_TCNT, cfg.tcnt0, 0);
+        itu.write(TMDR, if cfg.pwm { 0x08 } else { 0 }, 0);
+        itu.write(TSTR, 0x08, 0);
+        let mut reference = Reference { tcnt: cfg.tcnt0, flags: 0, tioca: false };
+        let mut t = 0;
+        for (gap, what, value) in steps {
+            let next = t + gap;
+            reference.step_to(t, next, cfg.shift, &cfg);
+            t = next;
+            prop_assert_eq!(itu.tcnt(3, t), reference.tcnt, "TCNT at {}", t);
+            prop_assert_eq!(itu.read(base + OFF_TSR, t) & 0x07, reference.flags, "TSR at {}", t);
+            prop_assert_eq!(itu.tioca(3, t).0, reference.tioca, "TIOCA at {}", t);
+            // Small values keep compare matches frequent.
+            let v = if value & 0x8000 != 0 { value } else { value % 300 };
+            match what {
+                0 => { put16(&mut itu, OFF_GRA, v, t); cfg.gra = v; }
+                1 => { put16(&mut itu, OFF_GRB, v, t); cfg.grb = v; }
+                2 => { put16(&mut itu, OFF_TCNT, v, t); reference.tcnt = v; }
+                _ => {}
+            }
+        }
+    }
+}

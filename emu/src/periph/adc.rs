@@ -240,6 +240,9 @@ impl Adc {
         let Some(mut run) = self.run else {
             return;
         };
+        if now < run.end(run.done) {
+            return;
+        }
         let completed = run.completed_by(now);
         if completed <= run.done {
             return;

@@ -245,6 +245,9 @@ struct Channel {
     /// Copy of TMDR.PWMn.
     pwm: bool,
     synced_at: u64,
+    /// Count edges after `synced_at` before the first compare match or overflow: within them
+    /// TCNT only counts up (the fast path of a catch-up).
+    quiet: u64,
 }
 
 impl Channel {
@@ -264,7 +267,33 @@ impl Channel {
             running: false,
             pwm: false,
             synced_at: 0,
+            quiet: 0,
         }
+        .with_quiet()
+    }
+
+    fn with_quiet(mut self) -> Self {
+        self.recompute_quiet();
+        self
+    }
+
+    /// Recomputes `quiet` from the current configuration (after every register change and
+    /// every catch-up that passed an event). The first wrap of TCNT is itself a compare match
+    /// (the clearing value) or an overflow, so TCNT + n never wraps within the quiet edges.
+    fn recompute_quiet(&mut self) {
+        let orbit = self.orbit();
+        let mut first = orbit.first_hit(0xFFFF).unwrap_or(u64::MAX);
+        if self.compares_a()
+            && let Some(k) = orbit.first_hit(u64::from(self.gra))
+        {
+            first = first.min(k);
+        }
+        if self.compares_b()
+            && let Some(k) = orbit.first_hit(u64::from(self.grb))
+        {
+            first = first.min(k);
+        }
+        self.quiet = first.saturating_sub(1);
     }
 
     /// log2 of the prescaler, or None for an external clock.
@@ -329,10 +358,11 @@ impl Channel {
     /// The state at `now` (≥ synced_at), without changing the channel.
     fn advanced(&self, now: u64) -> Advanced {
         let n = self.edges_until(now);
-        if n == 0 {
+        if n <= self.quiet {
+            // Only counting in between: TCNT + n cannot wrap here.
             return Advanced {
                 flags: self.flags,
-                tcnt: self.tcnt,
+                tcnt: self.tcnt.wrapping_add(n as u16),
                 tioca: self.tioca,
             };
         }
@@ -387,11 +417,19 @@ impl Channel {
         if now <= self.synced_at {
             return;
         }
+        let n = self.edges_until(now);
+        if n <= self.quiet {
+            self.tcnt = self.tcnt.wrapping_add(n as u16);
+            self.quiet -= n;
+            self.synced_at = now;
+            return;
+        }
         let a = self.advanced(now);
         self.flags = a.flags;
         self.tcnt = a.tcnt;
         self.tioca = a.tioca;
         self.synced_at = now;
+        self.recompute_quiet();
     }
 
     /// The state when the first count edge after `synced_at` numbered `k` (1-based) happens.
@@ -403,7 +441,7 @@ impl Channel {
 
     /// Earliest time after the last sync at which an enabled flag that is clear now gets set.
     fn next_irq_time(&self, now: u64) -> Option<u64> {
-        if !self.running || self.shift().is_none() {
+        if self.tier & TSR_FLAGS == 0 || !self.running || self.shift().is_none() {
             return None;
         }
         let pending = self.advanced(now).flags;
@@ -503,6 +541,7 @@ impl Channel {
             13 => self.brb = lo(self.brb),
             _ => {}
         }
+        self.recompute_quiet();
     }
 }
 
@@ -577,6 +616,9 @@ impl Itu {
 
     /// Writes a register at `now`.
     pub fn write(&mut self, addr: u32, value: u8, now: u64) {
+        // Every channel is brought to `now` (cheap when no compare match passed), so the
+        // interrupt decision that follows a write starts from synchronised channels.
+        self.sync(now);
         if let Some((n, off)) = decode(addr) {
             self.ch[n].write(off, value, now);
             return;
@@ -587,6 +629,7 @@ impl Itu {
                 self.tstr = value & 0x1F;
                 for (i, c) in self.ch.iter_mut().enumerate() {
                     c.running = self.tstr & (1 << i) != 0;
+                    c.recompute_quiet();
                 }
             }
             TSNC => self.tsnc = value & 0x1F,
@@ -595,6 +638,7 @@ impl Itu {
                 self.tmdr = value & 0x7F;
                 for (i, c) in self.ch.iter_mut().enumerate() {
                     c.pwm = self.tmdr & (1 << i) != 0;
+                    c.recompute_quiet();
                 }
             }
             TFCR => self.tfcr = value & 0x3F,
