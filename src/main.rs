@@ -9,8 +9,14 @@
 
 mod cost_report;
 mod emu_cmd;
+mod experiment;
 mod fit_cmd;
+mod plot;
 mod replay;
+mod robot;
+mod run_cmd;
+mod scenario;
+mod summary;
 
 use std::fs::File;
 use std::io::{self, BufRead, BufReader, BufWriter, Write};
@@ -29,6 +35,8 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
+    /// Run the swarm experiment (the default job: the arena, with its controls and plots).
+    Run(run_cmd::RunArgs),
     /// Feed the learner core from JSON Lines and print one JSON line per step (SPEC §2.6).
     Learn(LearnArgs),
     /// Measure the learner's H8/300H states per step and its RAM footprint (the default job).
@@ -131,7 +139,8 @@ fn main() -> ExitCode {
             emu_cmd::run(&args.image, args.max_states, args.trace, args.stats)
         }
         Some(Command::Fit(args)) => fit(&args),
-        None => cost(&CostArgs::default()),
+        Some(Command::Run(args)) => run(&args),
+        None => run(&run_cmd::RunArgs::default()),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -214,6 +223,14 @@ fn cost(args: &CostArgs) -> Result<(), Failure> {
 
 fn fit(args: &fit_cmd::FitArgs) -> Result<(), Failure> {
     let text = fit_cmd::run(args).map_err(Failure::Input)?;
+    io::stdout()
+        .lock()
+        .write_all(text.as_bytes())
+        .or_else(write_failure)
+}
+
+fn run(args: &run_cmd::RunArgs) -> Result<(), Failure> {
+    let text = run_cmd::run(args).map_err(Failure::Input)?;
     io::stdout()
         .lock()
         .write_all(text.as_bytes())

@@ -295,3 +295,115 @@ fn emu_trace_budget_and_bad_images_have_their_exit_statuses() {
     assert_eq!(out.status.code(), Some(2));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+fn temp_dir(name: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("h8swarm-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+#[test]
+fn run_writes_identical_metrics_for_any_thread_count() {
+    for robots in ["3", "80"] {
+        let mut files = Vec::new();
+        for threads in ["1", "2"] {
+            let dir = temp_dir(&format!("det-{robots}-{threads}"));
+            let out = h8swarm(
+                &[
+                    "run",
+                    "arena",
+                    "--steps",
+                    "40",
+                    "--repeats",
+                    "2",
+                    "--robots",
+                    robots,
+                    "--threads",
+                    threads,
+                    "--out",
+                    dir.to_str().expect("utf-8 path"),
+                ],
+                None,
+            );
+            assert!(
+                out.status.success(),
+                "{}",
+                String::from_utf8_lossy(&out.stderr)
+            );
+            let stdout = String::from_utf8_lossy(&out.stdout);
+            assert!(stdout.contains("learning.png"), "{stdout}");
+            for f in [
+                "metrics.csv",
+                "summary.json",
+                "learning.png",
+                "learning.svg",
+                "arena.png",
+                "fit.json",
+            ] {
+                assert!(dir.join(f).exists(), "{f} written");
+            }
+            files.push((
+                std::fs::read(dir.join("metrics.csv")).expect("metrics"),
+                std::fs::read(dir.join("summary.json")).expect("summary"),
+            ));
+            let _ = std::fs::remove_dir_all(&dir);
+        }
+        assert!(files[0].0.len() > 1000);
+        assert_eq!(
+            files[0], files[1],
+            "{robots} robots: output depends on the thread count"
+        );
+    }
+}
+
+#[test]
+fn run_reports_bad_scenarios_and_folders_clearly() {
+    let dir = temp_dir("bad");
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let bad_key = dir.join("bad_key.toml");
+    std::fs::write(&bad_key, "robots = 3\n[learner]\neta_q15 = 33\n").expect("write");
+    let bad_value = dir.join("bad_value.toml");
+    std::fs::write(&bad_value, "[world]\nmotor_time_constant_s = 0.5\n").expect("write");
+    let cases: Vec<(Vec<String>, &str)> = vec![
+        (vec!["run".into(), bad_key.display().to_string()], "eta_q15"),
+        (
+            vec!["run".into(), bad_value.display().to_string()],
+            "world.motor_time_constant_s",
+        ),
+        (
+            vec!["run".into(), "moon".into()],
+            "unknown built-in scenario `moon`",
+        ),
+        (
+            vec![
+                "run".into(),
+                "corridor".into(),
+                "--robots".into(),
+                "40".into(),
+            ],
+            "robots",
+        ),
+        (
+            vec!["run".into(), "arena".into(), "--steps".into(), "0".into()],
+            "`steps` = 0",
+        ),
+        (
+            vec![
+                "run".into(),
+                "arena".into(),
+                "--out".into(),
+                bad_key.join("sub").display().to_string(),
+            ],
+            "cannot create the output folder",
+        ),
+    ];
+    for (args, expected) in cases {
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let out = h8swarm(&args, None);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(stderr.contains(expected), "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"));
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

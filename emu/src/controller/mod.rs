@@ -221,7 +221,7 @@ pub struct StepReport {
     pub e: i16,
     /// The update's branch (None at the first step).
     pub update: Option<UpdateKind>,
-    /// The behaviour chosen.
+    /// The behaviour the motors run (the network's choice, or the forced one).
     pub behaviour: Behaviour,
     /// States by phase.
     pub phases: PhaseStates,
@@ -606,6 +606,20 @@ impl Controller {
     /// [`ControllerError::Persist`] when a due save fails on the bus (a chip that never
     /// answers, say).
     pub fn step<B: Bus>(&mut self, bus: &mut B) -> Result<StepReport, ControllerError> {
+        self.step_with(bus, None)
+    }
+
+    /// [`Self::step`], but the motors run `forced` instead of the network's choice when it is
+    /// given (the random-walk control of SPEC §5: the learner still runs and costs what it
+    /// costs, only its choice is not obeyed).
+    ///
+    /// # Errors
+    /// As [`Self::step`].
+    pub fn step_with<B: Bus>(
+        &mut self,
+        bus: &mut B,
+        forced: Option<Behaviour>,
+    ) -> Result<StepReport, ControllerError> {
         let start_states = bus.now();
         let mut ticks = self.ticks;
         let mut phases = PhaseStates::default();
@@ -673,7 +687,8 @@ impl Controller {
                 Insn::Reg,
                 Insn::MovBwPostInc,
             ]);
-            let (left, right, dir) = motor_row(out.behaviour);
+            let behaviour = forced.unwrap_or(out.behaviour);
+            let (left, right, dir) = motor_row(behaviour);
             fw.write16(ITU1 + GRB, left);
             fw.code(&[Insn::MovBwPostInc]);
             fw.write16(ITU2 + GRB, right);
@@ -695,8 +710,9 @@ impl Controller {
             fw.code(&[Insn::MovBwAbs16, Insn::Bcc8]);
             phases.isr = fw.isr_states;
             next_tick_at = fw.next_tick_at;
-            (p, out, saved)
+            (p, (out, behaviour), saved)
         };
+        let (out, behaviour) = out;
         self.next_tick_at = next_tick_at;
         self.ticks = ticks;
         self.steps += 1;
@@ -707,7 +723,7 @@ impl Controller {
             d: out.d,
             e: out.e,
             update: out.update,
-            behaviour: out.behaviour,
+            behaviour,
             phases,
             saved,
         })

@@ -1,0 +1,278 @@
+//! The swarm experiment: robots (emulated MCU, controller, sensors, EEPROMs) in the world, step
+//! after step, with the paper's metrics; repeats and controls in parallel; deterministic.
+//!
+//! One run is one condition (learning, learning off, random walk) and one repeat. Every robot's
+//! MCU boots at time 0 and its controller ticks every 10 ms, so all robots step at the same
+//! instants. At each step instant:
+//! 1. every MCU sleeps up to the instant (ticks emulated);
+//! 2. the world catches up in sub-steps of `world.substep_s` under the motor commands of the
+//!    previous step, and every sub-step's bumpers are sampled: a released→pressed edge of any
+//!    bumper is a collision (SPEC §3.4), counted for the behaviour that was running;
+//! 3. every robot's four rays are cast, its controller runs the step on its MCU (the A/D
+//!    samples the sensor models at the rays' distances), and its motor pins become the wheel
+//!    commands of its body.
+//!
+//! The new behaviour's wheel commands apply from the step instant, not the ≈ 0.2 ms later the
+//! controller writes GRB1/GRB2 (the world does not move during a step's computation). D is the
+//! controller's own D(t) (summed du of its four readings), as the paper plots it.
+//!
+//! Determinism: a run depends only on the scenario, the condition and the repeat; every random
+//! stream is split per repeat, robot and purpose ([`crate::robot::Seeds`]); robots are processed
+//! in index order (in parallel for large swarms, with results gathered in index order), so the
+//! output is byte-identical for any thread count.
+
+use anyhow::{Context, Result};
+use rayon::prelude::*;
+use sensors::{BumperSet, CollisionCounter, port2_pins};
+use world::{Arena, World, WorldParams};
+
+use crate::plot::Outline;
+use crate::robot::{Condition, Purpose, Robot, Seeds};
+use crate::scenario::{ArenaKind, Scenario};
+
+/// Swarms at least this large step their robots in parallel inside a run.
+pub const PARALLEL_ROBOTS: usize = 64;
+/// At most this many robots' paths are recorded for the arena figure.
+pub const TRACKED_ROBOTS: usize = 40;
+
+/// The metrics of one step of one run (SPEC §5).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepMetrics {
+    /// Mean over robots of D(t), du.
+    pub mean_d: f64,
+    /// Collisions per robot during this step's behaviour.
+    pub collisions_per_robot: f64,
+    /// Corridor only: coefficient of variation of the gaps between neighbours at the step.
+    pub gap_cv: Option<f64>,
+}
+
+/// Robot paths and outlines for the arena figure.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Track {
+    /// Per tracked robot, its centre at every step (metres).
+    pub paths: Vec<Vec<(f64, f64)>>,
+    /// Outlines of the tracked robots at a few instants.
+    pub outlines: Vec<Outline>,
+    /// The arena's walls.
+    pub walls: Vec<[(f64, f64); 2]>,
+}
+
+/// What one run produced.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RunOutput {
+    /// The condition.
+    pub condition: Condition,
+    /// The repeat index.
+    pub repeat: u32,
+    /// Per-step metrics.
+    pub steps: Vec<StepMetrics>,
+    /// Paths and outlines, when asked for.
+    pub track: Option<Track>,
+    /// EEPROM records written over the run (all robots).
+    pub saves: u64,
+}
+
+/// The arena of a scenario (the square scaled to keep the paper's density for other than 3
+/// robots).
+///
+/// # Errors
+/// An arena the world refuses.
+pub fn arena_of(s: &Scenario) -> Result<Arena> {
+    Ok(match s.arena {
+        ArenaKind::Corridor => Arena::paper_corridor(),
+        ArenaKind::Square if s.robots == world::arena::PAPER_ROBOTS => Arena::square(),
+        ArenaKind::Square => Arena::scaled_square(s.robots).context("arena")?,
+    })
+}
+
+/// The world parameters of a scenario.
+#[must_use]
+pub fn world_params(s: &Scenario) -> WorldParams {
+    WorldParams {
+        top_speed_m_per_s: s.world.top_speed_m_per_s,
+        motor_time_constant_s: s.world.motor_time_constant_s,
+        motor_gain_spread: s.world.motor_gain_spread,
+        wheel_track_m: s.world.wheel_track_m,
+        max_substep_s: s.world.substep_s,
+        sensor_max_range_m: s.world.sensor_range_m,
+        ..WorldParams::default()
+    }
+}
+
+/// Places the robots of a run (fails early, before any emulation, if they do not fit).
+///
+/// # Errors
+/// More robots than the arena holds, or a placement that gives up.
+pub fn build_world(s: &Scenario, repeat: u32) -> Result<World> {
+    let seed = Seeds::new(s.seed).get(repeat, u32::MAX, Purpose::World, 0);
+    World::new(arena_of(s)?, world_params(s), s.robots, seed).with_context(|| {
+        format!(
+            "cannot place {} robots in the {} (robots = {})",
+            s.robots,
+            arena_of(s).map(|a| a.describe()).unwrap_or_default(),
+            s.robots
+        )
+    })
+}
+
+/// Runs one condition of one repeat. `progress` is called with the number of steps done since
+/// its last call.
+///
+/// # Errors
+/// A world or controller failure (none is expected once the scenario checks out).
+pub fn run_one(
+    s: &Scenario,
+    condition: Condition,
+    repeat: u32,
+    record_track: bool,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<RunOutput> {
+    let n = s.robots;
+    let mut world = build_world(s, repeat)?;
+    let mut robots: Vec<Robot> = (0..n)
+        .map(|i| Robot::new(s, condition, repeat, i as u32))
+        .collect::<Result<_>>()?;
+    let par = n >= PARALLEL_ROBOTS;
+    let clock_hz = f64::from(s.timing.clock_hz);
+    let mut counters: Vec<CollisionCounter> = vec![CollisionCounter::new(); n];
+    let mut steps: Vec<StepMetrics> = Vec::with_capacity(s.steps as usize);
+    let tracked = if record_track {
+        n.min(TRACKED_ROBOTS)
+    } else {
+        0
+    };
+    let mut track = record_track.then(|| Track {
+        paths: vec![Vec::with_capacity(s.steps as usize); tracked],
+        outlines: Vec::new(),
+        walls: world
+            .arena()
+            .walls()
+            .iter()
+            .map(|w| [(w.a.0, w.a.1), (w.b.0, w.b.1)])
+            .collect(),
+    });
+    let snapshots = [0, s.steps / 3, 2 * s.steps / 3, s.steps.saturating_sub(1)];
+    let mut saves = 0u64;
+
+    for k in 0..s.steps {
+        // 1. Every MCU sleeps to the step instant.
+        let times: Vec<u64> = if par {
+            robots
+                .par_iter_mut()
+                .map(Robot::sleep)
+                .collect::<Result<_>>()?
+        } else {
+            robots.iter_mut().map(Robot::sleep).collect::<Result<_>>()?
+        };
+        let t_step_s = times.iter().copied().min().unwrap_or(0) as f64 / clock_hz;
+        // 2. The world catches up; the collisions belong to the previous step's behaviour.
+        let collided = advance_world(&mut world, t_step_s, s.world.substep_s, &mut counters, par)?;
+        if let Some(last) = steps.last_mut() {
+            last.collisions_per_robot = collided as f64 / n as f64;
+        }
+        if let Some(t) = track.as_mut() {
+            record(&world, t, tracked, snapshots.contains(&k), t_step_s)?;
+        }
+        // 3. Sense, step, drive.
+        let sense = |i: usize| -> Result<[Option<f64>; 4]> {
+            let mut d = [None; 4];
+            for (k, dk) in d.iter_mut().enumerate() {
+                *dk = world.sense(i, k)?;
+            }
+            Ok(d)
+        };
+        let distances: Vec<[Option<f64>; 4]> = if par {
+            (0..n).into_par_iter().map(sense).collect::<Result<_>>()?
+        } else {
+            (0..n).map(sense).collect::<Result<_>>()?
+        };
+        let results: Vec<(i16, bool)> = if par {
+            robots
+                .par_iter_mut()
+                .zip(distances.par_iter())
+                .map(|(r, d)| r.step(*d).map(|rep| (rep.d, rep.saved.is_some())))
+                .collect::<Result<_>>()?
+        } else {
+            robots
+                .iter_mut()
+                .zip(&distances)
+                .map(|(r, d)| r.step(*d).map(|rep| (rep.d, rep.saved.is_some())))
+                .collect::<Result<_>>()?
+        };
+        for (i, r) in robots.iter_mut().enumerate() {
+            let (left, right) = r.wheels();
+            world.set_wheels(i, left, right)?;
+        }
+        saves += results.iter().filter(|(_, saved)| *saved).count() as u64;
+        let mean_d = results.iter().map(|(d, _)| f64::from(*d)).sum::<f64>() / n as f64;
+        let gap_cv = match s.arena {
+            ArenaKind::Corridor => world.corridor_gap_cv()?,
+            ArenaKind::Square => None,
+        };
+        steps.push(StepMetrics {
+            mean_d,
+            collisions_per_robot: 0.0,
+            gap_cv,
+        });
+        progress(1);
+    }
+    // The last behaviour runs its full period too.
+    let end_s = world.elapsed_s() + s.timing.step_period_s;
+    let collided = advance_world(&mut world, end_s, s.world.substep_s, &mut counters, par)?;
+    if let Some(last) = steps.last_mut() {
+        last.collisions_per_robot = collided as f64 / n as f64;
+    }
+    Ok(RunOutput {
+        condition,
+        repeat,
+        steps,
+        track,
+        saves,
+    })
+}
+
+/// Advances the world to `target_s` in sub-steps of at most `substep_s`, sampling every robot's
+/// bumpers after each; returns the collisions (released→pressed edges) counted.
+fn advance_world(
+    world: &mut World,
+    target_s: f64,
+    substep_s: f64,
+    counters: &mut [CollisionCounter],
+    par: bool,
+) -> Result<u64> {
+    let mut collisions = 0u64;
+    loop {
+        let left = target_s - world.elapsed_s();
+        if left <= 1e-12 {
+            break;
+        }
+        let dt = left.min(substep_s);
+        if par {
+            world.advance_par(dt)?;
+        } else {
+            world.advance(dt)?;
+        }
+        for (i, c) in counters.iter_mut().enumerate() {
+            let [front, rear, left, right] = world.bumpers(i)?;
+            c.sample(port2_pins(BumperSet::from_flags(front, rear, left, right)));
+            collisions += c.take_collisions();
+        }
+    }
+    Ok(collisions)
+}
+
+fn record(world: &World, t: &mut Track, tracked: usize, snapshot: bool, time_s: f64) -> Result<()> {
+    for i in 0..tracked {
+        let p = world.pose(i)?;
+        t.paths[i].push((p.x_m, p.y_m));
+        if snapshot {
+            t.outlines.push(Outline {
+                robot: i,
+                time_s,
+                corners: world.corners(i)?,
+                heading: (p.heading_rad.cos(), p.heading_rad.sin()),
+            });
+        }
+    }
+    Ok(())
+}

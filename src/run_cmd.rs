@@ -1,0 +1,379 @@
+//! `h8swarm run [corridor|arena|FILE.toml] [--robots N] [--steps S] [--repeats R] [--seed X]
+//! [--threads T] [--out DIR]`: the paper's experiment with its controls, in parallel, with the
+//! metrics, the summary, the figures and the fit verdict written to DIR.
+
+use std::fmt::Write as _;
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::experiment::{RunOutput, build_world, run_one};
+use crate::plot::{ArenaFigure, LearningFigure, Series, arena_figure, learning_figure};
+use crate::robot::{Condition, controller_config};
+use crate::scenario::Scenario;
+use crate::summary::{Claim, ConditionStats, Estimate, claims, conditions};
+
+/// Options of `h8swarm run`.
+#[derive(Args, Debug, Default, Clone)]
+pub struct RunArgs {
+    /// `arena` (default), `corridor`, or a scenario file (.toml).
+    pub scenario: Option<String>,
+    /// Robots (the square arena is scaled to keep the paper's density).
+    #[arg(long)]
+    pub robots: Option<usize>,
+    /// Steps per run.
+    #[arg(long)]
+    pub steps: Option<u32>,
+    /// Repeats of each condition.
+    #[arg(long)]
+    pub repeats: Option<u32>,
+    /// Master seed.
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Worker threads (default: all cores). The output does not depend on it.
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Output folder (default `out/<scenario>`, with `-<N>robots` when --robots is given).
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+}
+
+#[derive(Serialize)]
+struct Summary<'a> {
+    h8swarm_version: &'static str,
+    scenario: &'a Scenario,
+    window_steps: u32,
+    eeprom_records_written: u64,
+    conditions: &'a [ConditionStats],
+    claims: &'a [Claim],
+}
+
+/// Runs the experiment; returns the text to print.
+///
+/// # Errors
+/// A bad scenario or option (naming the key or path), an output folder that cannot be written,
+/// more robots than the arena holds.
+pub fn run(a: &RunArgs) -> Result<String> {
+    let what = a.scenario.as_deref().unwrap_or("arena");
+    let s = Scenario::load(what)?.with_overrides(a.robots, a.steps, a.repeats, a.seed)?;
+    if a.threads == Some(0) {
+        bail!("--threads 0: give at least 1 (or leave it out for all cores)");
+    }
+    let out = a.out.clone().unwrap_or_else(|| {
+        let mut name = s.name.clone();
+        if let Some(n) = a.robots {
+            let _ = write!(name, "-{n}robots");
+        }
+        Path::new("out").join(name)
+    });
+    std::fs::create_dir_all(&out)
+        .with_context(|| format!("cannot create the output folder `{}`", out.display()))?;
+    let metrics_path = out.join("metrics.csv");
+    // Fail now, not after the runs, if the folder cannot be written.
+    std::fs::write(&metrics_path, b"")
+        .with_context(|| format!("cannot write `{}`", metrics_path.display()))?;
+    // Fail now if the robots do not fit the arena.
+    build_world(&s, 0)?;
+
+    let mut jobs: Vec<(Condition, u32)> = Vec::new();
+    let mut kinds = vec![Condition::Learning];
+    if s.controls.learning_off {
+        kinds.push(Condition::LearningOff);
+    }
+    if s.controls.random_walk {
+        kinds.push(Condition::RandomWalk);
+    }
+    for c in &kinds {
+        for r in 0..s.repeats {
+            jobs.push((*c, r));
+        }
+    }
+    let threads = a.threads.unwrap_or_else(|| {
+        std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
+    });
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .context("starting the worker threads")?;
+    let total = jobs.len() as u64 * u64::from(s.steps);
+    let bar = if std::io::stderr().is_terminal() {
+        let b = ProgressBar::new(total);
+        b.set_style(
+            ProgressStyle::with_template(
+                "{spinner} {elapsed_precise} [{bar:40}] {pos}/{len} robot-steps {msg} (eta {eta})",
+            )
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("=> "),
+        );
+        b.set_message(format!(
+            "x {} robots, {} runs on {threads} threads",
+            s.robots,
+            jobs.len()
+        ));
+        b
+    } else {
+        ProgressBar::hidden()
+    };
+    let started = Instant::now();
+    let runs: Vec<RunOutput> = pool.install(|| {
+        jobs.par_iter()
+            .map(|&(c, r)| {
+                let track = c == Condition::Learning && r == 0;
+                run_one(&s, c, r, track, &|k| bar.inc(k))
+            })
+            .collect::<Result<_>>()
+    })?;
+    bar.finish_and_clear();
+    let wall_s = started.elapsed().as_secs_f64();
+
+    write_metrics(&metrics_path, &runs)?;
+    let stats = conditions(&runs, s.steps, s.window);
+    let checked = claims(&stats);
+    let saves: u64 = runs.iter().map(|r| r.saves).sum();
+    let summary = Summary {
+        h8swarm_version: env!("CARGO_PKG_VERSION"),
+        scenario: &s,
+        window_steps: s.window,
+        eeprom_records_written: saves,
+        conditions: &stats,
+        claims: &checked,
+    };
+    let summary_path = out.join("summary.json");
+    std::fs::write(
+        &summary_path,
+        serde_json::to_string_pretty(&summary)? + "\n",
+    )
+    .with_context(|| format!("cannot write `{}`", summary_path.display()))?;
+
+    let fit = emu::fit::measure(&emu::fit::FitConfig {
+        controller: controller_config(&s, s.seed)?,
+        steps: 400,
+        seed: s.seed,
+    })?;
+    let fit_path = out.join("fit.json");
+    std::fs::write(&fit_path, serde_json::to_string_pretty(&fit)? + "\n")
+        .with_context(|| format!("cannot write `{}`", fit_path.display()))?;
+
+    let (png, svg, arena_png) = (
+        out.join("learning.png"),
+        out.join("learning.svg"),
+        out.join("arena.png"),
+    );
+    learning_figure(&learning(&s, &runs), &png, &svg)?;
+    if let Some(track) = runs.iter().find_map(|r| r.track.as_ref()) {
+        arena_figure(&arena(&s, track), &arena_png)?;
+    }
+
+    let robot_steps = jobs.len() as f64 * f64::from(s.steps) * s.robots as f64;
+    let simulated_s = jobs.len() as f64 * f64::from(s.steps) * s.timing.step_period_s;
+    let mut t = String::new();
+    let _ = writeln!(
+        t,
+        "h8swarm run {}: {} robots, {} steps of {} s, {} repeats x {} conditions, seed {}",
+        s.name,
+        s.robots,
+        s.steps,
+        s.timing.step_period_s,
+        s.repeats,
+        kinds.len(),
+        s.seed
+    );
+    let _ = writeln!(
+        t,
+        "wall {:.1} s on {threads} threads: {:.0} robot-steps/s, {:.0}x real time per run",
+        wall_s,
+        robot_steps / wall_s,
+        simulated_s / wall_s
+    );
+    let _ = writeln!(t);
+    let _ = writeln!(
+        t,
+        "{:<14} {:>22} {:>22} {:>22} {:>22}",
+        "condition", "D first window", "D last window", "coll./robot first", "coll./robot last"
+    );
+    for c in &stats {
+        let _ = writeln!(
+            t,
+            "{:<14} {:>22} {:>22} {:>22} {:>22}",
+            c.condition.name(),
+            fmt_est(&c.first.mean_d),
+            fmt_est(&c.last.mean_d),
+            fmt_est(&c.first.collisions_per_robot),
+            fmt_est(&c.last.collisions_per_robot)
+        );
+        if let (Some(f), Some(l)) = (&c.first.gap_cv, &c.last.gap_cv) {
+            let _ = writeln!(t, "{:<14} gap CV {} -> {}", "", fmt_est(f), fmt_est(l));
+        }
+    }
+    let _ = writeln!(
+        t,
+        "(windows of {} steps; mean over repeats [95 % interval])",
+        s.window
+    );
+    let _ = writeln!(t);
+    for c in &checked {
+        let _ = writeln!(
+            t,
+            "{} {} ({:.3} vs {:.3}{})",
+            if c.holds { "HOLDS " } else { "FAILS " },
+            c.claim,
+            c.values[0],
+            c.values[1],
+            if c.clear {
+                ", intervals apart"
+            } else {
+                ", intervals overlap"
+            }
+        );
+    }
+    let _ = writeln!(t);
+    let _ = writeln!(t, "fit: {}", fit.verdict);
+    let _ = writeln!(
+        t,
+        "wrote {} (metrics.csv, summary.json, fit.json); plots: {}, {}{}",
+        out.display(),
+        png.display(),
+        svg.display(),
+        if arena_png.exists() {
+            format!(", {}", arena_png.display())
+        } else {
+            String::new()
+        }
+    );
+    Ok(t)
+}
+
+fn fmt_est(e: &Estimate) -> String {
+    match (e.lo, e.hi) {
+        (Some(lo), Some(hi)) => format!("{:.2} [{:.2}, {:.2}]", e.mean, lo, hi),
+        _ => format!("{:.2}", e.mean),
+    }
+}
+
+fn write_metrics(path: &Path, runs: &[RunOutput]) -> Result<()> {
+    let mut w = csv::Writer::from_path(path)
+        .with_context(|| format!("cannot write `{}`", path.display()))?;
+    w.write_record([
+        "condition",
+        "repeat",
+        "step",
+        "mean_d",
+        "collisions_per_robot",
+        "gap_cv",
+    ])?;
+    for r in runs {
+        for (k, m) in r.steps.iter().enumerate() {
+            w.write_record([
+                r.condition.name().to_string(),
+                r.repeat.to_string(),
+                k.to_string(),
+                format!("{}", m.mean_d),
+                format!("{}", m.collisions_per_robot),
+                m.gap_cv.map(|v| format!("{v}")).unwrap_or_default(),
+            ])?;
+        }
+    }
+    w.flush()
+        .with_context(|| format!("cannot write `{}`", path.display()))?;
+    Ok(())
+}
+
+/// The learning figure: per condition, mean D per window and collisions per robot per window,
+/// mean over repeats with its 95 % band (or the range with fewer than two repeats).
+fn learning(s: &Scenario, runs: &[RunOutput]) -> LearningFigure {
+    let win = s.window.max(1) as usize;
+    let mut d = Vec::new();
+    let mut coll = Vec::new();
+    for c in [
+        Condition::Learning,
+        Condition::LearningOff,
+        Condition::RandomWalk,
+    ] {
+        let of_c: Vec<&RunOutput> = runs.iter().filter(|r| r.condition == c).collect();
+        if of_c.is_empty() {
+            continue;
+        }
+        let windows = s.steps as usize / win;
+        let (mut xs, mut dm, mut dl, mut dh, mut cm, mut cl, mut ch) =
+            (vec![], vec![], vec![], vec![], vec![], vec![], vec![]);
+        for w in 0..windows {
+            let range = w * win..(w + 1) * win;
+            let ds: Vec<f64> = of_c
+                .iter()
+                .map(|r| r.steps[range.clone()].iter().map(|m| m.mean_d).sum::<f64>() / win as f64)
+                .collect();
+            let cs: Vec<f64> = of_c
+                .iter()
+                .map(|r| {
+                    r.steps[range.clone()]
+                        .iter()
+                        .map(|m| m.collisions_per_robot)
+                        .sum::<f64>()
+                })
+                .collect();
+            xs.push((w * win + win / 2) as f64);
+            let (e, f) = (Estimate::of(&ds), Estimate::of(&cs));
+            dm.push(e.mean);
+            dl.push(e.lo.unwrap_or(e.mean));
+            dh.push(e.hi.unwrap_or(e.mean));
+            cm.push(f.mean);
+            cl.push(f.lo.unwrap_or(f.mean).max(0.0));
+            ch.push(f.hi.unwrap_or(f.mean));
+        }
+        let label = match c {
+            Condition::Learning => "learning".to_string(),
+            Condition::LearningOff => "learning off (η = 0)".to_string(),
+            Condition::RandomWalk => "random walk".to_string(),
+        };
+        let dashed = c != Condition::Learning;
+        d.push(Series {
+            label: label.clone(),
+            dashed,
+            x: xs.clone(),
+            mean: dm,
+            lo: dl,
+            hi: dh,
+        });
+        coll.push(Series {
+            label,
+            dashed,
+            x: xs,
+            mean: cm,
+            lo: cl,
+            hi: ch,
+        });
+    }
+    LearningFigure {
+        title: format!(
+            "h8swarm {}: {} robots, {} repeats, windows of {} steps ({} s per step)",
+            s.name, s.robots, s.repeats, s.window, s.timing.step_period_s
+        ),
+        x_label: "learning step".to_string(),
+        d,
+        collisions: coll,
+    }
+}
+
+fn arena(s: &Scenario, t: &crate::experiment::Track) -> ArenaFigure {
+    ArenaFigure {
+        title: format!(
+            "h8swarm {}: {} robots learning{} (repeat 0)",
+            s.name,
+            s.robots,
+            if t.paths.len() < s.robots {
+                format!(", paths of the first {}", t.paths.len())
+            } else {
+                String::new()
+            }
+        ),
+        walls: t.walls.clone(),
+        paths: t.paths.clone(),
+        outlines: t.outlines.clone(),
+    }
+}

@@ -1,0 +1,532 @@
+//! Scenarios: every parameter of an experiment (SPEC §3 and §5), as TOML, with the built-in
+//! `corridor` (paper env. 1) and `arena` (paper env. 2).
+//!
+//! A scenario file lists only what differs from the built-in it names in `base` (default
+//! `arena`); every table and key is optional, and an unknown key is an error naming it. Values
+//! are checked when the scenario is resolved, with messages that name the key and the valid
+//! range. `h8swarm run --robots N` on a square arena scales its side to keep the paper's
+//! density (3 robots in 1.8 m × 1.8 m: side = 1.8 m · √(N / 3)).
+
+use std::path::Path;
+
+use anyhow::{Context, Result, bail};
+use serde::{Deserialize, Serialize};
+
+/// The arenas of SPEC §5.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ArenaKind {
+    /// Walled corridor 3.0 m × (body width + 4 cm), robots in one line (paper env. 1).
+    Corridor,
+    /// Walled square 1.8 m × 1.8 m (paper env. 2), scaled for more robots to keep the density.
+    Square,
+}
+
+/// The learner and its controller.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct LearnerSpec {
+    /// Enabled behaviours M: 2 (forward, backward) or 4.
+    pub behaviours: usize,
+    /// Learning rate η as a real number in [0, 1) (stored in Q15: 0.1 → 3277, 0.001 → 33).
+    pub eta: f64,
+    /// Dead-zone threshold T in du.
+    pub threshold: i32,
+    /// History depth H (0–8).
+    pub history: usize,
+    /// The bias input +127.
+    pub bias: bool,
+    /// One EEPROM record every this many steps.
+    pub save_every: u32,
+}
+
+/// Timing of the robot.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct TimingSpec {
+    /// Step period in seconds (a whole number of 10 ms ticks).
+    pub step_period_s: f64,
+    /// MCU clock φ in Hz.
+    pub clock_hz: u32,
+}
+
+/// The physical world (defaults from SPEC §3.5 and the `world` crate).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct WorldSpec {
+    /// Top wheel speed in m/s.
+    pub top_speed_m_per_s: f64,
+    /// Motor lag time constant in seconds (0.020–0.100).
+    pub motor_time_constant_s: f64,
+    /// Per-wheel motor gain spread (0.05 = ±5 %).
+    pub motor_gain_spread: f64,
+    /// Wheel track in metres.
+    pub wheel_track_m: f64,
+    /// World sub-step in seconds.
+    pub substep_s: f64,
+    /// Farthest distance a sensor ray reports, metres.
+    pub sensor_range_m: f64,
+}
+
+/// The IR sensors (defaults: SPEC §3.1 and the `sensors` crate).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SensorSpec {
+    /// Gaussian read noise σ in volts.
+    pub noise_sigma_v: f64,
+    /// Probability that a read lands in a spike.
+    pub spike_probability: f64,
+    /// Unit-to-unit spread on (the datasheet's) or off (every sensor nominal).
+    pub spread: bool,
+}
+
+/// Which controls run beside learning (SPEC §5).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ControlSpec {
+    /// The same run with learning off (η = 0, frozen initial weights).
+    pub learning_off: bool,
+    /// The same run with uniformly random behaviours.
+    pub random_walk: bool,
+}
+
+/// A scenario file: everything optional, over a built-in base.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ScenarioFile {
+    /// The built-in this file changes: `arena` (default) or `corridor`.
+    pub base: Option<String>,
+    /// A name for the run.
+    pub name: Option<String>,
+    /// The arena: `corridor` or `square`.
+    pub arena: Option<ArenaKind>,
+    /// Robots.
+    pub robots: Option<usize>,
+    /// Steps per run.
+    pub steps: Option<u32>,
+    /// Repeats of each condition.
+    pub repeats: Option<u32>,
+    /// Master seed.
+    pub seed: Option<u64>,
+    /// Steps per metric window (first and last window of the summary, plot points).
+    pub window: Option<u32>,
+    /// The learner.
+    pub learner: Option<LearnerPatch>,
+    /// Timing.
+    pub timing: Option<TimingPatch>,
+    /// World.
+    pub world: Option<WorldPatch>,
+    /// Sensors.
+    pub sensors: Option<SensorPatch>,
+    /// Controls.
+    pub controls: Option<ControlPatch>,
+}
+
+macro_rules! patch {
+    ($patch:ident for $spec:ident { $($field:ident : $ty:ty),* $(,)? }) => {
+        #[doc = concat!("Optional values over a [`", stringify!($spec), "`].")]
+        #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+        #[serde(deny_unknown_fields)]
+        pub struct $patch {
+            $(
+                #[doc = concat!("Overrides `", stringify!($field), "`.")]
+                pub $field: Option<$ty>,
+            )*
+        }
+        impl $patch {
+            fn apply(&self, spec: &mut $spec) {
+                $( if let Some(v) = &self.$field { spec.$field = v.clone(); } )*
+            }
+        }
+    };
+}
+
+patch!(LearnerPatch for LearnerSpec { behaviours: usize, eta: f64, threshold: i32, history: usize, bias: bool, save_every: u32 });
+patch!(TimingPatch for TimingSpec { step_period_s: f64, clock_hz: u32 });
+patch!(WorldPatch for WorldSpec { top_speed_m_per_s: f64, motor_time_constant_s: f64, motor_gain_spread: f64, wheel_track_m: f64, substep_s: f64, sensor_range_m: f64 });
+patch!(SensorPatch for SensorSpec { noise_sigma_v: f64, spike_probability: f64, spread: bool });
+patch!(ControlPatch for ControlSpec { learning_off: bool, random_walk: bool });
+
+/// A resolved, checked scenario.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Scenario {
+    /// Its name.
+    pub name: String,
+    /// The arena.
+    pub arena: ArenaKind,
+    /// Robots.
+    pub robots: usize,
+    /// Steps per run.
+    pub steps: u32,
+    /// Repeats of each condition.
+    pub repeats: u32,
+    /// Master seed.
+    pub seed: u64,
+    /// Steps per metric window.
+    pub window: u32,
+    /// The learner.
+    pub learner: LearnerSpec,
+    /// Timing.
+    pub timing: TimingSpec,
+    /// World.
+    pub world: WorldSpec,
+    /// Sensors.
+    pub sensors: SensorSpec,
+    /// Controls.
+    pub controls: ControlSpec,
+}
+
+impl Default for LearnerSpec {
+    fn default() -> Self {
+        Scenario::arena().learner
+    }
+}
+
+impl Default for TimingSpec {
+    fn default() -> Self {
+        Scenario::arena().timing
+    }
+}
+
+impl Default for WorldSpec {
+    fn default() -> Self {
+        Self {
+            top_speed_m_per_s: world::params::TOP_SPEED_M_PER_S,
+            motor_time_constant_s: world::params::MOTOR_TIME_CONSTANT_S,
+            motor_gain_spread: world::params::MOTOR_GAIN_SPREAD,
+            wheel_track_m: world::params::WHEEL_TRACK_M,
+            substep_s: 0.010,
+            sensor_range_m: world::params::SENSOR_MAX_RANGE_M,
+        }
+    }
+}
+
+impl Default for SensorSpec {
+    fn default() -> Self {
+        Self {
+            noise_sigma_v: sensors::ir::NOISE_SIGMA_VOLTS,
+            spike_probability: sensors::ir::SPIKE_PROBABILITY,
+            spread: true,
+        }
+    }
+}
+
+impl Default for ControlSpec {
+    fn default() -> Self {
+        Self {
+            learning_off: true,
+            random_walk: true,
+        }
+    }
+}
+
+impl Scenario {
+    /// Paper env. 2: three robots in the 1.8 m square, all four behaviours, η = 0.001, T = 10,
+    /// 0.45 s steps, 10 000 steps, 5 repeats.
+    #[must_use]
+    pub fn arena() -> Self {
+        Self {
+            name: "arena".into(),
+            arena: ArenaKind::Square,
+            robots: 3,
+            steps: 10_000,
+            repeats: 5,
+            seed: 1,
+            window: 500,
+            learner: LearnerSpec {
+                behaviours: 4,
+                eta: 0.001,
+                threshold: 10,
+                history: 1,
+                bias: false,
+                save_every: 20,
+            },
+            timing: TimingSpec {
+                step_period_s: 0.45,
+                clock_hz: 25_000_000,
+            },
+            world: WorldSpec::default(),
+            sensors: SensorSpec::default(),
+            controls: ControlSpec::default(),
+        }
+    }
+
+    /// Paper env. 1: three robots in the corridor, forward and backward, η = 0.1, T = 10, 0.60 s
+    /// steps, 500 steps, 5 repeats.
+    #[must_use]
+    pub fn corridor() -> Self {
+        Self {
+            name: "corridor".into(),
+            arena: ArenaKind::Corridor,
+            steps: 500,
+            window: 50,
+            learner: LearnerSpec {
+                behaviours: 2,
+                eta: 0.1,
+                ..Self::arena().learner
+            },
+            timing: TimingSpec {
+                step_period_s: 0.60,
+                ..Self::arena().timing
+            },
+            ..Self::arena()
+        }
+    }
+
+    /// A built-in by name.
+    ///
+    /// # Errors
+    /// An unknown name, listing the built-ins.
+    pub fn builtin(name: &str) -> Result<Self> {
+        match name {
+            "arena" => Ok(Self::arena()),
+            "corridor" => Ok(Self::corridor()),
+            other => bail!(
+                "unknown built-in scenario `{other}`: valid are `arena` and `corridor`, or a path to a .toml file"
+            ),
+        }
+    }
+
+    /// `arena`, `corridor`, or a TOML file.
+    ///
+    /// # Errors
+    /// An unreadable file, bad TOML, an unknown key or a value out of range, naming it.
+    pub fn load(what: &str) -> Result<Self> {
+        if what == "arena" || what == "corridor" {
+            return Self::builtin(what);
+        }
+        let path = Path::new(what);
+        if path.extension().and_then(|e| e.to_str()) != Some("toml") && !path.exists() {
+            return Self::builtin(what);
+        }
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read scenario file `{what}`"))?;
+        Self::from_toml(&text).with_context(|| format!("scenario file `{what}`"))
+    }
+
+    /// Parses a scenario file's text over its base and checks it.
+    ///
+    /// # Errors
+    /// Bad TOML, an unknown key, or a value out of range.
+    pub fn from_toml(text: &str) -> Result<Self> {
+        let file: ScenarioFile = toml::from_str(text).map_err(|e| anyhow::anyhow!("{e}"))?;
+        let mut s = Self::builtin(file.base.as_deref().unwrap_or("arena")).context("key `base`")?;
+        if let Some(v) = file.name {
+            s.name = v;
+        }
+        if let Some(v) = file.arena {
+            s.arena = v;
+        }
+        if let Some(v) = file.robots {
+            s.robots = v;
+        }
+        if let Some(v) = file.steps {
+            s.steps = v;
+        }
+        if let Some(v) = file.repeats {
+            s.repeats = v;
+        }
+        if let Some(v) = file.seed {
+            s.seed = v;
+        }
+        if let Some(v) = file.window {
+            s.window = v;
+        }
+        if let Some(p) = &file.learner {
+            p.apply(&mut s.learner);
+        }
+        if let Some(p) = &file.timing {
+            p.apply(&mut s.timing);
+        }
+        if let Some(p) = &file.world {
+            p.apply(&mut s.world);
+        }
+        if let Some(p) = &file.sensors {
+            p.apply(&mut s.sensors);
+        }
+        if let Some(p) = &file.controls {
+            p.apply(&mut s.controls);
+        }
+        s.check()?;
+        Ok(s)
+    }
+
+    /// η as a Q15 integer (rounded).
+    #[must_use]
+    pub fn eta_q15(&self) -> i32 {
+        (self.learner.eta * 32768.0).round() as i32
+    }
+
+    /// Checks every value; the error names the key and the valid range.
+    ///
+    /// # Errors
+    /// The first value out of range.
+    pub fn check(&self) -> Result<()> {
+        fn range<T: PartialOrd + std::fmt::Display>(key: &str, v: T, lo: T, hi: T) -> Result<()> {
+            if v >= lo && v <= hi {
+                Ok(())
+            } else {
+                bail!("`{key}` = {v} is out of range: valid is {lo} to {hi}")
+            }
+        }
+        fn finite(key: &str, v: f64, lo: f64, hi: f64) -> Result<()> {
+            if v.is_finite() && v >= lo && v <= hi {
+                Ok(())
+            } else {
+                bail!("`{key}` = {v} is out of range: valid is {lo} to {hi}")
+            }
+        }
+        range("robots", self.robots, 1, 100_000)?;
+        range("steps", self.steps, 1, 10_000_000)?;
+        range("repeats", self.repeats, 1, 1000)?;
+        range("window", self.window, 1, self.steps)?;
+        range("learner.behaviours", self.learner.behaviours, 2, 4)?;
+        finite("learner.eta", self.learner.eta, 0.0, 32767.0 / 32768.0)?;
+        range("learner.threshold", self.learner.threshold, 0, 1020)?;
+        range(
+            "learner.history",
+            self.learner.history,
+            0,
+            nn_q15::MAX_HISTORY,
+        )?;
+        range("learner.save_every", self.learner.save_every, 1, 1_000_000)?;
+        finite(
+            "timing.step_period_s",
+            self.timing.step_period_s,
+            0.01,
+            600.0,
+        )?;
+        let ticks = self.timing.step_period_s / emu::controller::TICK_S;
+        if (ticks - ticks.round()).abs() > 1e-9 {
+            bail!(
+                "`timing.step_period_s` = {} is not a whole number of 10 ms ticks (0.45 and 0.60 are the paper's)",
+                self.timing.step_period_s
+            );
+        }
+        range(
+            "timing.clock_hz",
+            self.timing.clock_hz,
+            emu::controller::CLOCK_MIN_HZ,
+            emu::controller::CLOCK_MAX_HZ,
+        )?;
+        finite(
+            "world.top_speed_m_per_s",
+            self.world.top_speed_m_per_s,
+            0.001,
+            world::params::MAX_TOP_SPEED_M_PER_S,
+        )?;
+        finite(
+            "world.motor_time_constant_s",
+            self.world.motor_time_constant_s,
+            world::params::MOTOR_TIME_CONSTANT_MIN_S,
+            world::params::MOTOR_TIME_CONSTANT_MAX_S,
+        )?;
+        finite(
+            "world.motor_gain_spread",
+            self.world.motor_gain_spread,
+            0.0,
+            0.5,
+        )?;
+        finite("world.wheel_track_m", self.world.wheel_track_m, 0.05, 0.18)?;
+        finite("world.substep_s", self.world.substep_s, 0.001, 0.020)?;
+        finite("world.sensor_range_m", self.world.sensor_range_m, 0.1, 10.0)?;
+        finite(
+            "sensors.noise_sigma_v",
+            self.sensors.noise_sigma_v,
+            0.0,
+            1.0,
+        )?;
+        finite(
+            "sensors.spike_probability",
+            self.sensors.spike_probability,
+            0.0,
+            1.0,
+        )?;
+        if self.timing.step_period_s < self.world.substep_s {
+            bail!(
+                "`world.substep_s` = {} is longer than the step period {} s",
+                self.world.substep_s,
+                self.timing.step_period_s
+            );
+        }
+        Ok(())
+    }
+
+    /// Applies the command line's overrides and checks again.
+    ///
+    /// # Errors
+    /// A value out of range.
+    pub fn with_overrides(
+        mut self,
+        robots: Option<usize>,
+        steps: Option<u32>,
+        repeats: Option<u32>,
+        seed: Option<u64>,
+    ) -> Result<Self> {
+        if let Some(v) = robots {
+            self.robots = v;
+        }
+        if let Some(v) = steps {
+            self.steps = v;
+            self.window = self.window.min(v);
+        }
+        if let Some(v) = repeats {
+            self.repeats = v;
+        }
+        if let Some(v) = seed {
+            self.seed = v;
+        }
+        self.check().context("command-line option")?;
+        Ok(self)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn builtins_match_the_paper() {
+        let a = Scenario::arena();
+        assert_eq!(
+            (a.robots, a.steps, a.repeats, a.learner.behaviours),
+            (3, 10_000, 5, 4)
+        );
+        assert_eq!(a.eta_q15(), 33);
+        let c = Scenario::corridor();
+        assert_eq!((c.steps, c.learner.behaviours, c.eta_q15()), (500, 2, 3277));
+        assert_eq!(c.timing.step_period_s, 0.60);
+        a.check().unwrap();
+        c.check().unwrap();
+    }
+
+    #[test]
+    fn files_override_the_base_and_unknown_keys_fail() {
+        let s = Scenario::from_toml("base = \"corridor\"\nrobots = 4\n[learner]\neta = 0.05\n")
+            .unwrap();
+        assert_eq!(s.robots, 4);
+        assert_eq!(s.learner.behaviours, 2);
+        assert_eq!(s.eta_q15(), 1638);
+        let e = Scenario::from_toml("robts = 4\n").unwrap_err().to_string();
+        assert!(e.contains("robts"), "{e}");
+        let e = Scenario::from_toml("[learner]\netaa = 0.1\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("etaa"), "{e}");
+        let e = format!(
+            "{:#}",
+            Scenario::from_toml("[learner]\neta = 2.0\n").unwrap_err()
+        );
+        assert!(e.contains("learner.eta"), "{e}");
+        let e = format!(
+            "{:#}",
+            Scenario::from_toml("[timing]\nstep_period_s = 0.455\n").unwrap_err()
+        );
+        assert!(e.contains("10 ms ticks"), "{e}");
+        let e = format!(
+            "{:#}",
+            Scenario::from_toml("base = \"moon\"\n").unwrap_err()
+        );
+        assert!(e.contains("moon"), "{e}");
+    }
+}
