@@ -507,6 +507,14 @@ impl<B: Board> Mcu<B> {
         self.irq_valid_until.set(0);
     }
 
+    /// Before a write that changes the interrupt decision: forget the cached decision and
+    /// catch up the ITU channels that can request, so recomputing it is cheap.
+    #[inline]
+    fn before_irq_write(&mut self) {
+        self.invalidate_irq();
+        self.itu.sync_irq_sources(self.now);
+    }
+
     fn sync_adc(&mut self) {
         let now = self.now;
         let board = &mut self.board;
@@ -627,11 +635,11 @@ impl<B: Board> Mcu<B> {
         // interrupt; port writes (I²C bit-banging, motor direction) cannot.
         match a {
             itu::ITU_FIRST..=itu::ITU_LAST => {
-                self.invalidate_irq();
+                self.before_irq_write();
                 self.itu.write(a, v, now);
             }
             sci::SCI1_SMR..=sci::SCI1_RDR => {
-                self.invalidate_irq();
+                self.before_irq_write();
                 self.sci.write(a, v, now);
             }
             ports::P2DDR => self.p2.ddr = v,
@@ -651,13 +659,13 @@ impl<B: Board> Mcu<B> {
             ports::PBDDR => self.pb.ddr = v,
             ports::PBDR => self.pb.dr = v,
             adc::ADDRA..=adc::ADCR => {
-                self.invalidate_irq();
+                self.before_irq_write();
                 self.sync_adc();
                 self.adc.write(a, v, now);
             }
             SYSCR => self.syscr = v,
             intc::IPRA | intc::IPRB => {
-                self.invalidate_irq();
+                self.before_irq_write();
                 self.intc.write(a, v);
             }
             _ => {}
@@ -774,8 +782,8 @@ impl<B: Board> Bus for Mcu<B> {
             Area::Io => {
                 if itu::is_word_register(a) {
                     self.now += u64::from(itu::ITU_WORD_ACCESS_STATES);
-                    self.io_write8(a, hi);
-                    self.io_write8(a + 1, lo);
+                    self.before_irq_write();
+                    self.itu.write16(a, value, self.now);
                 } else {
                     self.now += u64::from(IO_ACCESS_STATES);
                     self.io_write8(a, hi);

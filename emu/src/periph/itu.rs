@@ -598,6 +598,16 @@ impl Itu {
         }
     }
 
+    /// Brings the channels with an interrupt enabled to `now`, so the interrupt decision that
+    /// follows starts from caught-up channels (cheap between compare matches).
+    pub fn sync_irq_sources(&mut self, now: u64) {
+        for c in &mut self.ch {
+            if c.tier != 0 {
+                c.sync(now);
+            }
+        }
+    }
+
     /// Reads a register at `now` (the instant the bus cycle ends).
     pub fn read(&mut self, addr: u32, now: u64) -> u8 {
         if let Some((n, off)) = decode(addr) {
@@ -616,9 +626,6 @@ impl Itu {
 
     /// Writes a register at `now`.
     pub fn write(&mut self, addr: u32, value: u8, now: u64) {
-        // Every channel is brought to `now` (cheap when no compare match passed), so the
-        // interrupt decision that follows a write starts from synchronised channels.
-        self.sync(now);
         if let Some((n, off)) = decode(addr) {
             self.ch[n].write(off, value, now);
             return;
@@ -645,6 +652,31 @@ impl Itu {
             TOER => self.toer = value | 0xC0,
             TOCR => self.tocr = value | 0xEC,
             _ => {}
+        }
+    }
+
+    /// Writes a 16-bit register (TCNT, GRA, GRB, BRA, BRB; `addr` even) in one bus cycle at
+    /// `now`: both bytes change at the same instant. Other addresses are written byte by byte.
+    pub fn write16(&mut self, addr: u32, value: u16, now: u64) {
+        match decode(addr) {
+            Some((n, off)) if off >= OFF_TCNT && off & 1 == 0 => {
+                let c = &mut self.ch[n];
+                c.sync(now);
+                match off {
+                    OFF_TCNT => c.tcnt = value,
+                    OFF_GRA => c.gra = value,
+                    OFF_GRB => c.grb = value,
+                    OFF_BRA => c.bra = value,
+                    OFF_BRB => c.brb = value,
+                    _ => {}
+                }
+                c.recompute_quiet();
+            }
+            _ => {
+                let [hi, lo] = value.to_be_bytes();
+                self.write(addr, hi, now);
+                self.write(addr + 1, lo, now);
+            }
         }
     }
 
