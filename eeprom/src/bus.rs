@@ -224,6 +224,35 @@ impl I2cBus {
         Ok(())
     }
 
+    /// A whole write transfer to the chip at `device`, at transaction level (see
+    /// [`Eeprom24lc256::write_transaction`]): the bus lines do not move and no edges are
+    /// counted. Returns when the chip's write cycle ends.
+    ///
+    /// # Errors
+    /// No such chip, time going backwards, a chip that is off or busy.
+    pub fn write_transaction(
+        &mut self,
+        stop_states: u64,
+        device: u8,
+        address: u16,
+        data: &[u8],
+    ) -> Result<u64, EepromError> {
+        self.advance_to(stop_states)?;
+        let i = self.index_of(device)?;
+        self.devices[i].write_transaction(stop_states, address, data)
+    }
+
+    /// The instant the write cycle of the chip at `device` ends, if one runs at `now`.
+    ///
+    /// # Errors
+    /// No such chip.
+    pub fn busy_until(&self, now: u64, device: u8) -> Result<Option<u64>, EepromError> {
+        let d = self.device(device)?;
+        Ok(d.is_busy_at(now)
+            .then(|| d.current_write_cycle().map(|c| c.end_states))
+            .flatten())
+    }
+
     /// Recomputes the wired-AND levels and tells every device about each transition.
     fn settle(&mut self, now: u64) {
         let scl = !self.master_scl_low;

@@ -928,17 +928,72 @@ impl Eeprom24lc256 {
         self.pending.clear();
         self.sda_pull = false;
         if sda_high {
-            self.stats.stops += 1;
-            if self.mode == Mode::WriteData && self.loaded != 0 && !self.acking {
-                self.start_write_cycle(now);
-            }
-            self.reset_front_end();
+            self.stop_condition(now);
         } else {
-            self.stats.starts += 1;
-            // A (repeated) START ends any transfer; a page write without its STOP writes nothing.
-            self.reset_front_end();
-            self.mode = Mode::Control;
+            self.start_condition();
         }
+    }
+
+    /// A STOP: a page write with data begins its write cycle; the front end returns to standby.
+    fn stop_condition(&mut self, now: u64) {
+        self.stats.stops += 1;
+        if self.mode == Mode::WriteData && self.loaded != 0 && !self.acking {
+            self.start_write_cycle(now);
+        }
+        self.reset_front_end();
+    }
+
+    /// A (repeated) START ends any transfer; a page write without its STOP writes nothing.
+    fn start_condition(&mut self) {
+        self.stats.starts += 1;
+        self.reset_front_end();
+        self.mode = Mode::Control;
+    }
+
+    /// A whole write transfer at transaction level: what the chip does when it sees START,
+    /// its write control byte, `address` and `data`, each acknowledged, and a STOP whose SDA
+    /// rise is at `stop_states` — the same state changes, through the same code, as the
+    /// pin-level path (the page buffer with its wrap, the pointer, the write cycle and its
+    /// seeded duration, the write counter, wear), without the edges. Returns the instant the
+    /// write cycle ends (or `stop_states` when `data` is empty: no cycle).
+    ///
+    /// An emulator shortcut for callers that know the transfer's timing (the robot controller
+    /// runs the master's pin sequence on a virtual clock); the timing monitor sees nothing.
+    ///
+    /// # Errors
+    /// [`EepromError::PoweredOff`] when the chip has no power, [`EepromError::Busy`] when its
+    /// write cycle runs at `stop_states` (it would not acknowledge its control byte).
+    pub fn write_transaction(
+        &mut self,
+        stop_states: u64,
+        address: u16,
+        data: &[u8],
+    ) -> Result<u64, EepromError> {
+        self.catch_up(stop_states);
+        if !self.powered {
+            return Err(EepromError::PoweredOff {
+                address: self.config.address,
+            });
+        }
+        if self.cycle.is_some() {
+            return Err(EepromError::Busy {
+                address: self.config.address,
+            });
+        }
+        self.pending.clear();
+        self.sda_pull = false;
+        self.start_condition();
+        let control = (CONTROL_CODE << 4) | ((self.config.address & 0b111) << 1);
+        let [high, low] = address.to_be_bytes();
+        for byte in [control, high, low].into_iter().chain(data.iter().copied()) {
+            // The control byte matches this chip and it is idle, so every byte is accepted.
+            let _ = self.accept_byte(byte);
+        }
+        self.stop_condition(stop_states);
+        Ok(self
+            .cycle
+            .as_ref()
+            .map_or(stop_states, |c| c.info.end_states))
     }
 }
 

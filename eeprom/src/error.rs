@@ -57,6 +57,14 @@ pub enum EepromError {
         /// The chip's bus address.
         address: u8,
     },
+    /// A transaction addressed a chip in its write cycle (it would not acknowledge).
+    #[error(
+        "the 24LC256 at 0x{address:02X} is in its write cycle: poll it (ACK polling) until it answers"
+    )]
+    Busy {
+        /// The chip's bus address.
+        address: u8,
+    },
     /// A write cycle time range outside the modelled 3–5 ms, or min > max.
     #[error(
         "write cycle time range {min_ns}..={max_ns} ns is invalid: valid is 3 000 000 <= min <= max <= 5 000 000 ns (DS21203 T_WC <= 5 ms; SPEC models 3-5 ms)"

@@ -38,6 +38,8 @@ fn benches(c: &mut Criterion) {
     let mut group = c.benchmark_group("controller");
     {
         let (mut ctl, mut m) = setup(1_000_000);
+        ctl.sleep_until_step(&mut m).expect("tick");
+        ctl.step(&mut m).expect("step");
         let t0 = m.now();
         ctl.sleep_until_step(&mut m).expect("tick");
         let r = ctl.step(&mut m).expect("step");

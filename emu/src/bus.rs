@@ -33,4 +33,10 @@ pub trait Bus {
     /// SLEEP: advances the clock until an interrupt request is pending or the clock reaches
     /// `deadline`, whichever is first. Returns whether an interrupt is pending.
     fn sleep_until_irq(&mut self, deadline: u64) -> bool;
+    /// The EEPROM bus behind port 4, for emulation shortcuts that act on the chips at
+    /// transaction level with exactly the pin-level outcome (the controller's fast save).
+    /// `None` (the default): only pin-level access.
+    fn eeprom_bus(&mut self) -> Option<&mut eeprom::I2cBus> {
+        None
+    }
 }

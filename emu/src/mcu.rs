@@ -828,6 +828,10 @@ impl<B: Board> Bus for Mcu<B> {
             }
         }
     }
+
+    fn eeprom_bus(&mut self) -> Option<&mut I2cBus> {
+        Some(&mut self.i2c)
+    }
 }
 
 #[cfg(test)]

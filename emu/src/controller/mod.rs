@@ -36,6 +36,7 @@
 //! - The record's payload is the weight matrix as the H8 holds it: row by row, big-endian i16.
 
 pub mod code;
+pub mod fast;
 pub mod fw;
 pub mod regs;
 
@@ -49,6 +50,7 @@ use nn_q15::{
 
 use crate::bus::Bus;
 use crate::ram::{RamMap, RamOverflow};
+use fast::FastPins;
 use fw::{FETCH_STATES, Fw, FwPins, SLEEP_STATES, states_of};
 use regs::*;
 
@@ -748,7 +750,19 @@ impl Controller {
         let pages = body.len().div_ceil(64);
         fw.lump(pages as u64 * (14 + 8) + 4 * body.len() as u64 + 7 * 6);
         fw.lump(crc16_states(&body[..body.len() - 2]) + crc16_states(&commit[..commit.len() - 2]));
-        let report = {
+        let report = if self.cfg.fast_forward && fw.bus.eeprom_bus().is_some() {
+            let tick_period = fw.tick_period;
+            let mut pins = FastPins::new(fw, tick_period);
+            let saved = {
+                let mut master = I2cMaster::new(&mut pins, self.timing);
+                self.persistence.save(&mut master, &record)
+            };
+            match (saved, pins.failure.take()) {
+                (Ok(r), _) => r,
+                (Err(_), Some(chip)) => return Err(ControllerError::I2c(chip)),
+                (Err(e), None) => return Err(e.into()),
+            }
+        } else {
             let mut pins = FwPins {
                 fw,
                 shadow: &mut self.p4_shadow,
