@@ -60,15 +60,6 @@ pub trait I2cPins {
     fn op_states(&self) -> u64 {
         0
     }
-    /// During ACK polling, after an unacknowledged poll of `poll_states` states that ended with
-    /// the repeated START of the next: how many more whole polls, at most `max`, are certain
-    /// to go unacknowledged, so that the master may count them without sending them; the pins
-    /// let their time pass. An emulator shortcut (the chip ignores the bus while busy, so the
-    /// skipped polls change nothing but the clock); the default, 0, sends every poll.
-    fn skip_polls(&mut self, poll_states: u64, max: u32) -> u32 {
-        let _ = (poll_states, max);
-        0
-    }
 }
 
 impl<P: I2cPins + ?Sized> I2cPins for &mut P {
@@ -92,9 +83,6 @@ impl<P: I2cPins + ?Sized> I2cPins for &mut P {
     }
     fn op_states(&self) -> u64 {
         (**self).op_states()
-    }
-    fn skip_polls(&mut self, poll_states: u64, max: u32) -> u32 {
-        (**self).skip_polls(poll_states, max)
     }
 }
 
@@ -618,39 +606,15 @@ impl<P: I2cPins> I2cMaster<P> {
         }
         let t0 = self.t;
         self.start();
-        let mut poll = 1;
-        while poll <= max_polls {
+        for poll in 1..=max_polls {
             self.stats.polls += 1;
-            let poll_t = self.t;
-            let (pin_ops, waits) = (self.stats.pin_ops, self.stats.wait_states);
             if self.write_byte(control_byte(device, false)) {
                 self.stop();
                 return Ok(poll);
             }
             if poll < max_polls {
                 self.repeated_start();
-                // Polls are alike while the chip is busy: the pins may let some pass unsent.
-                let period = self.t - poll_t;
-                let skipped = self.pins.skip_polls(period, max_polls - poll - 1);
-                if skipped > 0 {
-                    let per_poll_ops = self.stats.pin_ops - pin_ops;
-                    let per_poll_waits = self.stats.wait_states - waits;
-                    // The skipped polls end like the one just sent: every edge moves on.
-                    let dt = u64::from(skipped) * period;
-                    self.t += dt;
-                    self.last_fall += dt;
-                    self.last_rise += dt;
-                    self.last_sda += dt;
-                    self.stats.wait_states += u64::from(skipped) * per_poll_waits;
-                    self.stats.polls += u64::from(skipped);
-                    self.stats.pin_ops += u64::from(skipped) * per_poll_ops;
-                    self.stats.bytes_sent += u64::from(skipped);
-                    self.stats.nacks += u64::from(skipped);
-                    self.stats.starts += u64::from(skipped);
-                    poll += skipped;
-                }
             }
-            poll += 1;
         }
         self.stop();
         Err(MasterError::PollTimeout {

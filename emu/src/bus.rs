@@ -33,6 +33,13 @@ pub trait Bus {
     /// SLEEP: advances the clock until an interrupt request is pending or the clock reaches
     /// `deadline`, whichever is first. Returns whether an interrupt is pending.
     fn sleep_until_irq(&mut self, deadline: u64) -> bool;
+    /// The earliest instant after now at which some peripheral's state changes (a compare
+    /// match, an A/D conversion end, …), if the bus knows: polling loops may let the time up to
+    /// it pass without reading, since every read before it returns the same. `None` (the
+    /// default): unknown.
+    fn next_event_at(&self) -> Option<u64> {
+        None
+    }
     /// The EEPROM bus behind port 4, for emulation shortcuts that act on the chips at
     /// transaction level with exactly the pin-level outcome (the controller's fast save).
     /// `None` (the default): only pin-level access.

@@ -832,6 +832,10 @@ impl<B: Board> Bus for Mcu<B> {
     fn eeprom_bus(&mut self) -> Option<&mut I2cBus> {
         Some(&mut self.i2c)
     }
+
+    fn next_event_at(&self) -> Option<u64> {
+        self.next_event()
+    }
 }
 
 #[cfg(test)]

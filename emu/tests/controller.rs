@@ -257,15 +257,27 @@ fn same_seeds_same_steps() {
 
 #[test]
 fn fast_forward_gives_identical_steps_sleeps_and_clock() {
+    // Saves at many different offsets from the tick (the save lasts 1.5 ticks), both paper
+    // settings.
+    for (corridor, save_every, steps) in [(false, 7, 60), (false, 3, 150), (true, 2, 60)] {
+        fast_forward_case(corridor, save_every, steps);
+    }
+}
+
+fn fast_forward_case(corridor: bool, save_every: u32, steps: u32) {
     let go = |fast: bool| {
         let mut m = mcu(3);
-        let mut cfg = ControllerConfig::arena(5);
+        let mut cfg = if corridor {
+            ControllerConfig::corridor(5)
+        } else {
+            ControllerConfig::arena(5)
+        };
         cfg.fast_forward = fast;
-        cfg.save_every_steps = 7;
+        cfg.save_every_steps = save_every;
         let mut c = Controller::new(cfg).expect("valid");
         c.boot(&mut m).expect("boots");
         let mut log = Vec::new();
-        for _ in 0..60 {
+        for _ in 0..steps {
             let s = c.sleep_until_step(&mut m).expect("ticks");
             let r = c.step(&mut m).expect("steps");
             log.push((s, r, m.now()));
@@ -290,6 +302,10 @@ fn fast_forward_gives_identical_steps_sleeps_and_clock() {
         assert_eq!(a, b, "step {k}");
     }
     assert!(slow.iter().filter(|(_, r, _)| r.saved.is_some()).count() >= 8);
+    assert!(
+        slow.iter().any(|(_, r, _)| r.phases.isr > 0),
+        "a tick came during a step"
+    );
     assert_eq!(slow_chips, fast_chips, "EEPROM contents and write counts");
     assert!(
         slow_chips[0].1.iter().sum::<u32>() >= 12,

@@ -43,6 +43,8 @@ pub const CONTROLLER_ROUTINES: &[Routine] = &[
             ("MOV.B #H'C0,R0L", 2),
             ("MOV.B R0L,@P4PCR:8", 2),
             ("MOV.B #H'0F,R0L", 2),
+            ("MOV.B R0L,@P2PCR:8", 2),
+            ("MOV.B #H'0F,R0L", 2),
             ("MOV.B R0L,@PBDDR:8", 2),
             ("MOV.B #H'23,R0L", 2),
             ("MOV.B R0L,@TCR0:8", 2),

@@ -1,240 +1,456 @@
-//! The fast save: the same master, the same pin sequence, the same states — on a virtual bus.
+//! The fast save: the pin-level save's outcome and states, computed from timelines.
 //!
-//! [`FastPins`] is an `I2cPins` that charges every pin operation exactly what [`super::fw::FwPins`]
-//! charges, at the same points (so the tick interrupt is taken at the same instants), but does
-//! not write P4DDR: it decodes the master's bytes from its own pin operations, answers the ACK
-//! bits as the chips would (a chip in its write cycle does not acknowledge its control byte,
-//! decided at the fall of SCL after the byte's eighth bit, as the pin-level chip decides), and
-//! hands each completed write transfer to the chip at transaction level at the instant of its
-//! STOP ([`eeprom::I2cBus::write_transaction`]). During ACK polling it lets the master skip the
-//! polls that are certain to go unacknowledged. The outcome — the chips' memory, write counters
-//! and seeded write-cycle times, the states of the save, the MCU clock — is the pin-level one;
-//! the controller's tests compare the two run for run. Only the bus's edge counter differs (it
-//! counts pin-level traffic).
+//! The bit-banging master's pin sequence does not depend on the bytes it sends, only on how
+//! many and on the ACK bits it reads, so each piece of a save has a fixed timeline: a page
+//! write of n bytes; the START that opens ACK polling; one unanswered poll (the control byte and
+//! the repeated START of the next); the answered poll (the control byte and the STOP). Each
+//! timeline is recorded once, by running the real master ([`eeprom::I2cMaster`]) against
+//! recording pins that charge exactly what the port-4 pins charge ([`super::fw::FwPins`]: 7
+//! states per pin operation, the tick taken at the end of each operation and each wait), and
+//! noting the points where the tick could be taken, the instants the chip decides on a control
+//! byte (the fall of SCL after its eighth bit) and the STOP edge.
+//!
+//! A save then walks the timelines on the MCU's clock: the tick interrupt runs for real at the
+//! first point at or after its instant, shifting the rest; each page reaches the chip at
+//! transaction level at its STOP edge ([`eeprom::I2cBus::write_transaction`]: the same memory,
+//! counters and seeded write-cycle time as the pin-level transfer); each poll is answered iff the
+//! chip's write cycle has ended by its decision instant. The result — the states of the save, the
+//! polls, the chips' contents — is the pin-level one; the controller's tests compare the two run
+//! for run. Only the bus's edge counter differs (it counts pin-level traffic).
 
-use eeprom::I2cPins;
+use eeprom::persist::{COMMIT_BYTES, Persistence, Record, SaveReport, chip_for_sequence};
+use eeprom::{I2cMaster, I2cPins, MasterTiming};
 
+use super::ControllerError;
 use super::fw::{Fw, PIN_OP_STATES};
 use crate::bus::Bus;
 
-/// Of a pin operation's 7 states, those before its bus access ends (`MOV.B @P4DR:8` = 2 + 3).
+/// Of a pin read's 7 states, those up to the end of its bus access (`MOV.B @P4DR:8` = 2 + 3):
+/// the first point the tick can be taken at.
 const READ_ACCESS_STATES: u64 = 5;
-/// An upper bound of the tick interrupt's states (entry to RTE), for the poll-skipping margin.
-const ISR_STATES_BOUND: u64 = 200;
+/// ACK polls per page before a save gives up (as the pin-level save's bound).
+const MAX_POLLS: u32 = super::MAX_POLLS;
+/// The largest page write.
+const PAGE: usize = 64;
 
-/// The virtual I²C pins of the fast save.
-pub struct FastPins<'f, 'a, B: Bus> {
-    fw: &'f mut Fw<'a, B>,
-    scl_high: bool,
-    sda_high: bool,
-    /// Bits clocked in the current byte (SCL rises since the byte began).
-    bit: u32,
-    shift: u8,
-    /// Bytes of the current transfer (control byte first).
-    bytes: Vec<u8>,
-    /// Whether the transfer's control byte was acknowledged.
-    acked: bool,
-    /// The answer for the ninth clock of the current byte.
-    ack_now: bool,
-    /// The instant the last START completed (its SCL fall) and when the next control byte was
-    /// decided, for the poll-skipping estimate.
-    start_at: u64,
-    decision_offset: Option<u64>,
-    /// The chip the last control byte addressed.
-    last_device: Option<u8>,
-    tick_period: u64,
-    /// The first error the chips reported, if any (a chip off or missing): the transfer then
-    /// goes unacknowledged, as on the wire.
-    pub failure: Option<eeprom::EepromError>,
+/// One piece of a save's pin sequence, from the master's point of view (no interrupts).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Piece {
+    /// Offsets (from the piece's start) of the points where the tick can be taken: the end of
+    /// every pin operation and wait, and of every pin read's bus access.
+    points: Vec<u64>,
+    /// Length in states.
+    total: u64,
+    /// Offset of the first control byte's decision, if the piece sends one.
+    decision: Option<u64>,
+    /// Offset of the STOP edge, if the piece ends a transfer.
+    stop: Option<u64>,
 }
 
-impl<'f, 'a, B: Bus> FastPins<'f, 'a, B> {
-    /// Virtual pins on `fw`'s MCU; both lines released.
-    pub fn new(fw: &'f mut Fw<'a, B>, tick_period: u64) -> Self {
+/// What happens in a piece that the save must act on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Mark {
+    Decision,
+    Stop,
+}
+
+/// Pins that record the timeline of what the master does, answering reads from a script.
+struct Recorder {
+    t: u64,
+    scl_high: bool,
+    sda_high: bool,
+    bit: u32,
+    first_byte: bool,
+    points: Vec<u64>,
+    events: Vec<(Event, u64)>,
+    answers: Vec<bool>,
+}
+
+/// An instant in a recorded sequence.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Event {
+    /// A START completed (its SCL fall).
+    StartDone,
+    /// The chip decided on the control byte (the fall after its eighth bit).
+    Decision,
+    /// The STOP edge.
+    Stop,
+}
+
+impl Recorder {
+    fn new(answers: &[bool]) -> Self {
         Self {
-            fw,
+            t: 0,
             scl_high: true,
             sda_high: true,
             bit: 0,
-            shift: 0,
-            bytes: Vec::with_capacity(80),
-            acked: false,
-            ack_now: false,
-            start_at: 0,
-            decision_offset: None,
-            last_device: None,
-            tick_period,
-            failure: None,
+            first_byte: false,
+            points: Vec::new(),
+            events: Vec::new(),
+            answers: answers.iter().rev().copied().collect(),
         }
     }
 
-    /// A pin operation: 7 states, the tick taken at its end if due (as `FwPins` does).
     fn op(&mut self) {
-        self.fw.idle(PIN_OP_STATES);
-        self.fw.service();
-    }
-
-    fn device(&self) -> Option<u8> {
-        self.bytes.first().map(|c| 0x50 | ((c >> 1) & 0b111))
-    }
-
-    /// Whether the chip addressed by the control byte answers at `now`.
-    fn chip_ready(&mut self, now: u64, control: u8) -> bool {
-        if control >> 4 != 0b1010 || control & 1 != 0 {
-            // Only write control bytes are sent by the save; anything else is not for us.
-            return false;
-        }
-        let device = 0x50 | ((control >> 1) & 0b111);
-        match self.fw.bus.eeprom_bus().map(|b| b.busy_until(now, device)) {
-            Some(Ok(None)) => b_powered(self.fw.bus, device),
-            Some(Ok(Some(_))) => false,
-            Some(Err(e)) => {
-                self.failure.get_or_insert(e);
-                false
-            }
-            None => false,
-        }
-    }
-
-    fn scl_fall(&mut self) {
-        self.scl_high = false;
-        let now = self.fw.now();
-        if self.bit == 8 {
-            // The chips decide on the byte at this fall (the ninth clock follows).
-            let byte = self.shift;
-            self.ack_now = if self.bytes.is_empty() {
-                self.decision_offset = Some(now.saturating_sub(self.start_at));
-                self.last_device = Some(0x50 | ((byte >> 1) & 0b111));
-                self.acked = self.chip_ready(now, byte);
-                self.acked
-            } else {
-                self.acked
-            };
-        } else if self.bit == 9 {
-            self.bytes.push(self.shift);
-            self.bit = 0;
-            self.shift = 0;
-        } else if self.bit == 0 && self.bytes.is_empty() {
-            // The fall that completes a START.
-            self.start_at = now;
-        }
-    }
-
-    fn scl_rise(&mut self) {
-        self.scl_high = true;
-        if self.bit < 8 {
-            self.shift = (self.shift << 1) | u8::from(self.sda_high);
-        }
-        self.bit += 1;
-    }
-
-    fn start_condition(&mut self) {
-        self.bytes.clear();
-        self.bit = 0;
-        self.shift = 0;
-        self.acked = false;
-    }
-
-    fn stop_condition(&mut self) {
-        let now = self.fw.now();
-        if self.acked
-            && self.bytes.len() >= 4
-            && let Some(device) = self.device()
-        {
-            let address = u16::from_be_bytes([self.bytes[1], self.bytes[2]]);
-            let data = self.bytes[3..].to_vec();
-            if let Some(bus) = self.fw.bus.eeprom_bus()
-                && let Err(e) = bus.write_transaction(now, device, address, &data)
-            {
-                self.failure.get_or_insert(e);
-            }
-        }
-        self.start_condition();
+        self.t += PIN_OP_STATES;
+        self.points.push(self.t);
     }
 }
 
-fn b_powered<B: Bus>(bus: &mut B, device: u8) -> bool {
-    bus.eeprom_bus()
-        .and_then(|b| b.device(device).ok())
-        .is_some_and(eeprom::Eeprom24lc256::is_powered)
-}
-
-impl<B: Bus> I2cPins for FastPins<'_, '_, B> {
+impl I2cPins for Recorder {
     fn scl_low(&mut self) {
         self.op();
-        self.scl_fall();
+        self.scl_high = false;
+        match self.bit {
+            // The fall that completes a START (no bit clocked yet).
+            0 if self.first_byte => self.events.push((Event::StartDone, self.t)),
+            8 if self.first_byte => self.events.push((Event::Decision, self.t)),
+            9 => {
+                self.bit = 0;
+                self.first_byte = false;
+            }
+            _ => {}
+        }
     }
 
     fn scl_release(&mut self) {
         self.op();
-        self.scl_rise();
+        self.scl_high = true;
+        self.bit += 1;
     }
 
     fn sda_low(&mut self) {
         self.op();
         if self.sda_high && self.scl_high {
-            self.start_condition();
+            // START: the next byte is a control byte.
+            self.bit = 0;
+            self.first_byte = true;
         }
         self.sda_high = false;
     }
 
     fn sda_release(&mut self) {
         self.op();
-        let stop = !self.sda_high && self.scl_high;
-        self.sda_high = true;
-        if stop {
-            self.stop_condition();
+        if !self.sda_high && self.scl_high {
+            self.events.push((Event::Stop, self.t));
+            self.first_byte = false;
+            self.bit = 0;
         }
+        self.sda_high = true;
     }
 
     fn sda_is_high(&mut self) -> bool {
-        // MOV.B @P4DR:8,R0L (the tick may come after it) ; BTST #7,R0L.
-        self.fw.idle(READ_ACCESS_STATES);
-        self.fw.service();
-        self.fw.idle(PIN_OP_STATES - READ_ACCESS_STATES);
-        self.fw.service();
+        self.t += READ_ACCESS_STATES;
+        self.points.push(self.t);
+        self.t += PIN_OP_STATES - READ_ACCESS_STATES;
+        self.points.push(self.t);
         if self.bit == 9 {
-            // The ninth clock: low is an ACK.
-            !self.ack_now
+            // The ACK bit: answer from the script (true = ACK, read low).
+            !self.answers.pop().unwrap_or(true)
         } else {
-            // The save only reads ACK bits; a released line reads high.
             self.sda_high
         }
     }
 
     fn wait_states(&mut self, states: u64) {
-        self.fw.lump(states);
+        if states > 0 {
+            self.t += states;
+            self.points.push(self.t);
+        }
     }
 
     fn op_states(&self) -> u64 {
         PIN_OP_STATES
     }
+}
 
-    fn skip_polls(&mut self, poll_states: u64, max: u32) -> u32 {
-        // Right after a repeated START: the next control byte is decided `offset` later.
-        let (Some(offset), Some(device)) = (self.decision_offset, self.last_device) else {
-            return 0;
+/// Cuts `points` (absolute, from a recording) to `from..=to`, relative to `from`.
+fn piece(rec: &Recorder, from: u64, to: u64) -> Piece {
+    let rel = |t: u64| t - from;
+    Piece {
+        points: rec
+            .points
+            .iter()
+            .copied()
+            .filter(|&p| p > from && p <= to)
+            .map(rel)
+            .collect(),
+        total: to - from,
+        decision: rec
+            .events
+            .iter()
+            .find(|(e, t)| *e == Event::Decision && *t > from && *t <= to)
+            .map(|&(_, t)| rel(t)),
+        stop: rec
+            .events
+            .iter()
+            .find(|(e, t)| *e == Event::Stop && *t > from && *t <= to)
+            .map(|&(_, t)| rel(t)),
+    }
+}
+
+fn events(rec: &Recorder, kind: Event) -> Vec<u64> {
+    rec.events
+        .iter()
+        .filter(|(e, _)| *e == kind)
+        .map(|&(_, t)| t)
+        .collect()
+}
+
+/// The recorded pieces of a save for one master timing; page writes are recorded when first
+/// needed (a save uses at most three sizes).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SaveTimelines {
+    timing: MasterTiming,
+    /// Page writes of 1..=64 bytes (index n − 1), once recorded.
+    page_writes: Vec<Option<Piece>>,
+    /// ACK polling's opening START.
+    poll_start: Piece,
+    /// An unanswered poll: the control byte and the repeated START of the next.
+    poll_unanswered: Piece,
+    /// The answered poll: the control byte and the STOP.
+    poll_answered: Piece,
+}
+
+fn master_error(e: eeprom::MasterError) -> ControllerError {
+    ControllerError::Persist(e.into())
+}
+
+impl SaveTimelines {
+    /// Records the polling pieces by running the master with `timing` against recording pins.
+    ///
+    /// # Errors
+    /// Only if the master refuses its own recording (it cannot).
+    pub fn record(timing: MasterTiming) -> Result<Self, ControllerError> {
+        // Three polls: two unanswered, then answered.
+        let mut rec = Recorder::new(&[false, false, true]);
+        I2cMaster::new(&mut rec, timing)
+            .ack_poll(0x50, 3)
+            .map_err(master_error)?;
+        // START, then a poll begins at each START's completion.
+        let starts = events(&rec, Event::StartDone);
+        let (s0, s1, s2) = match starts[..] {
+            [a, b, c] => (a, b, c),
+            _ => return Err(master_error(eeprom::MasterError::InvalidPollBound)),
         };
-        let now = self.fw.now();
-        let end = match self.fw.bus.eeprom_bus().map(|b| b.busy_until(now, device)) {
-            Some(Ok(Some(end))) => end,
-            _ => return 0,
+        Ok(Self {
+            timing,
+            page_writes: vec![None; PAGE],
+            poll_start: piece(&rec, 0, s0),
+            poll_unanswered: piece(&rec, s1, s2),
+            poll_answered: piece(&rec, s2, rec.t),
+        })
+    }
+
+    /// Records the page write of `n` bytes (1 ..= 64) unless it is recorded already.
+    fn ensure_page_write(&mut self, n: usize) -> Result<(), ControllerError> {
+        let slot = self.page_writes.get_mut(n.wrapping_sub(1)).ok_or_else(|| {
+            master_error(eeprom::MasterError::EmptyTransfer {
+                operation: "page write",
+            })
+        })?;
+        if slot.is_none() {
+            let mut rec = Recorder::new(&[]);
+            I2cMaster::new(&mut rec, self.timing)
+                .page_write(0x50, 0, &[0; PAGE][..n])
+                .map_err(master_error)?;
+            let total = rec.t;
+            *slot = Some(piece(&rec, 0, total));
+        }
+        Ok(())
+    }
+}
+
+/// Walks `piece` on the MCU from now: the tick is taken, for real, at the first point at or
+/// after its instant; the marks are reported with their instants (an edge at a point comes
+/// before the tick taken there).
+fn walk<B: Bus>(
+    fw: &mut Fw<'_, B>,
+    piece: &Piece,
+    mut mark: impl FnMut(&mut Fw<'_, B>, Mark, u64),
+) {
+    let start = fw.now();
+    let mut shift = 0u64;
+    let mut done = 0u64;
+    let mut marks: Vec<(u64, Mark)> = [
+        piece.decision.map(|d| (d, Mark::Decision)),
+        piece.stop.map(|s| (s, Mark::Stop)),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    marks.sort_unstable_by_key(|m| m.0);
+    let mut next_mark = 0;
+    loop {
+        let tick_point = fw
+            .interrupts_enabled
+            .then_some(())
+            .and(fw.next_tick_at)
+            .and_then(|due| {
+                let i = piece
+                    .points
+                    .partition_point(|&p| p <= done || start + shift + p < due);
+                piece.points.get(i).copied()
+            });
+        let upto = tick_point.unwrap_or(piece.total);
+        while next_mark < marks.len() && marks[next_mark].0 <= upto {
+            let (rel, m) = marks[next_mark];
+            mark(fw, m, start + shift + rel);
+            next_mark += 1;
+        }
+        let target = start + shift + upto;
+        fw.idle(target - fw.now());
+        match tick_point {
+            Some(p) => {
+                fw.tick_handler();
+                shift = fw.now() - start - p;
+                done = p;
+            }
+            None => break,
+        }
+    }
+}
+
+/// The instant `piece`'s decision would happen if walked from now (with the tick, if it
+/// comes first, taken at its point).
+fn decision_at<B: Bus>(fw: &Fw<'_, B>, piece: &Piece, isr_states: u64) -> Option<u64> {
+    let start = fw.now();
+    let d = piece.decision?;
+    let delayed = fw.interrupts_enabled
+        && fw
+            .next_tick_at
+            .is_some_and(|due| piece.points.iter().any(|&p| p < d && start + p >= due));
+    Some(start + d + if delayed { isr_states } else { 0 })
+}
+
+/// Whether the chip answers its control byte at `t`: powered, present and not in a write cycle.
+fn chip_answers<B: Bus>(fw: &mut Fw<'_, B>, t: u64, chip: u8) -> Result<bool, ControllerError> {
+    let bus = fw.bus.eeprom_bus().ok_or_else(|| {
+        ControllerError::I2c(eeprom::EepromError::NoSuchDevice {
+            address: chip,
+            present: String::new(),
+        })
+    })?;
+    let busy = bus.busy_until(t, chip)?.is_some();
+    let powered = bus.device(chip)?.is_powered();
+    Ok(powered && !busy)
+}
+
+/// Saves `record` as [`Persistence::save`] does — the body pages in address order, then the
+/// commit page, each followed by ACK polling — with the pin-level outcome.
+///
+/// # Errors
+/// A chip that does not answer (off, missing) or never ends its write cycle within the poll
+/// bound, as the pin-level save would report it.
+pub fn save<B: Bus>(
+    fw: &mut Fw<'_, B>,
+    persistence: &Persistence,
+    timelines: &mut SaveTimelines,
+    isr_states: u64,
+    record: &Record,
+) -> Result<SaveReport, ControllerError> {
+    let (commit, body) = persistence.layout().encode(record)?;
+    let chip = chip_for_sequence(record.sequence);
+    let layout = persistence.layout();
+    let mut polls_per_page = Vec::with_capacity(body.len() / PAGE + 2);
+    let pages = body
+        .chunks(PAGE)
+        .enumerate()
+        .map(|(k, c)| (layout.body_addr() + (k * PAGE) as u16, c))
+        .chain(std::iter::once((layout.slot_addr(), &commit[..])));
+    for (address, data) in pages {
+        timelines.ensure_page_write(data.len())?;
+        let Some(piece) = &timelines.page_writes[data.len() - 1] else {
+            return Err(master_error(eeprom::MasterError::EmptyTransfer {
+                operation: "page write",
+            }));
         };
-        // Skip poll j only if its decision, delayed by every tick that could come first,
-        // is still before the end of the write cycle.
-        let mut k = 0u32;
-        while k < max {
-            let decide = now + u64::from(k) * poll_states + offset;
-            let ticks = (decide - now) / self.tick_period.max(1) + 1;
-            if decide + ticks * ISR_STATES_BOUND >= end {
+        let mut failure: Option<ControllerError> = None;
+        walk(fw, piece, |fw, m, t| {
+            if failure.is_some() {
+                return;
+            }
+            let outcome = match m {
+                Mark::Decision => chip_answers(fw, t, chip).and_then(|ok| {
+                    if ok {
+                        Ok(())
+                    } else {
+                        Err(ControllerError::Persist(
+                            eeprom::MasterError::Nack {
+                                device: chip,
+                                stage: eeprom::NackStage::Control,
+                            }
+                            .into(),
+                        ))
+                    }
+                }),
+                Mark::Stop => fw
+                    .bus
+                    .eeprom_bus()
+                    .map_or(Ok(0), |b| b.write_transaction(t, chip, address, data))
+                    .map(|_| ())
+                    .map_err(ControllerError::I2c),
+            };
+            if let Err(e) = outcome {
+                failure = Some(e);
+            }
+        });
+        if let Some(e) = failure {
+            return Err(e);
+        }
+        // ACK polling until the chip answers.
+        walk(fw, &timelines.poll_start, |_, _, _| {});
+        let mut polls = 1u32;
+        let period = timelines.poll_unanswered.total;
+        let offset = timelines.poll_unanswered.decision.unwrap_or(0);
+        loop {
+            // In bulk: the polls that end before the tick can come and decide before the write
+            // cycle ends are all unanswered and alike.
+            let now = fw.now();
+            let due = if fw.interrupts_enabled {
+                fw.next_tick_at.unwrap_or(now)
+            } else {
+                u64::MAX
+            };
+            let end = match fw.bus.eeprom_bus().map(|b| b.busy_until(now, chip)) {
+                Some(Ok(Some(end))) => end,
+                _ => now,
+            };
+            if period > 0 {
+                let free = due.saturating_sub(now + 1) / period;
+                let unanswered = end.saturating_sub(now + offset).div_ceil(period);
+                let bulk = free.min(unanswered).min(u64::from(MAX_POLLS - polls));
+                if bulk > 0 {
+                    fw.idle(bulk * period);
+                    polls += bulk as u32;
+                }
+            }
+            let decision =
+                decision_at(fw, &timelines.poll_unanswered, isr_states).unwrap_or_else(|| fw.now());
+            if chip_answers(fw, decision, chip)? {
+                walk(fw, &timelines.poll_answered, |_, _, _| {});
                 break;
             }
-            k += 1;
+            if polls >= MAX_POLLS {
+                return Err(ControllerError::Persist(
+                    eeprom::MasterError::PollTimeout {
+                        device: chip,
+                        polls,
+                        waited_states: 0,
+                    }
+                    .into(),
+                ));
+            }
+            walk(fw, &timelines.poll_unanswered, |_, _, _| {});
+            polls += 1;
         }
-        if k > 0 {
-            self.fw.idle(u64::from(k) * poll_states);
-            self.fw.service();
-        }
-        k
+        polls_per_page.push(polls);
     }
+    Ok(SaveReport {
+        chip,
+        sequence: record.sequence,
+        pages_written: polls_per_page.len(),
+        polls_per_page,
+        record_bytes: COMMIT_BYTES + body.len(),
+    })
 }

@@ -50,7 +50,7 @@ use nn_q15::{
 
 use crate::bus::Bus;
 use crate::ram::{RamMap, RamOverflow};
-use fast::FastPins;
+use fast::SaveTimelines;
 use fw::{FETCH_STATES, Fw, FwPins, SLEEP_STATES, states_of};
 use regs::*;
 
@@ -269,6 +269,10 @@ pub struct Controller {
     booted: bool,
     /// The next tick's instant, once known (see [`ControllerConfig::fast_forward`]).
     next_tick_at: Option<u64>,
+    /// The fast save's timelines (with [`ControllerConfig::fast_forward`]).
+    timelines: Option<SaveTimelines>,
+    /// States of one tick interrupt (entry to RTE), as measured on this MCU.
+    isr_states: Option<u64>,
 }
 
 fn config_error(
@@ -343,6 +347,7 @@ impl Controller {
             &vec![Q15::ZERO; n_in.min(nn_q15::MAX_INPUTS) * n_out],
         )?;
         let timing = MasterTiming::fast_mode(cfg.clock_hz)?;
+        let cfg_fast = cfg.fast_forward;
         Ok(Self {
             ticks_per_step: ticks.round() as u64,
             tick_counts,
@@ -358,6 +363,12 @@ impl Controller {
             next_sequence: 0,
             booted: false,
             next_tick_at: None,
+            timelines: if cfg_fast {
+                Some(SaveTimelines::record(timing)?)
+            } else {
+                None
+            },
+            isr_states: None,
         })
     }
 
@@ -463,6 +474,9 @@ impl Controller {
             fw.write8(P4DDR, 0);
             fw.code(&[Insn::Reg]);
             fw.write8(P4PCR, SDA_BIT | SCL_BIT);
+            // The bumpers' pull-ups (P2.0-P2.3), so that a released switch reads high.
+            fw.code(&[Insn::Reg]);
+            fw.write8(P2PCR, 0x0F);
             fw.write8(PBDR, 0);
             fw.code(&[Insn::Reg]);
             fw.write8(PBDDR, 0x0F);
@@ -568,7 +582,9 @@ impl Controller {
                 let tick_at = fw.bus.now();
                 let slept = tick_at - asleep_from;
                 fw.next_tick_at = fast.then_some(tick_at);
+                let isr_from = fw.isr_states;
                 fw.tick_handler();
+                self.isr_states = Some(fw.isr_states - isr_from);
                 report.ticks += 1;
                 // Main loop: MOV.L @TICKS:16,ER0 ; MOV.L @NEXT:16,ER1 ; CMP.L ; BLO.
                 fw.code(&[Insn::MovLAbs16, Insn::MovLAbs16, Insn::Reg, Insn::Bcc8]);
@@ -641,11 +657,28 @@ impl Controller {
             fw.bus.internal(CALL_RETURN_STATES / 2);
             fw.code(&[Insn::Reg]);
             fw.write8(ADCSR, ADCSR_ADST | ADCSR_SCAN | ADCSR_CKS | 3);
+            // 1: MOV.B @ADCSR:8,R0L ; BPL 1b — 2 + 3 + 4 states a poll, the read ending 5
+            // states in.
+            const POLL_STATES: u64 = 9;
+            const POLL_READ_END: u64 = 5;
             loop {
                 let v = fw.read8(ADCSR);
                 fw.code(&[Insn::Bcc8]);
                 if v & ADCSR_ADF != 0 {
                     break;
+                }
+                // Shortcut: every poll whose read ends before the next peripheral event reads
+                // the same; let them pass unread, unless the tick could come meanwhile.
+                if self.cfg.fast_forward
+                    && let (Some(event), Some(tick)) = (fw.bus.next_event_at(), fw.next_tick_at)
+                {
+                    let now = fw.now();
+                    let skip = event
+                        .saturating_sub(now + POLL_READ_END)
+                        .div_ceil(POLL_STATES);
+                    if skip > 0 && now + skip * POLL_STATES < tick {
+                        fw.idle(skip * POLL_STATES);
+                    }
                 }
             }
             fw.code(&[Insn::Reg]);
@@ -750,18 +783,12 @@ impl Controller {
         let pages = body.len().div_ceil(64);
         fw.lump(pages as u64 * (14 + 8) + 4 * body.len() as u64 + 7 * 6);
         fw.lump(crc16_states(&body[..body.len() - 2]) + crc16_states(&commit[..commit.len() - 2]));
-        let report = if self.cfg.fast_forward && fw.bus.eeprom_bus().is_some() {
-            let tick_period = fw.tick_period;
-            let mut pins = FastPins::new(fw, tick_period);
-            let saved = {
-                let mut master = I2cMaster::new(&mut pins, self.timing);
-                self.persistence.save(&mut master, &record)
-            };
-            match (saved, pins.failure.take()) {
-                (Ok(r), _) => r,
-                (Err(_), Some(chip)) => return Err(ControllerError::I2c(chip)),
-                (Err(e), None) => return Err(e.into()),
-            }
+        let report = if let (Some(timelines), Some(isr), true) = (
+            self.timelines.as_mut(),
+            self.isr_states,
+            fw.bus.eeprom_bus().is_some(),
+        ) {
+            fast::save(fw, &self.persistence, timelines, isr, &record)?
         } else {
             let mut pins = FwPins {
                 fw,

@@ -49,6 +49,8 @@ pub const VECTOR_IMIA0: u8 = 24;
 pub const P4DDR: u32 = 0xFF_FFC5;
 /// Port 4 data register (SPEC §4.1: H'FFFFC7).
 pub const P4DR: u32 = 0xFF_FFC7;
+/// Port 2 input pull-up control register (H'FFFFD8): bits 0-3 turn on the bumpers' pull-ups.
+pub const P2PCR: u32 = 0xFF_FFD8;
 /// Port 4 input pull-up control register (SPEC §4.1: H'FFFFDA); bits 7 and 6 turn on the
 /// pull-ups of SDA and SCL, which are the only thing that takes a released line high.
 pub const P4PCR: u32 = 0xFF_FFDA;
