@@ -416,13 +416,12 @@ pub fn save<B: Bus>(
                 Some(Ok(Some(end))) => end,
                 _ => now,
             };
-            if period > 0 {
-                let free = due.saturating_sub(now + 1) / period;
+            if let Some(free) = due.saturating_sub(now + 1).checked_div(period) {
                 let unanswered = end.saturating_sub(now + offset).div_ceil(period);
                 let bulk = free.min(unanswered).min(u64::from(MAX_POLLS - polls));
                 if bulk > 0 {
                     fw.idle(bulk * period);
-                    polls += bulk as u32;
+                    polls += u32::try_from(bulk).unwrap_or(0);
                 }
             }
             let decision =
