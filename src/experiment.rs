@@ -115,65 +115,117 @@ pub fn build_world(s: &Scenario, repeat: u32) -> Result<World> {
     })
 }
 
-/// Runs one condition of one repeat. `progress` is called with the number of steps done since
-/// its last call.
-///
-/// # Errors
-/// A world or controller failure (none is expected once the scenario checks out).
-pub fn run_one(
-    s: &Scenario,
+/// One run in progress: the world and its robots, stepped one step at a time.
+pub struct Swarm {
+    scenario: Scenario,
     condition: Condition,
     repeat: u32,
-    record_track: bool,
-    progress: &(dyn Fn(u64) + Sync),
-) -> Result<RunOutput> {
-    let n = s.robots;
-    let mut world = build_world(s, repeat)?;
-    let mut robots: Vec<Robot> = (0..n)
-        .map(|i| Robot::new(s, condition, repeat, i as u32))
-        .collect::<Result<_>>()?;
-    let par = n >= PARALLEL_ROBOTS;
-    let clock_hz = f64::from(s.timing.clock_hz);
-    let mut counters: Vec<CollisionCounter> = vec![CollisionCounter::new(); n];
-    let mut steps: Vec<StepMetrics> = Vec::with_capacity(s.steps as usize);
-    let tracked = if record_track {
-        n.min(TRACKED_ROBOTS)
-    } else {
-        0
-    };
-    let mut track = record_track.then(|| Track {
-        paths: vec![Vec::with_capacity(s.steps as usize); tracked],
-        outlines: Vec::new(),
-        walls: world
-            .arena()
-            .walls()
-            .iter()
-            .map(|w| [(w.a.0, w.a.1), (w.b.0, w.b.1)])
-            .collect(),
-    });
-    let snapshots = [0, s.steps / 3, 2 * s.steps / 3, s.steps.saturating_sub(1)];
-    let mut saves = 0u64;
+    world: World,
+    robots: Vec<Robot>,
+    counters: Vec<CollisionCounter>,
+    steps: Vec<StepMetrics>,
+    track: Option<Track>,
+    tracked: usize,
+    snapshots: [u32; 4],
+    saves: u64,
+    parallel: bool,
+}
 
-    for k in 0..s.steps {
-        // 1. Every MCU sleeps to the step instant.
+impl Swarm {
+    /// Places the robots and boots every robot's MCU.
+    ///
+    /// # Errors
+    /// Robots that do not fit the arena; a configuration the controller refuses.
+    pub fn new(
+        s: &Scenario,
+        condition: Condition,
+        repeat: u32,
+        record_track: bool,
+    ) -> Result<Self> {
+        let n = s.robots;
+        let world = build_world(s, repeat)?;
+        let robots: Vec<Robot> = (0..n)
+            .map(|i| Robot::new(s, condition, repeat, i as u32))
+            .collect::<Result<_>>()?;
+        let tracked = if record_track {
+            n.min(TRACKED_ROBOTS)
+        } else {
+            0
+        };
+        let track = record_track.then(|| Track {
+            paths: vec![Vec::with_capacity(s.steps as usize); tracked],
+            outlines: Vec::new(),
+            walls: world
+                .arena()
+                .walls()
+                .iter()
+                .map(|w| [(w.a.0, w.a.1), (w.b.0, w.b.1)])
+                .collect(),
+        });
+        Ok(Self {
+            scenario: s.clone(),
+            condition,
+            repeat,
+            world,
+            robots,
+            counters: vec![CollisionCounter::new(); n],
+            steps: Vec::with_capacity(s.steps as usize),
+            track,
+            tracked,
+            snapshots: [0, s.steps / 3, 2 * s.steps / 3, s.steps.saturating_sub(1)],
+            saves: 0,
+            parallel: n >= PARALLEL_ROBOTS,
+        })
+    }
+
+    /// Whether the robots are stepped in parallel (on rayon's current pool); by default from
+    /// [`PARALLEL_ROBOTS`] robots on. The results do not depend on it.
+    pub fn set_parallel(&mut self, parallel: bool) {
+        self.parallel = parallel;
+    }
+
+    /// Runs the next step: every MCU sleeps to the step instant, the world catches up (its
+    /// collisions are the previous step's), the robots sense, step and drive.
+    ///
+    /// # Errors
+    /// A world or controller failure (none is expected once the scenario checks out).
+    pub fn step(&mut self) -> Result<()> {
+        let n = self.robots.len();
+        let k = self.steps.len() as u32;
+        let par = self.parallel;
         let times: Vec<u64> = if par {
-            robots
+            self.robots
                 .par_iter_mut()
                 .map(Robot::sleep)
                 .collect::<Result<_>>()?
         } else {
-            robots.iter_mut().map(Robot::sleep).collect::<Result<_>>()?
+            self.robots
+                .iter_mut()
+                .map(Robot::sleep)
+                .collect::<Result<_>>()?
         };
-        let t_step_s = times.iter().copied().min().unwrap_or(0) as f64 / clock_hz;
-        // 2. The world catches up; the collisions belong to the previous step's behaviour.
-        let collided = advance_world(&mut world, t_step_s, s.world.substep_s, &mut counters, par)?;
-        if let Some(last) = steps.last_mut() {
+        let t_step_s = times.iter().copied().min().unwrap_or(0) as f64
+            / f64::from(self.scenario.timing.clock_hz);
+        let collided = advance_world(
+            &mut self.world,
+            t_step_s,
+            self.scenario.world.substep_s,
+            &mut self.counters,
+            par,
+        )?;
+        if let Some(last) = self.steps.last_mut() {
             last.collisions_per_robot = collided as f64 / n as f64;
         }
-        if let Some(t) = track.as_mut() {
-            record(&world, t, tracked, snapshots.contains(&k), t_step_s)?;
+        if let Some(t) = self.track.as_mut() {
+            record(
+                &self.world,
+                t,
+                self.tracked,
+                self.snapshots.contains(&k),
+                t_step_s,
+            )?;
         }
-        // 3. Sense, step, drive.
+        let world = &self.world;
         let sense = |i: usize| -> Result<[Option<f64>; 4]> {
             let mut d = [None; 4];
             for (k, dk) in d.iter_mut().enumerate() {
@@ -187,48 +239,82 @@ pub fn run_one(
             (0..n).map(sense).collect::<Result<_>>()?
         };
         let results: Vec<(i16, bool)> = if par {
-            robots
+            self.robots
                 .par_iter_mut()
                 .zip(distances.par_iter())
                 .map(|(r, d)| r.step(*d).map(|rep| (rep.d, rep.saved.is_some())))
                 .collect::<Result<_>>()?
         } else {
-            robots
+            self.robots
                 .iter_mut()
                 .zip(&distances)
                 .map(|(r, d)| r.step(*d).map(|rep| (rep.d, rep.saved.is_some())))
                 .collect::<Result<_>>()?
         };
-        for (i, r) in robots.iter_mut().enumerate() {
+        for (i, r) in self.robots.iter_mut().enumerate() {
             let (left, right) = r.wheels();
-            world.set_wheels(i, left, right)?;
+            self.world.set_wheels(i, left, right)?;
         }
-        saves += results.iter().filter(|(_, saved)| *saved).count() as u64;
+        self.saves += results.iter().filter(|(_, saved)| *saved).count() as u64;
         let mean_d = results.iter().map(|(d, _)| f64::from(*d)).sum::<f64>() / n as f64;
-        let gap_cv = match s.arena {
-            ArenaKind::Corridor => world.corridor_gap_cv()?,
+        let gap_cv = match self.scenario.arena {
+            ArenaKind::Corridor => self.world.corridor_gap_cv()?,
             ArenaKind::Square => None,
         };
-        steps.push(StepMetrics {
+        self.steps.push(StepMetrics {
             mean_d,
             collisions_per_robot: 0.0,
             gap_cv,
         });
+        Ok(())
+    }
+
+    /// Lets the last behaviour run its full period (its collisions counted) and returns the
+    /// run's metrics.
+    ///
+    /// # Errors
+    /// A world failure.
+    pub fn finish(mut self) -> Result<RunOutput> {
+        let end_s = self.world.elapsed_s() + self.scenario.timing.step_period_s;
+        let collided = advance_world(
+            &mut self.world,
+            end_s,
+            self.scenario.world.substep_s,
+            &mut self.counters,
+            self.parallel,
+        )?;
+        let n = self.robots.len();
+        if let Some(last) = self.steps.last_mut() {
+            last.collisions_per_robot = collided as f64 / n as f64;
+        }
+        Ok(RunOutput {
+            condition: self.condition,
+            repeat: self.repeat,
+            steps: self.steps,
+            track: self.track,
+            saves: self.saves,
+        })
+    }
+}
+
+/// Runs one condition of one repeat. `progress` is called with the number of steps done since
+/// its last call.
+///
+/// # Errors
+/// A world or controller failure (none is expected once the scenario checks out).
+pub fn run_one(
+    s: &Scenario,
+    condition: Condition,
+    repeat: u32,
+    record_track: bool,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<RunOutput> {
+    let mut swarm = Swarm::new(s, condition, repeat, record_track)?;
+    for _ in 0..s.steps {
+        swarm.step()?;
         progress(1);
     }
-    // The last behaviour runs its full period too.
-    let end_s = world.elapsed_s() + s.timing.step_period_s;
-    let collided = advance_world(&mut world, end_s, s.world.substep_s, &mut counters, par)?;
-    if let Some(last) = steps.last_mut() {
-        last.collisions_per_robot = collided as f64 / n as f64;
-    }
-    Ok(RunOutput {
-        condition,
-        repeat,
-        steps,
-        track,
-        saves,
-    })
+    swarm.finish()
 }
 
 /// Advances the world to `target_s` in sub-steps of at most `substep_s`, sampling every robot's

@@ -7,16 +7,9 @@
 //! outside ROM and RAM) and 126 when the program sleeps with nothing left to wake it.
 #![forbid(unsafe_code)]
 
-mod cost_report;
 mod emu_cmd;
-mod experiment;
-mod fit_cmd;
-mod plot;
-mod replay;
-mod robot;
-mod run_cmd;
-mod scenario;
-mod summary;
+
+use h8swarm::{cost_report, fit_cmd, replay, run_cmd};
 
 use std::fs::File;
 use std::io::{self, BufRead, BufReader, BufWriter, Write};

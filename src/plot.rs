@@ -1203,9 +1203,6 @@ fn write_error(path: &Path, e: std::io::Error) -> PlotError {
 
 #[cfg(test)]
 mod tests {
-    // A `harness = false` bench that includes this file compiles it with cfg(test) but drops
-    // the #[test] functions, leaving this import unused there.
-    #[allow(unused_imports)]
     use super::*;
 
     #[test]

@@ -1,8 +1,7 @@
 //! Tests of the figures module (`src/plot.rs`) through its public API: files written and valid,
 //! output bytes deterministic, bad data and bad paths reported as errors.
 
-#[path = "../src/plot.rs"]
-mod plot;
+use h8swarm::plot;
 
 use std::path::{Path, PathBuf};
 

@@ -33,11 +33,12 @@ pub trait Bus {
     /// SLEEP: advances the clock until an interrupt request is pending or the clock reaches
     /// `deadline`, whichever is first. Returns whether an interrupt is pending.
     fn sleep_until_irq(&mut self, deadline: u64) -> bool;
-    /// The earliest instant after now at which some peripheral's state changes (a compare
-    /// match, an A/D conversion end, …), if the bus knows: polling loops may let the time up to
-    /// it pass without reading, since every read before it returns the same. `None` (the
+    /// An instant before which every read of `addr` returns what a read now would, and has no
+    /// side effect, if the bus knows one (say, the end of the running A/D conversion for
+    /// ADCSR): a polling loop may let the time up to it pass without reading. `None` (the
     /// default): unknown.
-    fn next_event_at(&self) -> Option<u64> {
+    fn reads_stable_until(&self, addr: u32) -> Option<u64> {
+        let _ = addr;
         None
     }
     /// The EEPROM bus behind port 4, for emulation shortcuts that act on the chips at

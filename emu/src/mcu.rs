@@ -833,8 +833,12 @@ impl<B: Board> Bus for Mcu<B> {
         Some(&mut self.i2c)
     }
 
-    fn next_event_at(&self) -> Option<u64> {
-        self.next_event()
+    fn reads_stable_until(&self, addr: u32) -> Option<u64> {
+        // ADCSR changes only at the A/D converter's own events (a conversion's end sets ADF);
+        // reading it with ADF = 0 arms nothing.
+        (addr & crate::memmap::ADDRESS_MASK == crate::periph::adc::ADCSR)
+            .then(|| self.adc.next_event(self.now))
+            .flatten()
     }
 }
 

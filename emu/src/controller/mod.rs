@@ -670,7 +670,9 @@ impl Controller {
                 // Shortcut: every poll whose read ends before the next peripheral event reads
                 // the same; let them pass unread, unless the tick could come meanwhile.
                 if self.cfg.fast_forward
-                    && let (Some(event), Some(tick)) = (fw.bus.next_event_at(), fw.next_tick_at)
+                    && v & ADCSR_ADF == 0
+                    && let (Some(event), Some(tick)) =
+                        (fw.bus.reads_stable_until(ADCSR), fw.next_tick_at)
                 {
                     let now = fw.now();
                     let skip = event
