@@ -57,6 +57,10 @@ struct BodyPose {
     s: f64,
 }
 
+/// The wheel-speed difference below which a wheel is taken to have reached its target speed:
+/// 1e-12 m/s, a picometre per second, far below anything the model resolves.
+const SPEED_SNAP_M_S: f64 = 1e-12;
+
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 struct Motion {
     /// Wheel speeds now, m/s (left, right).
@@ -1129,7 +1133,13 @@ impl Drive {
             let mut mean = [0.0; 2];
             for (w, mean_w) in mean.iter_mut().enumerate() {
                 let l = self.lag.by_mode[usize::from(m.mode[w]).min(2)];
-                let diff = m.speed[w] - m.target[w];
+                let mut diff = m.speed[w] - m.target[w];
+                // A speed within SPEED_SNAP_M_S of its target has arrived: without the snap, a
+                // wheel decaying to a zero target keeps shrinking through subnormal floats,
+                // which cost x86 cores about a hundred cycles per operation.
+                if diff.abs() < SPEED_SNAP_M_S {
+                    diff = 0.0;
+                }
                 *mean_w = m.target[w] + diff * l.mean_factor;
                 m.speed[w] = m.target[w] + diff * l.decay;
             }
