@@ -24,7 +24,7 @@
 use anyhow::{Context, Result};
 use rayon::prelude::*;
 use sensors::{BumperSet, CollisionCounter, port2_pins};
-use world::{Arena, World, WorldParams};
+use world::{Arena, SensorMount, World, WorldParams};
 
 use crate::plot::Outline;
 use crate::robot::{Condition, Purpose, Robot, Seeds};
@@ -95,6 +95,20 @@ pub fn world_params(s: &Scenario) -> WorldParams {
         wheel_track_m: s.world.wheel_track_m,
         max_substep_s: s.world.substep_s,
         sensor_max_range_m: s.world.sensor_range_m,
+        sensor_mounts: SensorMount::default_mounts(
+            world::params::BODY_LENGTH_M,
+            world::params::BODY_WIDTH_M,
+        )
+        .into_iter()
+        .map(|m| {
+            let (sin, cos) = m.angle_rad.sin_cos();
+            SensorMount {
+                x_m: m.x_m - cos * s.world.sensor_setback_m,
+                y_m: m.y_m - sin * s.world.sensor_setback_m,
+                ..m
+            }
+        })
+        .collect(),
         ..WorldParams::default()
     }
 }

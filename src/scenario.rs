@@ -50,6 +50,10 @@ pub struct TimingSpec {
     pub clock_hz: u32,
 }
 
+/// The deepest sensor setback: less than the body's half width (90 mm), so the mount stays
+/// inside the body.
+pub const MAX_SENSOR_SETBACK_M: f64 = 0.08;
+
 /// The physical world (defaults from SPEC §3.5 and the `world` crate).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -66,6 +70,11 @@ pub struct WorldSpec {
     pub substep_s: f64,
     /// Farthest distance a sensor ray reports, metres.
     pub sensor_range_m: f64,
+    /// How far each IR sensor sits inside the body, back from the middle of its side along
+    /// its axis, metres (0 = on the side, SPEC §3.1; at most 0.08). Setting a GP2D12-class
+    /// sensor back by its 8 cm fold-back zone is the datasheet's remedy for the ambiguous
+    /// reading at contact.
+    pub sensor_setback_m: f64,
 }
 
 /// The IR sensors (defaults: SPEC §3.1 and the `sensors` crate).
@@ -143,7 +152,7 @@ macro_rules! patch {
 
 patch!(LearnerPatch for LearnerSpec { behaviours: usize, eta: f64, threshold: i32, history: usize, bias: bool, save_every: u32 });
 patch!(TimingPatch for TimingSpec { step_period_s: f64, clock_hz: u32 });
-patch!(WorldPatch for WorldSpec { top_speed_m_per_s: f64, motor_time_constant_s: f64, motor_gain_spread: f64, wheel_track_m: f64, substep_s: f64, sensor_range_m: f64 });
+patch!(WorldPatch for WorldSpec { top_speed_m_per_s: f64, motor_time_constant_s: f64, motor_gain_spread: f64, wheel_track_m: f64, substep_s: f64, sensor_range_m: f64, sensor_setback_m: f64 });
 patch!(SensorPatch for SensorSpec { noise_sigma_v: f64, spike_probability: f64, spread: bool });
 patch!(ControlPatch for ControlSpec { learning_off: bool, random_walk: bool });
 
@@ -199,6 +208,7 @@ impl Default for WorldSpec {
             // sampled 22 times per 0.45 s step.
             substep_s: world::params::MAX_SUBSTEP_S,
             sensor_range_m: world::params::SENSOR_MAX_RANGE_M,
+            sensor_setback_m: 0.0,
         }
     }
 }
@@ -432,6 +442,12 @@ impl Scenario {
         finite("world.wheel_track_m", self.world.wheel_track_m, 0.05, 0.18)?;
         finite("world.substep_s", self.world.substep_s, 0.001, 0.020)?;
         finite("world.sensor_range_m", self.world.sensor_range_m, 0.1, 10.0)?;
+        finite(
+            "world.sensor_setback_m",
+            self.world.sensor_setback_m,
+            0.0,
+            MAX_SENSOR_SETBACK_M,
+        )?;
         finite(
             "sensors.noise_sigma_v",
             self.sensors.noise_sigma_v,

@@ -27,7 +27,11 @@
 //!   whole number of ticks (0.45 s = 45, 0.60 s = 60). The first step comes with the first tick
 //!   after boot.
 //! - PWM: ITU1 (left) and ITU2 (right) in PWM mode at φ/8 with GRA = 1249: a 400 µs period
-//!   (2.5 kHz at 25 MHz); duty v = 1250 counts (GRB = 1249), 0.3 v = 375 counts (GRB = 374).
+//!   (2.5 kHz at 25 MHz); 0.3 v = 375 counts high (GRB = 374); v = 100 % duty with GRB = 1250,
+//!   above GRA, the hardware manual's recipe for a 100 % PWM output (the GRB compare match
+//!   never comes, so the pin stays high from the GRA match on). GRB = GRA would not do: with
+//!   equal compare values the PWM output does not change at all (it holds its level, low after
+//!   reset), the trap an earlier version of this firmware fell into.
 //!   Direction: PB0/PB1 = IN1/IN2 of the left H-bridge, PB2/PB3 of the right (H/L forward,
 //!   L/H reverse).
 //! - The sample is taken at the step's tick: each sensor's held value dates from its latest
@@ -58,6 +62,9 @@ use regs::*;
 pub const TICK_S: f64 = 0.010;
 /// PWM period in ITU counts at φ/8 (GRA + 1): 1250 counts, 400 µs at 25 MHz.
 pub const PWM_PERIOD_COUNTS: u16 = 1250;
+/// GRB for 100 % duty: above GRA (= [`PWM_PERIOD_COUNTS`] − 1), so its compare match never
+/// comes and the output stays high (the H8/3052 hardware manual's PWM-mode 100 % setting).
+pub const PWM_FULL_GRB: u16 = PWM_PERIOD_COUNTS;
 /// Lowest φ the H8/3052F runs at (hardware manual, electrical characteristics: 2 MHz).
 pub const CLOCK_MIN_HZ: u32 = 2_000_000;
 /// Highest φ of the H8/3052F (hardware manual: 25 MHz; the AKI board's crystal, SPEC §4.1).
@@ -490,8 +497,8 @@ impl Controller {
             fw.code(&[Insn::ImmW]);
             fw.write16(ITU1 + GRA, PWM_PERIOD_COUNTS - 1);
             fw.write16(ITU2 + GRA, PWM_PERIOD_COUNTS - 1);
-            fw.write16(ITU1 + GRB, PWM_PERIOD_COUNTS - 1);
-            fw.write16(ITU2 + GRB, PWM_PERIOD_COUNTS - 1);
+            fw.write16(ITU1 + GRB, PWM_FULL_GRB);
+            fw.write16(ITU2 + GRB, PWM_FULL_GRB);
             fw.code(&[Insn::Reg]);
             fw.write8(ITU0 + TIER, IMA);
             fw.code(&[Insn::Reg]);
@@ -835,7 +842,7 @@ impl Mark {
 /// backward (−v, −v), turn-left-forward (0.3 v, v), turn-right-forward (v, 0.3 v)).
 #[must_use]
 pub fn motor_row(b: Behaviour) -> (u16, u16, u8) {
-    const FULL: u16 = PWM_PERIOD_COUNTS - 1;
+    const FULL: u16 = PWM_FULL_GRB;
     // 0.3 v: 375 of 1250 counts high.
     const SLOW: u16 = (PWM_PERIOD_COUNTS * 3).div_ceil(10) - 1;
     const LEFT_FWD: u8 = 0b0001;
@@ -959,10 +966,10 @@ mod tests {
 
     #[test]
     fn motor_rows_follow_the_behaviours() {
-        assert_eq!(motor_row(Behaviour::Forward), (1249, 1249, 0b0101));
-        assert_eq!(motor_row(Behaviour::Backward), (1249, 1249, 0b1010));
-        assert_eq!(motor_row(Behaviour::TurnLeftForward), (374, 1249, 0b0101));
-        assert_eq!(motor_row(Behaviour::TurnRightForward), (1249, 374, 0b0101));
+        assert_eq!(motor_row(Behaviour::Forward), (1250, 1250, 0b0101));
+        assert_eq!(motor_row(Behaviour::Backward), (1250, 1250, 0b1010));
+        assert_eq!(motor_row(Behaviour::TurnLeftForward), (374, 1250, 0b0101));
+        assert_eq!(motor_row(Behaviour::TurnRightForward), (1250, 374, 0b0101));
     }
 
     #[test]
