@@ -207,6 +207,19 @@ pub fn run(a: &RunArgs) -> Result<String> {
             fmt_est(&c.first.collisions_per_robot),
             fmt_est(&c.last.collisions_per_robot)
         );
+        let mm = |e: &Estimate| Estimate {
+            mean: e.mean * 1e3,
+            lo: e.lo.map(|v| v * 1e3),
+            hi: e.hi.map(|v| v * 1e3),
+            n: e.n,
+        };
+        let _ = writeln!(
+            t,
+            "{:<14} moved per step {} -> {} mm",
+            "",
+            fmt_est(&mm(&c.first.moved_m)),
+            fmt_est(&mm(&c.last.moved_m))
+        );
         if let (Some(f), Some(l)) = (&c.first.gap_cv, &c.last.gap_cv) {
             let _ = writeln!(t, "{:<14} gap CV {} -> {}", "", fmt_est(f), fmt_est(l));
         }
@@ -265,6 +278,7 @@ fn write_metrics(path: &Path, runs: &[RunOutput]) -> Result<()> {
         "step",
         "mean_d",
         "collisions_per_robot",
+        "moved_m",
         "gap_cv",
     ])?;
     for r in runs {
@@ -275,6 +289,7 @@ fn write_metrics(path: &Path, runs: &[RunOutput]) -> Result<()> {
                 k.to_string(),
                 format!("{}", m.mean_d),
                 format!("{}", m.collisions_per_robot),
+                format!("{}", m.moved_m),
                 m.gap_cv.map(|v| format!("{v}")).unwrap_or_default(),
             ])?;
         }

@@ -74,6 +74,8 @@ pub struct WindowStats {
     pub mean_d: Estimate,
     /// Collisions per robot over the window.
     pub collisions_per_robot: Estimate,
+    /// Mean distance a robot's centre moved per step over the window, metres.
+    pub moved_m: Estimate,
     /// Corridor: mean gap CV over the window.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub gap_cv: Option<Estimate>,
@@ -128,6 +130,7 @@ pub fn window(runs: &[&RunOutput], from: u32, to: u32) -> WindowStats {
         to_step: to,
         mean_d: Estimate::of(&per_run(&|m| m.mean_d, true)),
         collisions_per_robot: Estimate::of(&per_run(&|m| m.collisions_per_robot, false)),
+        moved_m: Estimate::of(&per_run(&|m| m.moved_m, true)),
         gap_cv: gap,
     }
 }
