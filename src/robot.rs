@@ -67,11 +67,18 @@ pub struct RobotBoard {
     pub distance_mm: [Option<f64>; 4],
     /// The bumpers, as of the latest world sub-step.
     pub bumpers: [bool; 4],
+    /// The A/D input each sensor is wired to (the scenario's `sensors.channels`).
+    channels: [u8; 4],
 }
 
 impl Board for RobotBoard {
     fn analog_volts(&mut self, channel: u8, now_states: u64) -> f64 {
-        let k = usize::from(channel);
+        // An input no sensor is wired to reads 0 V.
+        let k = self
+            .channels
+            .iter()
+            .position(|&c| c == channel)
+            .unwrap_or(usize::MAX);
         match (self.sensors.get_mut(k), self.distance_mm.get(k)) {
             // Distances come from the world (finite, ≥ 0) and time only moves forward, so
             // `sample` cannot fail; if it did, the pin would read 0 V.
@@ -133,6 +140,7 @@ pub fn controller_config(s: &Scenario, weight_seed: u64) -> Result<ControllerCon
         save_every_steps: s.learner.save_every,
         step_period_s: s.timing.step_period_s,
         weight_seed,
+        sensor_channels: s.sensors.channels,
         fast_forward: true,
     })
 }
@@ -171,6 +179,7 @@ impl Robot {
             sensors,
             distance_mm: [None; 4],
             bumpers: [false; 4],
+            channels: s.sensors.channels,
         };
         let mut mcu = Mcu::new(
             McuConfig {

@@ -87,6 +87,9 @@ pub struct SensorSpec {
     pub spike_probability: f64,
     /// Unit-to-unit spread on (the datasheet's) or off (every sensor nominal).
     pub spread: bool,
+    /// The A/D input (0–7 for AN0–AN7) of each sensor, front, rear, left, right: four distinct
+    /// channels of one scan group (AN0–AN3 or AN4–AN7). Default AN0–AN3.
+    pub channels: [u8; 4],
 }
 
 /// Which controls run beside learning (SPEC §5).
@@ -153,7 +156,7 @@ macro_rules! patch {
 patch!(LearnerPatch for LearnerSpec { behaviours: usize, eta: f64, threshold: i32, history: usize, bias: bool, save_every: u32 });
 patch!(TimingPatch for TimingSpec { step_period_s: f64, clock_hz: u32 });
 patch!(WorldPatch for WorldSpec { top_speed_m_per_s: f64, motor_time_constant_s: f64, motor_gain_spread: f64, wheel_track_m: f64, substep_s: f64, sensor_range_m: f64, sensor_setback_m: f64 });
-patch!(SensorPatch for SensorSpec { noise_sigma_v: f64, spike_probability: f64, spread: bool });
+patch!(SensorPatch for SensorSpec { noise_sigma_v: f64, spike_probability: f64, spread: bool, channels: [u8; 4] });
 patch!(ControlPatch for ControlSpec { learning_off: bool, random_walk: bool });
 
 /// A resolved, checked scenario.
@@ -219,6 +222,7 @@ impl Default for SensorSpec {
             noise_sigma_v: sensors::ir::NOISE_SIGMA_VOLTS,
             spike_probability: sensors::ir::SPIKE_PROBABILITY,
             spread: true,
+            channels: emu::controller::DEFAULT_SENSOR_CHANNELS,
         }
     }
 }
@@ -387,6 +391,9 @@ impl Scenario {
             } else {
                 bail!("`{key}` = {v} is out of range: valid is {lo} to {hi}")
             }
+        }
+        if let Err(e) = emu::controller::check_sensor_channels(&self.sensors.channels) {
+            bail!("`sensors.channels` = {:?}: {e}", self.sensors.channels);
         }
         range("robots", self.robots, 1, 100_000)?;
         range("steps", self.steps, 1, 10_000_000)?;

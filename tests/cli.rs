@@ -364,7 +364,13 @@ fn run_reports_bad_scenarios_and_folders_clearly() {
     std::fs::write(&bad_key, "robots = 3\n[learner]\neta_q15 = 33\n").expect("write");
     let bad_value = dir.join("bad_value.toml");
     std::fs::write(&bad_value, "[world]\nmotor_time_constant_s = 0.5\n").expect("write");
+    let bad_channel = dir.join("bad_channel.toml");
+    std::fs::write(&bad_channel, "[sensors]\nchannels = [0, 1, 2, 9]\n").expect("write");
     let cases: Vec<(Vec<String>, &str)> = vec![
+        (
+            vec!["run".into(), bad_channel.display().to_string()],
+            "`sensors.channels` = [0, 1, 2, 9]: sensor_channels[3] (right) = 9: an analog input the H8/3052F has: 0 to 7 (AN0 to AN7)",
+        ),
         (vec!["run".into(), bad_key.display().to_string()], "eta_q15"),
         (
             vec!["run".into(), bad_value.display().to_string()],

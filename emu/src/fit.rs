@@ -145,11 +145,18 @@ pub struct FitReport {
 pub struct FitBoard {
     sensors: Vec<sensors::IrSensor>,
     distance_mm: [f64; 4],
+    /// The A/D input of each sensor (the controller's wiring).
+    channels: [u8; 4],
 }
 
 impl Board for FitBoard {
     fn analog_volts(&mut self, channel: u8, now_states: u64) -> f64 {
-        let k = usize::from(channel);
+        // An input no sensor is wired to reads 0 V.
+        let k = self
+            .channels
+            .iter()
+            .position(|&c| c == channel)
+            .unwrap_or(usize::MAX);
         match (self.sensors.get_mut(k), self.distance_mm.get(k)) {
             // The distances are finite and non-negative and time only moves forward, so a
             // sample cannot fail; a failure would read as 0 V, never panic.
@@ -193,6 +200,7 @@ pub fn measure(cfg: &FitConfig) -> Result<FitReport, ControllerError> {
     let board = FitBoard {
         sensors: sensors_v,
         distance_mm: [300.0, 500.0, 150.0, 800.0],
+        channels: cfg.controller.sensor_channels,
     };
     let mut mcu = Mcu::new(
         McuConfig {

@@ -81,6 +81,9 @@ const MOVB_DISP24_STATES: u32 = 10;
 /// States of JSR @aa:24 and RTS (SPEC §4.2: 10 each).
 const CALL_RETURN_STATES: u32 = 20;
 
+/// The default wiring of the four IR sensors (front, rear, left, right): AN0–AN3 (SPEC §3.2).
+pub const DEFAULT_SENSOR_CHANNELS: [u8; 4] = [0, 1, 2, 3];
+
 /// How the controller is set up.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ControllerConfig {
@@ -98,6 +101,10 @@ pub struct ControllerConfig {
     pub step_period_s: f64,
     /// Seed of the fresh random weights (used when no record is restored).
     pub weight_seed: u64,
+    /// The A/D input (AN0–AN7) each sensor is wired to, in sensor order front, rear, left,
+    /// right; [`DEFAULT_SENSOR_CHANNELS`] by default. The four must be distinct and in one scan
+    /// group (AN0–AN3 or AN4–AN7), since the firmware converts them in one scan.
+    pub sensor_channels: [u8; 4],
     /// Emulation shortcuts with identical results (tested): while asleep between two steps,
     /// only the first and the last tick interrupt are emulated register by register and the
     /// identical ones in between are charged as such; and the interrupt controller is only
@@ -118,6 +125,7 @@ impl ControllerConfig {
             save_every_steps: eeprom::persist::DEFAULT_SAVE_EVERY_STEPS,
             step_period_s: 0.45,
             weight_seed,
+            sensor_channels: DEFAULT_SENSOR_CHANNELS,
             fast_forward: true,
         }
     }
@@ -294,6 +302,49 @@ fn config_error(
     }
 }
 
+/// Checks a sensor wiring: the four A/D inputs must exist (AN0–AN7), differ, and share a scan
+/// group (what [`Controller::new`] checks of [`ControllerConfig::sensor_channels`]).
+///
+/// # Errors
+/// [`ControllerError::Config`] naming the first sensor whose channel is not valid.
+pub fn check_sensor_channels(ch: &[u8; 4]) -> Result<(), ControllerError> {
+    const FIELDS: [&str; 4] = [
+        "sensor_channels[0] (front)",
+        "sensor_channels[1] (rear)",
+        "sensor_channels[2] (left)",
+        "sensor_channels[3] (right)",
+    ];
+    for (k, &c) in ch.iter().enumerate() {
+        if c > 7 {
+            return Err(config_error(
+                FIELDS[k],
+                c,
+                "an analog input the H8/3052F has: 0 to 7 (AN0 to AN7)",
+            ));
+        }
+        if ch[..k].contains(&c) {
+            return Err(config_error(
+                FIELDS[k],
+                c,
+                "a channel no other sensor uses (each sensor needs its own A/D input)",
+            ));
+        }
+        if c / 4 != ch[0] / 4 {
+            return Err(config_error(
+                FIELDS[k],
+                c,
+                format!(
+                    "a channel in the scan group of the front sensor's AN{} (AN{} to AN{}): the firmware converts the four sensors in one scan",
+                    ch[0],
+                    ch[0] / 4 * 4,
+                    ch[0] / 4 * 4 + 3
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 impl Controller {
     /// Checks the configuration, places the controller's state in the on-chip RAM and builds
     /// the learner (its weights are set at boot).
@@ -317,6 +368,7 @@ impl Controller {
                 "2 (forward, backward) to 4 (all four behaviours)",
             ));
         }
+        check_sensor_channels(&cfg.sensor_channels)?;
         if cfg.save_every_steps == 0 {
             return Err(config_error(
                 "save_every_steps",
@@ -659,11 +711,13 @@ impl Controller {
             // Main loop: advance NEXT, call the A/D routine.
             fw.code(&[Insn::ImmL, Insn::MovLAbs16]);
 
-            // 1. A/D: scan AN0-AN3 once, poll ADF, stop, read and linearise.
+            // 1. A/D: scan the sensors' group (AN0-AN3 by default) once, poll ADF, stop, read
+            // and linearise.
             let t = Mark::new(&fw);
+            let group_ch = (self.cfg.sensor_channels[0] & 4) | 3;
             fw.bus.internal(CALL_RETURN_STATES / 2);
             fw.code(&[Insn::Reg]);
-            fw.write8(ADCSR, ADCSR_ADST | ADCSR_SCAN | ADCSR_CKS | 3);
+            fw.write8(ADCSR, ADCSR_ADST | ADCSR_SCAN | ADCSR_CKS | group_ch);
             // 1: MOV.B @ADCSR:8,R0L ; BPL 1b — 2 + 3 + 4 states a poll, the read ending 5
             // states in.
             const POLL_STATES: u64 = 9;
@@ -691,10 +745,11 @@ impl Controller {
                 }
             }
             fw.code(&[Insn::Reg]);
-            fw.write8(ADCSR, ADCSR_SCAN | ADCSR_CKS | 3);
+            fw.write8(ADCSR, ADCSR_SCAN | ADCSR_CKS | group_ch);
             let mut p = [0u8; 4];
-            for (k, pk) in p.iter_mut().enumerate() {
-                let code8 = fw.read8(ADDRAH + 2 * k as u32);
+            for (pk, &ch) in p.iter_mut().zip(&self.cfg.sensor_channels) {
+                // AN0/AN4 land in ADDRA, AN1/AN5 in ADDRB, and so on.
+                let code8 = fw.read8(ADDRAH + 2 * u32::from(ch & 3));
                 fw.bus
                     .internal(states_of(&[Insn::Reg, Insn::Reg]) + MOVB_DISP24_STATES);
                 fw.code(&[Insn::MovBwAbs16]);
@@ -911,6 +966,31 @@ pub fn crc16_states_estimate(n: usize) -> u64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn sensor_channels_must_exist_differ_and_share_a_scan_group() {
+        for (ch, field, why) in [
+            (
+                [0, 1, 2, 8],
+                "sensor_channels[3] (right) = 8",
+                "0 to 7 (AN0 to AN7)",
+            ),
+            (
+                [0, 1, 1, 3],
+                "sensor_channels[2] (left) = 1",
+                "no other sensor uses",
+            ),
+            ([4, 5, 6, 3], "sensor_channels[3] (right) = 3", "AN4 to AN7"),
+        ] {
+            let mut cfg = ControllerConfig::arena(1);
+            cfg.sensor_channels = ch;
+            let e = Controller::new(cfg).unwrap_err().to_string();
+            assert!(e.starts_with(field) && e.contains(why), "{ch:?}: {e}");
+        }
+        let mut cfg = ControllerConfig::arena(1);
+        cfg.sensor_channels = [7, 4, 5, 6];
+        assert!(Controller::new(cfg).is_ok());
+    }
 
     #[test]
     fn config_errors_name_the_setting() {
