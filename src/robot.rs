@@ -73,18 +73,13 @@ pub struct RobotBoard {
 
 impl Board for RobotBoard {
     fn analog_volts(&mut self, channel: u8, now_states: u64) -> f64 {
-        // An input no sensor is wired to reads 0 V.
-        let k = self
-            .channels
-            .iter()
-            .position(|&c| c == channel)
-            .unwrap_or(usize::MAX);
-        match (self.sensors.get_mut(k), self.distance_mm.get(k)) {
-            // Distances come from the world (finite, ≥ 0) and time only moves forward, so
-            // `sample` cannot fail; if it did, the pin would read 0 V.
-            (Some(s), Some(&d)) => s.sample(now_states, d).unwrap_or(0.0),
-            _ => 0.0,
-        }
+        emu::wiring::sensor_volts(
+            &mut self.sensors,
+            &self.distance_mm,
+            &self.channels,
+            channel,
+            now_states,
+        )
     }
 
     fn port2_pins(&mut self, _now_states: u64) -> u8 {

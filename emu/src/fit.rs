@@ -151,18 +151,8 @@ pub struct FitBoard {
 
 impl Board for FitBoard {
     fn analog_volts(&mut self, channel: u8, now_states: u64) -> f64 {
-        // An input no sensor is wired to reads 0 V.
-        let k = self
-            .channels
-            .iter()
-            .position(|&c| c == channel)
-            .unwrap_or(usize::MAX);
-        match (self.sensors.get_mut(k), self.distance_mm.get(k)) {
-            // The distances are finite and non-negative and time only moves forward, so a
-            // sample cannot fail; a failure would read as 0 V, never panic.
-            (Some(s), Some(&d)) => s.sample(now_states, Some(d)).unwrap_or(0.0),
-            _ => 0.0,
-        }
+        let d = self.distance_mm.map(Some);
+        crate::wiring::sensor_volts(&mut self.sensors, &d, &self.channels, channel, now_states)
     }
 
     fn port2_pins(&mut self, _now_states: u64) -> u8 {

@@ -29,6 +29,26 @@ pub const AN_IR_RIGHT: u8 = 3;
 /// The four IR channels in the order front, rear, left, right.
 pub const AN_IR: [u8; 4] = [AN_IR_FRONT, AN_IR_REAR, AN_IR_LEFT, AN_IR_RIGHT];
 
+/// The voltage on A/D input `channel` of a board whose sensor k is wired to `channels[k]` and
+/// finds its nearest obstacle at `distance_mm[k]` (`None`: nothing in range); 0 V on an input
+/// no sensor is wired to. The distances are finite and non-negative and a board's time only
+/// moves forward, so a sample cannot fail; if one did, the pin would read 0 V, never panic.
+pub fn sensor_volts(
+    sensors: &mut [sensors::IrSensor],
+    distance_mm: &[Option<f64>],
+    channels: &[u8; 4],
+    channel: u8,
+    now_states: u64,
+) -> f64 {
+    let Some(k) = channels.iter().position(|&c| c == channel) else {
+        return 0.0;
+    };
+    match (sensors.get_mut(k), distance_mm.get(k)) {
+        (Some(s), Some(&d)) => s.sample(now_states, d).unwrap_or(0.0),
+        _ => 0.0,
+    }
+}
+
 /// Port-2 bit of the front bumper (P2.0, active low; `sensors::port2_pins` order).
 pub const P2_BUMPER_FRONT: u8 = 0x01;
 /// Port-2 bit of the rear bumper (P2.1).
