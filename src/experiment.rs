@@ -201,6 +201,12 @@ impl Swarm {
         })
     }
 
+    /// The world the robots are in (poses, bumpers, wheel speeds), as of the latest step.
+    #[must_use]
+    pub fn world(&self) -> &World {
+        &self.world
+    }
+
     /// Whether the robots are stepped in parallel (on rayon's current pool); by default from
     /// [`PARALLEL_ROBOTS`] robots on. The results do not depend on it.
     pub fn set_parallel(&mut self, parallel: bool) {

@@ -32,7 +32,7 @@ enum Command {
     Run(run_cmd::RunArgs),
     /// Feed the learner core from JSON Lines and print one JSON line per step (SPEC §2.6).
     Learn(LearnArgs),
-    /// Measure the learner's H8/300H states per step and its RAM footprint (the default job).
+    /// Measure the learner's H8/300H states per step and its RAM footprint (the learner alone).
     Cost(CostArgs),
     /// Run an H8/300H program image (.mot) on the emulated H8/3052F, SCI1 as the console.
     Emu(EmuArgs),

@@ -51,7 +51,8 @@
 //!   other); robots are processed in index order.
 //! - **Collisions** (robot–wall, robot–robot) are resolved after the move, in robot index
 //!   order (each robot: walls, then its pairs with higher-index robots), for a fixed number of
-//!   passes (default 4, stopping early after a clean pass). The first pass resolves the
+//!   passes (default 32, stopping early after a clean pass: see
+//!   [`params::COLLISION_ITERATIONS`] for why so many). The first pass resolves the
 //!   contacts present after the move; each later pass re-tests only the pairs with a robot
 //!   moved by the pass before (the others were clean and have not moved), so a clean pass
 //!   proves that nothing overlaps. An overlap is removed by pushing along the

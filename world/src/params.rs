@@ -41,8 +41,15 @@ pub const MAX_ADVANCE_S: f64 = 3600.0;
 pub const SENSOR_MAX_RANGE_M: f64 = 1.5;
 /// Default placement clearance between bodies, and between bodies and walls: 50 mm (our choice).
 pub const PLACEMENT_CLEARANCE_M: f64 = 0.050;
-/// Default number of collision-resolution passes per sub-step (our choice).
-pub const COLLISION_ITERATIONS: u32 = 4;
+/// Default number of collision-resolution passes per sub-step (our choice). A chain of three
+/// bodies (one squeezed between two) converges only by a factor of about 4 per pass under the
+/// equal-share pushes, so a few millimetres of overlap need some 11–14 passes to reach the
+/// 1 nm contact skin; 32 leaves room for longer chains. Later passes only revisit the
+/// contacts the previous pass moved, so unused passes cost nothing, and a sub-step whose
+/// passes do not end clean falls back to blocking the robots involved (see the crate docs):
+/// with 4 passes, as before, learning robots jammed in threes were blocked whole and 1 000
+/// robots ran 35 % slower.
+pub const COLLISION_ITERATIONS: u32 = 32;
 /// Most rays a sensor cone may use (our limit).
 pub const MAX_RAYS_PER_SENSOR: u32 = 16;
 /// Widest accepted sensor cone half-angle: 0.5 rad (our limit; the Sharp beam is a few degrees).

@@ -433,6 +433,38 @@ fn a_robot_pushing_another_into_a_wall_is_blocked_without_penetration() {
     assert!(w.bumpers(1).unwrap()[REAR]);
 }
 
+/// A robot driving into a row of two idle robots pushes the whole row: the contacts of a chain
+/// converge within the default passes. (With 4 passes a three-body chain was left overlapping
+/// by micrometres, so the fallback blocked all three and the row never moved.)
+#[test]
+fn a_robot_pushes_a_row_of_two_and_all_three_move() {
+    let gap = 0.001;
+    let mut w = world_at(
+        Arena::square(),
+        exact_params(),
+        &[
+            pose(0.3, 0.9, 0.0),
+            pose(0.3 + 2.0 * HX + gap, 0.9, 0.0),
+            pose(0.3 + 4.0 * HX + 2.0 * gap, 0.9, 0.0),
+        ],
+    );
+    set_behaviour(&mut w, 0, Behaviour::Forward);
+    let start: Vec<f64> = (0..3).map(|i| w.pose(i).unwrap().x_m).collect();
+    for _ in 0..100 {
+        w.advance(0.02).unwrap();
+        assert_no_penetration(&w);
+    }
+    for (i, x0) in start.iter().enumerate() {
+        let moved = w.pose(i).unwrap().x_m - x0;
+        // Equal shares: the row moves at about a third of the driver's 0.15 m/s over 2 s.
+        assert!(moved > 0.05, "robot {i} moved only {moved} m");
+    }
+    assert!(
+        w.bumpers(2).unwrap()[REAR],
+        "the last robot is pushed from behind"
+    );
+}
+
 #[test]
 fn veering_robot_in_the_corridor_slides_along_without_penetrating() {
     // A strong gain mismatch turns the robot into the corridor wall; it must not pass through
