@@ -4,7 +4,7 @@
 # the change that makes the arena's claims hold. Each run's folder holds metrics.csv,
 # summary.json, the plots and fit.json; the claims and window means are printed.
 #
-#   scripts/paper-runs.sh [OUT]      (default OUT: out/paper; about 10 minutes on 2 cores)
+#   scripts/paper-runs.sh [OUT]      (default OUT: out/paper; about 2 minutes on 2 cores)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${1:-out/paper}
