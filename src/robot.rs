@@ -101,6 +101,13 @@ pub enum Condition {
 }
 
 impl Condition {
+    /// Every condition, in the order runs, tables and figures list them.
+    pub const ALL: [Condition; 3] = [
+        Condition::Learning,
+        Condition::LearningOff,
+        Condition::RandomWalk,
+    ];
+
     /// The name used in files.
     #[must_use]
     pub const fn name(self) -> &'static str {

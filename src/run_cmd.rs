@@ -305,11 +305,7 @@ fn learning(s: &Scenario, runs: &[RunOutput]) -> LearningFigure {
     let win = s.window.max(1) as usize;
     let mut d = Vec::new();
     let mut coll = Vec::new();
-    for c in [
-        Condition::Learning,
-        Condition::LearningOff,
-        Condition::RandomWalk,
-    ] {
+    for c in Condition::ALL {
         let of_c: Vec<&RunOutput> = runs.iter().filter(|r| r.condition == c).collect();
         if of_c.is_empty() {
             continue;

@@ -139,11 +139,7 @@ pub fn window(runs: &[&RunOutput], from: u32, to: u32) -> WindowStats {
 #[must_use]
 pub fn conditions(runs: &[RunOutput], steps: u32, win: u32) -> Vec<ConditionStats> {
     let mut out = Vec::new();
-    for c in [
-        Condition::Learning,
-        Condition::LearningOff,
-        Condition::RandomWalk,
-    ] {
+    for c in Condition::ALL {
         let of_c: Vec<&RunOutput> = runs.iter().filter(|r| r.condition == c).collect();
         if of_c.is_empty() {
             continue;

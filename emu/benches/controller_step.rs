@@ -3,7 +3,10 @@
 //! `step_without_save`: a whole step period of the arena's controller as the swarm runs it: the
 //! sleep through 45 ticks, then the A/D scan, the learner (13 × 4), the motors; saves are
 //! switched off (one record every 1 000 000 steps) so that every iteration does the same work.
-//! `save`: one A/B record of the 13 × 4 weights through the bit-banged I²C with ACK polling.
+//! `step_with_save`: a step that saves one A/B record of the 13 × 4 weights through the
+//! bit-banged I²C with ACK polling (every step saves). `step_with_save_pin_level`: the same
+//! with the emulation shortcuts off (every tick interrupt, A/D poll and I²C pin edge emulated
+//! register by register), the reference the shortcuts are measured against.
 //! The emulated states of each are printed once before timing.
 
 use std::hint::black_box;
@@ -25,9 +28,10 @@ impl Board for Wave {
     }
 }
 
-fn setup(save_every_steps: u32) -> (Controller, Mcu<Wave>) {
+fn setup(save_every_steps: u32, fast_forward: bool) -> (Controller, Mcu<Wave>) {
     let mut cfg = ControllerConfig::arena(1);
     cfg.save_every_steps = save_every_steps;
+    cfg.fast_forward = fast_forward;
     let mut c = Controller::new(cfg).expect("valid controller");
     let mut m = Mcu::new(McuConfig::default(), Wave).expect("valid MCU");
     c.boot(&mut m).expect("boots");
@@ -37,7 +41,7 @@ fn setup(save_every_steps: u32) -> (Controller, Mcu<Wave>) {
 fn benches(c: &mut Criterion) {
     let mut group = c.benchmark_group("controller");
     {
-        let (mut ctl, mut m) = setup(1_000_000);
+        let (mut ctl, mut m) = setup(1_000_000, true);
         ctl.sleep_until_step(&mut m).expect("tick");
         ctl.step(&mut m).expect("step");
         let t0 = m.now();
@@ -55,15 +59,18 @@ fn benches(c: &mut Criterion) {
             });
         });
     }
-    {
-        let (mut ctl, mut m) = setup(1);
+    for (name, fast) in [
+        ("step_with_save", true),
+        ("step_with_save_pin_level", false),
+    ] {
+        let (mut ctl, mut m) = setup(1, fast);
         ctl.sleep_until_step(&mut m).expect("tick");
         let r = ctl.step(&mut m).expect("step");
         eprintln!(
-            "controller/save: {} emulated states per save ({:?})",
+            "controller/{name}: {} emulated states per save ({:?})",
             r.phases.save, r.saved
         );
-        group.bench_function("step_with_save", |b| {
+        group.bench_function(name, |b| {
             b.iter(|| {
                 ctl.sleep_until_step(&mut m).expect("tick");
                 black_box(ctl.step(&mut m).expect("step"))

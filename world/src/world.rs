@@ -57,6 +57,28 @@ struct BodyPose {
     s: f64,
 }
 
+impl BodyPose {
+    /// The body's box, half extents `hx` along the heading and `hy` across.
+    #[inline]
+    fn obb(self, hx: f64, hy: f64) -> Obb {
+        Obb {
+            x: self.x,
+            y: self.y,
+            c: self.c,
+            s: self.s,
+            hx,
+            hy,
+        }
+    }
+
+    /// Whether the body's box reaches past a wall of the `w` × `h` arena.
+    #[inline]
+    fn crosses_walls(self, hx: f64, hy: f64, w: f64, h: f64) -> bool {
+        let (ex, ey) = self.obb(hx, hy).aabb_half_extents();
+        self.x - ex < 0.0 || self.x + ex > w || self.y - ey < 0.0 || self.y + ey > h
+    }
+}
+
 /// The wheel-speed difference below which a wheel is taken to have reached its target speed:
 /// 1e-12 m/s, a picometre per second, far below anything the model resolves.
 const SPEED_SNAP_M_S: f64 = 1e-12;
@@ -388,15 +410,7 @@ impl World {
 
     #[inline]
     fn obb(&self, i: usize) -> Obb {
-        let b = self.pose[i];
-        Obb {
-            x: b.x,
-            y: b.y,
-            c: b.c,
-            s: b.s,
-            hx: self.hx,
-            hy: self.hy,
-        }
+        self.pose[i].obb(self.hx, self.hy)
     }
 
     // ----- commands ----------------------------------------------------------------------------
@@ -704,12 +718,12 @@ impl World {
     }
 
     fn wall_penetration(&self, i: usize) -> bool {
-        let (ex, ey) = self.obb(i).aabb_half_extents();
-        let b = self.pose[i];
-        b.x - ex < 0.0
-            || b.x + ex > self.arena.width_m()
-            || b.y - ey < 0.0
-            || b.y + ey > self.arena.height_m()
+        self.pose[i].crosses_walls(
+            self.hx,
+            self.hy,
+            self.arena.width_m(),
+            self.arena.height_m(),
+        )
     }
 
     /// Resolves the pair (i, j); returns whether they overlapped.
@@ -1173,11 +1187,7 @@ impl Probe<'_> {
     /// Appends the overlapping pairs and the robots penetrating a wall, in the given order.
     fn collect(&self, pairs: &[[u32; 2]], walls: &[u32], out: &mut Candidates) {
         for &i in walls {
-            let b = self.pose[i as usize];
-            let (ac, as_) = (b.c.abs(), b.s.abs());
-            let ex = self.hx * ac + self.hy * as_;
-            let ey = self.hx * as_ + self.hy * ac;
-            if b.x - ex < 0.0 || b.x + ex > self.w || b.y - ey < 0.0 || b.y + ey > self.h {
+            if self.pose[i as usize].crosses_walls(self.hx, self.hy, self.w, self.h) {
                 out.walls.push(i);
             }
         }
@@ -1187,22 +1197,7 @@ impl Probe<'_> {
             if dx * dx + dy * dy >= self.reach2 {
                 continue;
             }
-            let oa = Obb {
-                x: a.x,
-                y: a.y,
-                c: a.c,
-                s: a.s,
-                hx: self.hx,
-                hy: self.hy,
-            };
-            let ob = Obb {
-                x: b.x,
-                y: b.y,
-                c: b.c,
-                s: b.s,
-                hx: self.hx,
-                hy: self.hy,
-            };
+            let (oa, ob) = (a.obb(self.hx, self.hy), b.obb(self.hx, self.hy));
             if obb_overlap(&oa, &ob, 0.0).is_some() {
                 out.pairs.push([i, j]);
             }
@@ -1373,15 +1368,7 @@ fn place_open(
         'scan: for row in cy.saturating_sub(1)..=(cy + 1).min(ny - 1) {
             for col in cx.saturating_sub(1)..=(cx + 1).min(nx - 1) {
                 for &j in &grid_cells[row * nx + col] {
-                    let q = poses[j as usize];
-                    let b = Obb {
-                        x: q.x,
-                        y: q.y,
-                        c: q.c,
-                        s: q.s,
-                        hx,
-                        hy,
-                    };
+                    let b = poses[j as usize].obb(hx, hy);
                     if obb_overlap(&a, &b, -clr).is_some() {
                         free = false;
                         break 'scan;
