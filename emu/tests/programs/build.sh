@@ -2,7 +2,7 @@
 # build.sh - build the differential test programs for the emulated H8/3052F.
 #
 # For every program <name>.c listed in PROGRAMS below:
-#   target: h8300-hms-gcc -mh -mint32 -O2 -nostdlib with crt0.S, runtime.S,
+#   target: h8300-hms-gcc -mh -mint32 -O2 -nostdlib with crt0.S, firmware/runtime.S,
 #           console.c and the linker script h8-3052f.ld, then
 #           h8300-hms-objcopy -O srec  ->  <name>.mot
 #   host:   gcc -O2 with console.c mapped to stdio, run  ->  <name>.expected
@@ -81,7 +81,8 @@ build_all() {
 
   # The .S files use no preprocessor directives: assemble them as they are.
   "${H8_PREFIX}gcc" "${TARGET_CFLAGS[@]}" -x assembler -c crt0.S -o "$obj/crt0.o"
-  "${H8_PREFIX}gcc" "${TARGET_CFLAGS[@]}" -x assembler -c runtime.S -o "$obj/runtime.o"
+  # The runtime helpers have one source for every H8 program of the project: the firmware's.
+  "${H8_PREFIX}gcc" "${TARGET_CFLAGS[@]}" -x assembler -c ../../../firmware/runtime.S -o "$obj/runtime.o"
   local support_objs=()
   local c
   for c in "${SUPPORT_C[@]}"; do

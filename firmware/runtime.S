@@ -21,7 +21,7 @@
 ;   __modsi3   ER0 = ER0 % ER1 (signed, sign of the dividend, as C99)
 ;   memcpy, memset: GCC emits calls to them for structure copies and
 ;     initialisers, even with -nostdlib.
-; Division by zero is undefined in C and never done by the test programs;
+; Division by zero is undefined in C and never done by the programs;
 ; here it returns whatever DIVXU leaves and never traps or loops.
 
 	.h8300h
