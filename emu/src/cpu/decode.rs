@@ -908,70 +908,17 @@ fn decode_inner<S: WordSource>(r: &mut Reader<'_, S>) -> Result<Instr, Stop> {
             bit: BitNum::Imm(bh & 7),
             target: BitTarget::Reg(bl),
         },
-        0x68 | 0x69 | 0x6c | 0x6d => {
-            let size = if op & 1 == 0 { Size::Byte } else { Size::Word };
-            let ers = bh & 7;
-            let (mem, is_inc) = match op & 0xfe {
-                0x68 => (O::Ind(ers), false),
-                _ => {
-                    if bh & 8 == 0 {
-                        (O::PostInc(ers), true)
-                    } else {
-                        (O::PreDec(ers), true)
-                    }
-                }
-            };
-            let _ = is_inc;
-            if bh & 8 == 0 {
-                I::Mov {
-                    size,
-                    src: mem,
-                    dst: O::Reg(bl),
-                }
-            } else {
-                I::Mov {
-                    size,
-                    src: O::Reg(bl),
-                    dst: mem,
-                }
+        0x68..=0x6f | 0x78 => {
+            if op == 0x6a && bh & 7 == 4 {
+                let addr = r.word()?;
+                return Ok(if bh & 8 == 0 {
+                    I::Movfpe { addr, rd: bl }
+                } else {
+                    I::Movtpe { rs: bl, addr }
+                });
             }
-        }
-        0x6a | 0x6b => {
-            let size = if op == 0x6a { Size::Byte } else { Size::Word };
-            let mem = match bh & 7 {
-                0 => O::Abs16(r.word()?),
-                2 => O::Abs24(r.long()?),
-                4 if op == 0x6a => {
-                    let addr = r.word()?;
-                    return Ok(if bh & 8 == 0 {
-                        I::Movfpe { addr, rd: bl }
-                    } else {
-                        I::Movtpe { rs: bl, addr }
-                    });
-                }
-                _ => return Err(Stop::Undefined),
-            };
-            mov_dir(size, bh & 8 != 0, mem, bl)
-        }
-        0x6e | 0x6f => {
-            let size = if op == 0x6e { Size::Byte } else { Size::Word };
-            let d = r.word()?;
-            mov_dir(size, bh & 8 != 0, O::Disp16(bh & 7, d), bl)
-        }
-        0x78 => {
-            // 78 s0 6A/6B 2d/Ad 00 dd dd dd: MOV.B/W with 24-bit displacement.
-            expect(bl == 0)?;
-            let ers = r3(bh)?;
-            let w1 = r.word()?;
-            let [op2, c1] = w1.to_be_bytes();
-            let size = match op2 {
-                0x6a => Size::Byte,
-                0x6b => Size::Word,
-                _ => return Err(Stop::Undefined),
-            };
-            expect(hi4(c1) & 7 == 2)?;
-            let d = r.long()?;
-            mov_dir(size, hi4(c1) & 8 != 0, O::Disp24(ers, d), lo4(c1))
+            let m = mem_form(r, Family::MovBw, op, b1)?;
+            mov_dir(m.size, m.store, m.mem, m.reg)
         }
         0x79 => {
             let imm = u32::from(r.word()?);
@@ -1073,6 +1020,104 @@ fn imm_op(sel: u8, size: Size, imm: u32, rd: u8) -> Result<Instr, Stop> {
     Ok(Instr::Alu { op, size, src, rd })
 }
 
+/// The instructions that share the MOV family's memory forms (Table A-2's rows 68–6F and 78):
+/// the same address modes, encoded the same way, with these differences.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Family {
+    /// MOV.B and MOV.W: opcodes 68–6F (bit 0 set for words), and 78 followed by 6A or 6B for
+    /// `@(d:24,ERs)`; the data register is any of 0–15.
+    MovBw,
+    /// MOV.L after its 01 00 prefix word: the word opcodes only; the data register is an ERn
+    /// (checked by the caller). In the 78 form, GNU as repeats the direction bit in bit 7 of
+    /// the register byte (78 1sss 0000), and the two must agree.
+    MovL,
+    /// LDC/STC after the 01 40 prefix word: the word opcodes only; the register field is 0
+    /// (checked by the caller for the word it decodes, here for the 78 form's second word).
+    Ccr,
+}
+
+/// A memory operand decoded from a MOV-family word, with what the word says around it.
+struct MemForm {
+    /// The operand size the opcode selects (byte or word; MOV.L and LDC/STC set their own).
+    size: Size,
+    /// The memory operand.
+    mem: Operand,
+    /// The direction bit: register to memory.
+    store: bool,
+    /// The data register field (4 bits, unchecked unless the family requires it).
+    reg: u8,
+}
+
+/// Decodes the memory operand of the MOV-family word `op c` (`c` = direction bit and address
+/// register in the high nibble, data register in the low one), pulling the words of its
+/// displacement or address: the one decoder of these forms for MOV.B/W, MOV.L and LDC/STC.
+/// (MOVFPE/MOVTPE, which share row 6A, are the caller's.)
+fn mem_form<S: WordSource>(
+    r: &mut Reader<'_, S>,
+    family: Family,
+    op: u8,
+    c: u8,
+) -> Result<MemForm, Stop> {
+    use Operand as O;
+    let (ch, cl) = (hi4(c), lo4(c));
+    let (ers, store) = (ch & 7, ch & 8 != 0);
+    let word_only = family != Family::MovBw;
+    let size = if op & 1 == 0 { Size::Byte } else { Size::Word };
+    if word_only && op != 0x78 && size == Size::Byte {
+        return Err(Stop::Undefined);
+    }
+    let mem = match op {
+        0x68 | 0x69 => O::Ind(ers),
+        0x6c | 0x6d => {
+            if store {
+                O::PreDec(ers)
+            } else {
+                O::PostInc(ers)
+            }
+        }
+        0x6e | 0x6f => O::Disp16(ers, r.word()?),
+        0x6a | 0x6b => match ers {
+            0 => O::Abs16(r.word()?),
+            2 => O::Abs24(r.long()?),
+            _ => return Err(Stop::Undefined),
+        },
+        0x78 => {
+            // 78 s0 + 6A/6B [2|A]r + the 32-bit displacement.
+            expect(cl == 0)?;
+            if family != Family::MovL {
+                expect(ch & 8 == 0)?;
+            }
+            let [op2, c2] = r.word()?.to_be_bytes();
+            let size = match op2 {
+                0x6a if !word_only => Size::Byte,
+                0x6b => Size::Word,
+                _ => return Err(Stop::Undefined),
+            };
+            expect(hi4(c2) & 7 == 2)?;
+            let store = hi4(c2) & 8 != 0;
+            match family {
+                Family::MovL => expect(store == (ch & 8 != 0))?,
+                Family::Ccr => expect(lo4(c2) == 0)?,
+                Family::MovBw => {}
+            }
+            let d = r.long()?;
+            return Ok(MemForm {
+                size,
+                mem: O::Disp24(ers, d),
+                store,
+                reg: lo4(c2),
+            });
+        }
+        _ => return Err(Stop::Undefined),
+    };
+    Ok(MemForm {
+        size,
+        mem,
+        store,
+        reg: cl,
+    })
+}
+
 /// A MOV between register `reg` and memory operand `mem`; `store` is the direction bit.
 fn mov_dir(size: Size, store: bool, mem: Operand, reg: u8) -> Instr {
     if store {
@@ -1118,84 +1163,20 @@ fn decode_01<S: WordSource>(r: &mut Reader<'_, S>, b1: u8) -> Result<Instr, Stop
     match b1 {
         0x00 => {
             // MOV.L with memory operands: 01 00 + a MOV.W-like word.
-            let w1 = r.word()?;
-            let [op, c1] = w1.to_be_bytes();
-            let (ch, cl) = (hi4(c1), lo4(c1));
-            let store = ch & 8 != 0;
-            let mem = match op {
-                0x69 => O::Ind(ch & 7),
-                0x6d => {
-                    if store {
-                        O::PreDec(ch & 7)
-                    } else {
-                        O::PostInc(ch & 7)
-                    }
-                }
-                0x6f => O::Disp16(ch & 7, r.word()?),
-                0x6b => match ch & 7 {
-                    0 => O::Abs16(r.word()?),
-                    2 => O::Abs24(r.long()?),
-                    _ => return Err(Stop::Undefined),
-                },
-                0x78 => {
-                    // GNU as sets bit 7 of the register byte for the store form (78 1ddd 0000);
-                    // the direction bit of the 6B word must agree with it.
-                    expect(cl == 0)?;
-                    let w2 = r.word()?;
-                    let [op2, c2] = w2.to_be_bytes();
-                    expect(op2 == 0x6b && hi4(c2) & 7 == 2)?;
-                    let store = hi4(c2) & 8 != 0;
-                    expect(store == (ch & 8 != 0))?;
-                    let d = r.long()?;
-                    return Ok(mov_dir(
-                        Size::Long,
-                        store,
-                        O::Disp24(ch & 7, d),
-                        r3(lo4(c2))?,
-                    ));
-                }
-                _ => return Err(Stop::Undefined),
-            };
-            Ok(mov_dir(Size::Long, store, mem, r3(cl)?))
+            let [op, c1] = r.word()?.to_be_bytes();
+            let m = mem_form(r, Family::MovL, op, c1)?;
+            Ok(mov_dir(Size::Long, m.store, m.mem, r3(m.reg)?))
         }
         0x40 => {
             // LDC/STC with memory operands: 01 40 + a MOV.W-like word whose register field is 0.
-            let w1 = r.word()?;
-            let [op, c1] = w1.to_be_bytes();
-            let (ch, cl) = (hi4(c1), lo4(c1));
-            expect(cl == 0)?;
-            let store = ch & 8 != 0;
-            let mem = match op {
-                0x69 => O::Ind(ch & 7),
-                0x6d => {
-                    if store {
-                        O::PreDec(ch & 7)
-                    } else {
-                        O::PostInc(ch & 7)
-                    }
-                }
-                0x6f => O::Disp16(ch & 7, r.word()?),
-                0x6b => match ch & 7 {
-                    0 => O::Abs16(r.word()?),
-                    2 => O::Abs24(r.long()?),
-                    _ => return Err(Stop::Undefined),
-                },
-                0x78 => {
-                    expect(ch & 8 == 0)?;
-                    let w2 = r.word()?;
-                    let [op2, c2] = w2.to_be_bytes();
-                    expect(op2 == 0x6b && c2 & 0x70 == 0x20 && c2 & 0xf == 0)?;
-                    let d = r.long()?;
-                    let mem = O::Disp24(ch, d);
-                    return Ok(if c2 & 0x80 != 0 {
-                        I::Stc(mem)
-                    } else {
-                        I::Ldc(mem)
-                    });
-                }
-                _ => return Err(Stop::Undefined),
-            };
-            Ok(if store { I::Stc(mem) } else { I::Ldc(mem) })
+            let [op, c1] = r.word()?.to_be_bytes();
+            expect(lo4(c1) == 0)?;
+            let m = mem_form(r, Family::Ccr, op, c1)?;
+            Ok(if m.store {
+                I::Stc(m.mem)
+            } else {
+                I::Ldc(m.mem)
+            })
         }
         0x80 => Ok(I::Sleep),
         0xc0 | 0xd0 => {
