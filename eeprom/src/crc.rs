@@ -16,17 +16,26 @@ pub const CRC16_CHECK: u16 = 0x29B1;
 /// shift-and-conditionally-XOR steps, MSB first.
 #[must_use]
 pub const fn crc16_update(crc: u16, byte: u8) -> u16 {
+    crc16_update_counting(crc, byte).0
+}
+
+/// [`crc16_update`], also counting how many of its eight steps XOR the polynomial: what the
+/// bitwise routine's conditional XOR costs on a CPU that runs it (the firmware's state count).
+#[must_use]
+pub const fn crc16_update_counting(crc: u16, byte: u8) -> (u16, u32) {
     let mut c = crc ^ ((byte as u16) << 8);
+    let mut xors = 0;
     let mut i = 0;
     while i < 8 {
         c = if c & 0x8000 != 0 {
+            xors += 1;
             (c << 1) ^ CRC16_POLY
         } else {
             c << 1
         };
         i += 1;
     }
-    c
+    (c, xors)
 }
 
 /// CRC-16/CCITT-FALSE of `data`.
@@ -65,6 +74,14 @@ mod tests {
     #[test]
     fn empty_message_is_the_init_value() {
         assert_eq!(crc16_ccitt_false(&[]), 0xFFFF);
+    }
+
+    #[test]
+    fn xors_are_the_steps_with_the_top_bit_set() {
+        // 0x80 into 0: step 1 XORs (0x8000), giving 0x1021; three shifts make 0x8108, so
+        // step 5 XORs again; the last three shift 0x1231 to 0x9188 without one.
+        assert_eq!(crc16_update_counting(0, 0x80), (crc16_update(0, 0x80), 2));
+        assert_eq!(crc16_update_counting(0, 0), (0, 0));
     }
 
     #[test]

@@ -92,7 +92,7 @@ pub mod sim;
 
 pub use bus::{EdgeCounts, I2cBus, LineLevels};
 pub use clock::Clock;
-pub use crc::{crc16_ccitt_false, crc16_update};
+pub use crc::{crc16_ccitt_false, crc16_update, crc16_update_counting};
 pub use device::{
     DeviceConfig, DeviceStats, Eeprom24lc256, PowerCutOutcome, TimingCheck, TimingViolation,
     WriteCycleInfo,

@@ -937,21 +937,16 @@ pub fn fresh_weights(seed: u64, n: usize) -> Vec<Q15> {
 /// States of the bitwise CRC-16/CCITT-FALSE routine in [`code`] over `bytes`: per byte the
 /// load, the XOR into the high byte and the bit counter (6 + 2 + 2), per bit the shift, the
 /// branch, the counter and the loop (2 + 4 + 2 + 4), plus 4 for each XOR with the polynomial,
-/// plus the byte loop (2 + 4).
+/// plus the byte loop (2 + 4). The XORs are counted by `eeprom`'s CRC, the one the records are
+/// checked with ([`eeprom::crc::crc16_update_counting`]).
 #[must_use]
 pub fn crc16_states(bytes: &[u8]) -> u64 {
-    let mut crc: u16 = 0xFFFF;
+    let mut crc = eeprom::crc::CRC16_INIT;
     let mut xors = 0u64;
     for &b in bytes {
-        crc ^= u16::from(b) << 8;
-        for _ in 0..8 {
-            if crc & 0x8000 != 0 {
-                crc = (crc << 1) ^ 0x1021;
-                xors += 1;
-            } else {
-                crc <<= 1;
-            }
-        }
+        let (next, n) = eeprom::crc::crc16_update_counting(crc, b);
+        crc = next;
+        xors += u64::from(n);
     }
     bytes.len() as u64 * (10 + 8 * 12 + 6) + 4 * xors + 4
 }
