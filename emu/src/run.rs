@@ -81,41 +81,40 @@ impl RunReport {
     /// console bytes.
     #[must_use]
     pub fn to_json(&self) -> String {
-        let (outcome, status, error) = match &self.outcome {
-            Outcome::Halted { exit_status } => ("halted", exit_status.to_string(), None),
-            Outcome::MaxStates => ("max_states", "null".to_string(), None),
-            Outcome::Error(e) => ("error", "null".to_string(), Some(e.to_string())),
-            Outcome::SleptForever { .. } => ("slept_forever", "null".to_string(), None),
+        let (outcome, exit_status, error) = match &self.outcome {
+            Outcome::Halted { exit_status } => ("halted", Some(*exit_status), None),
+            Outcome::MaxStates => ("max_states", None, None),
+            Outcome::Error(e) => ("error", None, Some(e.to_string())),
+            Outcome::SleptForever { .. } => ("slept_forever", None, None),
         };
-        let mut s = String::new();
-        let _ = write!(
-            s,
-            "{{\"outcome\":\"{outcome}\",\"exit_status\":{status},\"error\":{},\"instructions\":{},\"states\":{},\"emulated_seconds\":{:.9},\"phi_hz\":{PHI_HZ},\"interrupts\":{},\"console_bytes\":{}}}",
-            error.map_or_else(|| "null".to_string(), |e| json_string(&e)),
-            self.stats.instructions,
-            self.stats.states,
-            self.stats.emulated_seconds,
-            self.stats.interrupts,
-            self.stats.console_bytes,
-        );
-        s
+        let json = StatsJson {
+            outcome,
+            exit_status,
+            error,
+            instructions: self.stats.instructions,
+            states: self.stats.states,
+            emulated_seconds: self.stats.emulated_seconds,
+            phi_hz: PHI_HZ,
+            interrupts: self.stats.interrupts,
+            console_bytes: self.stats.console_bytes,
+        };
+        // A struct of numbers, strings and options always serialises.
+        serde_json::to_string(&json).unwrap_or_default()
     }
 }
 
-fn json_string(s: &str) -> String {
-    let mut out = String::from("\"");
-    for c in s.chars() {
-        match c {
-            '"' => out.push_str("\\\""),
-            '\\' => out.push_str("\\\\"),
-            c if (c as u32) < 0x20 => {
-                let _ = write!(out, "\\u{:04x}", c as u32);
-            }
-            c => out.push(c),
-        }
-    }
-    out.push('"');
-    out
+/// The `--stats` object, field by field in output order.
+#[derive(serde::Serialize)]
+struct StatsJson {
+    outcome: &'static str,
+    exit_status: Option<u8>,
+    error: Option<String>,
+    instructions: u64,
+    states: u64,
+    emulated_seconds: f64,
+    phi_hz: u64,
+    interrupts: u64,
+    console_bytes: u64,
 }
 
 /// Why a run could not start or could not write its output. The message names the stage; the
