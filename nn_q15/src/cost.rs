@@ -1,41 +1,25 @@
-//! H8/300H cost accounting (SPEC §2.7).
+//! H8/300H cost accounting (SPEC §2.7), re-derived from the robot firmware's compiled code.
 //!
-//! The learner reports every primitive it performs ([`Op`]) to a [`Meter`]. [`NoopMeter`]
-//! records nothing and compiles to nothing; [`H8Meter`] charges each primitive the H8/300H states
-//! of the instruction sequence an H8 implementation of the learner needs for it.
+//! The learner reports what it executes to a [`Meter`] as basic blocks ([`Op`]) of the
+//! firmware's learner routines (`firmware/learner.c`, compiled by `firmware/build.sh` with
+//! Debian's GCC 3.4.6 for the H8/300H: `learner_step`, `learner_update`, `learner_forward`),
+//! with how often each runs. [`NoopMeter`] records nothing and compiles to nothing;
+//! [`H8Meter`] charges each block the H8/300H states of its instructions.
 //!
 //! # Where the numbers come from
-//! [`Insn`] lists the instruction forms that implementation uses, each with its states and byte
-//! length for on-chip operands from SPEC §4.2 (Table A-1 of the H8/300H hardware manuals: every
-//! fetch and data access to on-chip ROM/RAM takes 2 states over a 16-bit bus). [`OP_TABLE`] gives,
-//! for every [`Op`], its instruction sequence; the states of an op are the sum over its sequence,
-//! computed at compile time. The sequences are those of the H8 learner routine sketched below, the
-//! register allocation being the one a hand-written routine would use (ER2 accumulator, ER4/ER5/ER6
-//! pointers, E3 inner counter, R3L outer counter):
+//! [`OP_TABLE`] holds, for every block, its instructions as the firmware's listing
+//! (`firmware/build.sh --listing DIR`, `robot.lst`) shows them, and their forms ([`Insn`]), each
+//! with its states for on-chip operands from SPEC §4.2 and the H8/300H manuals' Table A-1
+//! (2 states per fetch or data access to on-chip ROM and RAM; internal states as listed).
+//! Conditional branches cost the same taken or not, so a path's cost is the sum of the blocks
+//! it runs; the learner counts the data-dependent paths (a new maximum, saturations, the
+//! normalising shift count, the sign of each Δ product) and charges them.
 //!
-//! ```text
-//! forward:  MOV.L #W,ER4 ; MOV.L #Y,ER6 ; MOV.B #M,R3L
-//! row:      MOV.L #X,ER5 ; MOV.W #N,E3 ; SUB.L ER2,ER2
-//! mac:      MOV.W @ER4+,R0 ; MOV.B @ER5+,R1L ; EXTS.W R1 ; MULXS.W R1,ER0 ; ADD.L ER0,ER2
-//!           DEC.W #1,E3 ; BNE mac
-//!           MOV.L ER2,@ER6 ; ADDS #4,ER6 ; DEC.B R3L ; BNE row
-//! argmax:   MOV.L @ER6+,ER0 ; CMP.L ER1,ER0 ; BLE next ; [MOV.L ER0,ER1 ; MOV.B R2H,R2L]
-//! scale:    CMP.L #H'400000,ER1 ; BGE normalise          (max ≥ 1.0 in Q22?)
-//! plain:    MOV.L @ER6+,ER0 ; SHAR.L ER0 ×7 ; saturate ; MOV.W R0,@ER5 ; ADDS #2,ER5
-//! normalise: SHAR.L ER1 ; INC.B R3H ; CMP.L #H'8000,ER1 ; BGE …   (s times: m' = m >> s)
-//!           per output: MOV.L @ER6+,ER0 ; s × (SHAR.L ER0 ; DEC.B ; BNE) ; CMP.L ER4,ER0 ; BLE low
-//!           CMP.L ER1,ER0 ; BGE high ; MOV.W R0,E0 ; SUB.W R0,R0 ; SHAR.L ER0 ; DIVXS.W R1,ER0
-//! update:   |E| ≤ T? ; σ·η ; per input: MOV.B @ER5+,R1L ; EXTS.W R1 ; MOV.W R2,R0 ;
-//!           MULXS.W R1,ER0 ; BMI neg ; ADD.L #64,ER0 ; SHAR.L ×7 ; … ; MOV.W R0,@ER6 ; ADDS #2,ER6
-//!           per weight: MOV.W @ER5+,R1 ; MOV.W @ER4,R0 ; ADD.W R1,R0 (SUB.W) ; BVC ok ;
-//!           [BPL lo ; MOV.W #H'7FFF,R0 ; BRA ok | lo: MOV.W #H'8000,R0] ; ok: MOV.W R0,@ER4 ; ADDS #2,ER4
-//! ```
-//!
-//! Conditional branches cost the same taken or not on the H8/300H (Bcc d:8 is 4 states either
-//! way), so a path's cost depends only on which instructions it executes; the learner counts the
-//! data-dependent paths (saturations, a new maximum, the normalising shift count) and charges them.
+//! The model follows the listing exactly: the emulator's calibration test runs the firmware's
+//! routines on the H8/300H core over a grid of shapes and inputs and compares every phase with
+//! this meter, so a change of either side shows at once.
 
-/// One H8/300H instruction form with on-chip operands, as SPEC §4.2 lists them.
+/// One H8/300H instruction form with on-chip operands (SPEC §4.2).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Insn {
     /// Register-to-register ALU op (ADD/SUB/CMP/AND/OR/XOR/NEG/NOT/INC/DEC/EXTS/EXTU/MOV Rs,Rd),
@@ -52,16 +36,23 @@ pub enum Insn {
     MovBwPostInc,
     /// MOV.B/MOV.W with @aa:16 or @(d:16,ERs). SPEC §4.2: 6 states.
     MovBwAbs16,
+    /// MOV.B/MOV.W with @aa:24 (three words, one data access). SPEC §4.2: 8 states.
+    MovBwAbs24,
     /// MOV.L to or from @ERs. SPEC §4.2: 8 states.
     MovLInd,
     /// MOV.L with @ERs+ or @−ERd. SPEC §4.2: 10 states.
     MovLPostInc,
     /// MOV.L with @aa:16 or @(d:16,ERs). SPEC §4.2: 10 states.
     MovLAbs16,
+    /// MOV.L with @aa:24 (four words, two data accesses): 4 · 2 + 2 · 2 = 12 states
+    /// (manual Table A-1).
+    MovLAbs24,
     /// PUSH.L / POP.L (MOV.L with @−ER7 / @ER7+). SPEC §4.2: 10 states.
     PushPopL,
     /// Bcc d:8 (BRA included), taken or not. SPEC §4.2: 4 states.
     Bcc8,
+    /// Bcc d:16 (BRA included), taken or not. SPEC §4.2: 6 states.
+    Bcc16,
     /// JSR @aa:24. SPEC §4.2: 10 states.
     JsrAbs24,
     /// RTS. SPEC §4.2: 10 states.
@@ -73,6 +64,28 @@ pub enum Insn {
 }
 
 impl Insn {
+    /// Every form, for tables and tests.
+    pub const ALL: [Insn; 18] = [
+        Insn::Reg,
+        Insn::ImmW,
+        Insn::ImmL,
+        Insn::MovBwInd,
+        Insn::MovBwPostInc,
+        Insn::MovBwAbs16,
+        Insn::MovBwAbs24,
+        Insn::MovLInd,
+        Insn::MovLPostInc,
+        Insn::MovLAbs16,
+        Insn::MovLAbs24,
+        Insn::PushPopL,
+        Insn::Bcc8,
+        Insn::Bcc16,
+        Insn::JsrAbs24,
+        Insn::Rts,
+        Insn::MulxsW,
+        Insn::DivxsW,
+    ];
+
     /// States of the instruction with on-chip operands (SPEC §4.2).
     #[must_use]
     pub const fn states(self) -> u32 {
@@ -83,11 +96,14 @@ impl Insn {
             Insn::MovBwInd => 4,
             Insn::MovBwPostInc => 6,
             Insn::MovBwAbs16 => 6,
+            Insn::MovBwAbs24 => 8,
             Insn::MovLInd => 8,
             Insn::MovLPostInc => 10,
             Insn::MovLAbs16 => 10,
+            Insn::MovLAbs24 => 12,
             Insn::PushPopL => 10,
             Insn::Bcc8 => 4,
+            Insn::Bcc16 => 6,
             Insn::JsrAbs24 => 10,
             Insn::Rts => 10,
             Insn::MulxsW => 24,
@@ -102,202 +118,276 @@ impl Insn {
     pub const fn bytes(self) -> u32 {
         match self {
             Insn::Reg | Insn::MovBwInd | Insn::MovBwPostInc | Insn::Bcc8 | Insn::Rts => 2,
-            Insn::ImmW | Insn::MovBwAbs16 | Insn::MovLInd | Insn::MovLPostInc => 4,
+            Insn::ImmW | Insn::MovBwAbs16 | Insn::MovLInd | Insn::MovLPostInc | Insn::Bcc16 => 4,
             Insn::PushPopL | Insn::JsrAbs24 | Insn::MulxsW | Insn::DivxsW => 4,
-            Insn::ImmL | Insn::MovLAbs16 => 6,
+            Insn::ImmL | Insn::MovLAbs16 | Insn::MovBwAbs24 => 6,
+            Insn::MovLAbs24 => 8,
         }
     }
 
-    /// An example mnemonic of the form, for reports.
+    /// An example of the form in objdump's syntax, with its encoding (for tests that run it
+    /// on the core and for reports).
     #[must_use]
-    pub const fn example(self) -> &'static str {
+    pub const fn example(self) -> (&'static str, &'static [u8]) {
         match self {
-            Insn::Reg => "ADD.L ERs,ERd",
-            Insn::ImmW => "MOV.W #xx:16,Rd",
-            Insn::ImmL => "MOV.L #xx:32,ERd",
-            Insn::MovBwInd => "MOV.W @ERs,Rd",
-            Insn::MovBwPostInc => "MOV.W @ERs+,Rd",
-            Insn::MovBwAbs16 => "MOV.W @aa:16,Rd",
-            Insn::MovLInd => "MOV.L ERs,@ERd",
-            Insn::MovLPostInc => "MOV.L @ERs+,ERd",
-            Insn::MovLAbs16 => "MOV.L @aa:16,ERd",
-            Insn::PushPopL => "PUSH.L ERn",
-            Insn::Bcc8 => "Bcc d:8",
-            Insn::JsrAbs24 => "JSR @aa:24",
-            Insn::Rts => "RTS",
-            Insn::MulxsW => "MULXS.W Rs,ERd",
-            Insn::DivxsW => "DIVXS.W Rs,ERd",
+            Insn::Reg => ("add.l er1,er2", &[0x0A, 0x92]),
+            Insn::ImmW => ("mov.w #0x1234,r0", &[0x79, 0x00, 0x12, 0x34]),
+            Insn::ImmL => ("add.l #0x40,er2", &[0x7A, 0x12, 0x00, 0x00, 0x00, 0x40]),
+            Insn::MovBwInd => ("mov.w @er0,r2", &[0x69, 0x02]),
+            Insn::MovBwPostInc => ("mov.w @er5+,r3", &[0x6D, 0x53]),
+            Insn::MovBwAbs16 => ("mov.b @(0x1:16,er0),r2l", &[0x6E, 0x0A, 0x00, 0x01]),
+            Insn::MovBwAbs24 => (
+                "mov.b @0xffdf90:24,r2l",
+                &[0x6A, 0x2A, 0x00, 0xFF, 0xDF, 0x90],
+            ),
+            Insn::MovLInd => ("mov.l er1,@er2", &[0x01, 0x00, 0x69, 0xA1]),
+            Insn::MovLPostInc => ("mov.l @er5+,er3", &[0x01, 0x00, 0x6D, 0x53]),
+            Insn::MovLAbs16 => (
+                "mov.l @(0x20:16,er7),er2",
+                &[0x01, 0x00, 0x6F, 0x72, 0x00, 0x20],
+            ),
+            Insn::MovLAbs24 => (
+                "mov.l @0xffdf70:24,er6",
+                &[0x01, 0x00, 0x6B, 0x26, 0x00, 0xFF, 0xDF, 0x70],
+            ),
+            Insn::PushPopL => ("mov.l er4,@-er7", &[0x01, 0x00, 0x6D, 0xF4]),
+            Insn::Bcc8 => ("bne .+0", &[0x46, 0x00]),
+            Insn::Bcc16 => ("bne .+0:16", &[0x58, 0x60, 0x00, 0x00]),
+            Insn::JsrAbs24 => ("jsr @0x000000:24", &[0x5E, 0x00, 0x00, 0x00]),
+            Insn::Rts => ("rts", &[0x54, 0x70]),
+            Insn::MulxsW => ("mulxs.w r2,er3", &[0x01, 0xC0, 0x52, 0x23]),
+            Insn::DivxsW => ("divxs.w r4,er2", &[0x01, 0xD0, 0x53, 0x42]),
         }
     }
 }
 
-/// The learner's primitives: what it reports to a [`Meter`].
+/// A basic block of the firmware's learner routines: what the learner reports to a [`Meter`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[repr(u8)]
 pub enum Op {
-    /// Load a 32-bit pointer register with an immediate address.
-    PtrInit,
-    /// Set an 8-bit counter or index register from an immediate.
-    LoopInitB,
-    /// Set a 16-bit loop counter from an immediate.
-    LoopInitW,
-    /// Clear a 32-bit accumulator.
-    AccClear,
-    /// Multiply-accumulate one Q15 weight and one Q7 input into the i32 sum.
-    Mac,
-    /// One iteration's loop overhead: decrement the counter, branch back.
-    LoopIter,
-    /// Store a 32-bit sum through a pointer and advance the pointer.
-    StoreL,
-    /// Load a 32-bit sum with post-increment.
-    LoadL,
-    /// Compare two 32-bit registers and branch.
-    CmpBranch,
-    /// Take a new maximum: copy the value and its index.
-    NewMax,
-    /// Advance an 8-bit index register.
-    IndexInc,
-    /// Compare a 32-bit register with an immediate and branch.
-    CmpImmBranch,
-    /// Store an 8-bit variable to RAM.
-    StoreVarB,
-    /// Arithmetic shift right of a 32-bit register by one place.
-    Shr1,
-    /// Saturation test of an i32 to the i16 range: two compares with immediates and branches.
-    Sat16,
-    /// The constant load of a saturation that clamps.
-    SatClamp,
-    /// Store a 16-bit value through a pointer and advance the pointer.
-    StoreW,
-    /// One step of the search for the normalising shift s (m' = m >> s < 2^15).
-    NormShiftStep,
-    /// Keep m' and −m' in registers for the bound tests.
-    NormSetup,
-    /// One place of a variable arithmetic shift right done in a loop.
-    VarShiftStep,
-    /// Shift a 16-bit y' left 15 places into the 32-bit dividend.
-    Shl15,
-    /// 32/16 signed division.
-    Div,
-    /// An unconditional or conditional branch on its own (BRA to a join point, or a sign test).
-    Branch,
-    /// Load a 16-bit clamp constant.
-    ClampW,
-    /// Load a 16-bit variable from RAM.
-    LoadW,
-    /// Store a 16-bit variable to RAM.
-    StoreVarW,
-    /// One register-to-register instruction (copy, subtract, negate, immediate byte load).
-    RegOp,
-    /// Copy a 16-bit value and branch on its sign (|E|; NEG.W is charged as RegOp when taken).
-    AbsTest,
-    /// Compare two 16-bit registers and branch.
-    CmpBranchW,
-    /// Compute and store one σ·Δ_i = round(σ·η·x_i / 2^7). Both sign paths take the same states: BRA (4) on the positive path against two NEG.L (2 + 2) on the negative one.
-    DeltaCompute,
-    /// Per-row set-up of the weight update: reload the Δ pointer and counter, test whether the row is the winner's, advance the row index.
-    UpdateRow,
-    /// Apply one Δ to one weight: load Δ and w, add (winner) or subtract (others), test overflow, store, advance.
-    WeightApply,
-    /// A weight change that overflows upward: clamp to H'7FFF.
-    WeightClampHi,
-    /// A weight change that overflows downward: clamp to H'8000.
-    WeightClampLo,
-    /// Test a byte flag in RAM and branch.
-    FlagTest,
-    /// Load one proximity byte and add it into D.
-    SumIn,
-    /// Move one 4-byte proximity block one slot deeper in the input vector.
-    HistoryShift,
-    /// Load one proximity byte and store p − 128 as a Q7 input (XOR with H'80).
-    ProximityIn,
-    /// Load one Q15 output and store its high byte (O >> 8) as a Q7 input.
-    OutputIn,
-    /// Convert E to the Q7 evaluation input: three 1-bit shifts, two bound tests, store.
-    EvalIn,
+    /// `learner_step` entry: frame, the three callee-saved registers, D = p0 + p1 + p2 + p3, E = 0.
+    InEntry,
+    /// Load x's address and test `net_started`.
+    InStartedTest,
+    /// E = D − D(t−1) and the call of `learner_update` (the JSR runs in the caller).
+    InEval,
+    /// Test the history depth.
+    InHistoryTest,
+    /// Pointers and count of the history move (4H bytes, from the end).
+    InHistorySetup,
+    /// Move one history byte one block deeper.
+    InHistoryByte,
+    /// The four readings p − 128 (XOR H'80) into x.
+    InReadings,
+    /// Where the past outputs go (4 + 4H), the outputs' address and count.
+    InOutputsSetup,
+    /// One past output's high byte (O >> 8) into x.
+    InOutput,
+    /// E >> 3 and its upper bound test.
+    InEvalScale,
+    /// E >> 3 above 127: clamp (never with |E| ≤ 1020, kept for completeness).
+    InEvalHigh,
+    /// E >> 3 lower bound test.
+    InEvalLowTest,
+    /// E >> 3 below −128: clamp.
+    InEvalLow,
+    /// Store sat_i8(E >> 3) and test the bias flag.
+    InEvalStore,
     /// Store the bias input +127.
-    BiasIn,
-    /// Call and return of a routine that saves and restores ER4–ER6.
-    CallFrame,
+    InBias,
+    /// The call of `learner_forward`.
+    InForwardCall,
+    /// D(t−1) = D, started = 1, the winner as the result, restore and return.
+    InExit,
+    /// `learner_update` entry: frame, registers, T and −T, the test E > T.
+    UpdEntry,
+    /// E ≤ T: the test E ≥ −T (the dead zone when it holds).
+    UpdLowTest,
+    /// σ·η: load η, test the sign of E.
+    UpdSign,
+    /// E < 0: negate η.
+    UpdNeg,
+    /// x and Δ pointers, N.
+    UpdDeltaSetup,
+    /// One Δ: σ·η · x_i (MULXS.W) and its sign test.
+    DeltaHead,
+    /// Product ≥ 0: (p + 64) >> 7 as SHLL.L and byte moves.
+    DeltaPos,
+    /// Product < 0: −((64 − p) >> 7).
+    DeltaNeg,
+    /// Store Δ_i, count down.
+    DeltaTail,
+    /// Weights, winner and M for the row loop.
+    UpdRowsSetup,
+    /// One row: Δ pointer, N, is it the winner's?
+    UpdRowHead,
+    /// One weight: w ± Δ (ADD.W for the winner, SUB.W for the others), BVC, store.
+    UpdWeight,
+    /// Overflow towards the top: H'7FFF (C tells the direction).
+    UpdClampHi,
+    /// Overflow towards the bottom: H'7FFF, then H'8000.
+    UpdClampLo,
+    /// The winner's row ends with a BRA to the row loop's tail.
+    UpdWinRowExit,
+    /// Next row.
+    UpdRowTail,
+    /// Restore and return.
+    UpdExit,
+    /// `learner_forward` entry: frame, registers, the arrays' addresses and the shape into the frame.
+    FwdEntry,
+    /// One output's sum: x pointer, N, clear the accumulator.
+    FwdRowSetup,
+    /// One multiply-accumulate: w (Q15) × x (Q7) into the Q22 sum.
+    FwdMac,
+    /// Store y_j, next output.
+    FwdRowEnd,
+    /// The maximum starts at y_0.
+    FwdArgmaxInit,
+    /// The argmax loop's test (M times: M − 1 candidates and the exit).
+    FwdArgmaxTest,
+    /// One candidate y_j against the maximum.
+    FwdArgmaxLoad,
+    /// A new maximum and its index.
+    FwdNewMax,
+    /// Store the winner, rewind y, M; is the maximum below 1.0 (2^22)?
+    FwdScaleTest,
+    /// Below 1.0, one output: load y_j, test y_j < −2^22.
+    FwdPlainHead,
+    /// y_j < −2^22: O_j = −32768.
+    FwdPlainLow,
+    /// O_j = bits 7..22 of y_j (SHLL.L and byte moves).
+    FwdPlainOut,
+    /// Next output.
+    FwdPlainTail,
+    /// Leave the plain branch.
+    FwdPlainExit,
+    /// At or above 1.0: the maximum >> 8 (byte moves), shift count 0.
+    FwdNormSetup,
+    /// The normalising loop's test m' ≥ 2^15 (s − 7 times).
+    FwdNormTest,
+    /// One more place: m' >>= 1.
+    FwdNormShift,
+    /// m' and its sign-extended copy.
+    FwdNormReady,
+    /// One output: load y_j, >> 8 (byte moves), the shift counter.
+    FwdNormHead,
+    /// The shift loop's test (s − 7 times per output).
+    FwdNormStepTest,
+    /// y'_j >>= 1.
+    FwdNormStep,
+    /// Is y'_j ≤ −m'?
+    FwdNormLowTest,
+    /// O_j = −32768.
+    FwdNormLow,
+    /// Is y'_j ≥ m'?
+    FwdNormHighTest,
+    /// O_j = 32767 ((m' << 15) / m' = 32768 does not fit).
+    FwdNormHigh,
+    /// O_j = (y'_j << 15) / m' with DIVXS.W.
+    FwdNormDiv,
+    /// Next output.
+    FwdNormTail,
+    /// Restore and return.
+    FwdExit,
 }
 
 impl Op {
-    /// Number of primitives.
-    pub const COUNT: usize = Op::CallFrame as usize + 1;
+    /// Number of blocks.
+    pub const COUNT: usize = Op::FwdExit as usize + 1;
 
-    /// Every primitive, in declaration order.
+    /// Every block, in declaration order.
     pub const ALL: [Op; Op::COUNT] = [
-        Op::PtrInit,
-        Op::LoopInitB,
-        Op::LoopInitW,
-        Op::AccClear,
-        Op::Mac,
-        Op::LoopIter,
-        Op::StoreL,
-        Op::LoadL,
-        Op::CmpBranch,
-        Op::NewMax,
-        Op::IndexInc,
-        Op::CmpImmBranch,
-        Op::StoreVarB,
-        Op::Shr1,
-        Op::Sat16,
-        Op::SatClamp,
-        Op::StoreW,
-        Op::NormShiftStep,
-        Op::NormSetup,
-        Op::VarShiftStep,
-        Op::Shl15,
-        Op::Div,
-        Op::Branch,
-        Op::ClampW,
-        Op::LoadW,
-        Op::StoreVarW,
-        Op::RegOp,
-        Op::AbsTest,
-        Op::CmpBranchW,
-        Op::DeltaCompute,
-        Op::UpdateRow,
-        Op::WeightApply,
-        Op::WeightClampHi,
-        Op::WeightClampLo,
-        Op::FlagTest,
-        Op::SumIn,
-        Op::HistoryShift,
-        Op::ProximityIn,
-        Op::OutputIn,
-        Op::EvalIn,
-        Op::BiasIn,
-        Op::CallFrame,
+        Op::InEntry,
+        Op::InStartedTest,
+        Op::InEval,
+        Op::InHistoryTest,
+        Op::InHistorySetup,
+        Op::InHistoryByte,
+        Op::InReadings,
+        Op::InOutputsSetup,
+        Op::InOutput,
+        Op::InEvalScale,
+        Op::InEvalHigh,
+        Op::InEvalLowTest,
+        Op::InEvalLow,
+        Op::InEvalStore,
+        Op::InBias,
+        Op::InForwardCall,
+        Op::InExit,
+        Op::UpdEntry,
+        Op::UpdLowTest,
+        Op::UpdSign,
+        Op::UpdNeg,
+        Op::UpdDeltaSetup,
+        Op::DeltaHead,
+        Op::DeltaPos,
+        Op::DeltaNeg,
+        Op::DeltaTail,
+        Op::UpdRowsSetup,
+        Op::UpdRowHead,
+        Op::UpdWeight,
+        Op::UpdClampHi,
+        Op::UpdClampLo,
+        Op::UpdWinRowExit,
+        Op::UpdRowTail,
+        Op::UpdExit,
+        Op::FwdEntry,
+        Op::FwdRowSetup,
+        Op::FwdMac,
+        Op::FwdRowEnd,
+        Op::FwdArgmaxInit,
+        Op::FwdArgmaxTest,
+        Op::FwdArgmaxLoad,
+        Op::FwdNewMax,
+        Op::FwdScaleTest,
+        Op::FwdPlainHead,
+        Op::FwdPlainLow,
+        Op::FwdPlainOut,
+        Op::FwdPlainTail,
+        Op::FwdPlainExit,
+        Op::FwdNormSetup,
+        Op::FwdNormTest,
+        Op::FwdNormShift,
+        Op::FwdNormReady,
+        Op::FwdNormHead,
+        Op::FwdNormStepTest,
+        Op::FwdNormStep,
+        Op::FwdNormLowTest,
+        Op::FwdNormLow,
+        Op::FwdNormHighTest,
+        Op::FwdNormHigh,
+        Op::FwdNormDiv,
+        Op::FwdNormTail,
+        Op::FwdExit,
     ];
 
-    /// The table entry of this primitive.
+    /// The table entry of this block.
     #[must_use]
     pub const fn spec(self) -> &'static OpSpec {
         &OP_TABLE[self as usize]
     }
 
-    /// H8/300H states of one occurrence of this primitive.
+    /// H8/300H states of one run of this block.
     #[must_use]
     pub const fn states(self) -> u32 {
         OP_STATES[self as usize]
     }
 }
 
-/// One entry of the cost table: a primitive, the H8/300H instruction sequence that does it, and
-/// that sequence written out.
+/// One entry of the cost table: a block, its instruction forms, and its instructions as the
+/// firmware's listing shows them.
 #[derive(Clone, Copy, Debug)]
 pub struct OpSpec {
-    /// The primitive.
+    /// The block.
     pub op: Op,
-    /// Its instruction sequence (states and lengths from SPEC §4.2).
+    /// Its instruction forms (states and lengths from SPEC §4.2).
     pub insns: &'static [Insn],
-    /// The sequence as assembly text (`[clamp]` marks code charged separately when it runs).
+    /// Its instructions (objdump's syntax; `@name:24` for a variable's absolute address).
     pub asm: &'static str,
 }
 
 impl OpSpec {
-    /// Sum of the states of the sequence.
+    /// Sum of the states of the block's instructions.
     #[must_use]
     pub const fn states(&self) -> u32 {
         let mut total = 0;
@@ -309,7 +399,7 @@ impl OpSpec {
         total
     }
 
-    /// Sum of the byte lengths of the sequence (its ROM size when it occurs once in the code).
+    /// Sum of the byte lengths of the block's instructions.
     #[must_use]
     pub const fn bytes(&self) -> u32 {
         let mut total = 0;
@@ -324,236 +414,346 @@ impl OpSpec {
 
 use Insn::*;
 
-/// The cost table: for each [`Op`] (in declaration order) its H8/300H instruction sequence.
+/// The cost table: for each [`Op`] (in declaration order) its instructions.
 pub const OP_TABLE: [OpSpec; Op::COUNT] = [
     OpSpec {
-        op: Op::PtrInit,
-        insns: &[ImmL],
-        asm: "MOV.L #addr,ER5",
-    },
-    OpSpec {
-        op: Op::LoopInitB,
-        insns: &[Reg],
-        asm: "MOV.B #n,R3L",
-    },
-    OpSpec {
-        op: Op::LoopInitW,
-        insns: &[ImmW],
-        asm: "MOV.W #n,E3",
-    },
-    OpSpec {
-        op: Op::AccClear,
-        insns: &[Reg],
-        asm: "SUB.L ER2,ER2",
-    },
-    OpSpec {
-        op: Op::Mac,
-        insns: &[MovBwPostInc, MovBwPostInc, Reg, MulxsW, Reg],
-        asm: "MOV.W @ER4+,R0 ; MOV.B @ER5+,R1L ; EXTS.W R1 ; MULXS.W R1,ER0 ; ADD.L ER0,ER2",
-    },
-    OpSpec {
-        op: Op::LoopIter,
-        insns: &[Reg, Bcc8],
-        asm: "DEC.W #1,E3 ; BNE loop",
-    },
-    OpSpec {
-        op: Op::StoreL,
-        insns: &[MovLInd, Reg],
-        asm: "MOV.L ER2,@ER6 ; ADDS #4,ER6",
-    },
-    OpSpec {
-        op: Op::LoadL,
-        insns: &[MovLPostInc],
-        asm: "MOV.L @ER6+,ER0",
-    },
-    OpSpec {
-        op: Op::CmpBranch,
-        insns: &[Reg, Bcc8],
-        asm: "CMP.L ER1,ER0 ; BLE next",
-    },
-    OpSpec {
-        op: Op::NewMax,
-        insns: &[Reg, Reg],
-        asm: "MOV.L ER0,ER1 ; MOV.B R2H,R2L",
-    },
-    OpSpec {
-        op: Op::IndexInc,
-        insns: &[Reg],
-        asm: "INC.B R2H",
-    },
-    OpSpec {
-        op: Op::CmpImmBranch,
-        insns: &[ImmL, Bcc8],
-        asm: "CMP.L #H'400000,ER1 ; BGE normalise",
-    },
-    OpSpec {
-        op: Op::StoreVarB,
-        insns: &[MovBwAbs16],
-        asm: "MOV.B R2L,@var:16",
-    },
-    OpSpec {
-        op: Op::Shr1,
-        insns: &[Reg],
-        asm: "SHAR.L ER0",
-    },
-    OpSpec {
-        op: Op::Sat16,
-        insns: &[ImmL, Bcc8, ImmL, Bcc8],
-        asm: "CMP.L #H'7FFF,ER0 ; BLE 1f ; [clamp] ; 1: CMP.L #-H'8000,ER0 ; BGE 2f ; [clamp] ; 2:",
-    },
-    OpSpec {
-        op: Op::SatClamp,
-        insns: &[ImmL],
-        asm: "MOV.L #H'7FFF,ER0 (or #-H'8000)",
-    },
-    OpSpec {
-        op: Op::StoreW,
-        insns: &[MovBwInd, Reg],
-        asm: "MOV.W R0,@ER5 ; ADDS #2,ER5",
-    },
-    OpSpec {
-        op: Op::NormShiftStep,
-        insns: &[Reg, Reg, ImmL, Bcc8],
-        asm: "SHAR.L ER1 ; INC.B R3H ; CMP.L #H'8000,ER1 ; BGE 1b",
-    },
-    OpSpec {
-        op: Op::NormSetup,
-        insns: &[Reg, Reg],
-        asm: "MOV.L ER1,ER4 ; NEG.L ER4",
-    },
-    OpSpec {
-        op: Op::VarShiftStep,
-        insns: &[Reg, Reg, Bcc8],
-        asm: "SHAR.L ER0 ; DEC.B R2L ; BNE 1b",
-    },
-    OpSpec {
-        op: Op::Shl15,
-        insns: &[Reg, Reg, Reg],
-        asm: "MOV.W R0,E0 ; SUB.W R0,R0 ; SHAR.L ER0",
-    },
-    OpSpec {
-        op: Op::Div,
-        insns: &[DivxsW],
-        asm: "DIVXS.W R1,ER0",
-    },
-    OpSpec {
-        op: Op::Branch,
-        insns: &[Bcc8],
-        asm: "BRA store",
-    },
-    OpSpec {
-        op: Op::ClampW,
-        insns: &[ImmW],
-        asm: "MOV.W #H'7FFF,R0",
-    },
-    OpSpec {
-        op: Op::LoadW,
-        insns: &[MovBwAbs16],
-        asm: "MOV.W @var:16,R0",
-    },
-    OpSpec {
-        op: Op::StoreVarW,
-        insns: &[MovBwAbs16],
-        asm: "MOV.W R0,@var:16",
-    },
-    OpSpec {
-        op: Op::RegOp,
-        insns: &[Reg],
-        asm: "SUB.W R1,R2",
-    },
-    OpSpec {
-        op: Op::AbsTest,
-        insns: &[Reg, Bcc8],
-        asm: "MOV.W R0,R1 ; BPL 1f",
-    },
-    OpSpec {
-        op: Op::CmpBranchW,
-        insns: &[Reg, Bcc8],
-        asm: "CMP.W R2,R1 ; BLE done",
-    },
-    OpSpec {
-        op: Op::DeltaCompute,
+        op: Op::InEntry,
         insns: &[
-            MovBwPostInc,
-            Reg,
-            Reg,
-            MulxsW,
-            Bcc8,
-            ImmL,
-            Reg,
-            Reg,
-            Reg,
-            Reg,
-            Reg,
-            Reg,
-            Reg,
-            Bcc8,
-            MovBwInd,
-            Reg,
+            Reg, PushPopL, PushPopL, PushPopL, Reg, MovBwInd, Reg, MovBwAbs16, Reg, Reg,
+            MovBwAbs16, Reg, Reg, MovBwAbs16, Reg, Reg, Reg, MovBwAbs16,
         ],
-        asm: "MOV.B @ER5+,R1L ; EXTS.W R1 ; MOV.W R2,R0 ; MULXS.W R1,ER0 ; BMI 1f ; ADD.L #64,ER0 ; SHAR.L ER0 ×7 ; BRA 2f ; 1: NEG.L ER0 ; ADD.L #64,ER0 ; SHLR.L ER0 ×7 ; NEG.L ER0 ; 2: MOV.W R0,@ER6 ; ADDS #2,ER6",
+        asm: "subs #4,er7; mov.l er4-er6,@-er7; mov.l er0,er4; mov.b @er0,r5l; extu.w r5; 3 x (mov.b @(k:16,er0),r2l; extu.w r2; add.w r2,r5); sub.w r2,r2; mov.w r2,@(0xe:16,er7)",
     },
     OpSpec {
-        op: Op::UpdateRow,
-        insns: &[ImmL, ImmW, MovBwAbs16, Reg, Bcc8, Reg, Reg, Bcc8],
-        asm: "MOV.L #DELTA,ER5 ; MOV.W #N,E3 ; MOV.B @WIN:16,R3H ; CMP.B R3H,R3L ; BNE other ; … ; INC.B R3L ; CMP.B #M,R3L ; BNE row",
+        op: Op::InStartedTest,
+        insns: &[MovLAbs24, MovBwAbs24, Bcc8],
+        asm: "mov.l @net_x:24,er6; mov.b @net_started:24,r2l; beq",
     },
     OpSpec {
-        op: Op::WeightApply,
-        insns: &[MovBwPostInc, MovBwInd, Reg, Bcc8, MovBwInd, Reg],
-        asm: "MOV.W @ER5+,R1 ; MOV.W @ER4,R0 ; ADD.W R1,R0 ; BVC 1f ; [clamp] ; 1: MOV.W R0,@ER4 ; ADDS #2,ER4",
+        op: Op::InEval,
+        insns: &[MovBwAbs24, Reg, Reg, MovBwAbs16, Reg, JsrAbs24],
+        asm: "mov.w @net_d_prev:24,r2; mov.w r5,r3; sub.w r2,r3; mov.w r3,@(0xe:16,er7); mov.w r3,r0; jsr @learner_update",
     },
     OpSpec {
-        op: Op::WeightClampHi,
-        insns: &[Bcc8, ImmW, Bcc8],
-        asm: "BPL lo ; MOV.W #H'7FFF,R0 ; BRA 1b",
+        op: Op::InHistoryTest,
+        insns: &[MovBwAbs24, Bcc8],
+        asm: "mov.b @net_history:24,r2l; beq",
     },
     OpSpec {
-        op: Op::WeightClampLo,
-        insns: &[Bcc8, ImmW],
-        asm: "BPL lo ; lo: MOV.W #H'8000,R0",
+        op: Op::InHistorySetup,
+        insns: &[Reg, Reg, Reg, Reg, Reg, Reg, Reg, Reg, Reg, Reg, Reg],
+        asm: "extu.w r2; extu.l er2; shll.l er2; shll.l er2; mov.l er2,er3; add.l er6,er3; mov.l er3,er1; adds #2,er1; adds #1,er1; subs #1,er3; mov.w r2,r0",
     },
     OpSpec {
-        op: Op::FlagTest,
-        insns: &[MovBwAbs16, Bcc8],
-        asm: "MOV.B @FLAG:16,R0L ; BEQ first",
+        op: Op::InHistoryByte,
+        insns: &[MovBwInd, Reg, MovBwInd, Reg, Reg, Bcc8],
+        asm: "mov.b @er3,r2l; subs #1,er3; mov.b r2l,@er1; subs #1,er1; dec.w #1,r0; bne",
     },
     OpSpec {
-        op: Op::SumIn,
-        insns: &[MovBwPostInc, Reg, Reg],
-        asm: "MOV.B @ER4+,R0L ; EXTU.W R0 ; ADD.W R0,R2",
+        op: Op::InReadings,
+        insns: &[
+            MovBwInd, Reg, MovBwInd, MovBwAbs16, Reg, MovBwAbs16, MovBwAbs16, Reg, MovBwAbs16,
+            MovBwAbs16, Reg, MovBwAbs16,
+        ],
+        asm: "mov.b @er4,r2l; xor.b #0x80,r2l; mov.b r2l,@er6; 3 x (mov.b @(k:16,er4),r2l; xor.b #0x80,r2l; mov.b r2l,@(k:16,er6))",
     },
     OpSpec {
-        op: Op::HistoryShift,
-        insns: &[MovLPostInc, MovLPostInc, Reg, Bcc8],
-        asm: "MOV.L @-ER5,ER0 ; MOV.L ER0,@-ER6 ; DEC.B R3L ; BNE 1b",
+        op: Op::InOutputsSetup,
+        insns: &[
+            Reg, MovBwAbs24, Reg, Reg, Reg, MovLAbs24, Reg, Reg, Reg, MovBwAbs24,
+        ],
+        asm: "sub.l er2,er2; mov.b @net_history:24,r2l; shll.l er2; shll.l er2; add.b #4,r2l; mov.l @net_o:24,er0; sub.l er1,er1; mov.b r2l,r1l; add.l er6,er1; mov.b @net_n_out:24,r3l",
     },
     OpSpec {
-        op: Op::ProximityIn,
-        insns: &[MovBwPostInc, Reg, MovBwInd, Reg],
-        asm: "MOV.B @ER4+,R0L ; XOR.B #H'80,R0L ; MOV.B R0L,@ER6 ; ADDS #1,ER6",
+        op: Op::InOutput,
+        insns: &[MovBwPostInc, MovBwInd, Reg, Reg, Bcc8],
+        asm: "mov.w @er0+,r2; mov.b r2h,@er1; adds #1,er1; add.b #-1,r3l; bne",
     },
     OpSpec {
-        op: Op::OutputIn,
-        insns: &[MovBwPostInc, MovBwInd, Reg],
-        asm: "MOV.W @ER4+,R0 ; MOV.B R0H,@ER6 ; ADDS #1,ER6",
+        op: Op::InEvalScale,
+        insns: &[MovBwAbs16, Reg, Reg, Reg, ImmW, Bcc8],
+        asm: "mov.w @(0xe:16,er7),r0; shar.w r0 (x3); cmp.w #0x7f,r0; ble",
     },
     OpSpec {
-        op: Op::EvalIn,
-        insns: &[Reg, Reg, Reg, ImmW, Bcc8, ImmW, Bcc8, MovBwInd, Reg],
-        asm: "SHAR.W R0 ×3 ; CMP.W #127,R0 ; BLE 1f ; [clamp] ; 1: CMP.W #-128,R0 ; BGE 2f ; [clamp] ; 2: MOV.B R0L,@ER6 ; ADDS #1,ER6",
+        op: Op::InEvalHigh,
+        insns: &[ImmW, Bcc8],
+        asm: "mov.w #0x7f,r0; bra",
     },
     OpSpec {
-        op: Op::BiasIn,
+        op: Op::InEvalLowTest,
+        insns: &[ImmW, Bcc8],
+        asm: "cmp.w #0xff80,r0; bge",
+    },
+    OpSpec {
+        op: Op::InEvalLow,
+        insns: &[ImmW],
+        asm: "mov.w #0xff80,r0",
+    },
+    OpSpec {
+        op: Op::InEvalStore,
+        insns: &[MovBwInd, Reg, MovBwAbs24, Bcc8],
+        asm: "mov.b r0l,@er1; adds #1,er1; mov.b @net_bias:24,r2l; beq",
+    },
+    OpSpec {
+        op: Op::InBias,
         insns: &[Reg, MovBwInd],
-        asm: "MOV.B #127,R0L ; MOV.B R0L,@ER6",
+        asm: "mov.b #0x7f,r2l; mov.b r2l,@er1",
     },
     OpSpec {
-        op: Op::CallFrame,
+        op: Op::InForwardCall,
+        insns: &[JsrAbs24],
+        asm: "jsr @learner_forward",
+    },
+    OpSpec {
+        op: Op::InExit,
         insns: &[
-            JsrAbs24, PushPopL, PushPopL, PushPopL, PushPopL, PushPopL, PushPopL, Rts,
+            MovBwAbs24, Reg, MovBwAbs24, Reg, MovBwAbs24, PushPopL, PushPopL, PushPopL, Reg, Rts,
         ],
-        asm: "JSR @routine:24 ; PUSH.L ER4 ; PUSH.L ER5 ; PUSH.L ER6 ; … ; POP.L ER6 ; POP.L ER5 ; POP.L ER4 ; RTS",
+        asm: "mov.w r5,@net_d_prev:24; mov.b #1,r2l; mov.b r2l,@net_started:24; sub.l er0,er0; mov.b @net_win:24,r0l; mov.l @er7+,er6-er4; adds #4,er7; rts",
+    },
+    OpSpec {
+        op: Op::UpdEntry,
+        insns: &[
+            Reg, Reg, PushPopL, PushPopL, PushPopL, MovBwAbs24, Reg, Reg, Reg, Bcc8,
+        ],
+        asm: "subs #4,er7 (x2); mov.l er4-er6,@-er7; mov.w @net_threshold:24,r2; mov.w r2,r3; neg.w r3; cmp.w r2,r0; bgt",
+    },
+    OpSpec {
+        op: Op::UpdLowTest,
+        insns: &[Reg, Bcc16],
+        asm: "cmp.w r3,r0; bge:16",
+    },
+    OpSpec {
+        op: Op::UpdSign,
+        insns: &[MovBwAbs24, Reg, Bcc8],
+        asm: "mov.w @net_eta:24,r6; mov.w r0,r0; bgt",
+    },
+    OpSpec {
+        op: Op::UpdNeg,
+        insns: &[Reg],
+        asm: "neg.w r6",
+    },
+    OpSpec {
+        op: Op::UpdDeltaSetup,
+        insns: &[MovLAbs24, MovLAbs24, MovLAbs16, MovBwAbs24],
+        asm: "mov.l @net_x:24,er5; mov.l @net_delta:24,er4; mov.l er4,@(0xc:16,er7); mov.w @net_n_in:24,r1",
+    },
+    OpSpec {
+        op: Op::DeltaHead,
+        insns: &[MovBwPostInc, Reg, MulxsW, Reg, Bcc8],
+        asm: "mov.b @er5+,r2l; exts.w r2; mulxs.w r6,er2; mov.l er2,er2; blt",
+    },
+    OpSpec {
+        op: Op::DeltaPos,
+        insns: &[ImmL, Reg, Reg, Reg, Reg, Reg, Reg, Bcc8],
+        asm: "add.l #0x40,er2; mov.l er4,er3; adds #2,er4; shll.l er2; mov.w e2,r0; mov.b r2h,r2l; mov.b r0l,r2h; bra",
+    },
+    OpSpec {
+        op: Op::DeltaNeg,
+        insns: &[Reg, Reg, Reg, Reg, Reg, Reg, Reg, Reg, Reg, Reg, Reg, Reg],
+        asm: "sub.l er3,er3; add.b #0x40,r3l; sub.l er2,er3; mov.l er3,er2; mov.l er4,er3; adds #2,er4; shll.l er2; mov.w e2,r0; mov.b r2h,r2l; mov.b r0l,r2h; exts.l er2; neg.w r2",
+    },
+    OpSpec {
+        op: Op::DeltaTail,
+        insns: &[MovBwInd, Reg, Bcc8],
+        asm: "mov.w r2,@er3; dec.w #1,r1; bne",
+    },
+    OpSpec {
+        op: Op::UpdRowsSetup,
+        insns: &[MovLAbs24, MovBwAbs24, MovBwAbs16, MovBwAbs24, Reg],
+        asm: "mov.l @net_w:24,er0; mov.b @net_win:24,r2l; mov.b r2l,@(0x13:16,er7); mov.b @net_n_out:24,r6l; sub.b r5l,r5l",
+    },
+    OpSpec {
+        op: Op::UpdRowHead,
+        insns: &[MovLAbs16, MovBwAbs24, MovBwAbs16, Reg, Bcc8],
+        asm: "mov.l @(0xc:16,er7),er4; mov.w @net_n_in:24,r1; mov.b @(0x13:16,er7),r3l; cmp.b r3l,r5l; bne",
+    },
+    OpSpec {
+        op: Op::UpdWeight,
+        insns: &[MovBwInd, MovBwPostInc, Reg, Bcc8, MovBwInd, Reg, Reg, Bcc8],
+        asm: "mov.w @er0,r2; mov.w @er4+,r3; add.w r3,r2 | sub.w r3,r2; bvc; mov.w r2,@er0; adds #2,er0; dec.w #1,r1; bne",
+    },
+    OpSpec {
+        op: Op::UpdClampHi,
+        insns: &[ImmW, Bcc8],
+        asm: "mov.w #0x7fff,r2; bcc | bcs",
+    },
+    OpSpec {
+        op: Op::UpdClampLo,
+        insns: &[ImmW, Bcc8, ImmW],
+        asm: "mov.w #0x7fff,r2; bcc | bcs; mov.w #0x8000,r2",
+    },
+    OpSpec {
+        op: Op::UpdWinRowExit,
+        insns: &[Bcc8],
+        asm: "bra",
+    },
+    OpSpec {
+        op: Op::UpdRowTail,
+        insns: &[Reg, Reg, Bcc16],
+        asm: "add.b #1,r5l; cmp.b r6l,r5l; bcs:16",
+    },
+    OpSpec {
+        op: Op::UpdExit,
+        insns: &[PushPopL, PushPopL, PushPopL, Reg, Reg, Rts],
+        asm: "mov.l @er7+,er6-er4; adds #4,er7 (x2); rts",
+    },
+    OpSpec {
+        op: Op::FwdEntry,
+        insns: &[
+            ImmL, PushPopL, PushPopL, PushPopL, MovLAbs24, MovLAbs24, MovLAbs16, MovLAbs16,
+            MovLAbs24, MovLAbs16, MovBwAbs24, MovBwAbs16, MovLAbs24, MovLAbs16, MovBwAbs24,
+            MovBwAbs16,
+        ],
+        asm: "add.l #-24,er7; mov.l er4-er6,@-er7; mov.l @net_w:24,er5; mov.l @net_y:24,er1; mov.l er1,@(0x20:16,er7); mov.l er1,@(0x10:16,er7); mov.l @net_o:24,er2; mov.l er2,@(0x1c:16,er7); mov.b @net_n_out:24,r6l; mov.b r6l,@(0x1b:16,er7); mov.l @net_x:24,er3; mov.l er3,@(0x14:16,er7); mov.w @net_n_in:24,r1; mov.w r1,@(0xe:16,er7)",
+    },
+    OpSpec {
+        op: Op::FwdRowSetup,
+        insns: &[MovLAbs16, MovBwAbs16, Reg],
+        asm: "mov.l @(0x14:16,er7),er4; mov.w @(0xe:16,er7),r0; sub.l er1,er1",
+    },
+    OpSpec {
+        op: Op::FwdMac,
+        insns: &[MovBwPostInc, MovBwPostInc, Reg, MulxsW, Reg, Reg, Bcc8],
+        asm: "mov.w @er5+,r3; mov.b @er4+,r2l; exts.w r2; mulxs.w r2,er3; add.l er3,er1; dec.w #1,r0; bne",
+    },
+    OpSpec {
+        op: Op::FwdRowEnd,
+        insns: &[MovLAbs16, MovLInd, Reg, MovLAbs16, Reg, Bcc8],
+        asm: "mov.l @(0x20:16,er7),er2; mov.l er1,@er2; adds #4,er2; mov.l er2,@(0x20:16,er7); add.b #-1,r6l; bne",
+    },
+    OpSpec {
+        op: Op::FwdArgmaxInit,
+        insns: &[MovLAbs16, Reg, MovLPostInc, MovLAbs16],
+        asm: "mov.l @(0x10:16,er7),er3; mov.l er3,er5; mov.l @er5+,er3; mov.l er5,@(0x20:16,er7)",
+    },
+    OpSpec {
+        op: Op::FwdArgmaxTest,
+        insns: &[Reg, MovBwAbs16, Reg, Bcc8],
+        asm: "add.b #1,r6l; mov.b @(0x1b:16,er7),r1l; cmp.b r1l,r6l; bcc",
+    },
+    OpSpec {
+        op: Op::FwdArgmaxLoad,
+        insns: &[MovLAbs16, MovLPostInc, MovLAbs16, Reg, Bcc8],
+        asm: "mov.l @(0x20:16,er7),er5; mov.l @er5+,er2; mov.l er5,@(0x20:16,er7); cmp.l er3,er2; ble",
+    },
+    OpSpec {
+        op: Op::FwdNewMax,
+        insns: &[Reg, Reg, Bcc8],
+        asm: "mov.l er2,er3; mov.b r6l,r0l; bra",
+    },
+    OpSpec {
+        op: Op::FwdScaleTest,
+        insns: &[MovBwAbs24, MovLAbs16, MovLAbs16, MovBwAbs16, ImmL, Bcc8],
+        asm: "mov.b r0l,@net_win:24; mov.l @(0x10:16,er7),er2; mov.l er2,@(0x20:16,er7); mov.b @(0x1b:16,er7),r6l; cmp.l #0x3fffff,er3; bgt",
+    },
+    OpSpec {
+        op: Op::FwdPlainHead,
+        insns: &[MovLAbs16, MovLPostInc, MovLAbs16, ImmL, Bcc8],
+        asm: "mov.l @(0x20:16,er7),er3; mov.l @er3+,er0; mov.l er3,@(0x20:16,er7); cmp.l #0xffc00000,er0; bge",
+    },
+    OpSpec {
+        op: Op::FwdPlainLow,
+        insns: &[ImmW, MovLAbs16, MovBwInd, Reg, MovLAbs16, Bcc8],
+        asm: "mov.w #0x8000,r2; mov.l @(0x1c:16,er7),er5; mov.w r2,@er5; adds #2,er5; mov.l er5,@(0x1c:16,er7); bra",
+    },
+    OpSpec {
+        op: Op::FwdPlainOut,
+        insns: &[MovLAbs16, Reg, Reg, MovLAbs16, Reg, Reg, Reg, Reg, MovBwInd],
+        asm: "mov.l @(0x1c:16,er7),er2; mov.l er2,er1; adds #2,er1; mov.l er1,@(0x1c:16,er7); shll.l er0; mov.w e0,r3; mov.b r0h,r0l; mov.b r3l,r0h; mov.w r0,@er2",
+    },
+    OpSpec {
+        op: Op::FwdPlainTail,
+        insns: &[Reg, Bcc8],
+        asm: "add.b #-1,r6l; bne",
+    },
+    OpSpec {
+        op: Op::FwdPlainExit,
+        insns: &[Bcc16],
+        asm: "bra:16",
+    },
+    OpSpec {
+        op: Op::FwdNormSetup,
+        insns: &[Reg, Reg, Reg, Reg, Reg, Reg, Reg],
+        asm: "sub.b r0l,r0l; mov.w e3,r2; mov.b r3h,r3l; mov.b r2l,r3h; mov.b r2h,r2l; exts.w r2; mov.w r2,e3",
+    },
+    OpSpec {
+        op: Op::FwdNormTest,
+        insns: &[ImmL, Bcc8],
+        asm: "cmp.l #0x7fff,er3; ble",
+    },
+    OpSpec {
+        op: Op::FwdNormShift,
+        insns: &[Reg, Reg, Bcc8],
+        asm: "shar.l er3; add.b #1,r0l; bra",
+    },
+    OpSpec {
+        op: Op::FwdNormReady,
+        insns: &[Reg, Reg, Reg],
+        asm: "mov.w r3,r4; mov.w r3,r1; exts.l er1",
+    },
+    OpSpec {
+        op: Op::FwdNormHead,
+        insns: &[
+            MovLAbs16,
+            MovLPostInc,
+            MovLAbs16,
+            Reg,
+            Reg,
+            Reg,
+            Reg,
+            Reg,
+            Reg,
+            Reg,
+        ],
+        asm: "mov.l @(0x20:16,er7),er5; mov.l @er5+,er3; mov.l er5,@(0x20:16,er7); mov.w e3,r2; mov.b r3h,r3l; mov.b r2l,r3h; mov.b r2h,r2l; exts.w r2; mov.w r2,e3; mov.b r0l,r2l",
+    },
+    OpSpec {
+        op: Op::FwdNormStepTest,
+        insns: &[Reg, Bcc8],
+        asm: "mov.b r2l,r2l; beq",
+    },
+    OpSpec {
+        op: Op::FwdNormStep,
+        insns: &[Reg, Reg, Bcc8],
+        asm: "shar.l er3; add.b #-1,r2l; bra",
+    },
+    OpSpec {
+        op: Op::FwdNormLowTest,
+        insns: &[Reg, Reg, Reg, Bcc8],
+        asm: "mov.l er1,er2; neg.l er2; cmp.l er3,er2; blt",
+    },
+    OpSpec {
+        op: Op::FwdNormLow,
+        insns: &[ImmW, MovLAbs16, MovBwInd, Reg, MovLAbs16, Bcc8],
+        asm: "mov.w #0x8000,r2; mov.l @(0x1c:16,er7),er3; mov.w r2,@er3; adds #2,er3; mov.l er3,@(0x1c:16,er7); bra",
+    },
+    OpSpec {
+        op: Op::FwdNormHighTest,
+        insns: &[Reg, Bcc8],
+        asm: "cmp.l er3,er1; bgt",
+    },
+    OpSpec {
+        op: Op::FwdNormHigh,
+        insns: &[ImmW, MovLAbs16, MovBwInd, Reg, MovLAbs16, Bcc8],
+        asm: "mov.w #0x7fff,r2; mov.l @(0x1c:16,er7),er5; mov.w r2,@er5; adds #2,er5; mov.l er5,@(0x1c:16,er7); bra",
+    },
+    OpSpec {
+        op: Op::FwdNormDiv,
+        insns: &[
+            Reg, Reg, Reg, Reg, Reg, MovLAbs16, Reg, Reg, MovLAbs16, DivxsW, MovBwInd,
+        ],
+        asm: "mov.l er3,er2; shlr.w e2; mov.w r2,e2; xor.w r2,r2; rotxr.l er2; mov.l @(0x1c:16,er7),er3; mov.l er3,er5; adds #2,er5; mov.l er5,@(0x1c:16,er7); divxs.w r4,er2; mov.w r2,@er3",
+    },
+    OpSpec {
+        op: Op::FwdNormTail,
+        insns: &[Reg, Bcc16],
+        asm: "add.b #-1,r6l; bne:16",
+    },
+    OpSpec {
+        op: Op::FwdExit,
+        insns: &[PushPopL, PushPopL, PushPopL, ImmL, Rts],
+        asm: "mov.l @er7+,er6-er4; add.l #24,er7; rts",
     },
 ];
 
@@ -572,21 +772,21 @@ const fn op_states_table() -> [u32; Op::COUNT] {
 /// States of every [`Op`], indexed by `op as usize`, computed from [`OP_TABLE`].
 pub const OP_STATES: [u32; Op::COUNT] = op_states_table();
 
-/// A routine of the H8 learner as code: how many times each primitive's instruction sequence
-/// appears in its text (not how often it runs), plus instructions on paths no primitive covers.
-/// Its size is the ROM estimate of the routine.
+/// A routine of the firmware's learner as code: its blocks, each once. Its size is what the
+/// blocks' instructions take (a lower bound of the routine's ROM: alignment and the unreached
+/// paths are not in it); the image itself is the measure of ROM.
 #[derive(Clone, Copy, Debug)]
 pub struct Routine {
     /// The routine's name.
     pub name: &'static str,
-    /// (primitive, number of places its sequence appears in the code).
+    /// (block, number of places it appears in the code).
     pub code: &'static [(Op, u32)],
-    /// Instructions of alternative paths that no primitive's sequence lists.
+    /// Instructions outside the blocks.
     pub extra: &'static [Insn],
 }
 
 impl Routine {
-    /// Estimated code size in bytes.
+    /// Code size of the blocks in bytes.
     #[must_use]
     pub const fn bytes(&self) -> u32 {
         let mut total = 0;
@@ -604,94 +804,35 @@ impl Routine {
     }
 }
 
-/// The learner's three routines as code, following the routine sketched in the module docs
-/// (the callee half of [`Op::CallFrame`], pushes, pops and RTS, is counted with the callee).
+const fn range(first: Op, last: Op) -> [(Op, u32); Op::COUNT] {
+    let mut out = [(Op::InEntry, 0); Op::COUNT];
+    let mut i = first as usize;
+    while i <= last as usize {
+        out[i] = (Op::ALL[i], 1);
+        i += 1;
+    }
+    out
+}
+
+const INPUT_BLOCKS: [(Op, u32); Op::COUNT] = range(Op::InEntry, Op::InExit);
+const UPDATE_BLOCKS: [(Op, u32); Op::COUNT] = range(Op::UpdEntry, Op::UpdExit);
+const FORWARD_BLOCKS: [(Op, u32); Op::COUNT] = range(Op::FwdEntry, Op::FwdExit);
+
+/// The firmware's three learner routines as their blocks.
 pub const LEARNER_ROUTINES: [Routine; 3] = [
     Routine {
-        name: "learner input (D, E, input vector)",
-        code: &[
-            (Op::CallFrame, 1),
-            (Op::PtrInit, 7),
-            (Op::AccClear, 1),
-            (Op::LoopInitB, 4),
-            (Op::SumIn, 1),
-            (Op::LoopIter, 3),
-            (Op::FlagTest, 1),
-            (Op::LoadW, 1),
-            (Op::RegOp, 2),
-            (Op::StoreVarW, 1),
-            (Op::HistoryShift, 1),
-            (Op::ProximityIn, 1),
-            (Op::OutputIn, 1),
-            (Op::EvalIn, 1),
-            (Op::ClampW, 2),
-            (Op::BiasIn, 1),
-        ],
+        name: "learner_step (D, E, input vector)",
+        code: &INPUT_BLOCKS,
         extra: &[],
     },
     Routine {
-        name: "learner update",
-        code: &[
-            (Op::CallFrame, 1),
-            (Op::LoadW, 3),
-            (Op::AbsTest, 1),
-            (Op::RegOp, 2),
-            (Op::CmpBranchW, 1),
-            (Op::Branch, 2),
-            (Op::PtrInit, 3),
-            (Op::LoopInitW, 1),
-            (Op::DeltaCompute, 1),
-            (Op::LoopIter, 3),
-            (Op::LoopInitB, 1),
-            (Op::UpdateRow, 1),
-            (Op::WeightApply, 2),
-            (Op::WeightClampHi, 2),
-            (Op::WeightClampLo, 2),
-        ],
-        // The negative-product path of the Δ computation: NEG.L, ADD.L #64, SHLR.L ×7, NEG.L.
-        extra: &[
-            Insn::Reg,
-            Insn::ImmL,
-            Insn::Reg,
-            Insn::Reg,
-            Insn::Reg,
-            Insn::Reg,
-            Insn::Reg,
-            Insn::Reg,
-            Insn::Reg,
-            Insn::Reg,
-        ],
+        name: "learner_update",
+        code: &UPDATE_BLOCKS,
+        extra: &[],
     },
     Routine {
-        name: "learner forward pass",
-        code: &[
-            (Op::CallFrame, 1),
-            (Op::PtrInit, 8),
-            (Op::LoopInitB, 7),
-            (Op::LoopInitW, 1),
-            (Op::AccClear, 1),
-            (Op::Mac, 1),
-            (Op::LoopIter, 5),
-            (Op::StoreL, 1),
-            (Op::LoadL, 4),
-            (Op::CmpBranch, 3),
-            (Op::NewMax, 1),
-            (Op::IndexInc, 1),
-            (Op::StoreVarB, 1),
-            (Op::CmpImmBranch, 1),
-            (Op::Shr1, 7),
-            (Op::Sat16, 1),
-            (Op::SatClamp, 2),
-            (Op::StoreW, 2),
-            (Op::NormShiftStep, 1),
-            (Op::NormSetup, 1),
-            (Op::RegOp, 1),
-            (Op::VarShiftStep, 1),
-            (Op::Shl15, 1),
-            (Op::Div, 1),
-            (Op::Branch, 2),
-            (Op::ClampW, 2),
-        ],
+        name: "learner_forward",
+        code: &FORWARD_BLOCKS,
         extra: &[],
     },
 ];
@@ -733,7 +874,7 @@ pub trait Meter {
     const ACTIVE: bool;
     /// The learner enters `phase`; later charges belong to it.
     fn enter(&mut self, phase: Phase);
-    /// The learner performed `op` `count` times.
+    /// The learner ran block `op` `count` times.
     fn charge(&mut self, op: Op, count: u32);
 }
 
@@ -749,9 +890,9 @@ impl Meter for NoopMeter {
     fn charge(&mut self, _op: Op, _count: u32) {}
 }
 
-/// A meter that charges H8/300H states per phase from [`OP_STATES`] and counts every primitive.
+/// A meter that charges H8/300H states per phase from [`OP_STATES`] and counts every block.
 ///
-/// It keeps one count per (phase, primitive) pair, so a charge is a single addition; states are
+/// It keeps one count per (phase, block) pair, so a charge is a single addition; states are
 /// the counts weighted by [`OP_STATES`] when asked for.
 #[derive(Clone, Debug)]
 pub struct H8Meter {
@@ -791,7 +932,7 @@ impl H8Meter {
         Phase::ALL.iter().map(|&p| self.states(p)).sum()
     }
 
-    /// How many times `op` was charged so far, over all phases.
+    /// How many times block `op` ran so far, over all phases.
     #[must_use]
     pub fn count(&self, op: Op) -> u64 {
         self.counts.iter().map(|per_op| per_op[op as usize]).sum()
@@ -841,13 +982,16 @@ mod tests {
     }
 
     #[test]
-    fn the_spec_example_mac_is_two_loads_exts_mulxs_add() {
+    fn the_mac_is_two_loads_exts_mulxs_add_and_the_loop() {
         // SPEC §2.7: "one multiply-accumulate: two post-increment loads, EXTS, MULXS.W, ADD.L";
-        // SPEC §4.2: @ERs+ 6, EXTS 2, MULXS.W 24, ADD.L (register) 2.
-        assert_eq!(Op::Mac.states(), 6 + 6 + 2 + 24 + 2);
-        assert_eq!(Op::Div.states(), 24);
-        assert_eq!(Op::LoopIter.states(), 2 + 4);
-        assert_eq!(Op::CallFrame.states(), 10 + 6 * 10 + 10);
+        // SPEC §4.2: @ERs+ 6, EXTS 2, MULXS.W 24, ADD.L 2; the loop's DEC.W 2 and BNE 4.
+        assert_eq!(Op::FwdMac.states(), 6 + 6 + 2 + 24 + 2 + 2 + 4);
+        assert_eq!(Op::FwdNormDiv.states(), 62);
+        // A dead-zone update: entry 52, the second bound test 8, exit 44.
+        assert_eq!(
+            Op::UpdEntry.states() + Op::UpdLowTest.states() + Op::UpdExit.states(),
+            104
+        );
     }
 
     #[test]
@@ -857,23 +1001,11 @@ mod tests {
         for insn in [Insn::Reg, Insn::ImmW, Insn::ImmL] {
             assert_eq!(insn.states(), insn.bytes(), "{insn:?}");
         }
-        // A branch fetches its own word and then refills the prefetch queue at the target
-        // (taken) or the next word (not taken): two fetches either way.
+        // A branch fetches its own words and then refills the prefetch queue at the target
+        // (taken) or the next word (not taken).
         assert_eq!(Insn::Bcc8.states(), 2 * Insn::Bcc8.bytes());
-    }
-
-    #[test]
-    fn routine_sizes_add_up_from_the_sequences() {
-        // The forward routine holds one multiply-accumulate sequence (12 bytes: two 2-byte
-        // loads, EXTS, a 4-byte MULXS.W, ADD.L) among everything else.
-        assert_eq!(Op::Mac.spec().bytes(), 2 + 2 + 2 + 4 + 2);
-        for r in LEARNER_ROUTINES {
-            assert!(
-                r.bytes() > 100 && r.bytes() < 1000,
-                "{}: {}",
-                r.name,
-                r.bytes()
-            );
+        for insn in Insn::ALL {
+            assert_eq!(insn.example().1.len() as u32, insn.bytes(), "{insn:?}");
         }
     }
 
@@ -881,14 +1013,14 @@ mod tests {
     fn h8_meter_charges_per_phase_and_noop_records_nothing() {
         let mut m = H8Meter::new();
         m.enter(Phase::Forward);
-        m.charge(Op::Mac, 13);
+        m.charge(Op::FwdMac, 13);
         m.enter(Phase::Update);
-        m.charge(Op::Div, 1);
-        assert_eq!(m.states(Phase::Forward), 13 * 40);
-        assert_eq!(m.states(Phase::Update), 24);
+        m.charge(Op::UpdWeight, 1);
+        assert_eq!(m.states(Phase::Forward), 13 * 46);
+        assert_eq!(m.states(Phase::Update), 28);
         assert_eq!(m.states(Phase::Input), 0);
-        assert_eq!(m.total_states(), 13 * 40 + 24);
-        assert_eq!(m.count(Op::Mac), 13);
+        assert_eq!(m.total_states(), 13 * 46 + 28);
+        assert_eq!(m.count(Op::FwdMac), 13);
         m.reset();
         assert_eq!(m.total_states(), 0);
     }

@@ -12,8 +12,14 @@ pub enum ShapeError {
         /// The number of inputs asked for.
         got: usize,
     },
-    /// M outside 2 ..= 4 (the enabled behaviours of SPEC §2.2).
+    /// M outside 2 ..= 8 (the learner core's bound).
     Outputs {
+        /// The number of outputs asked for.
+        got: usize,
+    },
+    /// A learner that drives the robot with M outside 2 ..= 4: one output per behaviour, and
+    /// the robot has four (SPEC §2.2).
+    Behaviours {
         /// The number of outputs asked for.
         got: usize,
     },
@@ -45,9 +51,15 @@ impl fmt::Display for ShapeError {
             ),
             ShapeError::Outputs { got } => write!(
                 f,
-                "{got} outputs: valid is {} to {} (one per enabled behaviour)",
+                "{got} outputs: valid is {} to {}",
                 crate::net::MIN_OUTPUTS,
                 crate::net::MAX_OUTPUTS
+            ),
+            ShapeError::Behaviours { got } => write!(
+                f,
+                "{got} outputs: a learner that drives the robot has one per enabled behaviour, {} to {}",
+                crate::net::MIN_OUTPUTS,
+                crate::learner::MAX_BEHAVIOURS
             ),
             ShapeError::Length {
                 what,

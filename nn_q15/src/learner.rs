@@ -12,8 +12,7 @@ use crate::error::{ConfigError, ShapeError};
 use crate::format::{Q7, Q15, evaluation_to_q7, output_to_q7, proximity_to_q7};
 use crate::input::{InputLayout, SENSORS};
 use crate::net::{
-    ForwardOut, MAX_INPUTS, MAX_OUTPUTS, Network, Params, Shape, UpdateKind, forward_core,
-    update_core,
+    ForwardOut, MAX_INPUTS, Network, Params, Shape, UpdateKind, forward_core, update_core,
 };
 
 /// The four primitive behaviours (SPEC §2.3 step 4).
@@ -160,26 +159,20 @@ fn step_core<Mt: Meter>(
 ) -> (ForwardOut, i16, i16, Option<UpdateKind>) {
     let StepData { w, x, o, delta } = data;
     let n_out = o.len();
+    // The blocks of the firmware's `learner_step` (see `crate::cost`); its calls of
+    // `learner_update` and `learner_forward` (the JSRs) are part of this phase.
     meter.enter(Phase::Input);
-    meter.charge(Op::CallFrame, 1);
 
     // 1. D(t), E(t−1). D ≤ 4 · 255 = 1020 and |E| ≤ 1020: both fit an i16.
     let d = p.iter().map(|&v| i16::from(v)).sum::<i16>();
-    let k = SENSORS as u32;
-    meter.charge(Op::PtrInit, 1);
-    meter.charge(Op::AccClear, 1);
-    meter.charge(Op::LoopInitB, 1);
-    meter.charge(Op::SumIn, k);
-    meter.charge(Op::LoopIter, k);
-    meter.charge(Op::FlagTest, 1);
+    meter.charge(Op::InEntry, 1);
+    meter.charge(Op::InStartedTest, 1);
     let e = if carried.started {
-        meter.charge(Op::LoadW, 1);
-        meter.charge(Op::RegOp, 1);
+        meter.charge(Op::InEval, 1);
         d - carried.d_prev
     } else {
         0
     };
-    meter.charge(Op::StoreVarW, 1);
 
     // 2. The update on the previous input and winner.
     let update = if carried.started {
@@ -198,42 +191,47 @@ fn step_core<Mt: Meter>(
 
     // 3. x(t): history one block deeper, the new readings, past outputs, E, bias.
     meter.enter(Phase::Input);
+    meter.charge(Op::InHistoryTest, 1);
     let h = layout.history();
     if h > 0 {
         x.copy_within(0..SENSORS * h, SENSORS);
-        meter.charge(Op::PtrInit, 2);
-        meter.charge(Op::LoopInitB, 1);
-        meter.charge(Op::HistoryShift, h as u32);
+        meter.charge(Op::InHistorySetup, 1);
+        meter.charge(Op::InHistoryByte, (SENSORS * h) as u32);
     }
     for (xk, &pk) in x.iter_mut().zip(p) {
         *xk = Q7::from_bits(proximity_to_q7(pk));
     }
-    meter.charge(Op::PtrInit, 2);
-    meter.charge(Op::LoopInitB, 1);
-    meter.charge(Op::ProximityIn, k);
-    meter.charge(Op::LoopIter, k);
+    meter.charge(Op::InReadings, 1);
     let at = layout.outputs_at();
     for (xj, oj) in x[at..at + n_out].iter_mut().zip(o.iter()) {
         *xj = Q7::from_bits(output_to_q7(oj.to_bits()));
     }
-    meter.charge(Op::PtrInit, 2);
-    meter.charge(Op::LoopInitB, 1);
-    meter.charge(Op::OutputIn, n_out as u32);
-    meter.charge(Op::LoopIter, n_out as u32);
+    meter.charge(Op::InOutputsSetup, 1);
+    meter.charge(Op::InOutput, n_out as u32);
     let e_in = evaluation_to_q7(e);
     x[at + n_out] = Q7::from_bits(e_in);
-    meter.charge(Op::RegOp, 1);
-    meter.charge(Op::EvalIn, 1);
-    if Mt::ACTIVE && i16::from(e_in) != e >> 3 {
-        meter.charge(Op::ClampW, 1);
+    meter.charge(Op::InEvalScale, 1);
+    if Mt::ACTIVE {
+        // |E| ≤ 1020 keeps E >> 3 in −128 … 127; the clamps are there for any i16.
+        let e3 = e >> 3;
+        if e3 > 127 {
+            meter.charge(Op::InEvalHigh, 1);
+        } else {
+            meter.charge(Op::InEvalLowTest, 1);
+            meter.charge(Op::InEvalLow, u32::from(e3 < -128));
+        }
     }
+    meter.charge(Op::InEvalStore, 1);
     if layout.bias() {
         x[at + n_out + 1] = Q7::from_bits(i8::MAX);
-        meter.charge(Op::BiasIn, 1);
+        meter.charge(Op::InBias, 1);
     }
+    meter.charge(Op::InForwardCall, 1);
 
     // 4. The forward pass picks the behaviour.
     let forward = forward_core(w, x, n_out, meter);
+    meter.enter(Phase::Input);
+    meter.charge(Op::InExit, 1);
     for (oj, &bits) in o.iter_mut().zip(forward.o_bits()) {
         *oj = Q15::from_bits(bits);
     }
@@ -271,6 +269,12 @@ impl<const N: usize, const M: usize> Learner<N, M> {
     /// The learner's RAM footprint on the H8 in bytes: the sum of [`Self::RAM_ITEMS`].
     pub const RAM_BYTES: u32 = ram_bytes(N, M);
 
+    /// M is at most [`MAX_BEHAVIOURS`] (one output per behaviour), checked at compile time.
+    const BEHAVIOURS_OK: () = assert!(
+        M <= MAX_BEHAVIOURS,
+        "a learner that drives the robot has at most 4 outputs, one per behaviour"
+    );
+
     /// A learner starting from `net` (weights as initialised), with `params` and the input
     /// `layout`; output j runs behaviour `Behaviour::ALL[j]`.
     ///
@@ -281,6 +285,7 @@ impl<const N: usize, const M: usize> Learner<N, M> {
         params: Params,
         layout: InputLayout,
     ) -> Result<Self, ConfigError> {
+        let () = Self::BEHAVIOURS_OK;
         let needed = layout.n_inputs(M);
         if needed != N {
             return Err(ConfigError::Inputs {
@@ -381,8 +386,13 @@ impl<const N: usize, const M: usize> Learner<N, M> {
     }
 }
 
+/// Most behaviours a robot's learner drives: the four primitive behaviours (SPEC §2.2). The
+/// learner core takes up to [`crate::MAX_OUTPUTS`] outputs; [`Learner`] and [`DynLearner`] map each
+/// output to a behaviour, so they take at most four.
+pub const MAX_BEHAVIOURS: usize = 4;
+
 /// Capacity of a [`DynLearner`]'s weight storage: the largest network, 256 × 4.
-pub const MAX_WEIGHTS: usize = MAX_INPUTS * MAX_OUTPUTS;
+pub const MAX_WEIGHTS: usize = MAX_INPUTS * MAX_BEHAVIOURS;
 
 /// The same learner with its shape chosen at run time (within the bounds of [`Shape`]), for
 /// what-if studies and the emulated controller. Storage is `heapless` at the largest shape, so
@@ -392,10 +402,10 @@ pub struct DynLearner {
     shape: Shape,
     params: Params,
     layout: InputLayout,
-    behaviours: heapless::Vec<Behaviour, MAX_OUTPUTS>,
+    behaviours: heapless::Vec<Behaviour, MAX_BEHAVIOURS>,
     w: heapless::Vec<Q15, MAX_WEIGHTS>,
     x: heapless::Vec<Q7, MAX_INPUTS>,
-    o: heapless::Vec<Q15, MAX_OUTPUTS>,
+    o: heapless::Vec<Q15, MAX_BEHAVIOURS>,
     carried: Carried,
 }
 
@@ -412,6 +422,9 @@ impl DynLearner {
         weights: &[Q15],
     ) -> Result<Self, ShapeError> {
         let shape = Shape::new(layout.n_inputs(n_out), n_out)?;
+        if n_out > MAX_BEHAVIOURS {
+            return Err(ShapeError::Behaviours { got: n_out });
+        }
         if weights.len() != shape.n_weights() {
             return Err(ShapeError::Length {
                 what: "weights",

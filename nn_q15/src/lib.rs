@@ -39,7 +39,8 @@ pub use error::{ConfigError, ParamError, ShapeError};
 pub use format::{Q7, Q15, Q22};
 pub use input::{InputLayout, MAX_HISTORY, SENSORS};
 pub use learner::{
-    Behaviour, DynLearner, Learner, MAX_WEIGHTS, RamItem, StepOut, ram_bytes, ram_items,
+    Behaviour, DynLearner, Learner, MAX_BEHAVIOURS, MAX_WEIGHTS, RamItem, StepOut, ram_bytes,
+    ram_items,
 };
 pub use net::{
     ForwardOut, MAX_INPUTS, MAX_OUTPUTS, MIN_OUTPUTS, Network, Params, Shape, UpdateKind,
