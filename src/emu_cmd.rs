@@ -10,7 +10,7 @@
 
 use std::io::{self, BufWriter, Write};
 
-use emu::run::{Outcome, RunOptions, run_image};
+use emu::chip::run::{Outcome, RunOptions, run_image};
 
 use crate::Failure;
 
@@ -42,8 +42,10 @@ pub fn run(image: &str, max_states: Option<u64>, trace: bool, stats: bool) -> Re
     drop(trace_out);
     let report = match report {
         Ok(r) => r,
-        Err(emu::run::RunError::Io(e)) if e.kind() == io::ErrorKind::BrokenPipe => return Ok(()),
-        Err(emu::run::RunError::Io(e)) => {
+        Err(emu::chip::run::RunError::Io(e)) if e.kind() == io::ErrorKind::BrokenPipe => {
+            return Ok(());
+        }
+        Err(emu::chip::run::RunError::Io(e)) => {
             return Err(Failure::Tool(
                 anyhow::Error::new(e).context("writing the console"),
             ));

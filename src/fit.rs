@@ -15,10 +15,10 @@ use rand::{Rng, RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 use serde::Serialize;
 
-use crate::controller::code::rom_estimate;
-use crate::controller::{Controller, ControllerConfig, ControllerError, PhaseStates};
-use crate::mcu::{Board, Mcu, McuConfig};
-use crate::memmap::{RAM_BYTES, ROM_BYTES};
+use emu::board::model::code::rom_estimate;
+use emu::board::model::{Controller, ControllerConfig, ControllerError, PhaseStates};
+use emu::chip::mcu::{Board, Mcu, McuConfig};
+use emu::core::memmap::{RAM_BYTES, ROM_BYTES};
 
 /// Endurance of a 24LC256 page: 1 000 000 write cycles (SPEC §3.6; Microchip DS21203).
 pub const ENDURANCE_CYCLES: f64 = 1_000_000.0;
@@ -152,7 +152,7 @@ pub struct FitBoard {
 impl Board for FitBoard {
     fn analog_volts(&mut self, channel: u8, now_states: u64) -> f64 {
         let d = self.distance_mm.map(Some);
-        crate::wiring::sensor_volts(&mut self.sensors, &d, &self.channels, channel, now_states)
+        emu::board::wiring::sensor_volts(&mut self.sensors, &d, &self.channels, channel, now_states)
     }
 
     fn port2_pins(&mut self, _now_states: u64) -> u8 {

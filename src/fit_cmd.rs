@@ -1,13 +1,13 @@
 //! `h8swarm fit`: the verdict of SPEC §6 for the default network and the paper's two settings,
 //! what-ifs, and the largest network within a CPU budget, all measured by running the
-//! controller on the emulated H8/3052F (`emu::fit`).
+//! controller on the emulated H8/3052F ([`crate::fit`]).
 
 use std::fmt::Write as _;
 
+use crate::fit::{Budget, FitConfig, FitReport, largest_fitting, measure};
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
-use emu::controller::ControllerConfig;
-use emu::fit::{Budget, FitConfig, FitReport, largest_fitting, measure};
+use emu::board::model::ControllerConfig;
 use nn_q15::InputLayout;
 use serde::Serialize;
 

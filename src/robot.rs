@@ -7,10 +7,10 @@
 //! streams; adding a robot or a thread changes nobody else's numbers.
 
 use anyhow::{Context, Result};
-use emu::bus::Bus;
-use emu::controller::{Controller, ControllerConfig, StepReport};
-use emu::mcu::{Board, Mcu, McuConfig};
-use emu::wiring::{Bridge, MotorDrive};
+use emu::board::model::{Controller, ControllerConfig, StepReport};
+use emu::board::wiring::{Bridge, MotorDrive};
+use emu::chip::mcu::{Board, Mcu, McuConfig};
+use emu::core::bus::Bus;
 use nn_q15::{Behaviour, InputLayout, Params};
 use rand::{Rng, RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -73,7 +73,7 @@ pub struct RobotBoard {
 
 impl Board for RobotBoard {
     fn analog_volts(&mut self, channel: u8, now_states: u64) -> f64 {
-        emu::wiring::sensor_volts(
+        emu::board::wiring::sensor_volts(
             &mut self.sensors,
             &self.distance_mm,
             &self.channels,

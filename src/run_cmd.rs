@@ -151,7 +151,7 @@ pub fn run(a: &RunArgs) -> Result<String> {
     )
     .with_context(|| format!("cannot write `{}`", summary_path.display()))?;
 
-    let fit = emu::fit::measure(&emu::fit::FitConfig {
+    let fit = crate::fit::measure(&crate::fit::FitConfig {
         controller: controller_config(&s, s.seed)?,
         steps: 400,
         seed: s.seed,

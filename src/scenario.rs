@@ -222,7 +222,7 @@ impl Default for SensorSpec {
             noise_sigma_v: sensors::ir::NOISE_SIGMA_VOLTS,
             spike_probability: sensors::ir::SPIKE_PROBABILITY,
             spread: true,
-            channels: emu::controller::DEFAULT_SENSOR_CHANNELS,
+            channels: emu::board::model::DEFAULT_SENSOR_CHANNELS,
         }
     }
 }
@@ -392,7 +392,7 @@ impl Scenario {
                 bail!("`{key}` = {v} is out of range: valid is {lo} to {hi}")
             }
         }
-        if let Err(e) = emu::controller::check_sensor_channels(&self.sensors.channels) {
+        if let Err(e) = emu::board::model::check_sensor_channels(&self.sensors.channels) {
             bail!("`sensors.channels` = {:?}: {e}", self.sensors.channels);
         }
         range("robots", self.robots, 1, 100_000)?;
@@ -415,7 +415,7 @@ impl Scenario {
             0.01,
             600.0,
         )?;
-        let ticks = self.timing.step_period_s / emu::controller::TICK_S;
+        let ticks = self.timing.step_period_s / emu::board::model::TICK_S;
         if (ticks - ticks.round()).abs() > 1e-9 {
             bail!(
                 "`timing.step_period_s` = {} is not a whole number of 10 ms ticks (0.45 and 0.60 are the paper's)",
@@ -425,8 +425,8 @@ impl Scenario {
         range(
             "timing.clock_hz",
             self.timing.clock_hz,
-            emu::controller::CLOCK_MIN_HZ,
-            emu::controller::CLOCK_MAX_HZ,
+            emu::board::model::CLOCK_MIN_HZ,
+            emu::board::model::CLOCK_MAX_HZ,
         )?;
         finite(
             "world.top_speed_m_per_s",

@@ -12,9 +12,9 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use emu::bus::Bus;
-use emu::controller::{Controller, ControllerConfig};
-use emu::mcu::{Board, Mcu, McuConfig};
+use emu::board::model::{Controller, ControllerConfig};
+use emu::chip::mcu::{Board, Mcu, McuConfig};
+use emu::core::bus::Bus;
 
 struct Wave;
 

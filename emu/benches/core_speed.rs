@@ -6,9 +6,9 @@
 //! second"; the target is at least 100 M states/s (4 × real time at φ = 25 MHz).
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use emu::bus::Bus;
-use emu::cpu::Cpu;
-use emu::machine::Machine;
+use emu::chip::machine::Machine;
+use emu::core::bus::Bus;
+use emu::core::cpu::Cpu;
 
 /// States emulated per benchmark iteration.
 const STATES_PER_ITER: u64 = 2_000_000;

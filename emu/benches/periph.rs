@@ -6,13 +6,13 @@
 //! including the bus cycle's clock advance and the peripheral's lazy catch-up).
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use emu::bus::Bus;
-use emu::mcu::{Mcu, McuConfig, NullBoard};
-use emu::periph::adc::{ADCSR, ADCSR_ADST, ADCSR_SCAN, ADDRA};
-use emu::periph::itu::{
+use emu::chip::mcu::{Mcu, McuConfig, NullBoard};
+use emu::chip::periph::adc::{ADCSR, ADCSR_ADST, ADCSR_SCAN, ADDRA};
+use emu::chip::periph::itu::{
     CHANNEL_BASE, IMFA, OFF_GRA, OFF_GRB, OFF_TCNT, OFF_TCR, OFF_TIER, OFF_TSR, TMDR, TSTR,
 };
-use emu::periph::ports::{P2DR, P2PCR, P4DDR, P4PCR};
+use emu::chip::periph::ports::{P2DR, P2PCR, P4DDR, P4PCR};
+use emu::core::bus::Bus;
 use std::hint::black_box;
 
 const ACCESSES: u64 = 1000;

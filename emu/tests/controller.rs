@@ -1,9 +1,9 @@
 //! The controller on the emulated MCU: boot, the tick, steps within bounds derived here from
 //! SPEC §4.2, saves and their restore, a power cut in the middle of a save, determinism.
 
-use emu::bus::Bus;
-use emu::controller::{Controller, ControllerConfig, StepReport};
-use emu::mcu::{Board, Mcu, McuConfig};
+use emu::board::model::{Controller, ControllerConfig, StepReport};
+use emu::chip::mcu::{Board, Mcu, McuConfig};
+use emu::core::bus::Bus;
 use nn_q15::Q15;
 
 /// A board whose four sensors read voltages that change with time (so the learner sees
@@ -320,9 +320,9 @@ fn fast_forward_case(corridor: bool, save_every: u32, steps: u32) {
 /// step, not read back from the timer's registers; and the H-bridge inputs on port B.
 #[test]
 fn each_behaviour_drives_the_pins_with_its_duty_and_direction() {
-    use emu::wiring::Bridge;
+    use emu::board::wiring::Bridge;
     use nn_q15::Behaviour;
-    let period = u64::from(emu::controller::PWM_PERIOD_COUNTS) * 8;
+    let period = u64::from(emu::board::model::PWM_PERIOD_COUNTS) * 8;
     for (b, duty, bridge) in [
         (Behaviour::Forward, (1.0, 1.0), Bridge::Forward),
         (Behaviour::Backward, (1.0, 1.0), Bridge::Reverse),

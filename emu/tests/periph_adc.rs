@@ -2,15 +2,15 @@
 //! that state, the input sampled at the sampling instant (a board whose voltage changes with
 //! time), scan order and repetition, ADI, the ADF clearing rule and the ADDR byte order.
 
-use emu::bus::Bus;
-use emu::mcu::{Board, Mcu, McuConfig};
-use emu::memmap::IO_ACCESS_STATES;
-use emu::periph::adc::{
+use emu::chip::mcu::{Board, Mcu, McuConfig};
+use emu::chip::periph::adc::{
     ADCR, ADCSR, ADCSR_ADF, ADCSR_ADIE, ADCSR_ADST, ADCSR_CKS, ADCSR_SCAN, ADDRA, ADDRB, ADDRC,
     ADDRD, CONV_STATES_CKS0, CONV_STATES_CKS1, SAMPLE_OFFSET_CKS0, SAMPLE_OFFSET_CKS1,
     SCAN_CONV_STATES_CKS0, VECTOR_ADI,
 };
-use emu::periph::intc::{IPRA, IPRA_ITU0, IPRB, IPRB_AD};
+use emu::chip::periph::intc::{IPRA, IPRA_ITU0, IPRB, IPRB_AD};
+use emu::core::bus::Bus;
+use emu::core::memmap::IO_ACCESS_STATES;
 use sensors::adc10_code;
 
 /// A board whose channel n reads `base[n] + slope · t` volts and that records every question.

@@ -2,12 +2,12 @@
 //! clock fast-forwarded (one jump, not stepped), interrupt entry through vector 24 with the
 //! manual's state count, and the run API on the same MCU.
 
-use emu::bus::Bus;
-use emu::cpu::{CCR_I, Cpu, Event};
-use emu::machine::Machine;
-use emu::mcu::{Mcu, McuConfig, NullBoard};
-use emu::memmap::ADDRESS_MASK;
-use emu::periph::itu;
+use emu::chip::machine::Machine;
+use emu::chip::mcu::{Mcu, McuConfig, NullBoard};
+use emu::chip::periph::itu;
+use emu::core::bus::Bus;
+use emu::core::cpu::{CCR_I, Cpu, Event};
+use emu::core::memmap::ADDRESS_MASK;
 
 /// The tick program (assembled once with h8300-hms-as 2.16.1, `.h8300h`):
 /// ```text
@@ -196,17 +196,17 @@ fn machine_runs_on_the_mcu_with_its_peripherals() {
     let mut cpu = Cpu::new();
     cpu.reset(&mut m);
     let mut out = Vec::new();
-    let report = emu::run::run_machine(
+    let report = emu::chip::run::run_machine(
         &mut cpu,
         &mut m,
-        &emu::run::RunOptions::default(),
+        &emu::chip::run::RunOptions::default(),
         &mut out,
         None,
     )
     .unwrap();
     assert_eq!(
         report.outcome,
-        emu::run::Outcome::Halted { exit_status: 0x2a }
+        emu::chip::run::Outcome::Halted { exit_status: 0x2a }
     );
     assert_eq!(report.stats.interrupts, 1);
     assert!(report.stats.states > GRA * 8);

@@ -2,14 +2,14 @@
 //! timing, the flag clearing rule, interrupt vectors, and the lazily computed counter against a
 //! state-by-state reference model.
 
-use emu::bus::Bus;
-use emu::mcu::{Mcu, McuConfig, NullBoard};
-use emu::periph::itu::{
+use emu::board::wiring::{Bridge, ITU_MOTOR_LEFT, ITU_MOTOR_RIGHT};
+use emu::chip::mcu::{Mcu, McuConfig, NullBoard};
+use emu::chip::periph::itu::{
     self, CHANNEL_BASE, IMFA, IMFB, Itu, OFF_GRA, OFF_GRB, OFF_TCNT, OFF_TCR, OFF_TIER, OFF_TIOR,
     OFF_TSR, OVF, TMDR, TSTR,
 };
-use emu::periph::ports::{PBDDR, PBDR};
-use emu::wiring::{Bridge, ITU_MOTOR_LEFT, ITU_MOTOR_RIGHT};
+use emu::chip::periph::ports::{PBDDR, PBDR};
+use emu::core::bus::Bus;
 use proptest::prelude::*;
 
 /// TCR: counter cleared by GRA, φ/8 (the controller's setting, SPEC §3.5).

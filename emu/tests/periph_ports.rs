@@ -2,12 +2,12 @@
 //! from the board, and port 4 as the open-drain master of the I²C bus (a START and an address
 //! byte acknowledged by a 24LC256).
 
-use emu::bus::Bus;
-use emu::mcu::{Board, Mcu, McuConfig, NullBoard};
-use emu::periph::ports::{
+use emu::board::wiring::{P2_BUMPER_FRONT, P2_BUMPER_LEFT, P2_BUMPERS, P4_SCL, P4_SDA};
+use emu::chip::mcu::{Board, Mcu, McuConfig, NullBoard};
+use emu::chip::periph::ports::{
     DDR_READ_VALUE, P2DDR, P2DR, P2PCR, P4DDR, P4DR, P4PCR, PADDR, PADR, PBDDR, PBDR,
 };
-use emu::wiring::{P2_BUMPER_FRONT, P2_BUMPER_LEFT, P2_BUMPERS, P4_SCL, P4_SDA};
+use emu::core::bus::Bus;
 use sensors::{Bumper, BumperSet, port2_pins};
 
 /// A board whose bumpers change with time: front pressed from state 1000, left from 2000.

@@ -2,13 +2,13 @@
 //! the run API panic; and the add/subtract flags agree with a reference computed in wide
 //! integers.
 
-use emu::bus::Bus;
-use emu::cpu::decode::{Size, decode_bytes};
-use emu::cpu::disasm::{disassemble, format_instr};
-use emu::cpu::{CCR_C, CCR_H, CCR_N, CCR_V, CCR_Z, Cpu};
-use emu::machine::Machine;
-use emu::run::{RunOptions, run_image};
-use emu::srec::{self, Chunk, SrecImage};
+use emu::chip::machine::Machine;
+use emu::chip::run::{RunOptions, run_image};
+use emu::core::bus::Bus;
+use emu::core::cpu::decode::{Size, decode_bytes};
+use emu::core::cpu::disasm::{disassemble, format_instr};
+use emu::core::cpu::{CCR_C, CCR_H, CCR_N, CCR_V, CCR_Z, Cpu};
+use emu::core::srec::{self, Chunk, SrecImage};
 use proptest::prelude::*;
 
 proptest! {

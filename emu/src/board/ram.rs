@@ -7,7 +7,7 @@
 
 use std::fmt;
 
-use crate::memmap::{RAM_BYTES, RAM_END, RAM_START};
+use crate::core::memmap::{RAM_BYTES, RAM_END, RAM_START};
 
 /// One placed item.
 #[derive(Clone, Debug, PartialEq, Eq)]

@@ -7,10 +7,10 @@
 
 use std::ops::{Deref, DerefMut};
 
-use crate::bus::Bus;
-pub use crate::mcu::LoadError;
-use crate::mcu::{Mcu, McuConfig, NullBoard};
-use crate::srec::SrecImage;
+pub use crate::chip::mcu::LoadError;
+use crate::chip::mcu::{Mcu, McuConfig, NullBoard};
+use crate::core::bus::Bus;
+use crate::core::srec::SrecImage;
 
 /// The MCU with nothing connected outside it, at φ = 25 MHz.
 #[derive(Clone, Debug)]
@@ -24,7 +24,7 @@ impl Default for Machine {
 
 impl Machine {
     /// A machine with erased flash (H'FF), zeroed RAM, peripherals after reset and the clock
-    /// at 0 (memory is allocated on first use, see [`crate::mcu`]).
+    /// at 0 (memory is allocated on first use, see [`crate::chip::mcu`]).
     #[must_use]
     pub fn new() -> Self {
         match Mcu::new(McuConfig::default(), NullBoard) {

@@ -14,7 +14,7 @@
 //!
 //! # Peripherals and time
 //! The clock counts states since reset; every bus access advances it by the states of the
-//! area it touches ([`crate::memmap`]) before it takes effect. Word accesses to the ITU's
+//! area it touches ([`crate::core::memmap`]) before it takes effect. Word accesses to the ITU's
 //! 16-bit registers take one 3-state cycle ([`itu::ITU_WORD_ACCESS_STATES`]); other I/O word
 //! accesses take two byte cycles, upper byte first. Peripherals are synchronised lazily: each
 //! keeps the time it was last brought up to date and catches up, in O(1), when accessed, when
@@ -35,7 +35,7 @@
 //! a release, since only the master could then pull it). Every write to P4DDR, P4DR or P4PCR
 //! passes the new pulls to the bus at the instant of the write; P4DR reads return the bus
 //! lines at the instant of the read (input bits, through the pull-up rule of
-//! [`crate::periph::ports`]). The chips' own events (end of a write cycle) are applied lazily
+//! [`crate::chip::periph::ports`]). The chips' own events (end of a write cycle) are applied lazily
 //! by the bus.
 //!
 //! # Other registers
@@ -47,21 +47,21 @@ use std::cell::Cell;
 
 use eeprom::{DeviceConfig, EepromError, I2cBus, PowerCutOutcome};
 
-use crate::bus::Bus;
-use crate::memmap::{
-    ADDRESS_MASK, Area, IO_ACCESS_STATES, RAM_BYTES, RAM_START, ROM_BYTES, ROM_END,
-};
-use crate::periph::adc::{self, Adc};
-use crate::periph::intc::{self, Intc};
-use crate::periph::itu::{self, Itu};
-use crate::periph::ports::{self, Port};
-use crate::periph::sci::{self, Sci};
-use crate::srec::SrecImage;
-use crate::wiring::{
+use crate::board::wiring::{
     ITU_MOTOR_LEFT, ITU_MOTOR_RIGHT, MotorDrive, MotorPins, P4_SCL, P4_SDA, PA_TIOCA0, PA_TIOCA1,
     PA_TIOCA2, PB_LEFT_IN1, PB_LEFT_IN2, PB_RIGHT_IN1, PB_RIGHT_IN2, PB_TIOCA3, PB_TIOCA4,
     PwmOutput,
 };
+use crate::chip::periph::adc::{self, Adc};
+use crate::chip::periph::intc::{self, Intc};
+use crate::chip::periph::itu::{self, Itu};
+use crate::chip::periph::ports::{self, Port};
+use crate::chip::periph::sci::{self, Sci};
+use crate::core::bus::Bus;
+use crate::core::memmap::{
+    ADDRESS_MASK, Area, IO_ACCESS_STATES, RAM_BYTES, RAM_START, ROM_BYTES, ROM_END,
+};
+use crate::core::srec::SrecImage;
 
 /// The clock φ of the AKI-H8/3052F board: 25 MHz, 1 state = 40 ns (SPEC §4.1).
 pub const DEFAULT_CLOCK_HZ: u32 = 25_000_000;
@@ -836,7 +836,7 @@ impl<B: Board> Bus for Mcu<B> {
     fn reads_stable_until(&self, addr: u32) -> Option<u64> {
         // ADCSR changes only at the A/D converter's own events (a conversion's end sets ADF);
         // reading it with ADF = 0 arms nothing.
-        (addr & crate::memmap::ADDRESS_MASK == crate::periph::adc::ADCSR)
+        (addr & crate::core::memmap::ADDRESS_MASK == crate::chip::periph::adc::ADCSR)
             .then(|| self.adc.next_event(self.now))
             .flatten()
     }

@@ -2,7 +2,7 @@
 //!
 //! [`run_image`] parses a `.mot` image, loads it into a [`Machine`] — the same [`Mcu`] the
 //! robot's controller runs on (flash, RAM, SCI1 as console, ITU, A/D, ports, interrupt
-//! controller, EEPROMs on port 4) with a [`NullBoard`](crate::mcu::NullBoard) outside it — resets the CPU through vector 0 and runs it until the program halts
+//! controller, EEPROMs on port 4) with a [`NullBoard`](crate::chip::mcu::NullBoard) outside it — resets the CPU through vector 0 and runs it until the program halts
 //! (SLEEP with CCR.I = 1 and no NMI pending; exit status = low byte of R0, SPEC §7), the state
 //! budget runs out, or the core stops on an error (undefined opcode, fetch outside ROM/RAM).
 //! Bytes the program transmits on SCI1 go to the console writer as they leave TDR; the
@@ -12,12 +12,12 @@
 use std::fmt::Write as _;
 use std::io::Write;
 
-use crate::bus::Bus;
-use crate::cpu::disasm::format_instr;
-use crate::cpu::{Cpu, CpuError, Event};
-use crate::machine::{LoadError, Machine};
-use crate::mcu::{Board, Mcu};
-use crate::srec::{self, SrecError};
+use crate::chip::machine::{LoadError, Machine};
+use crate::chip::mcu::{Board, Mcu};
+use crate::core::bus::Bus;
+use crate::core::cpu::disasm::format_instr;
+use crate::core::cpu::{Cpu, CpuError, Event};
+use crate::core::srec::{self, SrecError};
 
 /// The system clock φ of the AKI-H8/3052F board: 25 MHz, 1 state = 40 ns (SPEC §4.1).
 pub const PHI_HZ: u64 = 25_000_000;
@@ -173,7 +173,7 @@ pub fn run_machine(
     run_mcu(cpu, machine.mcu_mut(), options, console, trace)
 }
 
-/// [`run_machine`] on any [`Mcu`], whatever board is outside it (a [`NullBoard`](crate::mcu::NullBoard) for
+/// [`run_machine`] on any [`Mcu`], whatever board is outside it (a [`NullBoard`](crate::chip::mcu::NullBoard) for
 /// `h8swarm emu`, the robot for machine-code controllers). `emulated_seconds` uses the MCU's φ.
 ///
 /// # Errors

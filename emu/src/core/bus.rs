@@ -1,14 +1,14 @@
 //! The bus every program on the emulated MCU talks through.
 //!
 //! As in mooneye-gb, time is right by construction: every access advances the MCU clock by the
-//! states of the area it touches ([`crate::memmap::Area`]), so a program (the Rust controller
+//! states of the area it touches ([`crate::core::memmap::Area`]), so a program (the Rust controller
 //! or machine code run by the H8/300H core) cannot touch the hardware without paying for it.
 //! Internal operation states (the manual's N·S_N) are charged with [`Bus::internal`].
 
 /// A bus on the H8/3052F's 24-bit address space with a clock in states.
 ///
 /// Conventions shared by every implementation:
-/// - addresses are masked to 24 bits ([`crate::memmap::ADDRESS_MASK`]);
+/// - addresses are masked to 24 bits ([`crate::core::memmap::ADDRESS_MASK`]);
 /// - word accesses ignore address bit 0 (the H8/300H always accesses words at even addresses);
 /// - the clock advances by the access's states *before* the access takes effect, so a device
 ///   sees a read or write at the instant the bus cycle ends;

@@ -4,11 +4,11 @@
 //! each test are known to encode what the test says).
 #![allow(dead_code)]
 
-use emu::bus::Bus;
-use emu::cpu::decode::decode_bytes;
-use emu::cpu::disasm::format_instr;
-use emu::cpu::{CCR_I, Cpu, CpuError, Event};
-use emu::machine::Machine;
+use emu::chip::machine::Machine;
+use emu::core::bus::Bus;
+use emu::core::cpu::decode::decode_bytes;
+use emu::core::cpu::disasm::format_instr;
+use emu::core::cpu::{CCR_I, Cpu, CpuError, Event};
 
 /// Where the instruction under test sits.
 pub const CODE: u32 = 0x1000;

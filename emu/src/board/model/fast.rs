@@ -23,7 +23,7 @@ use eeprom::{I2cMaster, I2cPins, MasterTiming};
 
 use super::ControllerError;
 use super::fw::{Fw, PIN_OP_STATES};
-use crate::bus::Bus;
+use crate::core::bus::Bus;
 
 /// Of a pin read's 7 states, those up to the end of its bus access (`MOV.B @P4DR:8` = 2 + 3):
 /// the first point the tick can be taken at.

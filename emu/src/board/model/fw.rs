@@ -13,9 +13,9 @@ use eeprom::I2cPins;
 use nn_q15::cost::Insn;
 
 use super::regs::{IMA, ITU0, P4DDR, P4DR, SCL_BIT, SDA_BIT, TSR, VECTOR_IMIA0};
-use crate::bus::Bus;
-use crate::cpu::timing::{N_INTERRUPT_INTERNAL, N_PRIORITY_DECISION_INTERNAL};
-use crate::memmap::{RAM_ACCESS_STATES, ROM_ACCESS_STATES};
+use crate::core::bus::Bus;
+use crate::core::cpu::timing::{N_INTERRUPT_INTERNAL, N_PRIORITY_DECISION_INTERNAL};
+use crate::core::memmap::{RAM_ACCESS_STATES, ROM_ACCESS_STATES};
 
 /// States of one instruction-fetch cycle from the on-chip flash (SPEC §4.1: 2 states, 16-bit).
 pub const FETCH_STATES: u32 = ROM_ACCESS_STATES;

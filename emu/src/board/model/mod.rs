@@ -52,8 +52,8 @@ use nn_q15::{
     ram_items,
 };
 
-use crate::bus::Bus;
-use crate::ram::{RamMap, RamOverflow};
+use crate::board::ram::{RamMap, RamOverflow};
+use crate::core::bus::Bus;
 use fast::SaveTimelines;
 use fw::{FETCH_STATES, Fw, FwPins, SLEEP_STATES, states_of};
 use regs::*;
@@ -82,7 +82,7 @@ const MOVB_DISP24_STATES: u32 = 10;
 const CALL_RETURN_STATES: u32 = 20;
 
 /// The default wiring of the four IR sensors (front, rear, left, right): AN0–AN3 (SPEC §3.2).
-pub const DEFAULT_SENSOR_CHANNELS: [u8; 4] = crate::wiring::AN_IR;
+pub const DEFAULT_SENSOR_CHANNELS: [u8; 4] = crate::board::wiring::AN_IR;
 
 /// How the controller is set up.
 #[derive(Clone, Debug, PartialEq)]

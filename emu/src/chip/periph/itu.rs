@@ -121,8 +121,8 @@ pub const CCLR_GRB: u8 = 2;
 
 /// States of a word access to TCNT/GRA/GRB/BRA/BRB: one 3-state cycle on the ITU's internal
 /// 16-bit bus (manual, ITU register descriptions; the 3 states are SPEC §4.1's on-chip I/O
-/// figure, [`crate::memmap::IO_ACCESS_STATES`]).
-pub const ITU_WORD_ACCESS_STATES: u32 = crate::memmap::IO_ACCESS_STATES;
+/// figure, [`crate::core::memmap::IO_ACCESS_STATES`]).
+pub const ITU_WORD_ACCESS_STATES: u32 = crate::core::memmap::IO_ACCESS_STATES;
 
 /// IMIA vector of each channel (H8/3052F manual Table 5-3: 24, 28, 32, 36, 40; IMIB is +1,
 /// OVI +2).

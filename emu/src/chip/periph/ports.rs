@@ -17,7 +17,7 @@
 //!   robot. The pull-up is off for output bits, as on the chip. Ports A and B have no
 //!   pull-ups.
 //! - Pins driven by a peripheral (TIOCA outputs of the ITU) read their peripheral level; the
-//!   MCU computes those levels ([`crate::mcu`]).
+//!   MCU computes those levels ([`crate::chip::mcu`]).
 
 /// Address of P2DDR, port 2 data direction register (write-only; SPEC §4.1: H'FFFFC1).
 pub const P2DDR: u32 = 0xFF_FFC1;

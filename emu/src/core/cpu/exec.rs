@@ -7,8 +7,8 @@ use super::decode::{
 };
 use super::timing as t;
 use super::{CCR_C, CCR_H, CCR_I, CCR_N, CCR_V, CCR_Z, Cpu, CpuError, Event, RunState};
-use crate::bus::Bus;
-use crate::memmap::{ADDRESS_MASK, Area};
+use crate::core::bus::Bus;
+use crate::core::memmap::{ADDRESS_MASK, Area};
 
 /// Size parameters used by the flag computations.
 #[derive(Clone, Copy)]

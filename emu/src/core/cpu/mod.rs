@@ -39,8 +39,8 @@ pub mod disasm;
 mod exec;
 pub mod timing;
 
-use crate::bus::Bus;
-use crate::memmap::Area;
+use crate::core::bus::Bus;
+use crate::core::memmap::Area;
 use decode::{DecodeError, Decoded, Instr, WordSource, decode};
 
 /// CCR bit 7: interrupt mask.
@@ -168,7 +168,7 @@ struct BusFetch<'b, B: Bus> {
 impl<B: Bus> WordSource for BusFetch<'_, B> {
     #[inline]
     fn next_word(&mut self) -> Option<u16> {
-        let a = self.addr & crate::memmap::ADDRESS_MASK;
+        let a = self.addr & crate::core::memmap::ADDRESS_MASK;
         if !Area::of(a).executable() {
             self.refused = Some(a);
             return None;
@@ -204,7 +204,7 @@ impl Cpu {
         let v = u32::from(VECTOR_RESET) * VECTOR_BYTES;
         let hi = u32::from(bus.read16(v));
         let lo = u32::from(bus.read16(v + 2));
-        self.pc = ((hi << 16) | lo) & crate::memmap::ADDRESS_MASK & !1;
+        self.pc = ((hi << 16) | lo) & crate::core::memmap::ADDRESS_MASK & !1;
     }
 
     /// The program counter (24 bits).
@@ -216,7 +216,7 @@ impl Cpu {
     /// Sets the program counter (masked to 24 bits, bit 0 cleared: instructions are
     /// word-aligned).
     pub fn set_pc(&mut self, pc: u32) {
-        self.pc = pc & crate::memmap::ADDRESS_MASK & !1;
+        self.pc = pc & crate::core::memmap::ADDRESS_MASK & !1;
     }
 
     /// The condition code register.
@@ -411,13 +411,13 @@ impl Cpu {
         let a = u32::from(v) * VECTOR_BYTES;
         let hi = u32::from(bus.read16(a));
         let lo = u32::from(bus.read16(a + 2));
-        ((hi << 16) | lo) & crate::memmap::ADDRESS_MASK & !1
+        ((hi << 16) | lo) & crate::core::memmap::ADDRESS_MASK & !1
     }
 
     /// Exception handling shared by interrupts and TRAPA: push PC and CCR, set I, load PC from
     /// the vector.
     fn enter_exception<B: Bus>(&mut self, bus: &mut B, v: u8, return_pc: u32) {
-        let frame = (u32::from(self.ccr) << 24) | (return_pc & crate::memmap::ADDRESS_MASK);
+        let frame = (u32::from(self.ccr) << 24) | (return_pc & crate::core::memmap::ADDRESS_MASK);
         self.push32(bus, frame);
         self.ccr |= CCR_I;
         self.pc = Self::read_vector(bus, v);

@@ -5,7 +5,7 @@
 //! branch-address reads, stack operations, byte data accesses, word data accesses and internal
 //! operations; the states are `I·S_I + J·S_J + K·S_K + L·S_L + M·S_M + N·S_N`, each S the states
 //! of one access to the area it touches. The core performs every fetch and data access through
-//! the [`crate::bus::Bus`] (which charges S per area), so only two things are left to this table:
+//! the [`crate::core::bus::Bus`] (which charges S per area), so only two things are left to this table:
 //! the internal states N, and the *extra* instruction fetches of the one-word branches (I is one
 //! more than the instruction's length: the prefetch of the branch target), charged by the core as
 //! a word fetch at the target.
