@@ -231,7 +231,7 @@ impl Robot {
 
     /// The wheel commands the motor pins give now.
     pub fn wheels(&mut self) -> (WheelCommand, WheelCommand) {
-        let pins = self.mcu.motors();
+        let pins = emu::board::wiring::motor_pins(&mut self.mcu);
         (wheel(&pins.left), wheel(&pins.right))
     }
 }

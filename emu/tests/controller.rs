@@ -1,7 +1,7 @@
 //! The controller on the emulated MCU: boot, the tick, steps within bounds derived here from
 //! SPEC §4.2, saves and their restore, a power cut in the middle of a save, determinism.
 
-use emu::board::model::{Controller, ControllerConfig, StepReport};
+use emu::board::model::{Controller, ControllerConfig, ModelBus, StepReport};
 use emu::chip::mcu::{Board, Mcu, McuConfig};
 use emu::core::bus::Bus;
 use nn_q15::Q15;
@@ -183,6 +183,9 @@ impl Bus for CutAt<'_> {
     }
 }
 
+/// No emulation shortcuts through the wrapper: the model runs it register by register.
+impl ModelBus for CutAt<'_> {}
+
 #[test]
 fn a_power_cut_in_the_middle_of_a_save_leaves_the_last_committed_weights() {
     // Find when the second save (sequence 1, on chip 0x51) runs in an uninterrupted twin.
@@ -320,7 +323,7 @@ fn fast_forward_case(corridor: bool, save_every: u32, steps: u32) {
 /// step, not read back from the timer's registers; and the H-bridge inputs on port B.
 #[test]
 fn each_behaviour_drives_the_pins_with_its_duty_and_direction() {
-    use emu::board::wiring::Bridge;
+    use emu::board::wiring::{Bridge, motor_pins};
     use nn_q15::Behaviour;
     let period = u64::from(emu::board::model::PWM_PERIOD_COUNTS) * 8;
     for (b, duty, bridge) in [
@@ -342,7 +345,7 @@ fn each_behaviour_drives_the_pins_with_its_duty_and_direction() {
         let mut t = start;
         while t < start + 4 * period {
             m.advance_to(t);
-            let p = m.motors();
+            let p = motor_pins(&mut m);
             high_l += u64::from(p.left.pwm.level);
             high_r += u64::from(p.right.pwm.level);
             assert_eq!(

@@ -2,7 +2,7 @@
 //! timing, the flag clearing rule, interrupt vectors, and the lazily computed counter against a
 //! state-by-state reference model.
 
-use emu::board::wiring::{Bridge, ITU_MOTOR_LEFT, ITU_MOTOR_RIGHT};
+use emu::board::wiring::{Bridge, ITU_MOTOR_LEFT, ITU_MOTOR_RIGHT, motor_pins};
 use emu::chip::mcu::{Mcu, McuConfig, NullBoard};
 use emu::chip::periph::itu::{
     self, CHANNEL_BASE, IMFA, IMFB, Itu, OFF_GRA, OFF_GRB, OFF_TCNT, OFF_TCR, OFF_TIER, OFF_TIOR,
@@ -33,7 +33,7 @@ fn pwm_period_is_gra_plus_one_and_high_time_grb_plus_one_counts_of_0_32_us() {
     setup(&mut m, ITU_MOTOR_RIGHT, TCR_GRA_PHI8, 1249, 936);
     m.write8(TMDR, 0x06); // PWM1, PWM2
     m.write8(TSTR, 0x06);
-    let pins = m.motors();
+    let pins = motor_pins(&mut m);
     for (drive, grb) in [(pins.left, 311u64), (pins.right, 936)] {
         assert!(drive.pwm.running);
         assert_eq!(drive.pwm.period_states, 1250 * 8);
@@ -59,7 +59,7 @@ fn the_tioca_pin_follows_the_waveform() {
     let level_at = |m: &Mcu<NullBoard>, t: u64| {
         let mut c = m.clone();
         c.advance_to(t);
-        c.motors().left.pwm.level
+        motor_pins(&mut c).left.pwm.level
     };
     assert!(!level_at(&m, first_a - 1));
     for k in 0..50u64 {
@@ -76,7 +76,7 @@ fn the_tioca_pin_follows_the_waveform() {
     for _ in 0..8000 {
         c.internal(1);
         c.sync();
-        if c.motors().left.pwm.level {
+        if motor_pins(&mut c).left.pwm.level {
             high += 1;
         }
     }
@@ -92,16 +92,16 @@ fn pwm_edge_cases_follow_the_manual() {
     setup(&mut m, 2, 0x43, 30, 99);
     m.write8(TMDR, 0x06);
     m.write8(TSTR, 0x06);
-    let p = m.motors();
+    let p = motor_pins(&mut m);
     assert_eq!(p.left.pwm.high_states, p.left.pwm.period_states);
     assert_eq!(p.right.pwm.period_states, 100 * 8);
     assert_eq!(p.right.pwm.high_states, (99 - 30) * 8);
     // Stopping the timer holds the output and reports no PWM.
     m.advance_to(m.now() + 10_000);
-    let level = m.motors().left.pwm.level;
+    let level = motor_pins(&mut m).left.pwm.level;
     assert!(level);
     m.write8(TSTR, 0x00);
-    let p = m.motors();
+    let p = motor_pins(&mut m);
     assert!(!p.left.pwm.running);
     assert_eq!(p.left.pwm.level, level);
     assert!((p.left.pwm.duty() - 1.0).abs() < 1e-12);
@@ -118,7 +118,7 @@ fn direction_pins_map_to_the_h_bridge_truth_table() {
         (0b0000_1100, Bridge::Coast, Bridge::Brake),
     ] {
         m.write8(PBDR, pb);
-        let p = m.motors();
+        let p = motor_pins(&mut m);
         assert_eq!(
             (p.left.bridge(), p.right.bridge()),
             (left, right),
@@ -127,7 +127,7 @@ fn direction_pins_map_to_the_h_bridge_truth_table() {
     }
     // Pins that are not outputs do not drive the bridge.
     m.write8(PBDDR, 0x00);
-    assert_eq!(m.motors().left.bridge(), Bridge::Coast);
+    assert_eq!(motor_pins(&mut m).left.bridge(), Bridge::Coast);
 }
 
 #[test]

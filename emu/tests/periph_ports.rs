@@ -2,10 +2,11 @@
 //! from the board, and port 4 as the open-drain master of the I²C bus (a START and an address
 //! byte acknowledged by a 24LC256).
 
-use emu::board::wiring::{P2_BUMPER_FRONT, P2_BUMPER_LEFT, P2_BUMPERS, P4_SCL, P4_SDA};
+use emu::board::wiring::{P2_BUMPER_FRONT, P2_BUMPER_LEFT, P2_BUMPERS};
 use emu::chip::mcu::{Board, Mcu, McuConfig, NullBoard};
 use emu::chip::periph::ports::{
-    DDR_READ_VALUE, P2DDR, P2DR, P2PCR, P4DDR, P4DR, P4PCR, PADDR, PADR, PBDDR, PBDR,
+    DDR_READ_VALUE, P2DDR, P2DR, P2PCR, P4_SCL, P4_SDA, P4DDR, P4DR, P4PCR, PADDR, PADR, PBDDR,
+    PBDR,
 };
 use emu::core::bus::Bus;
 use sensors::{Bumper, BumperSet, port2_pins};

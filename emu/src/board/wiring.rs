@@ -17,6 +17,14 @@
 //! reset state), which holds for the robot's firmware: it uses ITU0–2 only. The H-bridges are
 //! Toshiba TA7291P-class (SPEC §3.5): IN1/IN2 = H/L forward, L/H reverse, H/H brake, L/L
 //! coast; the PWM drives the bridge's reference/enable input.
+//!
+//! Which port bit each TIOCA output shares, and the I²C lines of the EEPROM bus the chip model
+//! carries, are the chip's own pin numbering ([`crate::chip::periph::ports`]); this module says
+//! what the robot connects to them and reads the motor pins as H-bridge inputs
+//! ([`motor_pins`]).
+
+use crate::chip::mcu::{Board, Mcu};
+use crate::chip::periph::ports::{PA_TIOCA1, PA_TIOCA2};
 
 /// A/D channel of the front IR sensor: AN0 (result in ADDRA).
 pub const AN_IR_FRONT: u8 = 0;
@@ -60,11 +68,6 @@ pub const P2_BUMPER_RIGHT: u8 = 0x08;
 /// All four bumper bits of port 2.
 pub const P2_BUMPERS: u8 = 0x0F;
 
-/// Port-4 bit of the I²C data line SDA (P4.7, SPEC §3.6).
-pub const P4_SDA: u8 = 0x80;
-/// Port-4 bit of the I²C clock line SCL (P4.6, SPEC §3.6).
-pub const P4_SCL: u8 = 0x40;
-
 /// ITU channel whose TIOCA drives the left motor's PWM (ITU1, pin TIOCA1 = PA4).
 pub const ITU_MOTOR_LEFT: usize = 1;
 /// ITU channel whose TIOCA drives the right motor's PWM (ITU2, pin TIOCA2 = PA6).
@@ -73,17 +76,6 @@ pub const ITU_MOTOR_RIGHT: usize = 2;
 pub const ITU_TICK: usize = 0;
 /// Interrupt vector of the system tick: ITU0 IMIA0 (SPEC §4.1: 24).
 pub const VECTOR_TICK: u8 = 24;
-
-/// Port-A bit of TIOCA0 (PA2).
-pub const PA_TIOCA0: u8 = 0x04;
-/// Port-A bit of TIOCA1 (PA4), the left motor's PWM.
-pub const PA_TIOCA1: u8 = 0x10;
-/// Port-A bit of TIOCA2 (PA6), the right motor's PWM.
-pub const PA_TIOCA2: u8 = 0x40;
-/// Port-B bit of TIOCA3 (PB0; here the left IN1 as a plain port pin).
-pub const PB_TIOCA3: u8 = 0x01;
-/// Port-B bit of TIOCA4 (PB2; here the right IN1 as a plain port pin).
-pub const PB_TIOCA4: u8 = 0x04;
 
 /// Port-B bit of the left H-bridge's IN1 (PB0).
 pub const PB_LEFT_IN1: u8 = 0x01;
@@ -175,6 +167,51 @@ pub struct MotorPins {
     pub left: MotorDrive,
     /// The right motor (ITU2 TIOCA2, PB2/PB3).
     pub right: MotorDrive,
+}
+
+/// Both motors' driver inputs now, read from the chip's pins: the PWM of ITU1/ITU2 on TIOCA1
+/// (PA4) and TIOCA2 (PA6), IN1/IN2 on PB0–PB3.
+pub fn motor_pins<B: Board>(mcu: &mut Mcu<B>) -> MotorPins {
+    let pb = mcu.port_b_pins();
+    MotorPins {
+        left: motor_drive(mcu, ITU_MOTOR_LEFT, PA_TIOCA1, pb, PB_LEFT_IN1, PB_LEFT_IN2),
+        right: motor_drive(
+            mcu,
+            ITU_MOTOR_RIGHT,
+            PA_TIOCA2,
+            pb,
+            PB_RIGHT_IN1,
+            PB_RIGHT_IN2,
+        ),
+    }
+}
+
+/// One H-bridge's inputs: the PWM from ITU channel `ch` (its TIOCA on port-A bit `pa_bit`,
+/// which holds the port's latch when the ITU does not drive it) and IN1/IN2 from port B.
+fn motor_drive<B: Board>(
+    mcu: &mut Mcu<B>,
+    ch: usize,
+    pa_bit: u8,
+    pb: u8,
+    in1: u8,
+    in2: u8,
+) -> MotorDrive {
+    let out = mcu.tioca(ch);
+    let level = if out.drives {
+        out.level
+    } else {
+        mcu.port_a_pins() & pa_bit != 0
+    };
+    MotorDrive {
+        pwm: PwmOutput {
+            running: out.wave.is_some(),
+            level,
+            period_states: out.wave.map_or(0, |w| w.period_states),
+            high_states: out.wave.map_or(0, |w| w.high_states),
+        },
+        in1: pb & in1 != 0,
+        in2: pb & in2 != 0,
+    }
 }
 
 #[cfg(test)]

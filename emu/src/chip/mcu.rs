@@ -47,15 +47,12 @@ use std::cell::Cell;
 
 use eeprom::{DeviceConfig, EepromError, I2cBus, PowerCutOutcome};
 
-use crate::board::wiring::{
-    ITU_MOTOR_LEFT, ITU_MOTOR_RIGHT, MotorDrive, MotorPins, P4_SCL, P4_SDA, PA_TIOCA0, PA_TIOCA1,
-    PA_TIOCA2, PB_LEFT_IN1, PB_LEFT_IN2, PB_RIGHT_IN1, PB_RIGHT_IN2, PB_TIOCA3, PB_TIOCA4,
-    PwmOutput,
-};
 use crate::chip::periph::adc::{self, Adc};
 use crate::chip::periph::intc::{self, Intc};
-use crate::chip::periph::itu::{self, Itu};
-use crate::chip::periph::ports::{self, Port};
+use crate::chip::periph::itu::{self, Itu, PwmWave};
+use crate::chip::periph::ports::{
+    self, P4_SCL, P4_SDA, PA_TIOCA0, PA_TIOCA1, PA_TIOCA2, PB_TIOCA3, PB_TIOCA4, Port,
+};
 use crate::chip::periph::sci::{self, Sci};
 use crate::core::bus::Bus;
 use crate::core::memmap::{
@@ -161,6 +158,19 @@ pub enum LoadError {
     /// No data at all.
     #[error("the image holds no data records")]
     Empty,
+}
+
+/// An ITU channel's TIOCA output at one instant ([`Mcu::tioca`]): while the ITU drives the pin
+/// it shares with port A or B, the pin reads `level`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TiocaOutput {
+    /// The ITU drives the pin (PWM mode, or an output-compare setting of IOA).
+    pub drives: bool,
+    /// The output's level now.
+    pub level: bool,
+    /// The steady waveform, while the ITU drives the pin and the channel counts in PWM mode
+    /// with an internal clock.
+    pub wave: Option<PwmWave>,
 }
 
 /// The H8/3052F with its board and the robot's EEPROM bus.
@@ -427,37 +437,32 @@ impl<B: Board> Mcu<B> {
         .min()
     }
 
-    /// The motor driver inputs now (ITU1/ITU2 PWM on TIOCA1/TIOCA2, IN1/IN2 on PB0–PB3).
-    pub fn motors(&mut self) -> MotorPins {
-        let pb = self.pb_pins();
-        MotorPins {
-            left: self.motor_drive(ITU_MOTOR_LEFT, PA_TIOCA1, pb, PB_LEFT_IN1, PB_LEFT_IN2),
-            right: self.motor_drive(ITU_MOTOR_RIGHT, PA_TIOCA2, pb, PB_RIGHT_IN1, PB_RIGHT_IN2),
-        }
-    }
-
-    fn motor_drive(&mut self, ch: usize, pa_bit: u8, pb: u8, in1: u8, in2: u8) -> MotorDrive {
-        let (itu_level, drives) = self.itu.tioca(ch, self.now);
-        let level = if drives {
-            itu_level
-        } else {
-            self.pa.output_levels() & pa_bit != 0
-        };
-        let wave = if drives && self.itu.running(ch) {
-            self.itu.pwm(ch, level)
+    /// What ITU channel `n`'s TIOCA output does now (channels out of range: neither driving nor
+    /// counting).
+    pub fn tioca(&mut self, n: usize) -> TiocaOutput {
+        let (level, drives) = self.itu.tioca(n, self.now);
+        let wave = if drives && self.itu.running(n) {
+            self.itu.pwm(n, level)
         } else {
             None
         };
-        MotorDrive {
-            pwm: PwmOutput {
-                running: wave.is_some(),
-                level,
-                period_states: wave.map_or(0, |w| w.period_states),
-                high_states: wave.map_or(0, |w| w.high_states),
-            },
-            in1: pb & in1 != 0,
-            in2: pb & in2 != 0,
+        TiocaOutput {
+            drives,
+            level,
+            wave,
         }
+    }
+
+    /// Levels of port A's pins now: TIOCA0–2 where the ITU drives them, else the output latch;
+    /// input pins read 0 (port A has no pull-ups and nothing outside drives it here).
+    pub fn port_a_pins(&mut self) -> u8 {
+        self.pa_pins()
+    }
+
+    /// Levels of port B's pins now: TIOCA3/TIOCA4 where the ITU drives them, else the output
+    /// latch; input pins read 0.
+    pub fn port_b_pins(&mut self) -> u8 {
+        self.pb_pins()
     }
 
     /// Cuts the robot's power now: the EEPROMs lose power (a write cycle under way is
@@ -827,18 +832,6 @@ impl<B: Board> Bus for Mcu<B> {
                 false
             }
         }
-    }
-
-    fn eeprom_bus(&mut self) -> Option<&mut I2cBus> {
-        Some(&mut self.i2c)
-    }
-
-    fn reads_stable_until(&self, addr: u32) -> Option<u64> {
-        // ADCSR changes only at the A/D converter's own events (a conversion's end sets ADF);
-        // reading it with ADF = 0 arms nothing.
-        (addr & crate::core::memmap::ADDRESS_MASK == crate::chip::periph::adc::ADCSR)
-            .then(|| self.adc.next_event(self.now))
-            .flatten()
     }
 }
 

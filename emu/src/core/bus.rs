@@ -33,18 +33,4 @@ pub trait Bus {
     /// SLEEP: advances the clock until an interrupt request is pending or the clock reaches
     /// `deadline`, whichever is first. Returns whether an interrupt is pending.
     fn sleep_until_irq(&mut self, deadline: u64) -> bool;
-    /// An instant before which every read of `addr` returns what a read now would, and has no
-    /// side effect, if the bus knows one (say, the end of the running A/D conversion for
-    /// ADCSR): a polling loop may let the time up to it pass without reading. `None` (the
-    /// default): unknown.
-    fn reads_stable_until(&self, addr: u32) -> Option<u64> {
-        let _ = addr;
-        None
-    }
-    /// The EEPROM bus behind port 4, for emulation shortcuts that act on the chips at
-    /// transaction level with exactly the pin-level outcome (the controller's fast save).
-    /// `None` (the default): only pin-level access.
-    fn eeprom_bus(&mut self) -> Option<&mut eeprom::I2cBus> {
-        None
-    }
 }

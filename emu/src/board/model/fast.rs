@@ -22,8 +22,8 @@ use eeprom::persist::{COMMIT_BYTES, Persistence, Record, SaveReport, chip_for_se
 use eeprom::{I2cMaster, I2cPins, MasterTiming};
 
 use super::ControllerError;
+use super::ModelBus;
 use super::fw::{Fw, PIN_OP_STATES};
-use crate::core::bus::Bus;
 
 /// Of a pin read's 7 states, those up to the end of its bus access (`MOV.B @P4DR:8` = 2 + 3):
 /// the first point the tick can be taken at.
@@ -264,7 +264,7 @@ impl SaveTimelines {
 /// Walks `piece` on the MCU from now: the tick is taken, for real, at the first point at or
 /// after its instant; the marks are reported with their instants (an edge at a point comes
 /// before the tick taken there).
-fn walk<B: Bus>(
+fn walk<B: ModelBus>(
     fw: &mut Fw<'_, B>,
     piece: &Piece,
     mut mark: impl FnMut(&mut Fw<'_, B>, Mark, u64),
@@ -313,7 +313,7 @@ fn walk<B: Bus>(
 
 /// The instant `piece`'s decision would happen if walked from now (with the tick, if it
 /// comes first, taken at its point).
-fn decision_at<B: Bus>(fw: &Fw<'_, B>, piece: &Piece, isr_states: u64) -> Option<u64> {
+fn decision_at<B: ModelBus>(fw: &Fw<'_, B>, piece: &Piece, isr_states: u64) -> Option<u64> {
     let start = fw.now();
     let d = piece.decision?;
     let delayed = fw.interrupts_enabled
@@ -324,7 +324,11 @@ fn decision_at<B: Bus>(fw: &Fw<'_, B>, piece: &Piece, isr_states: u64) -> Option
 }
 
 /// Whether the chip answers its control byte at `t`: powered, present and not in a write cycle.
-fn chip_answers<B: Bus>(fw: &mut Fw<'_, B>, t: u64, chip: u8) -> Result<bool, ControllerError> {
+fn chip_answers<B: ModelBus>(
+    fw: &mut Fw<'_, B>,
+    t: u64,
+    chip: u8,
+) -> Result<bool, ControllerError> {
     let bus = fw.bus.eeprom_bus().ok_or_else(|| {
         ControllerError::I2c(eeprom::EepromError::NoSuchDevice {
             address: chip,
@@ -342,7 +346,7 @@ fn chip_answers<B: Bus>(fw: &mut Fw<'_, B>, t: u64, chip: u8) -> Result<bool, Co
 /// # Errors
 /// A chip that does not answer (off, missing) or never ends its write cycle within the poll
 /// bound, as the pin-level save would report it.
-pub fn save<B: Bus>(
+pub fn save<B: ModelBus>(
     fw: &mut Fw<'_, B>,
     persistence: &Persistence,
     timelines: &mut SaveTimelines,

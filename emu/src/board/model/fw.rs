@@ -12,8 +12,8 @@
 use eeprom::I2cPins;
 use nn_q15::cost::Insn;
 
+use super::ModelBus;
 use super::regs::{IMA, ITU0, P4DDR, P4DR, SCL_BIT, SDA_BIT, TSR, VECTOR_IMIA0};
-use crate::core::bus::Bus;
 use crate::core::cpu::timing::{N_INTERRUPT_INTERNAL, N_PRIORITY_DECISION_INTERNAL};
 use crate::core::memmap::{RAM_ACCESS_STATES, ROM_ACCESS_STATES};
 
@@ -63,7 +63,7 @@ const ISR_REGISTER_CODE: [Insn; 6] = [
 
 /// The firmware's view of the MCU while it runs: the bus, whether interrupts are enabled, the
 /// tick counter the interrupt handler keeps, and the states spent in the handler so far.
-pub struct Fw<'a, B: Bus> {
+pub struct Fw<'a, B: ModelBus> {
     /// The MCU.
     pub bus: &'a mut B,
     /// CCR.I = 0: the tick interrupt is taken when pending.
@@ -79,7 +79,7 @@ pub struct Fw<'a, B: Bus> {
     pub tick_period: u64,
 }
 
-impl<'a, B: Bus> Fw<'a, B> {
+impl<'a, B: ModelBus> Fw<'a, B> {
     /// A view of `bus` with the tick counter `ticks`.
     pub fn new(bus: &'a mut B, ticks: &'a mut u64, interrupts_enabled: bool) -> Self {
         Self {
@@ -183,7 +183,7 @@ impl<'a, B: Bus> Fw<'a, B> {
 /// MOV.B R2L,@P4DDR:8` (2 + 2 + 3 = 7 states, the edge at the end of the write); reading SDA is
 /// `MOV.B @P4DR:8,R0L ; BTST #7,R0L` (2 + 3 + 2 = 7). The master's waits are the firmware's delay
 /// loops; the shifts and branches that pick each bit run inside them.
-pub struct FwPins<'f, 'a, B: Bus> {
+pub struct FwPins<'f, 'a, B: ModelBus> {
     /// The firmware's view of the MCU.
     pub fw: &'f mut Fw<'a, B>,
     /// The P4DDR shadow.
@@ -193,7 +193,7 @@ pub struct FwPins<'f, 'a, B: Bus> {
 /// States of one I²C pin operation (see [`FwPins`]).
 pub const PIN_OP_STATES: u64 = 7;
 
-impl<B: Bus> FwPins<'_, '_, B> {
+impl<B: ModelBus> FwPins<'_, '_, B> {
     fn set_ddr(&mut self, bit: u8, pull: bool) {
         if pull {
             *self.shadow |= bit;
@@ -205,7 +205,7 @@ impl<B: Bus> FwPins<'_, '_, B> {
     }
 }
 
-impl<B: Bus> I2cPins for FwPins<'_, '_, B> {
+impl<B: ModelBus> I2cPins for FwPins<'_, '_, B> {
     fn scl_low(&mut self) {
         self.set_ddr(SCL_BIT, true);
     }

@@ -53,10 +53,48 @@ use nn_q15::{
 };
 
 use crate::board::ram::{RamMap, RamOverflow};
+use crate::chip::mcu::{Board, Mcu};
+use crate::chip::periph::adc::ADCSR as ADCSR_ADDR;
 use crate::core::bus::Bus;
+use crate::core::memmap::ADDRESS_MASK;
 use fast::SaveTimelines;
 use fw::{FETCH_STATES, Fw, FwPins, SLEEP_STATES, states_of};
 use regs::*;
+
+/// What the model asks of the MCU besides the bus: the two facts its emulation shortcuts
+/// ([`ControllerConfig::fast_forward`]) need, which no program on the chip could ask and the
+/// core's [`Bus`] therefore does not carry. Implemented for [`Mcu`]; a bus that answers
+/// neither (the defaults, as a test's wrapper around an MCU may) runs the model register by
+/// register and I²C pin by pin, with the same results.
+pub trait ModelBus: Bus {
+    /// An instant before which every read of `addr` returns what a read now would, and has no
+    /// side effect, if the MCU knows one (the end of the running A/D conversion for ADCSR): the
+    /// model's ADF polling loop lets the time up to it pass without reading. `None`: unknown.
+    fn reads_stable_until(&self, addr: u32) -> Option<u64> {
+        let _ = addr;
+        None
+    }
+
+    /// The EEPROM bus behind port 4, for the fast save that acts on the chips at transaction
+    /// level with exactly the pin-level outcome ([`fast`]). `None`: pin-level access only.
+    fn eeprom_bus(&mut self) -> Option<&mut eeprom::I2cBus> {
+        None
+    }
+}
+
+impl<B: Board> ModelBus for Mcu<B> {
+    fn reads_stable_until(&self, addr: u32) -> Option<u64> {
+        // ADCSR changes only at the A/D converter's own events (a conversion's end sets ADF);
+        // reading it with ADF = 0 arms nothing.
+        (addr & ADDRESS_MASK == ADCSR_ADDR)
+            .then(|| self.adc().next_event(self.now()))
+            .flatten()
+    }
+
+    fn eeprom_bus(&mut self) -> Option<&mut eeprom::I2cBus> {
+        Some(self.i2c_mut())
+    }
+}
 
 /// The tick period: 10 ms.
 pub const TICK_S: f64 = 0.010;
@@ -514,7 +552,7 @@ impl Controller {
     ///
     /// # Errors
     /// None from the hardware model today; kept fallible for the bus errors of later boards.
-    pub fn boot<B: Bus>(&mut self, bus: &mut B) -> Result<BootReport, ControllerError> {
+    pub fn boot<B: ModelBus>(&mut self, bus: &mut B) -> Result<BootReport, ControllerError> {
         let t0 = bus.now();
         self.ticks = 0;
         self.next_step_tick = 1;
@@ -617,7 +655,7 @@ impl Controller {
     /// # Errors
     /// [`ControllerError::NoTick`] when SLEEP wakes without the tick pending (the ITU was
     /// stopped or reprogrammed behind the controller's back).
-    pub fn sleep_until_step<B: Bus>(
+    pub fn sleep_until_step<B: ModelBus>(
         &mut self,
         bus: &mut B,
     ) -> Result<SleepReport, ControllerError> {
@@ -682,7 +720,7 @@ impl Controller {
     /// # Errors
     /// [`ControllerError::Persist`] when a due save fails on the bus (a chip that never
     /// answers, say).
-    pub fn step<B: Bus>(&mut self, bus: &mut B) -> Result<StepReport, ControllerError> {
+    pub fn step<B: ModelBus>(&mut self, bus: &mut B) -> Result<StepReport, ControllerError> {
         self.step_with(bus, None)
     }
 
@@ -692,7 +730,7 @@ impl Controller {
     ///
     /// # Errors
     /// As [`Self::step`].
-    pub fn step_with<B: Bus>(
+    pub fn step_with<B: ModelBus>(
         &mut self,
         bus: &mut B,
         forced: Option<Behaviour>,
@@ -829,7 +867,7 @@ impl Controller {
     }
 
     /// Writes the weights as the next A/B record.
-    fn save<B: Bus>(&mut self, fw: &mut Fw<'_, B>) -> Result<SaveSummary, ControllerError> {
+    fn save<B: ModelBus>(&mut self, fw: &mut Fw<'_, B>) -> Result<SaveSummary, ControllerError> {
         let payload: Vec<u8> = self
             .learner
             .weights()
@@ -880,7 +918,7 @@ struct Mark {
 }
 
 impl Mark {
-    fn new<B: Bus>(fw: &Fw<'_, B>) -> Self {
+    fn new<B: ModelBus>(fw: &Fw<'_, B>) -> Self {
         Self {
             t0: fw.now(),
             isr0: fw.isr_states,
@@ -888,7 +926,7 @@ impl Mark {
     }
 
     /// States of the phase, interrupts excluded.
-    fn done<B: Bus>(&self, fw: &Fw<'_, B>) -> u64 {
+    fn done<B: ModelBus>(&self, fw: &Fw<'_, B>) -> u64 {
         (fw.now() - self.t0) - (fw.isr_states - self.isr0)
     }
 }

@@ -41,6 +41,24 @@ pub const PBDDR: u32 = 0xFF_FFD4;
 /// Address of PBDR, port B data register (H'FFFFD6).
 pub const PBDR: u32 = 0xFF_FFD6;
 
+/// Port-A bit of TIOCA0 (PA2; H8/3052F manual, port A pin functions).
+pub const PA_TIOCA0: u8 = 0x04;
+/// Port-A bit of TIOCA1 (PA4).
+pub const PA_TIOCA1: u8 = 0x10;
+/// Port-A bit of TIOCA2 (PA6).
+pub const PA_TIOCA2: u8 = 0x40;
+/// Port-B bit of TIOCA3 (PB0; port B pin functions).
+pub const PB_TIOCA3: u8 = 0x01;
+/// Port-B bit of TIOCA4 (PB2).
+pub const PB_TIOCA4: u8 = 0x04;
+
+/// Port-4 bit of the EEPROM bus's data line SDA (P4.7, SPEC §3.6). The H8/3052F has no I²C
+/// module: the chip model carries the robot's I²C bus on these two pins, bit-banged by
+/// firmware through P4DDR (see [`crate::chip::mcu`]).
+pub const P4_SDA: u8 = 0x80;
+/// Port-4 bit of the EEPROM bus's clock line SCL (P4.6, SPEC §3.6).
+pub const P4_SCL: u8 = 0x40;
+
 /// What a read of a write-only DDR returns: every bit 1 (H8/3052F manual, port sections: "DDR
 /// is a write-only register ... all bits are read as 1").
 pub const DDR_READ_VALUE: u8 = 0xFF;
