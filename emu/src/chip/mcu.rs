@@ -16,12 +16,19 @@
 //! The clock counts states since reset; every bus access advances it by the states of the
 //! area it touches ([`crate::core::memmap`]) before it takes effect. Word accesses to the ITU's
 //! 16-bit registers take one 3-state cycle ([`itu::ITU_WORD_ACCESS_STATES`]); other I/O word
-//! accesses take two byte cycles, upper byte first. Peripherals are synchronised lazily: each
-//! keeps the time it was last brought up to date and catches up, in O(1), when accessed, when
-//! the clock is fast-forwarded ([`Bus::sleep_until_irq`], [`Mcu::advance_to`]) or on
-//! [`Mcu::sync`]. The pending interrupt is cached until the next write to an interrupt source
-//! or priority register, or the next instant a source can raise a request, so [`Bus::pending_irq`], called by the core before
-//! every instruction, is one comparison in the common case.
+//! accesses take two byte cycles, upper byte first.
+//!
+//! Every on-chip module is a [`Peripheral`] that owns one block of I/O addresses: the ITU,
+//! SCI1, the ports, the A/D converter and the interrupt controller (with SYSCR). An I/O
+//! access goes to the module whose block holds the address; the chip asks
+//! every module the same questions for the next event, the interrupt requests and reset.
+//! Modules are synchronised lazily: each keeps the time it was last brought up to date and
+//! catches up, in O(1), when accessed, when the clock is fast-forwarded
+//! ([`Bus::sleep_until_irq`], [`Mcu::advance_to`]) or on [`Mcu::sync`]. The pending interrupt
+//! is cached until the next write to a module that can change it
+//! ([`Peripheral::AFFECTS_IRQ`]), or the next instant a source can raise a request, so
+//! [`Bus::pending_irq`], called by the core before every instruction, is one comparison in
+//! the common case.
 //!
 //! The board (the robot outside the chip, [`Board`]) is asked for analog inputs with each
 //! conversion's sampling instant — at the latest when the MCU is next synchronised (an A/D
@@ -30,30 +37,25 @@
 //! asked about and not later than the MCU clock.
 //!
 //! # I²C on port 4
-//! SDA = P4.7, SCL = P4.6 (SPEC §3.6): a line is pulled low while its DDR bit is 1 with DR = 0
-//! and released otherwise (a 1 in DR with DDR = 1 would drive the line high; it is treated as
-//! a release, since only the master could then pull it). Every write to P4DDR, P4DR or P4PCR
-//! passes the new pulls to the bus at the instant of the write; P4DR reads return the bus
-//! lines at the instant of the read (input bits, through the pull-up rule of
-//! [`crate::chip::periph::ports`]). The chips' own events (end of a write cycle) are applied lazily
-//! by the bus.
+//! The chip model carries the robot's EEPROM bus (two 24LC256 at 0x50 and 0x51, SPEC §3.6) on
+//! P4.7 (SDA) and P4.6 (SCL), as the ports module describes ([`crate::chip::periph::ports`]),
+//! so that the chips' own events (the end of a write cycle) are synchronised with the chip's
+//! clock; they are applied lazily by the bus.
 //!
 //! # Other registers
-//! SYSCR (H'FFFFF2) reads back what was written (reset H'0B). Registers of modules not
-//! modelled (DMAC, watchdog, SCI0, TPC, ports 1, 3, 5, 6, 7, 8, 9, the bus controller, the IRQ
-//! registers) read 0 and ignore writes.
+//! Registers of modules not modelled (DMAC, watchdog, SCI0, TPC, ports 1, 3, 5, 6, 7, 8, 9,
+//! the bus controller, the IRQ registers) read 0 and ignore writes.
 
 use std::cell::Cell;
 
 use eeprom::{DeviceConfig, EepromError, I2cBus, PowerCutOutcome};
 
-use crate::chip::periph::adc::{self, Adc};
-use crate::chip::periph::intc::{self, Intc};
+use crate::chip::periph::Peripheral;
+use crate::chip::periph::adc::Adc;
+use crate::chip::periph::intc::Intc;
 use crate::chip::periph::itu::{self, Itu, PwmWave};
-use crate::chip::periph::ports::{
-    self, P4_SCL, P4_SDA, PA_TIOCA0, PA_TIOCA1, PA_TIOCA2, PB_TIOCA3, PB_TIOCA4, Port,
-};
-use crate::chip::periph::sci::{self, Sci};
+use crate::chip::periph::ports::{PortPins, Ports};
+use crate::chip::periph::sci::Sci;
 use crate::core::bus::Bus;
 use crate::core::memmap::{
     ADDRESS_MASK, Area, IO_ACCESS_STATES, RAM_BYTES, RAM_START, ROM_BYTES, ROM_END,
@@ -67,11 +69,6 @@ pub const DEFAULT_CLOCK_HZ: u32 = 25_000_000;
 pub const MIN_CLOCK_HZ: u32 = 2_000_000;
 /// Highest φ accepted: 25 MHz (same table; also the top of the EEPROM model's clock range).
 pub const MAX_CLOCK_HZ: u32 = 25_000_000;
-
-/// Address of SYSCR, the system control register (SPEC §4.1: H'FFFFF2).
-pub const SYSCR: u32 = 0xFF_FFF2;
-/// Reset value of SYSCR in this model: H'0B (UE = 1, RAME = 1, STS = 000, SSBY = 0).
-pub const SYSCR_RESET: u8 = 0x0B;
 
 /// Index masks of the flash and RAM arrays (both sizes are powers of two).
 const ROM_INDEX_MASK: usize = ROM_BYTES as usize - 1;
@@ -184,17 +181,133 @@ pub struct Mcu<B: Board> {
     itu: Itu,
     adc: Adc,
     intc: Intc,
-    p2: Port,
-    p4: Port,
-    pa: Port,
-    pb: Port,
-    syscr: u8,
+    ports: Ports,
     i2c: I2cBus,
     board: B,
     /// The winning interrupt request as of the last computation.
     irq_cached: Cell<Option<u8>>,
     /// The cached request is valid while `now` is below this.
     irq_valid_until: Cell<u64>,
+}
+
+/// The on-chip module that owns an I/O address: the chip's map of its register blocks, each
+/// block as its module declares it ([`Peripheral::FIRST`]..=[`Peripheral::LAST`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Module {
+    Itu,
+    Sci,
+    Ports,
+    Adc,
+    Intc,
+    /// No module: reads 0, writes are ignored.
+    Unmodelled,
+}
+
+impl Module {
+    /// Every module, in the order the chip synchronises and resets them.
+    const ALL: [Module; 5] = [
+        Module::Itu,
+        Module::Adc,
+        Module::Sci,
+        Module::Ports,
+        Module::Intc,
+    ];
+
+    /// The module whose block holds `a` (an I/O address).
+    #[inline]
+    fn of(a: u32) -> Module {
+        match a {
+            <Itu as Peripheral>::FIRST..=<Itu as Peripheral>::LAST => Module::Itu,
+            <Sci as Peripheral>::FIRST..=<Sci as Peripheral>::LAST => Module::Sci,
+            <Ports as Peripheral>::FIRST..=<Ports as Peripheral>::LAST => Module::Ports,
+            <Adc as Peripheral>::FIRST..=<Adc as Peripheral>::LAST => Module::Adc,
+            <Intc as Peripheral>::FIRST..=<Intc as Peripheral>::LAST => Module::Intc,
+            _ => Module::Unmodelled,
+        }
+    }
+
+    /// Whether a write to the module can change the interrupt decision.
+    #[inline]
+    const fn affects_irq(self) -> bool {
+        match self {
+            Module::Itu => <Itu as Peripheral>::AFFECTS_IRQ,
+            Module::Sci => <Sci as Peripheral>::AFFECTS_IRQ,
+            Module::Ports => <Ports as Peripheral>::AFFECTS_IRQ,
+            Module::Adc => <Adc as Peripheral>::AFFECTS_IRQ,
+            Module::Intc => <Intc as Peripheral>::AFFECTS_IRQ,
+            Module::Unmodelled => false,
+        }
+    }
+}
+
+/// Evaluates `$body` with `$p` bound to module `$m` of the MCU `$mcu` and `$outside` to what
+/// that module sees outside itself (the board's analog inputs for the A/D converter; the
+/// port-2 pins, the EEPROM bus and the ITU for the ports; nothing for the others), or `$none`
+/// for [`Module::Unmodelled`]. The one place that says which field holds which module.
+macro_rules! on_module {
+    ($mcu:ident, $m:expr, |$p:ident, $outside:ident| $body:expr, $none:expr) => {
+        match $m {
+            Module::Itu => {
+                let ($p, $outside) = (&mut $mcu.itu, ());
+                $body
+            }
+            Module::Sci => {
+                let ($p, $outside) = (&mut $mcu.sci, ());
+                $body
+            }
+            Module::Ports => {
+                let board = &mut $mcu.board;
+                let $p = &mut $mcu.ports;
+                let $outside = PortPins {
+                    port2: &mut |t| board.port2_pins(t),
+                    i2c: &mut $mcu.i2c,
+                    itu: &mut $mcu.itu,
+                };
+                $body
+            }
+            Module::Adc => {
+                let board = &mut $mcu.board;
+                let $p = &mut $mcu.adc;
+                let $outside: &mut dyn FnMut(u8, u64) -> f64 =
+                    &mut |ch, t| board.analog_volts(ch, t);
+                $body
+            }
+            Module::Intc => {
+                let ($p, $outside) = (&mut $mcu.intc, ());
+                $body
+            }
+            Module::Unmodelled => $none,
+        }
+    };
+}
+
+/// `[$body; 5]` with `$p` bound to each module of `$mcu` in turn, by shared reference (for the
+/// questions that need nothing outside the module).
+macro_rules! each_module {
+    ($mcu:ident, |$p:ident| $body:expr) => {
+        [
+            {
+                let $p = &$mcu.itu;
+                $body
+            },
+            {
+                let $p = &$mcu.adc;
+                $body
+            },
+            {
+                let $p = &$mcu.sci;
+                $body
+            },
+            {
+                let $p = &$mcu.ports;
+                $body
+            },
+            {
+                let $p = &$mcu.intc;
+                $body
+            },
+        ]
+    };
 }
 
 impl<B: Board> Mcu<B> {
@@ -225,11 +338,7 @@ impl<B: Board> Mcu<B> {
             itu: Itu::new(),
             adc: Adc::new(),
             intc: Intc::new(),
-            p2: Port::new(),
-            p4: Port::new(),
-            pa: Port::new(),
-            pb: Port::new(),
-            syscr: SYSCR_RESET,
+            ports: Ports::new(),
             i2c,
             board,
             irq_cached: Cell::new(None),
@@ -395,9 +504,9 @@ impl<B: Board> Mcu<B> {
     /// Brings every peripheral and the EEPROM bus up to the current clock.
     pub fn sync(&mut self) {
         let now = self.now;
-        self.itu.sync(now);
-        self.sync_adc();
-        self.sci.sync(now);
+        for m in Module::ALL {
+            on_module!(self, m, |p, outside| Peripheral::sync(p, now, outside), ());
+        }
         // Time never goes back here (max), so the bus cannot refuse.
         let _ = self.i2c.advance_to(now.max(self.i2c.now()));
         self.invalidate_irq();
@@ -409,32 +518,20 @@ impl<B: Board> Mcu<B> {
     #[must_use]
     pub fn next_event(&self) -> Option<u64> {
         let now = self.now;
-        [
-            self.itu.next_event(now),
-            self.adc.next_event(now),
-            self.sci.next_irq_time(now),
-            self.i2c.next_event_states().filter(|&t| t > now),
-        ]
-        .into_iter()
-        .flatten()
-        .min()
+        each_module!(self, |p| Peripheral::next_event(p, now))
+            .into_iter()
+            .chain([self.i2c.next_event_states().filter(|&t| t > now)])
+            .flatten()
+            .min()
     }
 
     /// The earliest state after now at which an enabled interrupt request appears.
     fn next_irq_time(&self) -> Option<u64> {
         let now = self.now;
-        [
-            self.itu.next_irq_time(now),
-            self.adc.next_irq_time(now),
-            if self.sci_requests(now) == 0 {
-                self.sci.next_irq_time(now)
-            } else {
-                None
-            },
-        ]
-        .into_iter()
-        .flatten()
-        .min()
+        each_module!(self, |p| Peripheral::next_request(p, now))
+            .into_iter()
+            .flatten()
+            .min()
     }
 
     /// What ITU channel `n`'s TIOCA output does now (channels out of range: neither driving nor
@@ -456,13 +553,13 @@ impl<B: Board> Mcu<B> {
     /// Levels of port A's pins now: TIOCA0–2 where the ITU drives them, else the output latch;
     /// input pins read 0 (port A has no pull-ups and nothing outside drives it here).
     pub fn port_a_pins(&mut self) -> u8 {
-        self.pa_pins()
+        self.ports.pa_pins(&mut self.itu, self.now)
     }
 
     /// Levels of port B's pins now: TIOCA3/TIOCA4 where the ITU drives them, else the output
     /// latch; input pins read 0.
     pub fn port_b_pins(&mut self) -> u8 {
-        self.pb_pins()
+        self.ports.pb_pins(&mut self.itu, self.now)
     }
 
     /// Cuts the robot's power now: the EEPROMs lose power (a write cycle under way is
@@ -495,15 +592,9 @@ impl<B: Board> Mcu<B> {
     }
 
     fn reset_peripherals(&mut self) {
-        self.sci = Sci::new();
-        self.itu = Itu::new();
-        self.adc = Adc::new();
-        self.intc = Intc::new();
-        self.p2 = Port::new();
-        self.p4 = Port::new();
-        self.pa = Port::new();
-        self.pb = Port::new();
-        self.syscr = SYSCR_RESET;
+        for m in Module::ALL {
+            on_module!(self, m, |p, _outside| Peripheral::reset(p), ());
+        }
         self.invalidate_irq();
     }
 
@@ -520,22 +611,13 @@ impl<B: Board> Mcu<B> {
         self.itu.sync_irq_sources(self.now);
     }
 
-    fn sync_adc(&mut self) {
-        let now = self.now;
-        let board = &mut self.board;
-        self.adc.sync(now, &mut |ch, t| board.analog_volts(ch, t));
-    }
-
-    #[inline]
-    fn sci_requests(&self, now: u64) -> u64 {
-        self.sci.pending_irq(now).map_or(0, |v| 1u64 << v)
-    }
-
     /// Recomputes the pending interrupt and how long it stays valid.
     #[cold]
     fn refresh_irq(&self) -> Option<u8> {
         let now = self.now;
-        let requests = self.itu.requests(now) | self.adc.requests(now) | self.sci_requests(now);
+        let requests = each_module!(self, |p| Peripheral::requests(p, now))
+            .into_iter()
+            .fold(0, |all, r| all | r);
         let winner = self.intc.choose(requests);
         let valid_until = match self.next_irq_time() {
             Some(t) if t > now => t,
@@ -547,134 +629,30 @@ impl<B: Board> Mcu<B> {
         winner
     }
 
-    /// Pin levels of port A: ITU-driven TIOCA0–2 (PA2, PA4, PA6), else the output latch; input
-    /// pins with nothing connected float and read 0 (port A has no pull-ups).
-    fn pa_pins(&mut self) -> u8 {
-        let mut pins = self.pa.output_levels();
-        for (ch, bit) in [(0, PA_TIOCA0), (1, PA_TIOCA1), (2, PA_TIOCA2)] {
-            let (level, drives) = self.itu.tioca(ch, self.now);
-            if drives {
-                pins = (pins & !bit) | if level { bit } else { 0 };
-            }
-        }
-        pins
-    }
-
-    /// Pin levels of port B: ITU-driven TIOCA3/TIOCA4 (PB0, PB2), else the output latch.
-    fn pb_pins(&mut self) -> u8 {
-        let mut pins = self.pb.output_levels();
-        for (ch, bit) in [(3, PB_TIOCA3), (4, PB_TIOCA4)] {
-            let (level, drives) = self.itu.tioca(ch, self.now);
-            if drives {
-                pins = (pins & !bit) | if level { bit } else { 0 };
-            }
-        }
-        pins
-    }
-
-    /// Levels of port 4's input pins: SDA/SCL from the bus, the rest unconnected; a released
-    /// pin reads high only through its pull-up.
-    fn p4_inputs(&mut self) -> u8 {
-        let t = self.now.max(self.i2c.now());
-        let released = match self.i2c.lines(t) {
-            Ok(l) => {
-                !(P4_SDA | P4_SCL) | if l.sda { P4_SDA } else { 0 } | if l.scl { P4_SCL } else { 0 }
-            }
-            // Cannot happen (time never goes back here); read the lines as released.
-            Err(_) => 0xFF,
-        };
-        self.p4.open_drain_levels(released)
-    }
-
-    /// Passes port 4's pulls on SDA/SCL to the bus at the current instant.
-    fn update_i2c(&mut self) {
-        let low = self.p4.driven_low();
-        let scl_low = low & P4_SCL != 0;
-        let sda_low = low & P4_SDA != 0;
-        if self.i2c.master_pulls() != (scl_low, sda_low) {
-            let t = self.now.max(self.i2c.now());
-            // Cannot fail: time never goes back here.
-            let _ = self.i2c.set_master(t, scl_low, sda_low);
-        }
-    }
-
     fn io_read8(&mut self, a: u32) -> u8 {
-        // Reads catch peripherals up but change no request (flags clear only by writes), so
-        // the cached interrupt decision stays valid.
+        // Reads catch modules up but change no request (flags clear only by writes), so the
+        // cached interrupt decision stays valid.
         let now = self.now;
-        match a {
-            itu::ITU_FIRST..=itu::ITU_LAST => self.itu.read(a, now),
-            sci::SCI1_SMR..=sci::SCI1_RDR => self.sci.read(a, now),
-            ports::P2DDR | ports::P4DDR | ports::PADDR | ports::PBDDR => ports::DDR_READ_VALUE,
-            ports::P2DR => {
-                let released = self.board.port2_pins(now);
-                self.p2.read_dr(self.p2.open_drain_levels(released))
-            }
-            ports::P4DR => {
-                let inputs = self.p4_inputs();
-                self.p4.read_dr(inputs)
-            }
-            ports::PADR => {
-                let pins = self.pa_pins();
-                self.pa.read_dr(pins)
-            }
-            ports::PBDR => {
-                let pins = self.pb_pins();
-                self.pb.read_dr(pins)
-            }
-            ports::P2PCR => self.p2.pcr,
-            ports::P4PCR => self.p4.pcr,
-            adc::ADDRA..=adc::ADCR => {
-                self.sync_adc();
-                self.adc.read(a)
-            }
-            SYSCR => self.syscr,
-            intc::IPRA | intc::IPRB => self.intc.read(a),
-            _ => 0,
-        }
+        on_module!(
+            self,
+            Module::of(a),
+            |p, outside| Peripheral::read(p, a, now, outside),
+            0
+        )
     }
 
     fn io_write8(&mut self, a: u32, v: u8) {
         let now = self.now;
-        // Writes to the interrupt sources and to the priority registers change the pending
-        // interrupt; port writes (I²C bit-banging, motor direction) cannot.
-        match a {
-            itu::ITU_FIRST..=itu::ITU_LAST => {
-                self.before_irq_write();
-                self.itu.write(a, v, now);
-            }
-            sci::SCI1_SMR..=sci::SCI1_RDR => {
-                self.before_irq_write();
-                self.sci.write(a, v, now);
-            }
-            ports::P2DDR => self.p2.ddr = v,
-            ports::P2DR => self.p2.dr = v,
-            ports::P2PCR => self.p2.pcr = v,
-            ports::P4DDR => {
-                self.p4.ddr = v;
-                self.update_i2c();
-            }
-            ports::P4DR => {
-                self.p4.dr = v;
-                self.update_i2c();
-            }
-            ports::P4PCR => self.p4.pcr = v,
-            ports::PADDR => self.pa.ddr = v,
-            ports::PADR => self.pa.dr = v,
-            ports::PBDDR => self.pb.ddr = v,
-            ports::PBDR => self.pb.dr = v,
-            adc::ADDRA..=adc::ADCR => {
-                self.before_irq_write();
-                self.sync_adc();
-                self.adc.write(a, v, now);
-            }
-            SYSCR => self.syscr = v,
-            intc::IPRA | intc::IPRB => {
-                self.before_irq_write();
-                self.intc.write(a, v);
-            }
-            _ => {}
+        let module = Module::of(a);
+        if module.affects_irq() {
+            self.before_irq_write();
         }
+        on_module!(
+            self,
+            module,
+            |p, outside| Peripheral::write(p, a, v, now, outside),
+            ()
+        );
     }
 }
 
@@ -838,6 +816,7 @@ impl<B: Board> Bus for Mcu<B> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::chip::periph::adc;
 
     fn mcu() -> Mcu<NullBoard> {
         Mcu::new(McuConfig::default(), NullBoard).unwrap()
@@ -908,6 +887,7 @@ mod tests {
 
     #[test]
     fn syscr_and_unmodelled_registers() {
+        use crate::chip::periph::intc::{SYSCR, SYSCR_RESET};
         let mut m = mcu();
         assert_eq!(m.read8(SYSCR), SYSCR_RESET);
         m.write8(SYSCR, 0x09);

@@ -47,6 +47,8 @@
 
 use sensors::adc10_code;
 
+use super::Peripheral;
+
 /// Address of ADDRA (high byte; low byte at +1) (SPEC §3.2: H'FFFFE0).
 pub const ADDRA: u32 = 0xFF_FFE0;
 /// Address of ADDRB.
@@ -215,13 +217,6 @@ impl Adc {
         }
     }
 
-    /// Whether `addr` (24-bit) is an A/D register.
-    #[inline]
-    #[must_use]
-    pub const fn decodes(addr: u32) -> bool {
-        addr >= ADDRA && addr <= ADCR
-    }
-
     /// Whether a conversion run is under way (ADST = 1), as of the last synchronisation.
     #[must_use]
     pub const fn busy(&self) -> bool {
@@ -379,6 +374,47 @@ impl Adc {
             ADCR => self.adcr = value & ADCR_TRGE,
             _ => {}
         }
+    }
+}
+
+impl Peripheral for Adc {
+    /// The analog inputs: volts on a channel at an instant (the board's sensors).
+    type Outside<'a> = &'a mut dyn FnMut(u8, u64) -> f64;
+    const FIRST: u32 = ADDRA;
+    const LAST: u32 = ADCR;
+    const AFFECTS_IRQ: bool = true;
+
+    /// Catches up (sampling the conversions that ended), then reads.
+    fn read(&mut self, addr: u32, now: u64, mut volts: Self::Outside<'_>) -> u8 {
+        Adc::sync(self, now, &mut volts);
+        Adc::read(self, addr)
+    }
+
+    /// Catches up, then writes.
+    fn write(&mut self, addr: u32, value: u8, now: u64, mut volts: Self::Outside<'_>) {
+        Adc::sync(self, now, &mut volts);
+        Adc::write(self, addr, value, now);
+    }
+
+    fn sync(&mut self, now: u64, mut volts: Self::Outside<'_>) {
+        Adc::sync(self, now, &mut volts);
+    }
+
+    fn next_event(&self, now: u64) -> Option<u64> {
+        Adc::next_event(self, now)
+    }
+
+    #[inline]
+    fn requests(&self, now: u64) -> u64 {
+        Adc::requests(self, now)
+    }
+
+    fn next_request(&self, now: u64) -> Option<u64> {
+        self.next_irq_time(now)
+    }
+
+    fn reset(&mut self) {
+        *self = Adc::new();
     }
 }
 

@@ -14,6 +14,18 @@
 //! never masked) and the IRQ pins are not wired on the robot; the CPU core handles masking by
 //! CCR.I. The UI bit as a second mask (SYSCR.UE = 0) is not modelled (the core treats UI as a
 //! user bit, SYSCR.UE = 1 after reset).
+//!
+//! The module owns the interrupt controller's register block H'FFFFF2–H'FFFFF9 (the manual's
+//! Table 5-2: SYSCR, ISCR, IER, ISR, IPRA, IPRB). SYSCR reads back what was written (reset
+//! H'0B); IPRA/IPRB act as above; the IRQ registers (ISCR, IER, ISR: no IRQ pin is wired) and
+//! the bus controller's BRCR at H'FFFFF3 read 0 and ignore writes.
+
+use super::Peripheral;
+
+/// Address of SYSCR, the system control register (SPEC §4.1: H'FFFFF2).
+pub const SYSCR: u32 = 0xFF_FFF2;
+/// Reset value of SYSCR in this model: H'0B (UE = 1, RAME = 1, STS = 000, SSBY = 0).
+pub const SYSCR_RESET: u8 = 0x0B;
 
 /// Address of IPRA, interrupt priority register A (H8/3052F hardware manual, appendix B
 /// register map: H'FFFFF8).
@@ -83,9 +95,10 @@ const IPRB_GROUPS: [u64; 8] = [
     0,               // bit 0: reserved
 ];
 
-/// IPRA/IPRB and the priority decision.
+/// SYSCR, IPRA/IPRB and the priority decision.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Intc {
+    syscr: u8,
     ipra: u8,
     iprb: u8,
     /// Vectors at priority level 1, derived from IPRA/IPRB on every write.
@@ -99,35 +112,35 @@ impl Default for Intc {
 }
 
 impl Intc {
-    /// The controller after reset: every source at level 0.
+    /// The controller after reset: every source at level 0, SYSCR = [`SYSCR_RESET`].
     #[must_use]
     pub const fn new() -> Self {
         Intc {
+            syscr: SYSCR_RESET,
             ipra: IPR_RESET,
             iprb: IPR_RESET,
             level1: 0,
         }
     }
 
-    /// Whether `addr` (24-bit) is IPRA or IPRB.
-    #[must_use]
-    pub const fn decodes(addr: u32) -> bool {
-        addr == IPRA || addr == IPRB
-    }
-
-    /// Reads IPRA or IPRB (other addresses read 0). Every bit reads back as written.
+    /// Reads SYSCR, IPRA or IPRB (other addresses read 0). Every bit reads back as written.
     #[must_use]
     pub fn read(&self, addr: u32) -> u8 {
         match addr {
+            SYSCR => self.syscr,
             IPRA => self.ipra,
             IPRB => self.iprb,
             _ => 0,
         }
     }
 
-    /// Writes IPRA or IPRB (other addresses are ignored).
+    /// Writes SYSCR, IPRA or IPRB (other addresses are ignored).
     pub fn write(&mut self, addr: u32, value: u8) {
         match addr {
+            SYSCR => {
+                self.syscr = value;
+                return;
+            }
             IPRA => self.ipra = value,
             IPRB => self.iprb = value,
             _ => return,
@@ -164,6 +177,41 @@ impl Intc {
             // trailing_zeros of a non-zero u64 is at most 63.
             Some(pick.trailing_zeros() as u8)
         }
+    }
+}
+
+impl Peripheral for Intc {
+    type Outside<'a> = ();
+    const FIRST: u32 = SYSCR;
+    const LAST: u32 = IPRB;
+    const AFFECTS_IRQ: bool = true;
+
+    fn read(&mut self, addr: u32, _now: u64, (): ()) -> u8 {
+        Intc::read(self, addr)
+    }
+
+    fn write(&mut self, addr: u32, value: u8, _now: u64, (): ()) {
+        Intc::write(self, addr, value);
+    }
+
+    fn sync(&mut self, _now: u64, (): ()) {}
+
+    fn next_event(&self, _now: u64) -> Option<u64> {
+        None
+    }
+
+    /// The controller requests nothing itself: it chooses among the sources' requests
+    /// ([`Intc::choose`]).
+    fn requests(&self, _now: u64) -> u64 {
+        0
+    }
+
+    fn next_request(&self, _now: u64) -> Option<u64> {
+        None
+    }
+
+    fn reset(&mut self) {
+        *self = Intc::new();
     }
 }
 

@@ -48,6 +48,8 @@
 //! orbit: up to the clearing value or H'FFFF, then round a cycle of GRA + 1, GRB + 1 or
 //! 65 536 counts). Nothing is stepped per state.
 
+use super::Peripheral;
+
 /// Address of TSTR, timer start register (SPEC §4.1: H'FFFF60).
 pub const TSTR: u32 = 0xFF_FF60;
 /// Address of TSNC, timer synchro register.
@@ -584,13 +586,6 @@ impl Itu {
         }
     }
 
-    /// Whether `addr` (24-bit) is an ITU register.
-    #[inline]
-    #[must_use]
-    pub const fn decodes(addr: u32) -> bool {
-        addr >= ITU_FIRST && addr <= ITU_LAST
-    }
-
     /// Brings every channel to `now`.
     pub fn sync(&mut self, now: u64) {
         for c in &mut self.ch {
@@ -791,6 +786,44 @@ impl Itu {
             c.sync(now);
             c.tcnt
         })
+    }
+}
+
+impl Peripheral for Itu {
+    type Outside<'a> = ();
+    const FIRST: u32 = ITU_FIRST;
+    const LAST: u32 = ITU_LAST;
+    const AFFECTS_IRQ: bool = true;
+
+    #[inline]
+    fn read(&mut self, addr: u32, now: u64, (): ()) -> u8 {
+        Itu::read(self, addr, now)
+    }
+
+    #[inline]
+    fn write(&mut self, addr: u32, value: u8, now: u64, (): ()) {
+        Itu::write(self, addr, value, now);
+    }
+
+    fn sync(&mut self, now: u64, (): ()) {
+        Itu::sync(self, now);
+    }
+
+    fn next_event(&self, now: u64) -> Option<u64> {
+        Itu::next_event(self, now)
+    }
+
+    #[inline]
+    fn requests(&self, now: u64) -> u64 {
+        Itu::requests(self, now)
+    }
+
+    fn next_request(&self, now: u64) -> Option<u64> {
+        self.next_irq_time(now)
+    }
+
+    fn reset(&mut self) {
+        *self = Itu::new();
     }
 }
 

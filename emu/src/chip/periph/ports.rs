@@ -16,8 +16,20 @@
 //!   that forgets to enable the pull-ups it needs (bumpers, I²C) misreads as it would on the
 //!   robot. The pull-up is off for output bits, as on the chip. Ports A and B have no
 //!   pull-ups.
-//! - Pins driven by a peripheral (TIOCA outputs of the ITU) read their peripheral level; the
-//!   MCU computes those levels ([`crate::chip::mcu`]).
+//! - Pins driven by a peripheral (TIOCA outputs of the ITU) read their peripheral level.
+//! - Port 4's P4.7/P4.6 carry the robot's I²C bus to its EEPROMs ([`P4_SDA`], [`P4_SCL`]): a
+//!   line is pulled low while its DDR bit is 1 with DR = 0 and released otherwise (a 1 in DR
+//!   with DDR = 1 would drive the line high; it is treated as a release, since only the master
+//!   could then pull it). Every write to P4DDR or P4DR passes the new pulls to the bus at the
+//!   instant of the write; P4DR reads return the bus lines at the instant of the read.
+//!
+//! [`Ports`] is the four ports as one [`Peripheral`] owning the port block H'FFFFC0–H'FFFFDB;
+//! the registers of the ports not modelled (1, 3, 5, 6, 7, 8, 9) read 0 and ignore writes.
+
+use eeprom::I2cBus;
+
+use super::Peripheral;
+use super::itu::Itu;
 
 /// Address of P2DDR, port 2 data direction register (write-only; SPEC §4.1: H'FFFFC1).
 pub const P2DDR: u32 = 0xFF_FFC1;
@@ -125,6 +137,170 @@ impl Port {
     #[must_use]
     pub const fn output_levels(&self) -> u8 {
         self.ddr & self.dr
+    }
+}
+
+/// First address of the port block: P1DDR (H'FFFFC0).
+pub const PORTS_FIRST: u32 = 0xFF_FFC0;
+/// Last address of the port block: P5PCR (H'FFFFDB).
+pub const PORTS_LAST: u32 = 0xFF_FFDB;
+
+/// What the ports see around them during an access.
+pub struct PortPins<'a> {
+    /// Levels of the port-2 pins from outside at an instant: 0 where something pulls the pin
+    /// low, 1 where nothing does (the board's bumpers).
+    pub port2: &'a mut dyn FnMut(u64) -> u8,
+    /// The EEPROM bus on P4.7 (SDA) and P4.6 (SCL).
+    pub i2c: &'a mut I2cBus,
+    /// The ITU, whose TIOCA outputs share pins with ports A and B.
+    pub itu: &'a mut Itu,
+}
+
+/// Ports 2, 4, A and B.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Ports {
+    p2: Port,
+    p4: Port,
+    pa: Port,
+    pb: Port,
+}
+
+impl Ports {
+    /// The ports after reset.
+    #[must_use]
+    pub const fn new() -> Self {
+        Ports {
+            p2: Port::new(),
+            p4: Port::new(),
+            pa: Port::new(),
+            pb: Port::new(),
+        }
+    }
+
+    /// Pin levels of port A at `now`: ITU-driven TIOCA0–2 (PA2, PA4, PA6), else the output
+    /// latch; input pins with nothing connected float and read 0 (port A has no pull-ups).
+    pub fn pa_pins(&self, itu: &mut Itu, now: u64) -> u8 {
+        let mut pins = self.pa.output_levels();
+        for (ch, bit) in [(0, PA_TIOCA0), (1, PA_TIOCA1), (2, PA_TIOCA2)] {
+            let (level, drives) = itu.tioca(ch, now);
+            if drives {
+                pins = (pins & !bit) | if level { bit } else { 0 };
+            }
+        }
+        pins
+    }
+
+    /// Pin levels of port B at `now`: ITU-driven TIOCA3/TIOCA4 (PB0, PB2), else the output
+    /// latch.
+    pub fn pb_pins(&self, itu: &mut Itu, now: u64) -> u8 {
+        let mut pins = self.pb.output_levels();
+        for (ch, bit) in [(3, PB_TIOCA3), (4, PB_TIOCA4)] {
+            let (level, drives) = itu.tioca(ch, now);
+            if drives {
+                pins = (pins & !bit) | if level { bit } else { 0 };
+            }
+        }
+        pins
+    }
+
+    /// Levels of port 4's input pins: SDA/SCL from the bus, the rest unconnected; a released
+    /// pin reads high only through its pull-up.
+    fn p4_inputs(&self, i2c: &mut I2cBus, now: u64) -> u8 {
+        let t = now.max(i2c.now());
+        let released = match i2c.lines(t) {
+            Ok(l) => {
+                !(P4_SDA | P4_SCL) | if l.sda { P4_SDA } else { 0 } | if l.scl { P4_SCL } else { 0 }
+            }
+            // Cannot happen (time never goes back here); read the lines as released.
+            Err(_) => 0xFF,
+        };
+        self.p4.open_drain_levels(released)
+    }
+
+    /// Passes port 4's pulls on SDA/SCL to the bus at `now`.
+    fn update_i2c(&self, i2c: &mut I2cBus, now: u64) {
+        let low = self.p4.driven_low();
+        let scl_low = low & P4_SCL != 0;
+        let sda_low = low & P4_SDA != 0;
+        if i2c.master_pulls() != (scl_low, sda_low) {
+            let t = now.max(i2c.now());
+            // Cannot fail: time never goes back here.
+            let _ = i2c.set_master(t, scl_low, sda_low);
+        }
+    }
+}
+
+impl Peripheral for Ports {
+    type Outside<'a> = PortPins<'a>;
+    const FIRST: u32 = PORTS_FIRST;
+    const LAST: u32 = PORTS_LAST;
+    /// Port writes (I²C bit-banging, motor direction) request no interrupt.
+    const AFFECTS_IRQ: bool = false;
+
+    fn read(&mut self, addr: u32, now: u64, pins: PortPins<'_>) -> u8 {
+        match addr {
+            P2DDR | P4DDR | PADDR | PBDDR => DDR_READ_VALUE,
+            P2DR => {
+                let released = (pins.port2)(now);
+                self.p2.read_dr(self.p2.open_drain_levels(released))
+            }
+            P4DR => {
+                let inputs = self.p4_inputs(pins.i2c, now);
+                self.p4.read_dr(inputs)
+            }
+            PADR => {
+                let levels = self.pa_pins(pins.itu, now);
+                self.pa.read_dr(levels)
+            }
+            PBDR => {
+                let levels = self.pb_pins(pins.itu, now);
+                self.pb.read_dr(levels)
+            }
+            P2PCR => self.p2.pcr,
+            P4PCR => self.p4.pcr,
+            _ => 0,
+        }
+    }
+
+    fn write(&mut self, addr: u32, value: u8, now: u64, pins: PortPins<'_>) {
+        match addr {
+            P2DDR => self.p2.ddr = value,
+            P2DR => self.p2.dr = value,
+            P2PCR => self.p2.pcr = value,
+            P4DDR => {
+                self.p4.ddr = value;
+                self.update_i2c(pins.i2c, now);
+            }
+            P4DR => {
+                self.p4.dr = value;
+                self.update_i2c(pins.i2c, now);
+            }
+            P4PCR => self.p4.pcr = value,
+            PADDR => self.pa.ddr = value,
+            PADR => self.pa.dr = value,
+            PBDDR => self.pb.ddr = value,
+            PBDR => self.pb.dr = value,
+            _ => {}
+        }
+    }
+
+    /// Nothing to catch up: the ports hold latches; what they read is asked at the read.
+    fn sync(&mut self, _now: u64, _pins: PortPins<'_>) {}
+
+    fn next_event(&self, _now: u64) -> Option<u64> {
+        None
+    }
+
+    fn requests(&self, _now: u64) -> u64 {
+        0
+    }
+
+    fn next_request(&self, _now: u64) -> Option<u64> {
+        None
+    }
+
+    fn reset(&mut self) {
+        *self = Ports::new();
     }
 }
 

@@ -17,6 +17,8 @@
 //! waiting in TDR, as the manual says the transmitter is initialised. Times are evaluated
 //! lazily from the clock value of each access, so the SCI needs no stepping.
 
+use super::Peripheral;
+
 /// Address of SMR (serial mode register) of SCI1 (SPEC §4.1).
 pub const SCI1_SMR: u32 = 0xFF_FFB8;
 /// Address of BRR (bit rate register) of SCI1.
@@ -132,12 +134,6 @@ impl Sci {
             out: Vec::new(),
             sent: 0,
         }
-    }
-
-    /// Whether `addr` (24-bit) is one of SCI1's registers.
-    #[must_use]
-    pub const fn decodes(addr: u32) -> bool {
-        addr >= SCI1_SMR && addr <= SCI1_RDR
     }
 
     /// States of one frame with the current SMR and BRR.
@@ -316,6 +312,49 @@ impl Sci {
     #[must_use]
     pub const fn bytes_sent(&self) -> u64 {
         self.sent
+    }
+}
+
+impl Peripheral for Sci {
+    type Outside<'a> = ();
+    const FIRST: u32 = SCI1_SMR;
+    const LAST: u32 = SCI1_RDR;
+    const AFFECTS_IRQ: bool = true;
+
+    fn read(&mut self, addr: u32, now: u64, (): ()) -> u8 {
+        Sci::read(self, addr, now)
+    }
+
+    fn write(&mut self, addr: u32, value: u8, now: u64, (): ()) {
+        Sci::write(self, addr, value, now);
+    }
+
+    fn sync(&mut self, now: u64, (): ()) {
+        Sci::sync(self, now);
+    }
+
+    /// The next frame edge that changes TDRE or TEND.
+    fn next_event(&self, now: u64) -> Option<u64> {
+        self.next_irq_time(now)
+    }
+
+    #[inline]
+    fn requests(&self, now: u64) -> u64 {
+        self.pending_irq(now).map_or(0, |v| 1u64 << v)
+    }
+
+    /// [`Sci::next_irq_time`] while nothing is requested; once TXI or TEI is requested, SCI1
+    /// raises nothing new before a register access.
+    fn next_request(&self, now: u64) -> Option<u64> {
+        if Peripheral::requests(self, now) == 0 {
+            self.next_irq_time(now)
+        } else {
+            None
+        }
+    }
+
+    fn reset(&mut self) {
+        *self = Sci::new();
     }
 }
 
