@@ -57,6 +57,11 @@ static u16 save_count;
 static u32 rng;      /* xorshift32 state */
 
 void tick_isr(void) __attribute__((interrupt_handler));
+void boot(void);
+void ad_scan(u8 *p);
+void motors_set(u8 b);
+void robot_step(void);
+void weights_random(void);
 void tick_isr(void)
 {
     TSR0 &= (u8)~IMA; /* read with IMFA = 1, write 0: the flag clears */
@@ -156,7 +161,7 @@ void motors_set(u8 b)
     PBDR = r->dir;
 }
 
-static void robot_step(void)
+void robot_step(void)
 {
     u8 p[4];
     u8 b;
