@@ -1,9 +1,16 @@
 //! The robot board around the chip: [`wiring`] (which robot part sits on which pin, and what
 //! the motor pins mean to the H-bridges), [`ram`] (the on-chip RAM as a budget of placed
-//! items), and [`model`], the Rust model of the controller the robot runs.
+//! items), the robot's firmware ([`firmware`]: images, their [`symbols`], the configuration
+//! block; [`profile`]: states per function from the symbol table; [`oncore`]: the firmware's
+//! learner routines called by symbol), and [`model`], the Rust model of the controller the
+//! robot runs, checked against the firmware.
 //!
 //! The board knows the chip and the core; neither knows it.
 
+pub mod firmware;
 pub mod model;
+pub mod oncore;
+pub mod profile;
 pub mod ram;
+pub mod symbols;
 pub mod wiring;

@@ -1,0 +1,354 @@
+//! Firmware images on the robot board: loading an image with its symbol table, writing the
+//! configuration block (SPEC §8) into the flash at load, reading back what the firmware made of
+//! it, and running the image on the core.
+
+use std::path::Path;
+
+use crate::board::symbols::{SymbolError, SymbolTable};
+use crate::chip::mcu::{Board, LoadError, Mcu};
+use crate::core::cpu::{Cpu, CpuError, Event};
+use crate::core::srec::{self, SrecError, SrecImage};
+
+/// Where the configuration block sits in the flash (SPEC §8: "say H'000400, after the
+/// vectors").
+pub const CONFIG_BLOCK_ADDR: u32 = 0x400;
+/// Bytes of the block.
+pub const CONFIG_BLOCK_BYTES: usize = 32;
+/// The block's magic.
+pub const CONFIG_MAGIC: [u8; 4] = *b"H8SW";
+/// The block's format version.
+pub const CONFIG_VERSION: u8 = 1;
+/// Flags bit 0: the bias input.
+pub const FLAG_BIAS: u8 = 0x01;
+/// Flags bit 1: the random-walk control (the learner runs; the motors take a random behaviour).
+pub const FLAG_RANDOM_WALK: u8 = 0x02;
+
+/// The settings the emulator gives the firmware (see `firmware/README.md` for the layout).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ConfigBlock {
+    /// Behaviours M (2–4).
+    pub outputs: u8,
+    /// History depth H (0–8).
+    pub history: u8,
+    /// Flags ([`FLAG_BIAS`], [`FLAG_RANDOM_WALK`]).
+    pub flags: u8,
+    /// Spare inputs held at 0.
+    pub spare: u16,
+    /// η, Q15 (0–32767).
+    pub eta: i16,
+    /// T in du (0–32767).
+    pub threshold: i16,
+    /// One record every this many steps (0: never).
+    pub save_every: u16,
+    /// Ticks per step K.
+    pub ticks_per_step: u16,
+    /// Counts of φ/8 per tick: GRA0 + 1.
+    pub tick_counts: u16,
+    /// A/D channel of each sensor (front, rear, left, right).
+    pub channels: [u8; 4],
+    /// Seed of the fresh weights (xorshift32; the firmware ORs it with 1).
+    pub seed: u32,
+}
+
+impl ConfigBlock {
+    /// The firmware's compiled defaults: the arena (SPEC §5) at φ = 25 MHz.
+    pub const ARENA: ConfigBlock = ConfigBlock {
+        outputs: 4,
+        history: 1,
+        flags: 0,
+        spare: 0,
+        eta: 33,
+        threshold: 10,
+        save_every: 20,
+        ticks_per_step: 45,
+        tick_counts: 31_250,
+        channels: [0, 1, 2, 3],
+        seed: 1,
+    };
+
+    /// The 32 bytes of the block, big-endian, with its CRC-16.
+    #[must_use]
+    pub fn encode(&self) -> [u8; CONFIG_BLOCK_BYTES] {
+        let mut b = [0u8; CONFIG_BLOCK_BYTES];
+        b[0..4].copy_from_slice(&CONFIG_MAGIC);
+        b[4] = CONFIG_VERSION;
+        b[5] = self.outputs;
+        b[6] = self.history;
+        b[7] = self.flags;
+        b[8..10].copy_from_slice(&self.spare.to_be_bytes());
+        b[10..12].copy_from_slice(&self.eta.to_be_bytes());
+        b[12..14].copy_from_slice(&self.threshold.to_be_bytes());
+        b[14..16].copy_from_slice(&self.save_every.to_be_bytes());
+        b[16..18].copy_from_slice(&self.ticks_per_step.to_be_bytes());
+        b[18..20].copy_from_slice(&self.tick_counts.to_be_bytes());
+        b[20..24].copy_from_slice(&self.channels);
+        b[24..28].copy_from_slice(&self.seed.to_be_bytes());
+        // 28..30 reserved, 0.
+        let crc = eeprom::crc::crc16_ccitt_false(&b[..30]);
+        b[30..32].copy_from_slice(&crc.to_be_bytes());
+        b
+    }
+
+    /// Number of inputs N the block makes.
+    #[must_use]
+    pub fn n_inputs(&self) -> usize {
+        4 * (1 + usize::from(self.history))
+            + usize::from(self.outputs)
+            + 1
+            + usize::from(self.flags & FLAG_BIAS)
+            + usize::from(self.spare)
+    }
+}
+
+/// What the firmware made of the block at boot (its `cfg_status`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ConfigStatus {
+    /// The block was used.
+    Used,
+    /// No block: the compiled defaults run.
+    Absent,
+    /// The block's CRC did not match: the compiled defaults run.
+    Corrupt,
+    /// The firmware cannot run a value of the block (the field named): the defaults run.
+    Rejected {
+        /// The field, as the firmware's code names it.
+        field: &'static str,
+        /// The status byte.
+        code: u8,
+    },
+}
+
+impl ConfigStatus {
+    /// Decodes `cfg_status`.
+    #[must_use]
+    pub fn from_code(code: u8) -> ConfigStatus {
+        match code {
+            0 => ConfigStatus::Used,
+            1 => ConfigStatus::Absent,
+            2 => ConfigStatus::Corrupt,
+            c => ConfigStatus::Rejected {
+                code: c,
+                field: match c {
+                    0x10 => "version",
+                    0x11 => "outputs (valid 2 to 4)",
+                    0x12 => "history (valid 0 to 8)",
+                    0x13 => "flags (valid: bit 0 bias, bit 1 random walk)",
+                    0x14 => {
+                        "spare inputs (N = 4 (1 + H) + M + 1 + bias + spare must be at most 256)"
+                    }
+                    0x15 => "eta (valid 0 to 32767)",
+                    0x16 => "threshold (valid 0 to 32767)",
+                    0x18 => "ticks per step (valid 1 to 65535)",
+                    0x19 => "tick counts (valid 2 to 65535)",
+                    0x1A => "A/D channels (0 to 7, distinct, one scan group)",
+                    0x1B => "reserved (must be 0)",
+                    0x1C => {
+                        "network size (the network and a 256-byte stack do not fit the 8 KB RAM)"
+                    }
+                    _ => "unknown",
+                },
+            },
+        }
+    }
+}
+
+/// Why an image cannot be used.
+#[derive(Debug, thiserror::Error)]
+pub enum FirmwareError {
+    /// A file could not be read.
+    #[error("cannot read `{path}`")]
+    Read {
+        /// The file.
+        path: String,
+        /// The cause.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The image is not a valid S-record file.
+    #[error("`{path}` is not a valid S-record image")]
+    Srec {
+        /// The file.
+        path: String,
+        /// The cause.
+        #[source]
+        source: SrecError,
+    },
+    /// The symbol file is malformed.
+    #[error("`{path}`")]
+    Symbols {
+        /// The file.
+        path: String,
+        /// The cause.
+        #[source]
+        source: SymbolError,
+    },
+    /// A symbol the emulator needs is missing.
+    #[error("the image's symbol table has no `{0}`")]
+    MissingSymbol(String),
+    /// The image does not fit the flash.
+    #[error("loading the image into the flash")]
+    Load(#[from] LoadError),
+}
+
+/// A firmware image and its symbol table.
+#[derive(Clone, Debug)]
+pub struct Firmware {
+    /// The image.
+    pub image: SrecImage,
+    /// Its symbols.
+    pub symbols: SymbolTable,
+    /// Where it came from (for messages).
+    pub name: String,
+}
+
+/// The committed robot firmware (`firmware/robot.mot`, `firmware/robot.sym`), built into the
+/// emulator so that it runs from any folder.
+const ROBOT_MOT: &[u8] = include_bytes!("../../../firmware/robot.mot");
+const ROBOT_SYM: &str = include_str!("../../../firmware/robot.sym");
+
+impl Firmware {
+    /// The project's robot firmware (`firmware/robot.mot` and `robot.sym`, built in).
+    ///
+    /// # Errors
+    /// Only if the committed files were damaged (a test parses them).
+    pub fn robot() -> Result<Firmware, FirmwareError> {
+        let name = "firmware/robot.mot";
+        Ok(Firmware {
+            image: srec::parse(ROBOT_MOT).map_err(|source| FirmwareError::Srec {
+                path: name.to_string(),
+                source,
+            })?,
+            symbols: SymbolTable::parse(ROBOT_SYM).map_err(|source| FirmwareError::Symbols {
+                path: "firmware/robot.sym".to_string(),
+                source,
+            })?,
+            name: name.to_string(),
+        })
+    }
+
+    /// An image and its symbol file from disk.
+    ///
+    /// # Errors
+    /// [`FirmwareError`] naming the file that could not be read or parsed.
+    pub fn load(image: &Path, symbols: &Path) -> Result<Firmware, FirmwareError> {
+        let read = |p: &Path| {
+            std::fs::read(p).map_err(|source| FirmwareError::Read {
+                path: p.display().to_string(),
+                source,
+            })
+        };
+        let bytes = read(image)?;
+        let image_parsed = srec::parse(&bytes).map_err(|source| FirmwareError::Srec {
+            path: image.display().to_string(),
+            source,
+        })?;
+        let text = String::from_utf8_lossy(&read(symbols)?).into_owned();
+        let table = SymbolTable::parse(&text).map_err(|source| FirmwareError::Symbols {
+            path: symbols.display().to_string(),
+            source,
+        })?;
+        Ok(Firmware {
+            image: image_parsed,
+            symbols: table,
+            name: image.display().to_string(),
+        })
+    }
+
+    /// Bytes of the image (its ROM).
+    #[must_use]
+    pub fn rom_bytes(&self) -> usize {
+        self.image.data_len()
+    }
+
+    /// Whether the image has a configuration block (the symbol `config_block` at H'000400).
+    #[must_use]
+    pub fn has_config_block(&self) -> bool {
+        self.symbols.addr("config_block") == Some(CONFIG_BLOCK_ADDR)
+    }
+
+    /// The address of a symbol the emulator needs.
+    ///
+    /// # Errors
+    /// [`FirmwareError::MissingSymbol`].
+    pub fn addr(&self, name: &str) -> Result<u32, FirmwareError> {
+        self.symbols
+            .addr(name)
+            .ok_or_else(|| FirmwareError::MissingSymbol(name.to_string()))
+    }
+
+    /// Programs the image into `mcu`'s flash and, when given, the configuration block over it,
+    /// and resets `cpu` (PC from the reset vector).
+    ///
+    /// # Errors
+    /// [`FirmwareError::Load`] when the image does not fit the flash.
+    pub fn install<B: Board>(
+        &self,
+        mcu: &mut Mcu<B>,
+        cpu: &mut Cpu,
+        block: Option<&ConfigBlock>,
+    ) -> Result<(), FirmwareError> {
+        mcu.load_image(&self.image)?;
+        if let Some(b) = block {
+            mcu.poke(CONFIG_BLOCK_ADDR, &b.encode());
+        }
+        cpu.flush_decode_cache();
+        cpu.reset(mcu);
+        Ok(())
+    }
+}
+
+/// Reads a big-endian value of `N` bytes at `addr` (no bus cycle).
+#[must_use]
+pub fn peek_be<B: Board, const N: usize>(mcu: &Mcu<B>, addr: u32) -> u64 {
+    (0..N as u32).fold(0u64, |v, i| (v << 8) | u64::from(mcu.peek(addr + i)))
+}
+
+/// Why the firmware stopped.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// The core could not go on.
+    #[error("the core stopped")]
+    Cpu(#[from] CpuError),
+    /// The firmware halted (SLEEP with interrupts masked): a fault stub or `main` returned.
+    #[error("the firmware halted at PC H'{pc:06X} with exit status 0x{status:02X}{why}")]
+    Halted {
+        /// Where.
+        pc: u32,
+        /// R0L.
+        status: u8,
+        /// What the status means for the robot firmware.
+        why: String,
+    },
+}
+
+/// Runs `cpu` until the clock reaches `deadline` (sleeping through idle time).
+///
+/// # Errors
+/// [`RunError`] when the core stops or the firmware halts.
+pub fn run_until<B: Board>(cpu: &mut Cpu, mcu: &mut Mcu<B>, deadline: u64) -> Result<(), RunError> {
+    use crate::core::bus::Bus;
+    while mcu.now() < deadline {
+        match cpu.step(mcu, deadline)? {
+            Event::Halted => return Err(halted(cpu)),
+            Event::Asleep => break,
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
+/// The error for a halted CPU.
+#[must_use]
+pub fn halted(cpu: &Cpu) -> RunError {
+    let status = cpu.er(0) as u8;
+    let why = if (0x81..=0x80 + 60).contains(&status) {
+        format!(" (an unexpected exception: vector {})", status - 0x80)
+    } else {
+        String::new()
+    };
+    RunError::Halted {
+        pc: cpu.pc(),
+        status,
+        why,
+    }
+}
