@@ -1,0 +1,292 @@
+//! The robot firmware (firmware/, SPEC §8) running on the emulated H8/3052F: the image, the
+//! configuration block, boot, steps, motors, EEPROM records, restore after a power cut.
+
+use eeprom::persist::RecordLayout;
+use emu::board::firmware::{
+    CONFIG_BLOCK_ADDR, ConfigBlock, ConfigStatus, FLAG_RANDOM_WALK, Firmware, run_until,
+};
+use emu::board::wiring::{Bridge, motor_pins};
+use emu::chip::mcu::{Board, Mcu, McuConfig, NullBoard};
+use emu::core::bus::Bus;
+use emu::core::cpu::Cpu;
+
+/// 10 ms ticks of φ/8 at 25 MHz, in states.
+const TICK_STATES: u64 = 31_250 * 8;
+
+/// A board whose four IR voltages wander (a different slow triangle per channel), so that the
+/// learner sees rewards and punishments.
+struct Wandering;
+
+impl Board for Wandering {
+    fn analog_volts(&mut self, channel: u8, now_states: u64) -> f64 {
+        let period = 40_000_000 + 7_000_000 * u64::from(channel);
+        let phase = (now_states % period) as f64 / period as f64;
+        let tri = if phase < 0.5 {
+            phase * 2.0
+        } else {
+            2.0 - phase * 2.0
+        };
+        0.4 + 2.2 * tri
+    }
+    fn port2_pins(&mut self, _now_states: u64) -> u8 {
+        0xFF
+    }
+}
+
+fn firmware() -> Firmware {
+    Firmware::robot().expect("the committed firmware parses")
+}
+
+fn boot<B: Board>(board: B, block: Option<&ConfigBlock>) -> (Firmware, Mcu<B>, Cpu) {
+    let fw = firmware();
+    let mut mcu = Mcu::new(McuConfig::default(), board).unwrap();
+    let mut cpu = Cpu::new();
+    fw.install(&mut mcu, &mut cpu, block).unwrap();
+    (fw, mcu, cpu)
+}
+
+fn peek_u32<B: Board>(mcu: &Mcu<B>, addr: u32) -> u32 {
+    (0..4).fold(0, |v, i| (v << 8) | u32::from(mcu.peek(addr + i)))
+}
+
+fn peek_u16<B: Board>(mcu: &Mcu<B>, addr: u32) -> u16 {
+    (u16::from(mcu.peek(addr)) << 8) | u16::from(mcu.peek(addr + 1))
+}
+
+fn sym(fw: &Firmware, name: &str) -> u32 {
+    fw.symbols
+        .addr(name)
+        .unwrap_or_else(|| panic!("no symbol {name}"))
+}
+
+fn status<B: Board>(fw: &Firmware, mcu: &Mcu<B>) -> ConfigStatus {
+    ConfigStatus::from_code(mcu.peek(sym(fw, "cfg_status")))
+}
+
+#[test]
+fn the_image_holds_the_du_table_of_the_sensors_crate_and_the_block_at_h400() {
+    let fw = firmware();
+    assert!(fw.has_config_block());
+    assert_eq!(sym(&fw, "config_block"), CONFIG_BLOCK_ADDR);
+    let mut mcu = Mcu::new(McuConfig::default(), NullBoard).unwrap();
+    mcu.load_image(&fw.image).unwrap();
+    let table = sym(&fw, "du_table");
+    let image_table: Vec<u8> = (0..256).map(|i| mcu.peek(table + i)).collect();
+    assert_eq!(image_table, sensors::DU_TABLE.to_vec());
+    // The block is erased in the image: the emulator writes it.
+    assert!((0..32).all(|i| mcu.peek(CONFIG_BLOCK_ADDR + i) == 0xFF));
+    assert!(
+        fw.rom_bytes() > 4_000 && fw.rom_bytes() < 16_384,
+        "{}",
+        fw.rom_bytes()
+    );
+}
+
+#[test]
+fn the_configuration_block_is_used_checked_or_ignored() {
+    // Absent: the compiled defaults (the arena, 13 x 4).
+    let (fw, mut mcu, mut cpu) = boot(NullBoard, None);
+    run_until(&mut cpu, &mut mcu, 2 * TICK_STATES).unwrap();
+    assert_eq!(status(&fw, &mcu), ConfigStatus::Absent);
+    assert_eq!(peek_u16(&mcu, sym(&fw, "net_n_in")), 13);
+    assert_eq!(mcu.peek(sym(&fw, "net_n_out")), 4);
+
+    // Used: the corridor's network without history.
+    let block = ConfigBlock {
+        outputs: 2,
+        history: 0,
+        eta: 3277,
+        ticks_per_step: 60,
+        ..ConfigBlock::ARENA
+    };
+    let (fw, mut mcu, mut cpu) = boot(NullBoard, Some(&block));
+    run_until(&mut cpu, &mut mcu, 2 * TICK_STATES).unwrap();
+    assert_eq!(status(&fw, &mcu), ConfigStatus::Used);
+    assert_eq!(peek_u16(&mcu, sym(&fw, "net_n_in")), 7);
+    assert_eq!(mcu.peek(sym(&fw, "net_n_out")), 2);
+    assert_eq!(peek_u16(&mcu, sym(&fw, "net_eta")), 3277);
+
+    // Corrupt: one byte changed after the CRC was computed.
+    let (fw, mut mcu, mut cpu) = boot(NullBoard, Some(&block));
+    mcu.poke(CONFIG_BLOCK_ADDR + 10, &[0x7F]);
+    cpu.reset(&mut mcu);
+    run_until(&mut cpu, &mut mcu, 2 * TICK_STATES).unwrap();
+    assert_eq!(status(&fw, &mcu), ConfigStatus::Corrupt);
+    assert_eq!(mcu.peek(sym(&fw, "net_n_out")), 4);
+
+    // Rejected: values the firmware cannot run, each named.
+    for (bad, field) in [
+        (
+            ConfigBlock {
+                outputs: 5,
+                ..block
+            },
+            "outputs",
+        ),
+        (
+            ConfigBlock {
+                history: 9,
+                ..block
+            },
+            "history",
+        ),
+        (
+            ConfigBlock {
+                spare: 300,
+                ..block
+            },
+            "spare inputs",
+        ),
+        (ConfigBlock { eta: -1, ..block }, "eta"),
+        (
+            ConfigBlock {
+                ticks_per_step: 0,
+                ..block
+            },
+            "ticks per step",
+        ),
+        (
+            ConfigBlock {
+                channels: [0, 1, 2, 4],
+                ..block
+            },
+            "A/D channels",
+        ),
+        (
+            ConfigBlock {
+                flags: 0x80,
+                ..block
+            },
+            "flags",
+        ),
+    ] {
+        let (fw, mut mcu, mut cpu) = boot(NullBoard, Some(&bad));
+        run_until(&mut cpu, &mut mcu, 2 * TICK_STATES).unwrap();
+        match status(&fw, &mcu) {
+            ConfigStatus::Rejected { field: f, .. } => {
+                assert!(f.starts_with(field), "{f} for {bad:?}")
+            }
+            other => panic!("{bad:?}: {other:?}"),
+        }
+        // The defaults run.
+        assert_eq!(mcu.peek(sym(&fw, "net_n_out")), 4);
+    }
+}
+
+#[test]
+fn steps_come_every_k_ticks_and_the_motors_follow_the_behaviour() {
+    let block = ConfigBlock {
+        save_every: 0,
+        ..ConfigBlock::ARENA
+    };
+    let (fw, mut mcu, mut cpu) = boot(Wandering, Some(&block));
+    let steps = sym(&fw, "steps");
+    // The first step comes with the first tick.
+    run_until(&mut cpu, &mut mcu, TICK_STATES + 20_000).unwrap();
+    assert_eq!(peek_u32(&mcu, steps), 1);
+    let mut seen = [0u32; 4];
+    for k in 1..200u64 {
+        run_until(&mut cpu, &mut mcu, TICK_STATES * (1 + 45 * k) + 20_000).unwrap();
+        assert_eq!(peek_u32(&mcu, steps), 1 + k as u32);
+        let b = mcu.peek(sym(&fw, "behaviour"));
+        assert_eq!(b, mcu.peek(sym(&fw, "net_win")));
+        seen[usize::from(b)] += 1;
+        let pins = motor_pins(&mut mcu);
+        let (l, r) = (pins.left, pins.right);
+        let (want_l, want_r, dl, dr) = match b {
+            0 => (Bridge::Forward, Bridge::Forward, 1.0, 1.0),
+            1 => (Bridge::Reverse, Bridge::Reverse, 1.0, 1.0),
+            2 => (Bridge::Forward, Bridge::Forward, 0.3, 1.0),
+            _ => (Bridge::Forward, Bridge::Forward, 1.0, 0.3),
+        };
+        assert_eq!((l.bridge(), r.bridge()), (want_l, want_r), "behaviour {b}");
+        assert!(
+            (l.pwm.duty() - dl).abs() < 1e-9 && (r.pwm.duty() - dr).abs() < 1e-9,
+            "behaviour {b}: duty {} {}",
+            l.pwm.duty(),
+            r.pwm.duty()
+        );
+    }
+    assert!(
+        seen.iter().filter(|&&n| n > 0).count() >= 2,
+        "behaviours seen {seen:?}"
+    );
+}
+
+#[test]
+fn records_are_eeprom_persist_records_and_survive_a_power_cut() {
+    let block = ConfigBlock {
+        save_every: 5,
+        ..ConfigBlock::ARENA
+    };
+    let (fw, mut mcu, mut cpu) = boot(Wandering, Some(&block));
+    let end = TICK_STATES * (1 + 45 * 23) + 20_000; // 24 steps: saves after steps 5, 10, 15, 20
+    run_until(&mut cpu, &mut mcu, end).unwrap();
+    assert_eq!(
+        mcu.i2c().timing_violation_count(),
+        0,
+        "the firmware's I2C keeps DS21203's timing"
+    );
+    assert_eq!(peek_u32(&mcu, sym(&fw, "rec_sequence")), 4);
+    assert_eq!(peek_u16(&mcu, sym(&fw, "rec_failures")), 0);
+    let layout = RecordLayout::new(0, 104).unwrap();
+    let now = mcu.now();
+    let mut newest = None;
+    for chip in [0x50u8, 0x51] {
+        let mut image = vec![0u8; 4 * 64];
+        mcu.i2c_mut()
+            .device_mut(chip)
+            .unwrap()
+            .read(now, 0, &mut image)
+            .unwrap();
+        let record = layout.decode_slot(chip, &image).unwrap();
+        assert_eq!(record.sequence % 2, u32::from(chip - 0x50));
+        if record.sequence == 3 {
+            newest = Some(record);
+        }
+    }
+    let newest = newest.expect("record 3 on chip 0x51");
+    // After step 20 the weights were saved; four more steps have changed them since (maybe).
+    // Cut the power, power on, reboot: the firmware restores record 3.
+    mcu.power_cut().unwrap();
+    let t = mcu.now() + 25_000_000;
+    mcu.power_on(t).unwrap();
+    cpu.reset(&mut mcu);
+    run_until(&mut cpu, &mut mcu, t + 2 * TICK_STATES).unwrap();
+    assert_eq!(mcu.peek(sym(&fw, "restored")), 1);
+    assert_eq!(peek_u32(&mcu, sym(&fw, "rec_sequence")), 4);
+    let w = peek_u32(&mcu, sym(&fw, "net_w"));
+    let weights: Vec<u8> = (0..104).map(|i| mcu.peek(w + i)).collect();
+    assert_eq!(weights, newest.payload);
+}
+
+#[test]
+fn the_random_walk_flag_overrides_the_choice_but_not_the_learner() {
+    let block = ConfigBlock {
+        flags: FLAG_RANDOM_WALK,
+        save_every: 0,
+        ..ConfigBlock::ARENA
+    };
+    let (fw, mut mcu, mut cpu) = boot(Wandering, Some(&block));
+    let (mut differ, mut counts) = (0, [0u32; 4]);
+    for k in 0..200u64 {
+        run_until(&mut cpu, &mut mcu, TICK_STATES * (1 + 45 * k) + 20_000).unwrap();
+        let b = mcu.peek(sym(&fw, "behaviour"));
+        counts[usize::from(b)] += 1;
+        differ += u32::from(b != mcu.peek(sym(&fw, "net_win")));
+    }
+    assert!(counts.iter().all(|&n| n > 25), "{counts:?}");
+    assert!(differ > 100, "{differ}");
+}
+
+#[test]
+fn a_fault_halts_with_the_vector_named() {
+    let (fw, mut mcu, mut cpu) = boot(NullBoard, None);
+    run_until(&mut cpu, &mut mcu, 2 * TICK_STATES).unwrap();
+    // Jump into the stub of vector 11 (TRAPA #3) as an unexpected exception would.
+    cpu.set_pc(sym(&fw, "_vector_stubs") + 6 * 10);
+    let e = run_until(&mut cpu, &mut mcu, 3 * TICK_STATES)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("0x8B") && e.contains("vector 11"), "{e}");
+}
