@@ -64,6 +64,10 @@ struct LearnArgs {
     /// Add the H8/300H states of each step's forward pass and update to every output line.
     #[arg(long)]
     states: bool,
+    /// Run the robot firmware's own learner routines on the emulated H8/300H instead of
+    /// nn_q15 (the same lines; with --states, the states the core counts).
+    #[arg(long)]
+    on_core: bool,
 }
 
 #[derive(Args, Debug)]
@@ -176,13 +180,23 @@ fn learn(args: &LearnArgs) -> Result<(), Failure> {
     };
     let stdout = io::stdout();
     let mut out = BufWriter::new(stdout.lock());
-    let result = replay::run(&mut input, &mut out, args.states);
+    let engine = if args.on_core {
+        let fw = emu::board::firmware::Firmware::robot()
+            .map_err(|e| Failure::Tool(anyhow::Error::new(e).context("the built-in firmware")))?;
+        replay::Engine::OnCore(Box::new(fw))
+    } else {
+        replay::Engine::Model
+    };
+    let result = replay::run(&mut input, &mut out, args.states, &engine);
     // Whatever happened, the lines already produced are delivered.
     let flushed = out.flush();
     match result {
         Ok(_) => flushed.or_else(write_failure),
         Err(replay::ReplayFailure::Input(e)) => Err(Failure::Input(
             anyhow::Error::new(e).context(format!("replay `{}`", args.replay)),
+        )),
+        Err(replay::ReplayFailure::Core(e)) => Err(Failure::Tool(
+            anyhow::Error::new(e).context(format!("replay `{}` on the core", args.replay)),
         )),
         Err(replay::ReplayFailure::Io(e)) if e.kind() == io::ErrorKind::BrokenPipe => Ok(()),
         Err(replay::ReplayFailure::Io(e)) => Err(Failure::Input(

@@ -10,13 +10,20 @@
 //! Choices where SPEC §2.6 is silent: lines holding only white space are skipped (they still
 //! count for line numbers); unknown fields are errors, so a misspelt key never passes silently;
 //! numbers must be integers (no fraction, no exponent); η and T must be 0 … 32767 (Q15 ≥ 0 and
-//! a non-negative threshold); E may be any i16. `--states` adds the H8/300H states the step's
-//! forward pass and update cost (`"states": {"forward": …, "update": …}`); without it the output
-//! is exactly SPEC §2.6's.
+//! a non-negative threshold); E may be any i16; M may be 2 to 8 (the learner core's bound; a
+//! robot uses 2 or 4). `--states` adds the H8/300H states the step's forward pass and update
+//! cost (`"states": {"forward": …, "update": …}`); without it the output is exactly SPEC §2.6's.
+//!
+//! Two engines compute the lines: `nn_q15` (the default; states from its H8 meter) and, with
+//! `--on-core`, the robot firmware's own routines `learner_forward` and `learner_update` run on
+//! the emulated H8/300H ([`emu::board::oncore`]; states as the core counts them, each routine
+//! from its first instruction to its RTS). The two print the same lines for any input.
 
 use std::fmt;
 use std::io::{self, BufRead, Write};
 
+use emu::board::firmware::Firmware;
+use emu::board::oncore::{LearnerOnCore, OnCoreError};
 use nn_q15::{H8Meter, Params, Phase, Q7, Q15, Shape, forward_slice, update_slice};
 use serde::Serialize;
 use serde_json::{Map, Value};
@@ -50,6 +57,17 @@ pub enum ReplayFailure {
     Input(ReplayError),
     /// Reading the input or writing the output failed.
     Io(io::Error),
+    /// The firmware's routines could not be run on the core (exit status 1).
+    Core(OnCoreError),
+}
+
+/// What computes the output lines.
+#[derive(Clone, Debug)]
+pub enum Engine {
+    /// `nn_q15` (SPEC §2.3–2.4), states from its H8 meter.
+    Model,
+    /// The firmware's `learner_forward` and `learner_update` on the emulated H8/300H.
+    OnCore(Box<Firmware>),
 }
 
 impl From<io::Error> for ReplayFailure {
@@ -80,6 +98,40 @@ struct Header {
     weights: Vec<Q15>,
 }
 
+/// The learner a replay runs on.
+enum Running {
+    Model(Header),
+    OnCore(Box<LearnerOnCore>, Shape),
+}
+
+impl Running {
+    fn shape(&self) -> Shape {
+        match self {
+            Running::Model(h) => h.shape,
+            Running::OnCore(_, shape) => *shape,
+        }
+    }
+}
+
+fn start(h: Header, engine: &Engine) -> Result<Running, ReplayFailure> {
+    match engine {
+        Engine::Model => Ok(Running::Model(h)),
+        Engine::OnCore(fw) => {
+            let mut core = LearnerOnCore::new(fw).map_err(ReplayFailure::Core)?;
+            let weights: Vec<i16> = h.weights.iter().map(|w| w.to_bits()).collect();
+            core.setup(
+                h.shape.n_in(),
+                h.shape.n_out(),
+                h.params.eta().to_bits(),
+                h.params.threshold(),
+                &weights,
+            )
+            .map_err(ReplayFailure::Core)?;
+            Ok(Running::OnCore(Box::new(core), h.shape))
+        }
+    }
+}
+
 const HEADER_FIELDS: &str = "n_in, n_out, eta, threshold, weights";
 const STEP_FIELDS: &str = "x, e";
 
@@ -92,10 +144,11 @@ pub fn run(
     input: &mut dyn BufRead,
     out: &mut dyn Write,
     with_states: bool,
+    engine: &Engine,
 ) -> Result<usize, ReplayFailure> {
     let mut buf = Vec::new();
     let mut line_no = 0usize;
-    let mut header: Option<Header> = None;
+    let mut header: Option<Running> = None;
     let mut steps = 0usize;
     loop {
         buf.clear();
@@ -115,10 +168,19 @@ pub fn run(
         }
         let obj = parse_object(text, line_no).map_err(ReplayFailure::Input)?;
         match header.as_mut() {
-            None => header = Some(parse_header(&obj, line_no).map_err(ReplayFailure::Input)?),
-            Some(h) => {
-                let (x, e) = parse_step(&obj, line_no, h.shape).map_err(ReplayFailure::Input)?;
-                replay_step(h, &x, e, out, with_states)?;
+            None => {
+                let h = parse_header(&obj, line_no).map_err(ReplayFailure::Input)?;
+                header = Some(start(h, engine)?);
+            }
+            Some(running) => {
+                let (x, e) =
+                    parse_step(&obj, line_no, running.shape()).map_err(ReplayFailure::Input)?;
+                match running {
+                    Running::Model(h) => replay_step(h, &x, e, out, with_states)?,
+                    Running::OnCore(core, shape) => {
+                        replay_step_on_core(core, *shape, &x, e, out, with_states)?;
+                    }
+                }
                 steps += 1;
             }
         }
@@ -135,6 +197,33 @@ pub fn run(
     }
     out.flush()?;
     Ok(steps)
+}
+
+fn replay_step_on_core(
+    core: &mut LearnerOnCore,
+    shape: Shape,
+    x: &[Q7],
+    e: i16,
+    out: &mut dyn Write,
+    with_states: bool,
+) -> Result<(), ReplayFailure> {
+    let xs: Vec<i8> = x.iter().map(|v| v.to_bits()).collect();
+    let forward = core.forward(&xs).map_err(ReplayFailure::Core)?;
+    let update = core.update(e).map_err(ReplayFailure::Core)?;
+    let raw = core.weights();
+    let line = StepLine {
+        y: &forward.y,
+        o: &forward.o,
+        win: forward.win,
+        weights: raw.chunks(shape.n_in()).collect(),
+        states: with_states.then_some(States {
+            forward: forward.states,
+            update,
+        }),
+    };
+    serde_json::to_writer(&mut *out, &line).map_err(io::Error::other)?;
+    out.write_all(b"\n")?;
+    Ok(())
 }
 
 fn replay_step(
@@ -306,16 +395,16 @@ fn parse_header(obj: &Map<String, Value>, line: usize) -> Result<Header, ReplayE
         line,
         "n_in",
         1,
-        256,
+        nn_q15::MAX_INPUTS as i64,
         "the number of inputs N",
     )?;
     let n_out = int_in(
         field(obj, line, "n_out")?,
         line,
         "n_out",
-        2,
-        4,
-        "the number of outputs M (enabled behaviours)",
+        nn_q15::MIN_OUTPUTS as i64,
+        nn_q15::MAX_OUTPUTS as i64,
+        "the number of outputs M (a robot enables 2 or 4 behaviours; the learner takes up to 8)",
     )?;
     let eta = int_in(
         field(obj, line, "eta")?,
