@@ -22,7 +22,7 @@ static __inline__ void delay(u8 n)
 
 /* Delay loop counts (6 states an iteration), beside the states of the pin writes around
  * them; checked against the EEPROM model's timing monitor (emu's firmware tests). */
-#define D_LOW 6   /* SCL low: with the SDA write and the loop set-up, >= 48 states */
+#define D_LOW 6   /* SCL low before a repeated START or a STOP's rising edge: >= 48 states */
 #define D_HIGH 2  /* SCL high: >= 15 states */
 #define D_HOLD 2  /* START hold, START setup, STOP setup: >= 15 states */
 #define D_BUF 5   /* bus free after STOP: >= 33 states */
@@ -52,7 +52,7 @@ static __inline__ void sda_release(void)
 }
 
 /* START from idle: SDA falls while SCL is high. */
-static void start(void)
+static void start_condition(void)
 {
     sda_low();
     delay(D_HOLD);
@@ -60,7 +60,7 @@ static void start(void)
 }
 
 /* Repeated START with SCL low. */
-static void restart(void)
+static void repeated_start(void)
 {
     sda_release();
     delay(D_LOW);
@@ -72,7 +72,7 @@ static void restart(void)
 }
 
 /* STOP with SCL low: SDA rises while SCL is high. */
-static void stop(void)
+static void stop_condition(void)
 {
     sda_low();
     delay(D_LOW);
@@ -82,11 +82,12 @@ static void stop(void)
     delay(D_BUF);
 }
 
-/* One clock pulse with SCL low at entry and exit; returns SDA sampled while SCL is high. */
+/* One clock pulse with SCL low at entry and exit; returns SDA sampled while SCL is high. The
+ * SCL low time needs no delay here: from the previous falling edge, the return, the loop, the
+ * SDA write and the call take more than the 48 states of T_LOW (about 80, from the listing). */
 static u8 clock(void)
 {
     u8 sda;
-    delay(D_LOW);
     scl_release();
     delay(D_HIGH);
     sda = P4DR & SDA_BIT;
@@ -153,66 +154,66 @@ u8 i2c_bus_clear(void)
     }
     delay(D_HIGH);
     scl_low();
-    stop();
+    stop_condition();
     return 0;
 }
 
 /* START, control (W), address high and low: returns 1 when all three are ACKed. */
 static u8 address(u8 chip, u16 addr)
 {
-    start();
+    start_condition();
     return write_byte(control(chip, 0)) && write_byte((u8)(addr >> 8)) && write_byte((u8)addr);
 }
 
 u8 i2c_write(u8 chip, u16 addr, const u8 *src, u8 n)
 {
     if (!address(chip, addr)) {
-        stop();
+        stop_condition();
         return 1;
     }
     do {
         if (!write_byte(*src++)) {
-            stop();
+            stop_condition();
             return 1;
         }
     } while (--n);
-    stop();
+    stop_condition();
     return 0;
 }
 
 u16 i2c_ack_poll(u8 chip)
 {
     u16 polls = 0;
-    start();
+    start_condition();
     for (;;) {
         polls++;
         if (write_byte(control(chip, 0))) {
-            stop();
+            stop_condition();
             return polls;
         }
         if (polls == I2C_MAX_POLLS) {
-            stop();
+            stop_condition();
             return 0;
         }
-        restart();
+        repeated_start();
     }
 }
 
 u8 i2c_read(u8 chip, u16 addr, u8 *dst, u16 n)
 {
     if (!address(chip, addr)) {
-        stop();
+        stop_condition();
         return 1;
     }
-    restart();
+    repeated_start();
     if (!write_byte(control(chip, 1))) {
-        stop();
+        stop_condition();
         return 1;
     }
     while (n != 0) {
         n--;
         *dst++ = read_byte(n != 0);
     }
-    stop();
+    stop_condition();
     return 0;
 }
