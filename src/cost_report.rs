@@ -3,7 +3,8 @@
 //!
 //! The learner runs `steps` steps on proximities drawn from a seeded generator (uniform 0–255 per
 //! sensor, so every branch of the step is taken: rewards, punishments, dead zones, saturations);
-//! its initial weights are drawn from the same seed, uniform in ±0.5. The report gives the
+//! its initial weights are drawn from the same stream, uniform in ±0.5. The stream is robot 0's
+//! cost-input stream under the seed ([`crate::seeds`], purpose `CostInputs`). The report gives the
 //! minimum, mean and maximum states per phase and per step, their time at φ = 25 MHz, the share
 //! of a step period that is, and the RAM items.
 
@@ -128,7 +129,13 @@ pub fn measure(cfg: &CostConfig) -> Result<CostReport> {
     let layout = InputLayout::new(cfg.history, cfg.bias).context("--history")?;
     let params = Params::new(cfg.eta, cfg.threshold).context("--eta/--threshold")?;
     let n_in = layout.n_inputs(cfg.outputs);
-    let mut rng = ChaCha8Rng::seed_from_u64(cfg.seed);
+    let mut rng = ChaCha8Rng::seed_from_u64(crate::seeds::robot_stream(
+        cfg.seed,
+        0,
+        0,
+        0,
+        seeding::Purpose::CostInputs,
+    ));
     let weights: Vec<Q15> = (0..n_in * cfg.outputs)
         .map(|_| Q15::from_bits(rng.random_range(-16384i16..=16384)))
         .collect();

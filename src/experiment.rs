@@ -17,7 +17,7 @@
 //! controller's own D(t) (summed du of its four readings), as the paper plots it.
 //!
 //! Determinism: a run depends only on the scenario, the condition and the repeat; every random
-//! stream is split per repeat, robot and purpose ([`crate::robot::Seeds`]); robots are processed
+//! stream is split per repeat, robot and purpose ([`crate::seeds`]); robots are processed
 //! in index order (in parallel for large swarms, with results gathered in index order), so the
 //! output is byte-identical for any thread count.
 
@@ -27,8 +27,9 @@ use sensors::{BumperSet, CollisionCounter, port2_pins};
 use world::{Arena, SensorMount, World, WorldParams};
 
 use crate::plot::Outline;
-use crate::robot::{Condition, Purpose, Robot, Seeds};
+use crate::robot::{Condition, Robot};
 use crate::scenario::{ArenaKind, Scenario};
+use crate::seeds::world_seed;
 
 /// Swarms at least this large step their robots in parallel inside a run.
 pub const PARALLEL_ROBOTS: usize = 64;
@@ -124,7 +125,7 @@ pub fn world_params(s: &Scenario) -> WorldParams {
 /// # Errors
 /// More robots than the arena holds, or a placement that gives up.
 pub fn build_world(s: &Scenario, repeat: u32) -> Result<World> {
-    let seed = Seeds::new(s.seed).get(repeat, u32::MAX, Purpose::World, 0);
+    let seed = world_seed(s.seed, repeat);
     World::new(arena_of(s)?, world_params(s), s.robots, seed).with_context(|| {
         format!(
             "cannot place {} robots in the {} (robots = {})",

@@ -11,14 +11,17 @@
 //! endurance allows, and a one-line verdict with the tightest margin. Nothing in it is computed
 //! from a formula alone: the step states are what the emulated MCU counted.
 
-use rand::{Rng, RngExt, SeedableRng};
-use rand_pcg::Pcg64Mcg;
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use seeding::Purpose;
 use serde::Serialize;
 
 use emu::board::model::code::rom_estimate;
 use emu::board::model::{Controller, ControllerConfig, ControllerError, PhaseStates};
 use emu::chip::mcu::{Board, Mcu, McuConfig};
 use emu::core::memmap::{RAM_BYTES, ROM_BYTES};
+
+use crate::seeds::robot_stream;
 
 /// Endurance of a 24LC256 page: 1 000 000 write cycles (SPEC §3.6; Microchip DS21203).
 pub const ENDURANCE_CYCLES: f64 = 1_000_000.0;
@@ -30,7 +33,10 @@ pub struct FitConfig {
     pub controller: ControllerConfig,
     /// Steps to run (after boot).
     pub steps: u32,
-    /// Seed of the sensors and of their distances.
+    /// The master seed: the fit's robot is robot 0 of repeat 0 under it ([`crate::seeds`]), whose
+    /// streams give its sensors, their distances and its EEPROMs. (The initial weights come
+    /// with [`Self::controller`]; the commands take them from the same robot,
+    /// [`fit_weight_seed`].)
     pub seed: u64,
 }
 
@@ -161,6 +167,13 @@ impl Board for FitBoard {
     }
 }
 
+/// The initial-weight seed of the fit's robot under master seed `seed`: robot 0 of repeat 0's
+/// weight stream, as in a run.
+#[must_use]
+pub const fn fit_weight_seed(seed: u64) -> u64 {
+    robot_stream(seed, 0, 0, 0, Purpose::Weights)
+}
+
 /// Runs the controller as [`FitConfig`] says and reports.
 ///
 /// # Errors
@@ -169,15 +182,16 @@ impl Board for FitBoard {
 pub fn measure(cfg: &FitConfig) -> Result<FitReport, ControllerError> {
     let mut controller = Controller::new(cfg.controller.clone())?;
     let clock_hz = cfg.controller.clock_hz;
-    let mut seeds = Pcg64Mcg::seed_from_u64(cfg.seed);
+    // The fit's robot is robot 0 of repeat 0 under the seed (crate::seeds).
+    let stream = |k: u64, purpose: Purpose| robot_stream(cfg.seed, 0, 0, k, purpose);
     let mut sensors_v = Vec::with_capacity(4);
-    for _ in 0..4 {
+    for k in 0..4 {
         let params = sensors::IrParams {
             clock_hz,
             ..sensors::IrParams::default()
         };
         sensors_v.push(
-            sensors::IrSensor::new(params, seeds.next_u64()).map_err(|e| {
+            sensors::IrSensor::new(params, stream(k, Purpose::IrSensor)).map_err(|e| {
                 ControllerError::Config {
                     field: "clock_hz",
                     value: clock_hz.to_string(),
@@ -186,7 +200,7 @@ pub fn measure(cfg: &FitConfig) -> Result<FitReport, ControllerError> {
             })?,
         );
     }
-    let mut walk = Pcg64Mcg::seed_from_u64(seeds.next_u64());
+    let mut walk = ChaCha8Rng::seed_from_u64(stream(0, Purpose::FitDistances));
     let board = FitBoard {
         sensors: sensors_v,
         distance_mm: [300.0, 500.0, 150.0, 800.0],
@@ -195,7 +209,7 @@ pub fn measure(cfg: &FitConfig) -> Result<FitReport, ControllerError> {
     let mut mcu = Mcu::new(
         McuConfig {
             clock_hz,
-            eeprom_seed: seeds.next_u64(),
+            eeprom_seed: stream(0, Purpose::Eeproms),
         },
         board,
     )

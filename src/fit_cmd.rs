@@ -4,7 +4,7 @@
 
 use std::fmt::Write as _;
 
-use crate::fit::{Budget, FitConfig, FitReport, largest_fitting, measure};
+use crate::fit::{Budget, FitConfig, FitReport, fit_weight_seed, largest_fitting, measure};
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use emu::board::model::ControllerConfig;
@@ -55,7 +55,8 @@ pub struct FitArgs {
     /// Steps to run for each measurement.
     #[arg(long, default_value_t = 400)]
     pub steps: u32,
-    /// Seed of the sensors, their distances and the initial weights.
+    /// Master seed: the measured robot is robot 0 of repeat 0 of `h8swarm run` with this seed
+    /// (its sensors, their distances, its EEPROMs and its initial weights).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Print the reports as JSON.
@@ -90,9 +91,10 @@ struct LargestOut {
 }
 
 fn base_config(setting: Setting, seed: u64) -> ControllerConfig {
+    let weights = fit_weight_seed(seed);
     match setting {
-        Setting::Arena => ControllerConfig::arena(seed),
-        Setting::Corridor => ControllerConfig::corridor(seed),
+        Setting::Arena => ControllerConfig::arena(weights),
+        Setting::Corridor => ControllerConfig::corridor(weights),
     }
 }
 

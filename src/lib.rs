@@ -19,4 +19,5 @@ pub mod replay;
 pub mod robot;
 pub mod run_cmd;
 pub mod scenario;
+pub mod seeds;
 pub mod summary;

@@ -2,9 +2,9 @@
 //! MCU's port 4) and, in the world, its body.
 //!
 //! Every random draw comes from its own stream: the sensors (one each), the EEPROMs, the
-//! initial weights and the random-walk control each get a seed from [`Seeds`], which derives
-//! them from the run's seed, the repeat, the robot and the purpose with ChaCha8's independent
-//! streams; adding a robot or a thread changes nobody else's numbers.
+//! initial weights and the random-walk control each get a seed from the run's seed, the
+//! repeat, the robot and the purpose ([`crate::seeds::robot_stream`], the project's one
+//! derivation); adding a robot or a thread changes nobody else's numbers.
 
 use anyhow::{Context, Result};
 use emu::board::model::{Controller, ControllerConfig, StepReport};
@@ -12,53 +12,14 @@ use emu::board::wiring::{Bridge, MotorDrive};
 use emu::chip::mcu::{Board, Mcu, McuConfig};
 use emu::core::bus::Bus;
 use nn_q15::{Behaviour, InputLayout, Params};
-use rand::{Rng, RngExt, SeedableRng};
+use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use seeding::Purpose;
 use sensors::{BumperSet, IrParams, IrSensor, port2_pins};
 use world::{Direction, WheelCommand};
 
 use crate::scenario::Scenario;
-
-/// What a random stream is for.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[repr(u64)]
-pub enum Purpose {
-    /// The world: placement and motor gains.
-    World = 1,
-    /// The four IR sensors (sensor k uses `Sensor + k`).
-    Sensor = 16,
-    /// The two EEPROMs.
-    Eeprom = 32,
-    /// The initial weights.
-    Weights = 33,
-    /// The random-walk control's behaviours.
-    RandomWalk = 34,
-}
-
-/// Seeds split per repeat, robot and purpose.
-#[derive(Clone, Copy, Debug)]
-pub struct Seeds {
-    master: u64,
-}
-
-impl Seeds {
-    /// Seeds under the run's master seed.
-    #[must_use]
-    pub const fn new(master: u64) -> Self {
-        Self { master }
-    }
-
-    /// The seed for `purpose` (+ `index` within it) of `robot` in `repeat`: the first word of
-    /// ChaCha8 stream (repeat, robot, purpose) under the master seed. Robot `u32::MAX` is the
-    /// world's.
-    #[must_use]
-    pub fn get(&self, repeat: u32, robot: u32, purpose: Purpose, index: u64) -> u64 {
-        let mut rng = ChaCha8Rng::seed_from_u64(self.master);
-        let stream = (u64::from(repeat) << 40) ^ (u64::from(robot) << 8) ^ (purpose as u64 + index);
-        rng.set_stream(stream);
-        rng.next_u64()
-    }
-}
+use crate::seeds::robot_stream;
 
 /// The robot's hardware outside the chip: what the sensors see and the bumpers feel.
 pub struct RobotBoard {
@@ -153,7 +114,7 @@ impl Robot {
     /// # Errors
     /// A configuration the controller or the sensors refuse.
     pub fn new(s: &Scenario, condition: Condition, repeat: u32, index: u32) -> Result<Self> {
-        let seeds = Seeds::new(s.seed);
+        let stream = |k: u64, purpose: Purpose| robot_stream(s.seed, repeat, index, k, purpose);
         let ir = IrParams {
             clock_hz: s.timing.clock_hz,
             noise_sigma_volts: s.sensors.noise_sigma_v,
@@ -169,10 +130,8 @@ impl Robot {
         };
         let mut sensors_v = Vec::with_capacity(4);
         for k in 0..4 {
-            sensors_v.push(
-                IrSensor::new(ir.clone(), seeds.get(repeat, index, Purpose::Sensor, k))
-                    .context("sensors")?,
-            );
+            sensors_v
+                .push(IrSensor::new(ir.clone(), stream(k, Purpose::IrSensor)).context("sensors")?);
         }
         let sensors: [IrSensor; 4] = sensors_v
             .try_into()
@@ -186,19 +145,19 @@ impl Robot {
         let mut mcu = Mcu::new(
             McuConfig {
                 clock_hz: s.timing.clock_hz,
-                eeprom_seed: seeds.get(repeat, index, Purpose::Eeprom, 0),
+                eeprom_seed: stream(0, Purpose::Eeproms),
             },
             board,
         )
         .context("timing.clock_hz")?;
-        let mut cfg = controller_config(s, seeds.get(repeat, index, Purpose::Weights, 0))?;
+        let mut cfg = controller_config(s, stream(0, Purpose::Weights))?;
         if condition != Condition::Learning {
             cfg.params = Params::new(0, s.learner.threshold).context("learner.threshold")?;
         }
         let mut controller = Controller::new(cfg)?;
         controller.boot(&mut mcu)?;
         let walk = (condition == Condition::RandomWalk)
-            .then(|| ChaCha8Rng::seed_from_u64(seeds.get(repeat, index, Purpose::RandomWalk, 0)));
+            .then(|| ChaCha8Rng::seed_from_u64(stream(0, Purpose::RandomWalk)));
         Ok(Self {
             mcu,
             controller,

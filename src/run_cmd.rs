@@ -152,7 +152,7 @@ pub fn run(a: &RunArgs) -> Result<String> {
     .with_context(|| format!("cannot write `{}`", summary_path.display()))?;
 
     let fit = crate::fit::measure(&crate::fit::FitConfig {
-        controller: controller_config(&s, s.seed)?,
+        controller: controller_config(&s, crate::fit::fit_weight_seed(s.seed))?,
         steps: 400,
         seed: s.seed,
     })?;

@@ -5,6 +5,7 @@ use std::collections::VecDeque;
 
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use seeding::Purpose;
 
 use crate::clock::Clock;
 use crate::datasheet::{
@@ -23,13 +24,6 @@ pub const DEFAULT_STUCK_BIT_PROBABILITY: f64 = 1.0 / 1024.0;
 
 /// Value of an erased EEPROM byte; a new chip reads all 0xFF (DS21203: "erased" state).
 pub const ERASED_BYTE: u8 = 0xFF;
-
-/// RNG stream of the write cycle time draw.
-const STREAM_T_WC: u64 = 1;
-/// RNG stream of the power-cut corruption.
-const STREAM_CUT: u64 = 2;
-/// RNG stream of wear (stuck bits).
-const STREAM_WEAR: u64 = 3;
 
 /// Most timing violations kept in detail (all are counted).
 const VIOLATION_LOG_LEN: usize = 64;
@@ -55,8 +49,8 @@ pub struct DeviceConfig {
     /// Probability that a bit of a page past its limit becomes stuck in one write cycle (0..=1).
     pub stuck_bit_probability: f64,
     /// Seed of the device's random streams (write cycle time, power-cut corruption, wear). Each
-    /// purpose uses its own ChaCha8 stream keyed by this seed and the device address, so two
-    /// chips may share a seed.
+    /// purpose uses its own ChaCha8 generator seeded with `seeding::derive(seed, address,
+    /// purpose)`, so two chips may share a seed.
     pub seed: u64,
 }
 
@@ -343,10 +337,9 @@ pub struct Eeprom24lc256 {
     stats: DeviceStats,
 }
 
-fn stream(seed: u64, address: u8, purpose: u64) -> ChaCha8Rng {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    rng.set_stream((u64::from(address) << 8) | purpose);
-    rng
+/// The chip's stream for `purpose`: the project's one derivation, indexed by the address.
+fn stream(seed: u64, address: u8, purpose: Purpose) -> ChaCha8Rng {
+    ChaCha8Rng::seed_from_u64(seeding::derive(seed, u64::from(address), purpose))
 }
 
 fn check_range(address: u32, len: usize) -> Result<(), EepromError> {
@@ -405,9 +398,9 @@ impl Eeprom24lc256 {
             .states_at_most(config.t_wc_max_ns)
             .max(t_wc_min_states);
         Ok(Eeprom24lc256 {
-            rng_t_wc: stream(config.seed, config.address, STREAM_T_WC),
-            rng_cut: stream(config.seed, config.address, STREAM_CUT),
-            rng_wear: stream(config.seed, config.address, STREAM_WEAR),
+            rng_t_wc: stream(config.seed, config.address, Purpose::EepromWriteCycle),
+            rng_cut: stream(config.seed, config.address, Purpose::EepromPowerCut),
+            rng_wear: stream(config.seed, config.address, Purpose::EepromWear),
             clock,
             t_wc_min_states,
             t_wc_max_states,

@@ -72,9 +72,9 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!
-//! Randomness: each chip has three ChaCha8 streams (write-cycle time, cut corruption, wear)
-//! keyed by its seed and address; the same seeds give the same results, and no global RNG is
-//! used.
+//! Randomness: each chip has three ChaCha8 streams (write-cycle time, cut corruption, wear),
+//! seeded by the project's one derivation from the chip's seed, its address and the purpose
+//! (`seeding::derive`); the same seeds give the same results, and no global RNG is used.
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 

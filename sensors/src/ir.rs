@@ -5,12 +5,13 @@
 
 use rand_core::Rng;
 use rand_distr::{Distribution, StandardNormal};
+use seeding::Purpose;
 
 use crate::curve::{
     NOMINAL_DV_80_TO_10CM_VOLTS, NOMINAL_V_80CM_VOLTS, effective_distance_mm, nominal_volts_checked,
 };
 use crate::error::SensorError;
-use crate::rng::{Purpose, StreamRng, counter_unit_f64, stream, uniform_f64, unit_f64};
+use crate::rng::{StreamRng, counter_unit_f64, stream, uniform_f64, unit_f64};
 
 /// Default MCU clock φ = 25 MHz, 1 state = 40 ns (SPEC §4.1, AKI-H8/3052F board).
 pub const DEFAULT_CLOCK_HZ: u32 = 25_000_000;
@@ -282,7 +283,7 @@ impl IrSensor {
     pub fn new(params: IrParams, seed: u64) -> Result<Self, SensorError> {
         params.validate()?;
 
-        let mut spread = stream(seed, Purpose::Spread);
+        let mut spread = stream(seed, Purpose::SensorSpread);
         let dv = uniform_f64(
             &mut spread,
             params.dv_80_to_10cm_min_volts,
@@ -296,7 +297,7 @@ impl IrSensor {
         let gain = dv / NOMINAL_DV_80_TO_10CM_VOLTS;
         let offset_volts = v80 - gain * NOMINAL_V_80CM_VOLTS;
 
-        let mut timing = stream(seed, Purpose::Timing);
+        let mut timing = stream(seed, Purpose::SensorTiming);
         // Own period inside mean ± (spread − 2·jitter), so that every interval, which is the
         // period plus the difference of two jitters, stays inside mean ± spread.
         let margin_ms = params.period_spread_ms - 2.0 * params.period_jitter_ms;
@@ -323,7 +324,7 @@ impl IrSensor {
             next_refresh_states: 0,
             last_call_states: None,
             held_volts: None,
-            noise_rng: stream(seed, Purpose::Noise),
+            noise_rng: stream(seed, Purpose::SensorNoise),
         };
         sensor.next_refresh_states = sensor.refresh_instant_states(0);
         Ok(sensor)

@@ -11,7 +11,7 @@
 //! ```
 //! use sensors::{IrParams, IrSensor, DU_TABLE, adc10_code, code8_from_adc10};
 //!
-//! let mut front = IrSensor::new(IrParams::default(), 42)?;
+//! let mut front = IrSensor::new(IrParams::default(), 7)?;
 //! let now_states = 1_000_000; // 40 ms at φ = 25 MHz
 //! let volts = front.sample(now_states, Some(300.0))?; // a wall 30 cm away
 //! let c = code8_from_adc10(adc10_code(volts));
@@ -69,7 +69,8 @@
 //! firmware reads each sensor once per step). The sum is clamped to 0 V … 5 V.
 //!
 //! **Randomness.** Each sensor owns its randomness, from the `u64` seed the caller gives, split
-//! into independent streams per purpose (spread, timing, noise) with PCG-64 (`rand_pcg`).
+//! into independent streams per purpose (spread, timing, noise) by the project's one
+//! derivation (`seeding::derive`), each a PCG-64 generator (`rand_pcg`).
 //! Same seed, same parameters and same calls ⇒ identical readings. The noise stream advances
 //! once per [`IrSensor::sample`]; [`IrSensor::update`] draws nothing.
 //!

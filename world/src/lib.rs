@@ -91,7 +91,8 @@
 //!   headings, rejection-sampled with the clearance (default 50 mm) to walls and bodies, at
 //!   most `1000·n + 10 000` attempts. Too many robots is an error that says how many fit.
 //! - **Randomness**: only from the seed: placement and each robot's motor gains have their own
-//!   streams (adding a robot changes no other robot's gains).
+//!   streams, derived by the project's one rule (`seeding::derive(seed, robot, MotorGain)`,
+//!   `derive(seed, 0, Placement)`), so adding a robot changes no other robot's gains.
 //! - **Threads**: [`World::advance_par`] runs the per-robot phases (motors and kinematics,
 //!   candidate search, the first pass's overlap tests) on rayon's pool in fixed chunks merged
 //!   in index order; the pushes run on one thread in index order. Results are bit-identical to

@@ -1,8 +1,9 @@
 //! The world: robots' bodies, motors, kinematics, collisions, bumpers and sensor rays.
 
-use rand::RngExt;
+use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64;
 use rayon::prelude::*;
+use seeding::Purpose;
 
 use crate::arena::{Arena, ArenaKind};
 use crate::error::WorldError;
@@ -33,10 +34,6 @@ pub const REAR: usize = 1;
 pub const LEFT: usize = 2;
 /// Bumper index of the right switch (also the default right sensor).
 pub const RIGHT: usize = 3;
-
-/// Stream purposes for the seeded generators (one stream per purpose and robot).
-const PURPOSE_PLACEMENT: u64 = 0x706c_6163_656d_656e; // "placemen"
-const PURPOSE_MOTOR_GAIN: u64 = 0x6d6f_746f_7267_6169; // "motorgai"
 
 /// A robot's pose: centre in metres, heading in radians counter-clockwise from +x, in (−π, π].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -152,19 +149,10 @@ pub struct World {
     substeps: u64,
 }
 
-/// SplitMix64: turns (seed, purpose) into well-mixed generator state.
-fn splitmix64(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9e37_79b9_7f4a_7c15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
-}
-
-/// The generator for one purpose and one stream (robot index, or 0 for world-wide purposes).
-fn stream_rng(seed: u64, purpose: u64, stream: u64) -> Pcg64 {
-    let hi = splitmix64(seed ^ purpose);
-    let lo = splitmix64(hi ^ seed);
-    Pcg64::new((u128::from(hi) << 64) | u128::from(lo), u128::from(stream))
+/// The generator for one purpose and one index (robot index, or 0 for world-wide purposes):
+/// the project's one derivation, `seeding::derive(seed, index, purpose)`.
+fn stream_rng(seed: u64, purpose: Purpose, index: u64) -> Pcg64 {
+    Pcg64::seed_from_u64(seeding::derive(seed, index, purpose))
 }
 
 /// A uniform draw in [0, 1).
@@ -239,7 +227,7 @@ impl World {
         let spread = params.motor_gain_spread;
         let gains = (0..n)
             .map(|i| {
-                let mut rng = stream_rng(seed, PURPOSE_MOTOR_GAIN, i as u64);
+                let mut rng = stream_rng(seed, Purpose::MotorGain, i as u64);
                 let l = 1.0 + spread * (2.0 * unit(&mut rng) - 1.0);
                 let r = 1.0 + spread * (2.0 * unit(&mut rng) - 1.0);
                 [l, r]
@@ -1277,7 +1265,7 @@ fn place_corridor(
             clearance_m: clr,
         });
     }
-    let mut rng = stream_rng(seed, PURPOSE_PLACEMENT, 0);
+    let mut rng = stream_rng(seed, Purpose::Placement, 0);
     let mut cuts: Vec<f64> = (0..n).map(|_| unit(&mut rng) * free).collect();
     cuts.sort_by(f64::total_cmp);
     let mut poses = Vec::with_capacity(n);
@@ -1337,7 +1325,7 @@ fn place_open(
     };
     let max_attempts: u64 = 1000 * n as u64 + 10_000;
     let mut attempts: u64 = 0;
-    let mut rng = stream_rng(seed, PURPOSE_PLACEMENT, 0);
+    let mut rng = stream_rng(seed, Purpose::Placement, 0);
     let mut poses: Vec<BodyPose> = Vec::with_capacity(n);
     while poses.len() < n {
         if attempts >= max_attempts {

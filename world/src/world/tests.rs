@@ -489,13 +489,18 @@ fn veering_robot_in_the_corridor_slides_along_without_penetrating() {
     assert!(p.x_m > 2.5, "got stuck at {p:?}");
 }
 
+/// A test's random behaviours: stream `k` of the random-walk purpose under `seed`.
+fn walk_rng(seed: u64, k: u64) -> Pcg64 {
+    stream_rng(seed, Purpose::RandomWalk, k)
+}
+
 fn dense_swarm(seed: u64, n: usize, params: WorldParams) -> World {
     let params = WorldParams {
         placement_clearance_m: 0.01,
         ..params
     };
     let mut w = World::new(Arena::square(), params, n, seed).unwrap();
-    let mut rng = stream_rng(seed, 1, 1);
+    let mut rng = walk_rng(seed, 1);
     for r in 0..n {
         set_behaviour(&mut w, r, Behaviour::ALL[(unit(&mut rng) * 4.0) as usize]);
     }
@@ -517,7 +522,7 @@ proptest! {
     fn crowded_swarm_never_penetrates(seed in any::<u64>(), dt in 0.002f64..0.1) {
         let params = WorldParams { max_substep_s: 0.1, ..WorldParams::default() };
         let mut w = dense_swarm(seed, 20, params);
-        let mut rng = stream_rng(seed, 2, 2);
+        let mut rng = walk_rng(seed, 2);
         let steps = (12.0 / dt) as usize;
         let per_behaviour = (0.45 / dt).ceil() as usize;
         let mut contacts = 0;
@@ -542,7 +547,7 @@ proptest! {
             ..WorldParams::default()
         };
         let mut w = dense_swarm(seed, 20, params);
-        let mut rng = stream_rng(seed, 2, 2);
+        let mut rng = walk_rng(seed, 2);
         for k in 0..200 {
             if k % 5 == 0 {
                 shuffle_behaviours(&mut w, &mut rng);
@@ -758,7 +763,7 @@ proptest! {
     fn rays_equal_brute_force_after_motion(seed in any::<u64>(), n in 1usize..60, steps in 0usize..200) {
         let params = WorldParams { rays_per_sensor: 2, cone_half_angle_rad: 0.03, ..WorldParams::default() };
         let mut w = World::new(Arena::scaled_square(n).unwrap(), params, n, seed).unwrap();
-        let mut rng = stream_rng(seed, 3, 3);
+        let mut rng = walk_rng(seed, 3);
         for k in 0..steps {
             if k % 45 == 0 {
                 shuffle_behaviours(&mut w, &mut rng);
@@ -945,7 +950,7 @@ fn state_bits(w: &World) -> Vec<u64> {
 }
 
 fn drive_run(w: &mut World, steps: usize, seed: u64, parallel: bool) {
-    let mut rng = stream_rng(seed, 4, 4);
+    let mut rng = walk_rng(seed, 4);
     for k in 0..steps {
         if k % 45 == 0 {
             shuffle_behaviours(w, &mut rng);
@@ -1405,7 +1410,7 @@ proptest! {
             o
         };
         let start = order(&w);
-        let mut rng = stream_rng(seed, 5, 5);
+        let mut rng = walk_rng(seed, 5);
         let mut bumps = 0;
         for k in 0..6000 {
             if k % 60 == 0 {
