@@ -1,43 +1,199 @@
 //! "Does it fit the H8/3052?" (SPEC §6), measured by running the controller on the emulated
-//! MCU.
+//! MCU: by default the robot firmware (`firmware/robot.mot`, SPEC §8) on the H8/300H core,
+//! with the Rust model of the controller (`emu::board::model`) measured beside it.
 //!
 //! [`measure`] builds an MCU with four modelled IR sensors (`sensors::IrSensor`, datasheet
 //! spread and noise, their own seeds) whose true distances follow a seeded random walk between
 //! 30 mm and 1 m (so the learner sees rewards, punishments and dead zones, and the readings
-//! include the fold-back), boots the controller on it, and runs `steps` steps with the sleep
-//! between them, recording every phase of every step. The report gives the maximum and mean
-//! states per phase, the time at φ against the step period, the RAM items against the 8 192
-//! bytes, the ROM estimate against the 512 KB of flash, the EEPROM traffic and the lifetime the
-//! endurance allows, and a one-line verdict with the tightest margin. Nothing in it is computed
-//! from a formula alone: the step states are what the emulated MCU counted.
+//! include the fold-back), and runs the controller on it for `steps` step periods.
+//!
+//! With the firmware, the settings reach it through its configuration block (written into the
+//! flash at load); boot runs from reset until the first step begins (the first entry into the
+//! step's first phase, `ad_scan` for the robot firmware); the step periods are counted from
+//! there, one window of K ticks each, so each holds one step and the ticks and idle time up to
+//! the next. States are attributed to phases by PC through the image's symbol table,
+//! each phase a function with its callees ([`emu::board::profile`]); a window's busy states are
+//! all but those asleep. RAM is the image's `.data` and `.bss` (every variable, sized from the
+//! symbol table), the network's arrays carved at boot (from the firmware's own pointers), and
+//! the stack's high-water mark (the lowest SP the run saw). ROM is the image's bytes.
+//!
+//! With the model, the phases are the model's own accounting; RAM is its placement of the same
+//! items and ROM the firmware image's size (the model has no image of its own).
+//!
+//! The report gives the maximum and mean states per phase (with the other controller's mean
+//! and the ratio when both ran), the time at φ against the step period, the RAM items against
+//! the 8 192 bytes, the ROM against the 512 KB of flash, the EEPROM traffic and the lifetime the
+//! endurance allows, and a one-line verdict with the tightest margin.
 
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use seeding::Purpose;
 use serde::Serialize;
 
-use emu::board::model::code::rom_estimate;
+use emu::board::firmware::{
+    BlockError, ConfigBlock, ConfigStatus, Firmware, FirmwareError, RunError, halted,
+};
 use emu::board::model::{Controller, ControllerConfig, ControllerError, PhaseStates};
-use emu::chip::mcu::{Board, Mcu, McuConfig};
+use emu::board::profile::{PhaseDef, Profiler, UnknownFunction};
+use emu::chip::mcu::{Board, Mcu, McuConfig, McuError};
+use emu::core::bus::Bus;
+use emu::core::cpu::{Cpu, Event};
 use emu::core::memmap::{RAM_BYTES, ROM_BYTES};
 
 use crate::seeds::robot_stream;
 
 /// Endurance of a 24LC256 page: 1 000 000 write cycles (SPEC §3.6; Microchip DS21203).
 pub const ENDURANCE_CYCLES: f64 = 1_000_000.0;
+/// Longest boot the fit waits for before calling the image stuck: 10 s of MCU time.
+pub const BOOT_LIMIT_S: f64 = 10.0;
+
+/// Which controller the fit runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ControllerKind {
+    /// Machine code on the H8/300H core: the robot firmware or a user's image.
+    Firmware,
+    /// The Rust model of the controller.
+    Model,
+}
+
+/// A firmware image to measure and its phases.
+#[derive(Clone, Debug)]
+pub struct FirmwareUnderTest {
+    /// The image and its symbols.
+    pub firmware: Firmware,
+    /// The phases, each a name and its functions (see [`robot_phases`]).
+    pub phases: Vec<PhaseDef>,
+}
+
+impl FirmwareUnderTest {
+    /// The robot firmware with its phases.
+    ///
+    /// # Errors
+    /// Only if the built-in image were damaged.
+    pub fn robot() -> Result<Self, FirmwareError> {
+        Ok(FirmwareUnderTest {
+            firmware: Firmware::robot()?,
+            phases: robot_phases(),
+        })
+    }
+}
+
+/// The robot firmware's phases, in report order, and the functions that make them (SPEC §8).
+#[must_use]
+pub fn robot_phases() -> Vec<PhaseDef> {
+    vec![
+        PhaseDef::new(PHASE_ADC, &["ad_scan"]),
+        PhaseDef::new(PHASE_INPUT, &["learner_step"]),
+        PhaseDef::new(PHASE_UPDATE, &["learner_update"]),
+        PhaseDef::new(PHASE_FORWARD, &["learner_forward"]),
+        PhaseDef::new(PHASE_MOTORS, &["motors_set"]),
+        PhaseDef::new(PHASE_SAVE, &["record_save"]),
+        PhaseDef::new(PHASE_TICKS, &["tick_isr"]),
+        PhaseDef::new(PHASE_BOOT, &["boot"]),
+    ]
+}
+
+/// Phase names shared by the firmware's profile and the model's accounting.
+const PHASE_ADC: &str = "A/D";
+const PHASE_INPUT: &str = "input";
+const PHASE_UPDATE: &str = "update";
+const PHASE_FORWARD: &str = "forward";
+const PHASE_MOTORS: &str = "motors";
+const PHASE_SAVE: &str = "EEPROM save (amortised)";
+const PHASE_TICKS: &str = "tick interrupts";
+const PHASE_BOOT: &str = "boot";
+const PHASE_OTHER: &str = "main loop and the rest";
 
 /// What to measure.
 #[derive(Clone, Debug)]
 pub struct FitConfig {
-    /// The controller to run.
+    /// The controller's settings (the firmware gets them through its configuration block).
     pub controller: ControllerConfig,
-    /// Steps to run (after boot).
+    /// Step periods to run (after boot).
     pub steps: u32,
     /// The master seed: the fit's robot is robot 0 of repeat 0 under it ([`crate::seeds`]), whose
     /// streams give its sensors, their distances and its EEPROMs. (The initial weights come
     /// with [`Self::controller`]; the commands take them from the same robot,
     /// [`fit_weight_seed`].)
     pub seed: u64,
+    /// Which controller the verdict is about.
+    pub kind: ControllerKind,
+    /// The image when `kind` is [`ControllerKind::Firmware`] (and the ROM figure of the model).
+    pub firmware: FirmwareUnderTest,
+    /// Also run the other controller and put its figures beside each phase.
+    pub compare: bool,
+}
+
+/// Why the fit could not be measured.
+#[derive(Debug, thiserror::Error)]
+pub enum FitError {
+    /// The model controller refused the settings.
+    #[error(transparent)]
+    Controller(#[from] ControllerError),
+    /// The configuration block cannot carry a setting.
+    #[error(transparent)]
+    Block(#[from] BlockError),
+    /// The image could not be used.
+    #[error(transparent)]
+    Firmware(#[from] FirmwareError),
+    /// A phase names a function the image lacks.
+    #[error(transparent)]
+    Phase(#[from] UnknownFunction),
+    /// The firmware rejected its configuration block.
+    #[error("the firmware rejected its configuration block: {field} (cfg_status 0x{code:02X})")]
+    Rejected {
+        /// The field, as the firmware names it.
+        field: &'static str,
+        /// The status byte.
+        code: u8,
+    },
+    /// The firmware stopped.
+    #[error("the firmware stopped at state {at}")]
+    Run {
+        /// When.
+        at: u64,
+        /// Why.
+        #[source]
+        source: RunError,
+    },
+    /// The firmware never went to sleep after reset.
+    #[error(
+        "the firmware did not reach SLEEP within {BOOT_LIMIT_S} s of reset (PC H'{pc:06X}): the fit counts boot up to the first SLEEP"
+    )]
+    BootTimeout {
+        /// Where it was.
+        pc: u32,
+    },
+    /// The step's first phase did not come again.
+    #[error(
+        "the next step's `{phase}` did not begin within two step periods and {BOOT_LIMIT_S} s (PC H'{pc:06X})"
+    )]
+    StepTimeout {
+        /// The phase the step periods start with.
+        phase: String,
+        /// Where the CPU was.
+        pc: u32,
+    },
+    /// The MCU could not be built.
+    #[error("building the MCU")]
+    Mcu(#[from] McuError),
+    /// A what-if on an image without a configuration block.
+    #[error(
+        "`{image}` has no configuration block (symbol config_block at H'000400), so the settings cannot reach it; measure it without what-ifs"
+    )]
+    NoBlock {
+        /// The image.
+        image: String,
+    },
+    /// A sensor model refused the clock.
+    #[error("clock_hz = {clock_hz}: {why}")]
+    Sensor {
+        /// The clock.
+        clock_hz: u32,
+        /// The sensor model's reason.
+        why: String,
+    },
 }
 
 /// Maximum and mean of a per-step quantity in states.
@@ -53,12 +209,18 @@ pub struct Spread {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct PhaseLine {
     /// The phase.
-    pub phase: &'static str,
-    /// States per step (over all steps; for the save, steps without a save count as 0, so the
-    /// mean is the amortised cost).
+    pub phase: String,
+    /// States per step period (over all periods; for the save, periods without a save count
+    /// as 0, so the mean is the amortised cost).
     pub states: Spread,
     /// The maximum in microseconds at φ.
     pub max_us: f64,
+    /// The other controller's figures for the same phase, when it ran.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub other: Option<Spread>,
+    /// This controller's mean over the other's, when both are non-zero.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ratio: Option<f64>,
 }
 
 /// A RAM or ROM item.
@@ -66,7 +228,7 @@ pub struct PhaseLine {
 pub struct MemLine {
     /// What it holds.
     pub item: String,
-    /// Where it starts (RAM) or 0 (ROM estimate).
+    /// Where it starts.
     pub addr: u32,
     /// Its size.
     pub bytes: u32,
@@ -92,6 +254,13 @@ pub struct EepromLine {
 /// The verdict of SPEC §6.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct FitReport {
+    /// The controller measured.
+    pub controller: ControllerKind,
+    /// The image (firmware) or `"model"`.
+    pub source: String,
+    /// The other controller's source, when it ran beside.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub compared_with: Option<String>,
     /// Inputs N.
     pub n_in: usize,
     /// Outputs M.
@@ -116,12 +285,12 @@ pub struct FitReport {
     pub steps: u32,
     /// Seed.
     pub seed: u64,
-    /// States of boot (hardware set-up, recovery, weights).
+    /// States of boot (reset until the first step begins: hardware set-up, recovery, weights,
+    /// the first tick).
     pub boot_states: u64,
     /// States per phase.
     pub phases: Vec<PhaseLine>,
-    /// The CPU's busy states per step: the step's work plus the tick interrupts and the main
-    /// loop over one step period.
+    /// The CPU's busy states per step period.
     pub busy_per_step: Spread,
     /// Busy share of the step period, mean over the steps (percent).
     pub cpu_mean_percent: f64,
@@ -131,9 +300,12 @@ pub struct FitReport {
     pub ram: Vec<MemLine>,
     /// RAM used, bytes.
     pub ram_used: u32,
-    /// ROM estimate items.
+    /// The stack's high-water mark (bytes below the top of RAM), when measured.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stack_high_water: Option<u32>,
+    /// ROM items.
     pub rom: Vec<MemLine>,
-    /// ROM estimate, bytes.
+    /// ROM used, bytes.
     pub rom_used: u32,
     /// EEPROM traffic and lifetime.
     pub eeprom: EepromLine,
@@ -174,95 +346,308 @@ pub const fn fit_weight_seed(seed: u64) -> u64 {
     robot_stream(seed, 0, 0, 0, Purpose::Weights)
 }
 
-/// Runs the controller as [`FitConfig`] says and reports.
-///
-/// # Errors
-/// [`ControllerError`] when the configuration is impossible (clock, save period, step period,
-/// a network too large for the RAM (naming the item) or beyond the learner's bound).
-pub fn measure(cfg: &FitConfig) -> Result<FitReport, ControllerError> {
-    let mut controller = Controller::new(cfg.controller.clone())?;
-    let clock_hz = cfg.controller.clock_hz;
-    // The fit's robot is robot 0 of repeat 0 under the seed (crate::seeds).
-    let stream = |k: u64, purpose: Purpose| robot_stream(cfg.seed, 0, 0, k, purpose);
-    let mut sensors_v = Vec::with_capacity(4);
-    for k in 0..4 {
-        let params = sensors::IrParams {
-            clock_hz,
-            ..sensors::IrParams::default()
-        };
-        sensors_v.push(
-            sensors::IrSensor::new(params, stream(k, Purpose::IrSensor)).map_err(|e| {
-                ControllerError::Config {
-                    field: "clock_hz",
-                    value: clock_hz.to_string(),
-                    valid: e.to_string(),
-                }
-            })?,
-        );
-    }
-    let mut walk = ChaCha8Rng::seed_from_u64(stream(0, Purpose::FitDistances));
-    let board = FitBoard {
-        sensors: sensors_v,
-        distance_mm: [300.0, 500.0, 150.0, 800.0],
-        channels: cfg.controller.sensor_channels,
-    };
-    let mut mcu = Mcu::new(
-        McuConfig {
-            clock_hz,
-            eeprom_seed: stream(0, Purpose::Eeproms),
-        },
-        board,
-    )
-    .map_err(|e| ControllerError::Config {
-        field: "clock_hz",
-        value: clock_hz.to_string(),
-        valid: e.to_string(),
-    })?;
+/// The fit's robot: its MCU (sensors, EEPROMs) and the walk of its sensors' distances.
+struct Rig {
+    mcu: Mcu<FitBoard>,
+    walk: ChaCha8Rng,
+}
 
-    let boot = controller.boot(&mut mcu)?;
-    let mut per_step: Vec<PhaseStates> = Vec::with_capacity(cfg.steps as usize);
-    let mut busy: Vec<u64> = Vec::with_capacity(cfg.steps as usize);
-    let mut save_max = 0u64;
-    for _ in 0..cfg.steps {
-        let sleep = controller.sleep_until_step(&mut mcu)?;
-        // The world moves: each distance takes a bounded random step.
-        for d in &mut mcu.board_mut().distance_mm {
-            let delta: f64 = walk.random_range(-60.0..60.0);
+impl Rig {
+    fn new(cfg: &FitConfig) -> Result<Rig, FitError> {
+        let clock_hz = cfg.controller.clock_hz;
+        let stream = |k: u64, purpose: Purpose| robot_stream(cfg.seed, 0, 0, k, purpose);
+        let mut sensors_v = Vec::with_capacity(4);
+        for k in 0..4 {
+            let params = sensors::IrParams {
+                clock_hz,
+                ..sensors::IrParams::default()
+            };
+            sensors_v.push(
+                sensors::IrSensor::new(params, stream(k, Purpose::IrSensor)).map_err(|e| {
+                    FitError::Sensor {
+                        clock_hz,
+                        why: e.to_string(),
+                    }
+                })?,
+            );
+        }
+        let board = FitBoard {
+            sensors: sensors_v,
+            distance_mm: [300.0, 500.0, 150.0, 800.0],
+            channels: cfg.controller.sensor_channels,
+        };
+        let mcu = Mcu::new(
+            McuConfig {
+                clock_hz,
+                eeprom_seed: stream(0, Purpose::Eeproms),
+            },
+            board,
+        )?;
+        Ok(Rig {
+            mcu,
+            walk: ChaCha8Rng::seed_from_u64(stream(0, Purpose::FitDistances)),
+        })
+    }
+
+    /// The world moves before each step: each distance takes a bounded random step.
+    fn move_world(&mut self) {
+        for d in &mut self.mcu.board_mut().distance_mm {
+            let delta: f64 = self.walk.random_range(-60.0..60.0);
             *d = (*d + delta).clamp(30.0, 1000.0);
         }
-        let step = controller.step(&mut mcu)?;
-        save_max = save_max.max(step.phases.save);
-        busy.push(step.phases.work() + step.phases.isr + sleep.busy_states);
-        per_step.push(step.phases);
     }
+}
 
-    let spread = |f: &dyn Fn(&PhaseStates) -> u64| -> Spread {
-        let values: Vec<u64> = per_step.iter().map(f).collect();
-        spread_of(&values)
-    };
-    let us = |states: u64| states as f64 / f64::from(clock_hz) * 1e6;
-    let mut phases = Vec::new();
-    for (name, s) in [
-        ("A/D", spread(&|p| p.adc)),
-        ("input", spread(&|p| p.input)),
-        ("update", spread(&|p| p.update)),
-        ("forward", spread(&|p| p.forward)),
-        ("motors", spread(&|p| p.motors)),
-        ("EEPROM save (amortised)", spread(&|p| p.save)),
-        ("tick interrupts in the step", spread(&|p| p.isr)),
-    ] {
-        phases.push(PhaseLine {
-            phase: name,
-            states: s,
-            max_us: us(s.max),
+/// One controller's measurement before it becomes a report.
+struct Measured {
+    source: String,
+    boot_states: u64,
+    /// (phase, states in each step period).
+    phases: Vec<(String, Vec<u64>)>,
+    busy: Vec<u64>,
+    ram: Vec<MemLine>,
+    stack_high_water: Option<u32>,
+}
+
+impl Measured {
+    fn phase(&self, name: &str) -> Option<&[u64]> {
+        self.phases
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, v)| v.as_slice())
+    }
+}
+
+/// Runs the firmware for `cfg.steps` step periods.
+fn measure_firmware(cfg: &FitConfig) -> Result<Measured, FitError> {
+    let fw = &cfg.firmware.firmware;
+    let block = ConfigBlock::from_controller(&cfg.controller)?;
+    let block = if fw.has_config_block() {
+        Some(block)
+    } else if block == ConfigBlock::ARENA {
+        None
+    } else {
+        return Err(FitError::NoBlock {
+            image: fw.name.clone(),
         });
-    }
-    let busy_per_step = spread_of(&busy);
-    let period_states = cfg.controller.step_period_s * f64::from(clock_hz);
-    let cpu_mean_percent = busy_per_step.mean / period_states * 100.0;
-    let cpu_worst_percent = busy_per_step.max as f64 / period_states * 100.0;
+    };
+    let mut rig = Rig::new(cfg)?;
+    let mut cpu = Cpu::new();
+    fw.install(&mut rig.mcu, &mut cpu, block.as_ref())?;
+    let mut profiler = Profiler::new(&fw.symbols, &cfg.firmware.phases, PHASE_OTHER)?;
+    let clock = f64::from(cfg.controller.clock_hz);
+    let step = |profiler: &mut Profiler, cpu: &mut Cpu, mcu: &mut Mcu<FitBoard>, deadline: u64| {
+        let at = mcu.now();
+        match profiler.run_one(cpu, mcu, deadline) {
+            Ok(Event::Halted) => Err(FitError::Run {
+                at,
+                source: halted(cpu),
+            }),
+            Ok(e) => Ok(e),
+            Err(e) => Err(FitError::Run {
+                at,
+                source: RunError::Cpu(e),
+            }),
+        }
+    };
 
-    let ram: Vec<MemLine> = controller
+    // Boot: from reset until the first step begins (the first entry into the step's first
+    // phase, A/D for the robot firmware). The step periods are counted from there.
+    let step_phase = profiler
+        .names()
+        .iter()
+        .position(|n| n != PHASE_BOOT && n != PHASE_OTHER)
+        .unwrap_or(usize::MAX);
+    let boot_limit = (BOOT_LIMIT_S * clock) as u64;
+    if step_phase == usize::MAX {
+        // No phases: count from the first SLEEP instead.
+        while !cpu.sleeping() {
+            if rig.mcu.now() >= boot_limit {
+                return Err(FitError::BootTimeout { pc: cpu.pc() });
+            }
+            step(&mut profiler, &mut cpu, &mut rig.mcu, boot_limit)?;
+        }
+    } else {
+        while profiler.first_entry(step_phase).is_none() {
+            if rig.mcu.now() >= boot_limit {
+                return Err(FitError::BootTimeout { pc: cpu.pc() });
+            }
+            step(&mut profiler, &mut cpu, &mut rig.mcu, boot_limit)?;
+        }
+    }
+    let boot_states: u64 = profiler.states().iter().sum();
+    if let Some(addr) = fw.symbols.addr("cfg_status")
+        && block.is_some()
+        && let ConfigStatus::Rejected { field, code } = ConfigStatus::from_code(rig.mcu.peek(addr))
+    {
+        return Err(FitError::Rejected { field, code });
+    }
+
+    let period = match block {
+        Some(b) => b.step_period_states(),
+        None => ConfigBlock::ARENA.step_period_states(),
+    };
+    let n_phases = profiler.names().len();
+    let mut per_phase: Vec<Vec<u64>> = vec![Vec::with_capacity(cfg.steps as usize); n_phases];
+    let mut busy = Vec::with_capacity(cfg.steps as usize);
+    let mut before: Vec<u64> = profiler.states().to_vec();
+    // A step period runs from one step's start (the entry into its first phase) to the next
+    // one's: one step, its ticks and the idle time up to the next (K ticks in steady state;
+    // the first may be shorter when boot outlasted the first tick). Without phases, fixed
+    // windows of K ticks from the first SLEEP.
+    let mut window_end = rig.mcu.now();
+    for k in 0..u64::from(cfg.steps) {
+        // The world moves before each step's A/D scan.
+        rig.move_world();
+        if step_phase == usize::MAX {
+            window_end += period;
+            while rig.mcu.now() < window_end {
+                if step(&mut profiler, &mut cpu, &mut rig.mcu, window_end)? == Event::Asleep {
+                    break;
+                }
+            }
+        } else {
+            let limit = rig.mcu.now() + 2 * period + boot_limit;
+            while profiler.entries(step_phase) < k + 2 {
+                if rig.mcu.now() >= limit {
+                    return Err(FitError::StepTimeout {
+                        phase: profiler.names()[step_phase].clone(),
+                        pc: cpu.pc(),
+                    });
+                }
+                step(&mut profiler, &mut cpu, &mut rig.mcu, limit)?;
+            }
+        }
+        let now = profiler.states();
+        for (i, v) in per_phase.iter_mut().enumerate() {
+            v.push(now[i] - before[i]);
+        }
+        busy.push(now.iter().sum::<u64>() - before.iter().sum::<u64>());
+        before = now.to_vec();
+    }
+    let phases: Vec<(String, Vec<u64>)> = profiler
+        .names()
+        .iter()
+        .cloned()
+        .zip(per_phase)
+        .filter(|(n, _)| n != PHASE_BOOT)
+        .collect();
+    let stack_top = fw
+        .symbols
+        .addr("_stack_top")
+        .unwrap_or(emu::core::memmap::RAM_END + 1);
+    let stack_high_water = stack_top.saturating_sub(profiler.min_sp());
+    Ok(Measured {
+        source: fw.name.clone(),
+        boot_states,
+        phases,
+        busy,
+        ram: firmware_ram(fw, &rig.mcu, stack_high_water),
+        stack_high_water: Some(stack_high_water),
+    })
+}
+
+/// A big-endian u32 in RAM.
+fn peek_u32<B: Board>(mcu: &Mcu<B>, addr: u32) -> u32 {
+    (0..4).fold(0, |v, i| (v << 8) | u32::from(mcu.peek(addr + i)))
+}
+
+/// The image's RAM: every variable of `.data` and `.bss` (sized by the next symbol), the
+/// network's arrays (from the firmware's pointers, when it has them), the stack's high-water.
+fn firmware_ram<B: Board>(fw: &Firmware, mcu: &Mcu<B>, stack: u32) -> Vec<MemLine> {
+    let sym = |n: &str| fw.symbols.addr(n);
+    let mut lines = Vec::new();
+    if let (Some(start), Some(end)) = (
+        sym("_data_start").or(sym("_bss_start")),
+        sym("_bss_end").or(sym("_heap_start")),
+    ) {
+        let vars: Vec<&emu::board::symbols::Symbol> = fw
+            .symbols
+            .symbols()
+            .iter()
+            .filter(|s| {
+                matches!(s.kind, 'b' | 'B' | 'd' | 'D')
+                    && !s.name.starts_with('.')
+                    && !s.name.starts_with("__")
+                    && s.addr >= start
+                    && s.addr < end
+            })
+            .collect();
+        for (i, v) in vars.iter().enumerate() {
+            let next = vars.get(i + 1).map_or(end, |n| n.addr);
+            lines.push(MemLine {
+                item: format!("{} (variable)", v.c_name()),
+                addr: v.addr,
+                bytes: next - v.addr,
+            });
+        }
+    }
+    let net = ["net_w", "net_delta", "net_y", "net_o", "net_x"].map(&sym);
+    if let (Some(heap_end), [Some(w), Some(d), Some(y), Some(o), Some(x)]) = (sym("heap_end"), net)
+    {
+        let end = peek_u32(mcu, heap_end);
+        let p = [w, d, y, o, x].map(|a| peek_u32(mcu, a));
+        let names = [
+            "weights w (i16, N x M)",
+            "update deltas (i16, N)",
+            "sums y (i32, M)",
+            "outputs O (i16, M)",
+            "input vector x (i8, N, word-aligned)",
+        ];
+        for k in 0..5 {
+            let next = if k + 1 < 5 { p[k + 1] } else { end };
+            lines.push(MemLine {
+                item: format!("{} [carved at boot]", names[k]),
+                addr: p[k],
+                bytes: next.saturating_sub(p[k]),
+            });
+        }
+    }
+    let top = sym("_stack_top").unwrap_or(emu::core::memmap::RAM_END + 1);
+    lines.push(MemLine {
+        item: "stack (high-water mark measured)".to_string(),
+        addr: top - stack,
+        bytes: stack,
+    });
+    lines
+}
+
+/// Runs the model controller for `cfg.steps` step periods.
+fn measure_model(cfg: &FitConfig) -> Result<Measured, FitError> {
+    let mut controller = Controller::new(cfg.controller.clone())?;
+    let mut rig = Rig::new(cfg)?;
+    let boot = controller.boot(&mut rig.mcu)?;
+    // (the step's phases, the sleep's busy states, the sleep's ticks) for each step period:
+    // the step and the sleep after it, up to the next step (the firmware's periods, too, run
+    // from one step's tick to the next).
+    let mut per_step: Vec<(PhaseStates, u64, u64)> = Vec::with_capacity(cfg.steps as usize);
+    controller.sleep_until_step(&mut rig.mcu)?;
+    for _ in 0..cfg.steps {
+        rig.move_world();
+        let step = controller.step(&mut rig.mcu)?;
+        let sleep = controller.sleep_until_step(&mut rig.mcu)?;
+        per_step.push((step.phases, sleep.busy_states, sleep.ticks));
+    }
+    let isr = controller.isr_states().unwrap_or(0);
+    let col = |f: &dyn Fn(&(PhaseStates, u64, u64)) -> u64| -> Vec<u64> {
+        per_step.iter().map(f).collect()
+    };
+    // A step period: the step (with the ticks taken during it) and the sleep after it (its
+    // ticks, SLEEP and main's test after each).
+    let phases = vec![
+        (PHASE_ADC.to_string(), col(&|s| s.0.adc)),
+        (PHASE_INPUT.to_string(), col(&|s| s.0.input)),
+        (PHASE_UPDATE.to_string(), col(&|s| s.0.update)),
+        (PHASE_FORWARD.to_string(), col(&|s| s.0.forward)),
+        (PHASE_MOTORS.to_string(), col(&|s| s.0.motors)),
+        (PHASE_SAVE.to_string(), col(&|s| s.0.save)),
+        (PHASE_TICKS.to_string(), col(&|s| s.2 * isr + s.0.isr)),
+        (
+            PHASE_OTHER.to_string(),
+            col(&|s| s.0.main + s.1.saturating_sub(s.2 * isr)),
+        ),
+    ];
+    let ram = controller
         .ram()
         .items()
         .iter()
@@ -272,23 +657,101 @@ pub fn measure(cfg: &FitConfig) -> Result<FitReport, ControllerError> {
             bytes: p.bytes,
         })
         .collect();
-    let ram_used = controller.ram().used();
-    let rom: Vec<MemLine> = rom_estimate()
-        .into_iter()
-        .map(|l| MemLine {
-            item: l.name.to_string(),
-            addr: 0,
-            bytes: l.bytes,
+    Ok(Measured {
+        source: "model".to_string(),
+        boot_states: boot.states,
+        phases,
+        busy: col(&|s| s.0.work() + s.0.isr + s.1),
+        ram,
+        stack_high_water: None,
+    })
+}
+
+/// Runs the controller as [`FitConfig`] says and reports.
+///
+/// # Errors
+/// [`FitError`] when the configuration is impossible, the image unusable or it stops.
+pub fn measure(cfg: &FitConfig) -> Result<FitReport, FitError> {
+    let run = |kind| match kind {
+        ControllerKind::Firmware => measure_firmware(cfg),
+        ControllerKind::Model => measure_model(cfg),
+    };
+    let main = run(cfg.kind)?;
+    let other = if cfg.compare {
+        Some(run(match cfg.kind {
+            ControllerKind::Firmware => ControllerKind::Model,
+            ControllerKind::Model => ControllerKind::Firmware,
+        })?)
+    } else {
+        None
+    };
+    Ok(report(cfg, &main, other.as_ref()))
+}
+
+fn spread_of(values: &[u64]) -> Spread {
+    if values.is_empty() {
+        return Spread::default();
+    }
+    Spread {
+        max: values.iter().copied().max().unwrap_or(0),
+        mean: values.iter().sum::<u64>() as f64 / values.len() as f64,
+    }
+}
+
+fn report(cfg: &FitConfig, m: &Measured, other: Option<&Measured>) -> FitReport {
+    let c = &cfg.controller;
+    let clock_hz = c.clock_hz;
+    let us = |states: u64| states as f64 / f64::from(clock_hz) * 1e6;
+    let phases: Vec<PhaseLine> = m
+        .phases
+        .iter()
+        .map(|(name, v)| {
+            let s = spread_of(v);
+            let o = other.and_then(|o| o.phase(name)).map(spread_of);
+            PhaseLine {
+                phase: name.clone(),
+                states: s,
+                max_us: us(s.max),
+                other: o,
+                ratio: o
+                    .filter(|o| o.mean > 0.0 && s.mean > 0.0)
+                    .map(|o| s.mean / o.mean),
+            }
         })
         .collect();
-    let rom_used: u32 = rom.iter().map(|l| l.bytes).sum();
+    let save_max = m
+        .phase(PHASE_SAVE)
+        .map_or(0, |v| v.iter().copied().max().unwrap_or(0));
+    let busy_per_step = spread_of(&m.busy);
+    let period_states = c.step_period_s * f64::from(clock_hz);
+    let cpu_mean_percent = busy_per_step.mean / period_states * 100.0;
+    let cpu_worst_percent = busy_per_step.max as f64 / period_states * 100.0;
+    let ram_used: u32 = m.ram.iter().map(|l| l.bytes).sum();
 
-    let saves_per_hour =
-        3600.0 / (cfg.controller.step_period_s * f64::from(cfg.controller.save_every_steps));
+    let fw = &cfg.firmware.firmware;
+    let image = fw.rom_bytes() as u32;
+    let mut rom = vec![MemLine {
+        item: format!("{} (S-record data)", fw.name),
+        addr: 0,
+        bytes: image,
+    }];
+    if fw.has_config_block() {
+        rom.push(MemLine {
+            item: "of which the configuration block".to_string(),
+            addr: emu::board::firmware::CONFIG_BLOCK_ADDR,
+            bytes: emu::board::firmware::CONFIG_BLOCK_BYTES as u32,
+        });
+    }
+    let rom_used = image;
+
+    let n_in = c.n_inputs();
+    let payload = 2 * n_in * c.behaviours;
+    let record = eeprom::persist::RecordLayout::default();
+    let saves_per_hour = 3600.0 / (c.step_period_s * f64::from(c.save_every_steps));
     let page_writes_per_hour = saves_per_hour / 2.0;
     let eeprom = EepromLine {
-        bytes_per_save: controller.bytes_per_save(),
-        pages_per_save: controller.pages_per_save(),
+        bytes_per_save: record.bytes_per_save(payload),
+        pages_per_save: record.pages_per_record(payload),
         saves_per_hour,
         page_writes_per_hour,
         lifetime_hours: ENDURANCE_CYCLES / page_writes_per_hour,
@@ -311,44 +774,45 @@ pub fn measure(cfg: &FitConfig) -> Result<FitReport, ControllerError> {
         .copied()
         .fold(("RAM", f64::INFINITY), |a, b| if b.1 < a.1 { b } else { a });
     let fits = margins.iter().all(|m| m.1 >= 0.0);
-    let layout = cfg.controller.layout;
-    let n_in = cfg.controller.n_inputs();
     let verdict = format!(
-        "{}: {} x {} network, RAM {} of {} B, ROM ≈ {} B of {} KB, worst step {:.2} % of the {} s period (mean {:.3} %); tightest margin: {} with {:.1} % left",
+        "{}: {} x {} network, RAM {} of {} B, ROM {} B of {} KB, worst step {:.2} % of the {} s period (mean {:.3} %); tightest margin: {} with {:.1} % left",
         if fits { "FITS" } else { "DOES NOT FIT" },
         n_in,
-        cfg.controller.behaviours,
+        c.behaviours,
         ram_used,
         RAM_BYTES,
         rom_used,
         ROM_BYTES / 1024,
         cpu_worst_percent,
-        cfg.controller.step_period_s,
+        c.step_period_s,
         cpu_mean_percent,
         tightest,
         tightest_margin_percent
     );
-    let _ = boot;
-    Ok(FitReport {
+    FitReport {
+        controller: cfg.kind,
+        source: m.source.clone(),
+        compared_with: other.map(|o| o.source.clone()),
         n_in,
-        n_out: cfg.controller.behaviours,
-        history: layout.history(),
-        bias: layout.bias(),
-        spare: layout.spare(),
-        eta: cfg.controller.params.eta().to_bits(),
-        threshold: cfg.controller.params.threshold(),
-        save_every_steps: cfg.controller.save_every_steps,
-        step_period_s: cfg.controller.step_period_s,
+        n_out: c.behaviours,
+        history: c.layout.history(),
+        bias: c.layout.bias(),
+        spare: c.layout.spare(),
+        eta: c.params.eta().to_bits(),
+        threshold: c.params.threshold(),
+        save_every_steps: c.save_every_steps,
+        step_period_s: c.step_period_s,
         clock_hz,
         steps: cfg.steps,
         seed: cfg.seed,
-        boot_states: boot.states,
+        boot_states: m.boot_states,
         phases,
         busy_per_step,
         cpu_mean_percent,
         cpu_worst_percent,
-        ram,
+        ram: m.ram.clone(),
         ram_used,
+        stack_high_water: m.stack_high_water,
         rom,
         rom_used,
         eeprom,
@@ -356,16 +820,6 @@ pub fn measure(cfg: &FitConfig) -> Result<FitReport, ControllerError> {
         tightest,
         tightest_margin_percent,
         verdict,
-    })
-}
-
-fn spread_of(values: &[u64]) -> Spread {
-    if values.is_empty() {
-        return Spread::default();
-    }
-    Spread {
-        max: values.iter().copied().max().unwrap_or(0),
-        mean: values.iter().sum::<u64>() as f64 / values.len() as f64,
     }
 }
 
@@ -382,18 +836,20 @@ pub enum Budget {
 
 /// The largest network (inputs N, by spare inputs on top of `base`'s layout) that fits the RAM
 /// and keeps the `budget` CPU share within `cpu_budget_percent` of the step period, measured by
-/// running each candidate; None when even `base` does not. The search is a bisection over N up
-/// to the learner's bound (256 inputs), each probe a full [`measure`].
+/// running each candidate (without the other controller beside); None when even `base` does
+/// not. The search is a bisection over N up to the learner's bound (256 inputs), each probe a
+/// full [`measure`].
 ///
 /// # Errors
-/// [`ControllerError`] for an impossible base configuration.
+/// [`FitError`] for an impossible base configuration.
 pub fn largest_fitting(
     base: &FitConfig,
     cpu_budget_percent: f64,
     budget: Budget,
-) -> Result<Option<FitReport>, ControllerError> {
-    let fits = |spare: usize| -> Result<Option<FitReport>, ControllerError> {
+) -> Result<Option<FitReport>, FitError> {
+    let fits = |spare: usize| -> Result<Option<FitReport>, FitError> {
         let mut cfg = base.clone();
+        cfg.compare = false;
         cfg.controller.layout = base.controller.layout.with_spare(spare as u16);
         let share = |r: &FitReport| match budget {
             Budget::Mean => r.cpu_mean_percent,
@@ -401,7 +857,9 @@ pub fn largest_fitting(
         };
         match measure(&cfg) {
             Ok(r) if r.fits && share(&r) <= cpu_budget_percent => Ok(Some(r)),
-            Ok(_) | Err(ControllerError::Ram(_)) | Err(ControllerError::Shape(_)) => Ok(None),
+            Ok(_)
+            | Err(FitError::Controller(ControllerError::Ram(_) | ControllerError::Shape(_)))
+            | Err(FitError::Rejected { .. }) => Ok(None),
             Err(e) => Err(e),
         }
     };

@@ -1,13 +1,21 @@
 //! `h8swarm fit`: the verdict of SPEC §6 for the default network and the paper's two settings,
 //! what-ifs, and the largest network within a CPU budget, all measured by running the
-//! controller on the emulated H8/3052F ([`crate::fit`]).
+//! controller on the emulated H8/3052F ([`crate::fit`]): by default the robot firmware on the
+//! H8/300H core, with the Rust model's figures beside each phase.
 
 use std::fmt::Write as _;
 
-use crate::fit::{Budget, FitConfig, FitReport, fit_weight_seed, largest_fitting, measure};
+use std::path::PathBuf;
+
+use crate::fit::{
+    Budget, ControllerKind, FirmwareUnderTest, FitConfig, FitReport, fit_weight_seed,
+    largest_fitting, measure, robot_phases,
+};
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
+use emu::board::firmware::Firmware;
 use emu::board::model::ControllerConfig;
+use emu::board::profile::PhaseDef;
 use nn_q15::InputLayout;
 use serde::Serialize;
 
@@ -20,9 +28,36 @@ pub enum Setting {
     Corridor,
 }
 
+/// Which controller to measure.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum ControllerArg {
+    /// The robot firmware (or `--firmware IMAGE`) as machine code on the H8/300H core.
+    #[default]
+    Firmware,
+    /// The Rust model of the controller.
+    Model,
+}
+
 /// Options of `h8swarm fit`.
 #[derive(Args, Debug, Default)]
 pub struct FitArgs {
+    /// The controller the verdict is about; the other one is measured beside it.
+    #[arg(long, value_enum, default_value_t = ControllerArg::Firmware)]
+    pub controller: ControllerArg,
+    /// Measure this firmware image (Motorola S-records) instead of the robot firmware.
+    #[arg(long, value_name = "IMAGE")]
+    pub firmware: Option<PathBuf>,
+    /// The image's symbol table as `h8300-hms-nm -n` prints it (default: IMAGE with the
+    /// extension `.sym`).
+    #[arg(long, value_name = "FILE", requires = "firmware")]
+    pub symbols: Option<PathBuf>,
+    /// A phase of the image: NAME=FUNCTION[,FUNCTION…] (repeatable). Default: the robot
+    /// firmware's phases whose functions the image has.
+    #[arg(long = "phase", value_name = "NAME=SYMBOL")]
+    pub phases: Vec<String>,
+    /// Do not measure the other controller beside.
+    #[arg(long)]
+    pub alone: bool,
     /// Start from this setting (default: report both, arena first; with a what-if, arena).
     #[arg(long, value_enum)]
     pub setting: Option<Setting>,
@@ -133,6 +168,64 @@ fn apply_what_ifs(mut cfg: ControllerConfig, a: &FitArgs) -> Result<ControllerCo
     Ok(cfg)
 }
 
+/// Parses `--phase NAME=SYMBOL[,SYMBOL…]`.
+fn parse_phase(text: &str) -> Result<PhaseDef> {
+    let Some((name, functions)) = text.split_once('=') else {
+        bail!(
+            "--phase {text}: give NAME=FUNCTION (several functions separated by commas), e.g. forward=learner_forward"
+        );
+    };
+    let functions: Vec<&str> = functions.split(',').map(str::trim).collect();
+    if name.trim().is_empty() || functions.iter().any(|f| f.is_empty()) {
+        bail!(
+            "--phase {text}: the name and every function must be non-empty (NAME=FUNCTION[,FUNCTION…])"
+        );
+    }
+    Ok(PhaseDef::new(name.trim(), &functions))
+}
+
+/// The image to measure and its phases.
+fn firmware_under_test(a: &FitArgs) -> Result<FirmwareUnderTest> {
+    let Some(image) = &a.firmware else {
+        let mut fut = FirmwareUnderTest::robot().context("the built-in robot firmware")?;
+        if !a.phases.is_empty() {
+            fut.phases = a
+                .phases
+                .iter()
+                .map(|p| parse_phase(p))
+                .collect::<Result<_>>()?;
+        }
+        return Ok(fut);
+    };
+    let symbols = a
+        .symbols
+        .clone()
+        .unwrap_or_else(|| image.with_extension("sym"));
+    let firmware = Firmware::load(image, &symbols).with_context(|| {
+        format!(
+            "--firmware {}: the image and its symbol table (`{}`; give another with --symbols)",
+            image.display(),
+            symbols.display()
+        )
+    })?;
+    let phases = if a.phases.is_empty() {
+        robot_phases()
+            .into_iter()
+            .filter(|p| {
+                p.functions
+                    .iter()
+                    .all(|f| firmware.symbols.get(f).is_some_and(|s| s.is_function()))
+            })
+            .collect()
+    } else {
+        a.phases
+            .iter()
+            .map(|p| parse_phase(p))
+            .collect::<Result<_>>()?
+    };
+    Ok(FirmwareUnderTest { firmware, phases })
+}
+
 fn parse_budget(text: &str) -> Result<f64> {
     let t = text.trim().trim_end_matches('%').trim();
     let v: f64 = t
@@ -158,14 +251,24 @@ pub fn run(a: &FitArgs) -> Result<String> {
         (None, true) => vec![Setting::Arena],
         (None, false) => vec![Setting::Arena, Setting::Corridor],
     };
+    let firmware = firmware_under_test(a)?;
+    let kind = match a.controller {
+        ControllerArg::Firmware => ControllerKind::Firmware,
+        ControllerArg::Model => ControllerKind::Model,
+    };
+    // A user's image is measured alone: the model is a model of the robot firmware.
+    let compare = !a.alone && a.firmware.is_none();
+    let config = |controller: ControllerConfig| FitConfig {
+        controller,
+        steps: a.steps,
+        seed: a.seed,
+        kind,
+        firmware: firmware.clone(),
+        compare,
+    };
     let mut reports = Vec::new();
     for setting in &settings {
-        let cfg = apply_what_ifs(base_config(*setting, a.seed), a)?;
-        let fit = FitConfig {
-            controller: cfg,
-            steps: a.steps,
-            seed: a.seed,
-        };
+        let fit = config(apply_what_ifs(base_config(*setting, a.seed), a)?);
         let report = measure(&fit).map_err(anyhow::Error::new)?;
         let name = match (setting, a.what_if()) {
             (Setting::Arena, false) => "arena (paper env. 2; the default network)".to_string(),
@@ -177,12 +280,7 @@ pub fn run(a: &FitArgs) -> Result<String> {
     }
     let largest = match budget {
         Some(pct) => {
-            let cfg = apply_what_ifs(base_config(settings[0], a.seed), a)?;
-            let fit = FitConfig {
-                controller: cfg,
-                steps: a.steps,
-                seed: a.seed,
-            };
+            let fit = config(apply_what_ifs(base_config(settings[0], a.seed), a)?);
             Some(LargestOut {
                 cpu_budget_percent: pct,
                 by_mean: largest_fitting(&fit, pct, Budget::Mean).map_err(anyhow::Error::new)?,
@@ -266,20 +364,53 @@ fn render(s: &mut String, name: &str, r: &FitReport) {
     );
     let _ = writeln!(
         s,
-        "{:<30} {:>12} {:>12} {:>10}",
-        "states per step", "max", "mean", "max µs"
+        "measured: {}{}",
+        match r.controller {
+            crate::fit::ControllerKind::Firmware => format!("{} on the H8/300H core", r.source),
+            crate::fit::ControllerKind::Model => "the Rust model of the controller".to_string(),
+        },
+        match &r.compared_with {
+            Some(o) => format!("; beside it: {o}"),
+            None => String::new(),
+        }
+    );
+    let other = if r.compared_with.is_some() {
+        format!(
+            " {:>12} {:>7}",
+            match r.controller {
+                crate::fit::ControllerKind::Firmware => "model mean",
+                crate::fit::ControllerKind::Model => "fw mean",
+            },
+            "ratio"
+        )
+    } else {
+        String::new()
+    };
+    let _ = writeln!(
+        s,
+        "{:<30} {:>12} {:>12} {:>10}{other}",
+        "states per step period", "max", "mean", "max µs"
     );
     for p in &r.phases {
+        let beside = match (&r.compared_with, p.other) {
+            (Some(_), Some(o)) => format!(
+                " {:>12.1} {:>7}",
+                o.mean,
+                p.ratio.map_or("-".to_string(), |x| format!("{x:.3}"))
+            ),
+            (Some(_), None) => format!(" {:>12} {:>7}", "-", "-"),
+            _ => String::new(),
+        };
         let _ = writeln!(
             s,
-            "{:<30} {:>12} {:>12.1} {:>10.1}",
+            "{:<30} {:>12} {:>12.1} {:>10.1}{beside}",
             p.phase, p.states.max, p.states.mean, p.max_us
         );
     }
     let _ = writeln!(
         s,
         "{:<30} {:>12} {:>12.1} {:>10.1}",
-        "busy per step (with ticks)",
+        "busy per step period",
         r.busy_per_step.max,
         r.busy_per_step.mean,
         us(r.busy_per_step.max as f64)
@@ -289,17 +420,19 @@ fn render(s: &mut String, name: &str, r: &FitReport) {
         "CPU: {:.3} % of the step period on average, {:.2} % in the worst step (a save); boot {} states",
         r.cpu_mean_percent, r.cpu_worst_percent, r.boot_states
     );
-    let _ = writeln!(s, "RAM (bytes, placed from H'FFDF10):");
+    let _ = writeln!(s, "RAM (bytes):");
     for m in &r.ram {
         let _ = writeln!(s, "  H'{:06X} {:>6}  {}", m.addr, m.bytes, m.item);
     }
     let _ = writeln!(
         s,
-        "  total {} of 8192 ({:.1} %)",
+        "  total {} of 8192 ({:.1} %){}",
         r.ram_used,
-        f64::from(r.ram_used) / 8192.0 * 100.0
+        f64::from(r.ram_used) / 8192.0 * 100.0,
+        r.stack_high_water
+            .map_or(String::new(), |h| format!("; stack high-water {h} B"))
     );
-    let _ = writeln!(s, "ROM estimate (bytes):");
+    let _ = writeln!(s, "ROM (bytes):");
     for m in &r.rom {
         let _ = writeln!(s, "  {:>6}  {}", m.bytes, m.item);
     }

@@ -501,9 +501,10 @@ mod tests {
 
     fn replay(input: &str) -> (String, Result<usize, String>) {
         let mut out = Vec::new();
-        let r = run(&mut input.as_bytes(), &mut out, false).map_err(|e| match e {
+        let r = run(&mut input.as_bytes(), &mut out, false, &Engine::Model).map_err(|e| match e {
             ReplayFailure::Input(e) => e.to_string(),
             ReplayFailure::Io(e) => format!("io: {e}"),
+            ReplayFailure::Core(e) => format!("core: {e}"),
         });
         (String::from_utf8(out).unwrap(), r)
     }

@@ -155,6 +155,9 @@ pub fn run(a: &RunArgs) -> Result<String> {
         controller: controller_config(&s, crate::fit::fit_weight_seed(s.seed))?,
         steps: 400,
         seed: s.seed,
+        kind: crate::fit::ControllerKind::Firmware,
+        firmware: crate::fit::FirmwareUnderTest::robot()?,
+        compare: true,
     })?;
     let fit_path = out.join("fit.json");
     std::fs::write(&fit_path, serde_json::to_string_pretty(&fit)? + "\n")

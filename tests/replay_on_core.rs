@@ -83,7 +83,11 @@ fn case(g: &mut Gen) -> String {
     let steps: Vec<(Vec<i8>, i16)> = (0..1 + g.below(12))
         .map(|_| {
             let x = (0..n).map(|_| g.next() as i8).collect();
-            let e = if g.below(2) == 0 { g.next() as i16 } else { g.below(40) as i16 - 20 };
+            let e = if g.below(2) == 0 {
+                g.next() as i16
+            } else {
+                g.below(40) as i16 - 20
+            };
             (x, e)
         })
         .collect();

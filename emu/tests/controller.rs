@@ -66,11 +66,19 @@ const FORWARD_13X4_MAX: u64 = MAC_13X4_MIN + 4 * 200 + 17 * 14 + 4 * 17 * 8;
 
 /// The A/D phase: a scan of four conversions with CKS = 1 (SPEC §3.2: 134 states; the later
 /// conversions of a scan 128, H8/3052F hardware manual) at least; at most those plus one more
-/// poll of ADF (MOV.B @aa:8 = 2 + 3 states, BPL = 4), the start and stop writes, four result
-/// reads (2 + 3) with the du lookup (EXTU ×2, MOV.B @(d:24) = 10) and the store (MOV.B @aa:16
-/// = 6), and the call and return (10 + 10).
+/// poll of ADF (MOV.B @aa:8 = 2 + 3 states, BGE = 4), the set-up and the start write
+/// (MOV.B @aa:24 = 8, four register ops, 2 + 3), the stop write and a clear (2 + 5 + 2), four
+/// channel lookups and result reads (four register ops, MOV.B @(d:24) = 10, AND.L and ADD.L
+/// #imm = 6 each, SHLL.L, MOV.B @ERn from I/O = 2 + 3) with the du lookup (EXTU ×2,
+/// MOV.B @(d:24) = 10), the store and the loop (MOV.B @ERn = 4, ADD.B, CMP.B, BLS = 4), and
+/// the return (RTS = 10) — the firmware's ad_scan.
 const ADC_MIN: u64 = 134 + 3 * 128;
-const ADC_MAX: u64 = 4 * 134 + 9 + 2 * (2 + 2 + 3) + 4 * (5 + 4 + 10 + 6) + 20;
+const ADC_MAX: u64 = 4 * 134
+    + 9
+    + (8 + 4 * 2 + 5)
+    + (2 + 5 + 2)
+    + 4 * ((4 * 2 + 10 + 6 + 2 + 6 + 5) + (2 * 2 + 10) + (4 + 2 + 2 + 4))
+    + 10;
 
 #[test]
 fn the_step_lies_within_bounds_derived_from_the_instruction_states() {

@@ -82,7 +82,7 @@ fn draw_e(g: &mut Gen, threshold: i16) -> i16 {
         1 => -threshold,
         2 => threshold.saturating_add(1),
         3 => (g.below(41) as i16) - 20,
-        4 => (g.i16() >> 5),
+        4 => g.i16() >> 5,
         _ => g.i16(),
     }
 }

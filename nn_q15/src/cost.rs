@@ -38,6 +38,8 @@ pub enum Insn {
     MovBwAbs16,
     /// MOV.B/MOV.W with @aa:24 (three words, one data access). SPEC §4.2: 8 states.
     MovBwAbs24,
+    /// MOV.B/MOV.W with @(d:24,ERs) (four words, one data access). SPEC §4.2: 10 states.
+    MovBwDisp24,
     /// MOV.L to or from @ERs. SPEC §4.2: 8 states.
     MovLInd,
     /// MOV.L with @ERs+ or @−ERd. SPEC §4.2: 10 states.
@@ -65,7 +67,7 @@ pub enum Insn {
 
 impl Insn {
     /// Every form, for tables and tests.
-    pub const ALL: [Insn; 18] = [
+    pub const ALL: [Insn; 19] = [
         Insn::Reg,
         Insn::ImmW,
         Insn::ImmL,
@@ -73,6 +75,7 @@ impl Insn {
         Insn::MovBwPostInc,
         Insn::MovBwAbs16,
         Insn::MovBwAbs24,
+        Insn::MovBwDisp24,
         Insn::MovLInd,
         Insn::MovLPostInc,
         Insn::MovLAbs16,
@@ -97,6 +100,7 @@ impl Insn {
             Insn::MovBwPostInc => 6,
             Insn::MovBwAbs16 => 6,
             Insn::MovBwAbs24 => 8,
+            Insn::MovBwDisp24 => 10,
             Insn::MovLInd => 8,
             Insn::MovLPostInc => 10,
             Insn::MovLAbs16 => 10,
@@ -121,7 +125,7 @@ impl Insn {
             Insn::ImmW | Insn::MovBwAbs16 | Insn::MovLInd | Insn::MovLPostInc | Insn::Bcc16 => 4,
             Insn::PushPopL | Insn::JsrAbs24 | Insn::MulxsW | Insn::DivxsW => 4,
             Insn::ImmL | Insn::MovLAbs16 | Insn::MovBwAbs24 => 6,
-            Insn::MovLAbs24 => 8,
+            Insn::MovLAbs24 | Insn::MovBwDisp24 => 8,
         }
     }
 
@@ -139,6 +143,10 @@ impl Insn {
             Insn::MovBwAbs24 => (
                 "mov.b @0xffdf90:24,r2l",
                 &[0x6A, 0x2A, 0x00, 0xFF, 0xDF, 0x90],
+            ),
+            Insn::MovBwDisp24 => (
+                "mov.b @(0x10:24,er2),r2l",
+                &[0x78, 0x20, 0x6A, 0x2A, 0x00, 0x00, 0x00, 0x10],
             ),
             Insn::MovLInd => ("mov.l er1,@er2", &[0x01, 0x00, 0x69, 0xA1]),
             Insn::MovLPostInc => ("mov.l @er5+,er3", &[0x01, 0x00, 0x6D, 0x53]),

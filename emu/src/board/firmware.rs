@@ -89,6 +89,72 @@ impl ConfigBlock {
         b
     }
 
+    /// The block for the settings of the model controller's configuration: the same network,
+    /// parameters, save period, step period (in 10 ms ticks) and wiring; the tick in counts of
+    /// φ/8 at its clock; the weight seed folded to 32 bits as the model folds it (so both start
+    /// from the same weights).
+    ///
+    /// # Errors
+    /// A setting the block cannot carry, naming it and what would be valid.
+    pub fn from_controller(
+        cfg: &crate::board::model::ControllerConfig,
+    ) -> Result<ConfigBlock, BlockError> {
+        let bad = |field: &'static str, value: String, valid: &'static str| BlockError {
+            field,
+            value,
+            valid,
+        };
+        let ticks = cfg.step_period_s / crate::board::model::TICK_S;
+        if !(ticks.is_finite()
+            && (ticks - ticks.round()).abs() < 1e-9
+            && (1.0..=65535.0).contains(&ticks.round()))
+        {
+            return Err(bad(
+                "step_period_s",
+                cfg.step_period_s.to_string(),
+                "a whole number of 10 ms ticks, 0.01 to 655.35 s",
+            ));
+        }
+        let tick_counts = (crate::board::model::TICK_S * f64::from(cfg.clock_hz) / 8.0).round();
+        if !(2.0..=65535.0).contains(&tick_counts) {
+            return Err(bad(
+                "clock_hz",
+                cfg.clock_hz.to_string(),
+                "2 to 25 MHz (a 10 ms tick of φ/8 counts must fit ITU0's 16-bit GRA)",
+            ));
+        }
+        let save_every = u16::try_from(cfg.save_every_steps).map_err(|_| {
+            bad(
+                "save_every_steps",
+                cfg.save_every_steps.to_string(),
+                "1 to 65535 steps",
+            )
+        })?;
+        let spare = u16::try_from(cfg.layout.spare())
+            .map_err(|_| bad("spare inputs", cfg.layout.spare().to_string(), "0 to 256"))?;
+        let outputs = u8::try_from(cfg.behaviours)
+            .map_err(|_| bad("behaviours", cfg.behaviours.to_string(), "2 to 4"))?;
+        Ok(ConfigBlock {
+            outputs,
+            history: cfg.layout.history() as u8,
+            flags: if cfg.layout.bias() { FLAG_BIAS } else { 0 },
+            spare,
+            eta: cfg.params.eta().to_bits(),
+            threshold: cfg.params.threshold(),
+            save_every,
+            ticks_per_step: ticks.round() as u16,
+            tick_counts: tick_counts as u16,
+            channels: cfg.sensor_channels,
+            seed: (cfg.weight_seed ^ (cfg.weight_seed >> 32)) as u32,
+        })
+    }
+
+    /// The step period in states: K ticks of `tick_counts` counts of φ/8.
+    #[must_use]
+    pub fn step_period_states(&self) -> u64 {
+        u64::from(self.ticks_per_step) * u64::from(self.tick_counts) * 8
+    }
+
     /// Number of inputs N the block makes.
     #[must_use]
     pub fn n_inputs(&self) -> usize {
@@ -98,6 +164,18 @@ impl ConfigBlock {
             + usize::from(self.flags & FLAG_BIAS)
             + usize::from(self.spare)
     }
+}
+
+/// A setting the configuration block cannot carry.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{field} = {value}: the firmware's configuration block takes {valid}")]
+pub struct BlockError {
+    /// The setting.
+    pub field: &'static str,
+    /// Its value.
+    pub value: String,
+    /// What would be valid.
+    pub valid: &'static str,
 }
 
 /// What the firmware made of the block at boot (its `cfg_status`).

@@ -202,7 +202,7 @@ impl LearnerOnCore {
         }
         self.cpu.set_ccr(CCR_I);
         self.cpu.set_pc(entry);
-        self.profiler.enter_function(entry);
+        self.profiler.enter_function(entry, self.mcu.now());
         let t0 = self.mcu.now();
         while self.cpu.pc() != self.a.exit {
             let deadline = t0 + CALL_LIMIT_STATES;

@@ -64,6 +64,11 @@ pub struct Profiler {
     states: Vec<u64>,
     idle: u64,
     min_sp: u32,
+    last_wake: Option<u64>,
+    /// When each phase's function was first entered.
+    first_entries: Vec<Option<u64>>,
+    /// How often each phase's functions were entered.
+    entries: Vec<u64>,
     function_starts: Vec<u32>,
 }
 
@@ -109,6 +114,9 @@ impl Profiler {
             stack: Vec::new(),
             idle: 0,
             min_sp: u32::MAX,
+            last_wake: None,
+            first_entries: vec![None; other_ix + 1],
+            entries: vec![0; other_ix + 1],
             function_starts,
         })
     }
@@ -131,6 +139,25 @@ impl Profiler {
         self.idle
     }
 
+    /// When one of `phase`'s functions was first entered (the clock after the call), if one
+    /// was; `phase` indexes [`Profiler::names`].
+    #[must_use]
+    pub fn first_entry(&self, phase: usize) -> Option<u64> {
+        self.first_entries.get(phase).copied().flatten()
+    }
+
+    /// How often one of `phase`'s functions was entered so far.
+    #[must_use]
+    pub fn entries(&self, phase: usize) -> u64 {
+        self.entries.get(phase).copied().unwrap_or(0)
+    }
+
+    /// When the CPU last woke from SLEEP (an interrupt ended the wait), if it has.
+    #[must_use]
+    pub fn last_wake(&self) -> Option<u64> {
+        self.last_wake
+    }
+
     /// The lowest ER7 seen (u32::MAX before the first instruction).
     #[must_use]
     pub fn min_sp(&self) -> u32 {
@@ -142,17 +169,24 @@ impl Profiler {
     }
 
     /// Enters the function at `entry` as a call would (for a caller that sets the PC itself
-    /// rather than executing a JSR: its RTS leaves the frame again).
-    pub fn enter_function(&mut self, entry: u32) {
-        self.enter(entry);
+    /// rather than executing a JSR: its RTS leaves the frame again); `now` is the clock.
+    pub fn enter_function(&mut self, entry: u32, now: u64) {
+        self.enter_at(entry, now);
     }
 
-    fn enter(&mut self, entry: u32) {
-        let phase = self
-            .by_entry
-            .get(&entry)
-            .copied()
-            .unwrap_or_else(|| self.current());
+    fn enter_at(&mut self, entry: u32, now: u64) {
+        let own = self.by_entry.get(&entry).copied();
+        // An entry into a phase from outside it (a phase's functions calling each other stay
+        // one entry).
+        if let Some(p) = own
+            && self.current() != p
+        {
+            self.entries[p] += 1;
+            if self.first_entries[p].is_none() {
+                self.first_entries[p] = Some(now);
+            }
+        }
+        let phase = own.unwrap_or_else(|| self.current());
         // A runaway recursion must not grow the shadow stack without bound.
         if self.stack.len() < 4096 {
             self.stack.push(Frame { phase });
@@ -207,6 +241,7 @@ impl Profiler {
                 if bus.now() >= deadline {
                     return Ok(Event::Asleep);
                 }
+                self.last_wake = Some(bus.now());
             }
             let t0 = bus.now();
             let event = cpu.step(bus, deadline)?;
@@ -216,21 +251,22 @@ impl Profiler {
                     let cur = self.current();
                     self.states[cur] += dt;
                     match cpu.last_executed().instr {
-                        Instr::Jsr(_) | Instr::Bsr { .. } => self.enter(cpu.pc()),
-                        Instr::Trapa(_) => self.enter(cpu.pc()),
+                        Instr::Jsr(_) | Instr::Bsr { .. } | Instr::Trapa(_) => {
+                            self.enter_at(cpu.pc(), bus.now());
+                        }
                         Instr::Rts | Instr::Rte => self.leave(),
                         Instr::Jmp(_) => {
                             let to = cpu.pc();
                             if self.function_starts.binary_search(&to).is_ok() {
                                 self.leave();
-                                self.enter(to);
+                                self.enter_at(to, bus.now());
                             }
                         }
                         _ => {}
                     }
                 }
                 Event::Interrupt(_) => {
-                    self.enter(cpu.pc());
+                    self.enter_at(cpu.pc(), t0);
                     let cur = self.current();
                     self.states[cur] += dt;
                 }

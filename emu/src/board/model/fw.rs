@@ -48,16 +48,17 @@ pub const fn states_of(insns: &[Insn]) -> u32 {
     total
 }
 
-/// The tick interrupt's handler body after entry: save ER0, read TSR0 (IMFA = 1), clear IMFA,
-/// write TSR0 back, increment the 32-bit tick counter in RAM, restore ER0; RTE follows.
-/// (`PUSH.L ER0 ; MOV.B @TSR0:8,R0L ; BCLR #0,R0L ; MOV.B R0L,@TSR0:8 ; MOV.L @TICKS:16,ER0 ;
-/// INC.L #1,ER0 ; MOV.L ER0,@TICKS:16 ; POP.L ER0 ; RTE`; the two TSR0 accesses go over the bus.)
-const ISR_REGISTER_CODE: [Insn; 6] = [
+/// The firmware's tick interrupt handler (`tick_isr`, from the listing) around its two TSR0
+/// accesses: `PUSH.L ER2 ; PUSH.L ER3 ; MOV.L #TSR0,ER2 ;` [MOV.B @ER2,R3L] `AND.B #H'FE,R3L ;`
+/// [MOV.B R3L,@ER2] `MOV.L @ticks:24,ER2 ; ADDS #1,ER2 ; MOV.L ER2,@ticks:24 ; POP.L ER3 ;
+/// POP.L ER2 ;` then RTE.
+const ISR_BEFORE_READ: [Insn; 3] = [Insn::PushPopL, Insn::PushPopL, Insn::ImmL];
+const ISR_BETWEEN: [Insn; 1] = [Insn::Reg];
+const ISR_AFTER_WRITE: [Insn; 5] = [
+    Insn::MovLAbs24,
+    Insn::Reg,
+    Insn::MovLAbs24,
     Insn::PushPopL,
-    Insn::Reg,
-    Insn::MovLAbs16,
-    Insn::Reg,
-    Insn::MovLAbs16,
     Insn::PushPopL,
 ];
 
@@ -159,15 +160,15 @@ impl<'a, B: ModelBus> Fw<'a, B> {
     pub fn tick_handler(&mut self) {
         let t0 = self.bus.now();
         self.bus.internal(INTERRUPT_ENTRY_STATES);
-        // PUSH.L ER0, then MOV.B @TSR0:8,R0L (IMFA reads 1) ; BCLR #0,R0L ; MOV.B R0L,@TSR0:8
-        // clears it (the chip's read-1-then-write-0 rule).
-        self.bus.internal(states_of(&ISR_REGISTER_CODE[..1]));
+        // TSR0 is read with IMFA = 1 and written back with it cleared (the chip's
+        // read-1-then-write-0 rule).
+        self.bus.internal(states_of(&ISR_BEFORE_READ));
         self.bus.internal(FETCH_STATES);
         let tsr = self.bus.read8(ITU0 + TSR);
-        self.bus.internal(states_of(&ISR_REGISTER_CODE[1..2]));
+        self.bus.internal(states_of(&ISR_BETWEEN));
         self.bus.internal(FETCH_STATES);
         self.bus.write8(ITU0 + TSR, tsr & !IMA);
-        self.bus.internal(states_of(&ISR_REGISTER_CODE[2..]));
+        self.bus.internal(states_of(&ISR_AFTER_WRITE));
         self.bus.internal(RTE_STATES);
         *self.ticks += 1;
         self.isr_states += self.bus.now() - t0;

@@ -58,7 +58,7 @@ use crate::chip::periph::adc::ADCSR as ADCSR_ADDR;
 use crate::core::bus::Bus;
 use crate::core::memmap::ADDRESS_MASK;
 use fast::SaveTimelines;
-use fw::{FETCH_STATES, Fw, FwPins, SLEEP_STATES, states_of};
+use fw::{FETCH_STATES, Fw, FwPins, SLEEP_STATES};
 use regs::*;
 
 /// What the model asks of the MCU besides the bus: the two facts its emulation shortcuts
@@ -114,10 +114,38 @@ pub const INITIAL_WEIGHT_AMPLITUDE: i16 = 16384;
 /// Most ACK polls per page write before the save gives up (well past a 5 ms write cycle).
 pub const MAX_POLLS: u32 = 2000;
 
-/// States of `MOV.B @(d:24,ERs),Rd` (SPEC §4.2: 10; the du table lookup in flash).
-const MOVB_DISP24_STATES: u32 = 10;
-/// States of JSR @aa:24 and RTS (SPEC §4.2: 10 each).
-const CALL_RETURN_STATES: u32 = 20;
+/// The firmware's I²C bus timing, from the listing of `firmware/i2c.c` (states between the
+/// edges its code makes; every one above DS21203's 400 kHz minima): SCL low 94 (a bit's low
+/// half: the return from `clock`, the loop, the SDA write and the call: 92 or 96 by the bit's
+/// value), SCL high 34 (`delay(2)`, the SDA sample, the shadow update), START hold 29 and
+/// repeated-START setup 31 (`delay(2)` and a pin write), data setup 41 (the SDA write to the
+/// SCL rise), STOP setup 29, bus free 90 (`delay(5)`, the return and the next START's first
+/// pin write). The model's master keeps these as its minima, so its bus runs at the firmware's
+/// pace (about 190 kHz instead of the chip's 400 kHz).
+///
+/// # Errors
+/// [`eeprom::EepromError::InvalidClock`] for a clock the EEPROM model refuses.
+pub fn firmware_i2c_timing(clock_hz: u32) -> Result<MasterTiming, eeprom::EepromError> {
+    Ok(MasterTiming {
+        clock: eeprom::clock::Clock::new(clock_hz)?,
+        scl_low_states: 94,
+        scl_high_states: 34,
+        start_setup_states: 31,
+        start_hold_states: 29,
+        data_setup_states: 41,
+        stop_setup_states: 29,
+        bus_free_states: 90,
+    })
+}
+
+/// main's test after each wake-up (from the listing): MOV.L @ticks:24,ER2 ; SUB.L ER3,ER2 ;
+/// MOV.L ER2,ER2 ; BLT back to SLEEP.
+const MAIN_TICK_TEST: [Insn; 4] = [Insn::MovLAbs24, Insn::Reg, Insn::Reg, Insn::Bcc8];
+/// States of the random walk's draw in the firmware's robot_step (from the listing): JSR
+/// @xorshift32 (10) and its 210 states (three shift loops of 13, 1 and 5 places, the loads and
+/// stores, RTS), SUB.L, MOV.B @net_n_out:24, MOV.W E0,R0, EXTU.L (14), JSR @__mulsi3 (10) and
+/// its 84 states (three MULXU.W), MOV.W E0,R0, EXTU.L (4).
+pub const RANDOM_WALK_DRAW_STATES: u64 = 10 + 210 + 14 + 10 + 84 + 4;
 
 /// The default wiring of the four IR sensors (front, rear, left, right): AN0–AN3 (SPEC §3.2).
 pub const DEFAULT_SENSOR_CHANNELS: [u8; 4] = crate::board::wiring::AN_IR;
@@ -236,13 +264,15 @@ pub struct PhaseStates {
     pub save: u64,
     /// Tick interrupts taken during the step (entry to RTE).
     pub isr: u64,
+    /// The main loop's own code in the step (the calls, the behaviour, the save test).
+    pub main: u64,
 }
 
 impl PhaseStates {
     /// The step's own work: every phase but the interrupts.
     #[must_use]
     pub const fn work(&self) -> u64 {
-        self.adc + self.input + self.update + self.forward + self.motors + self.save
+        self.adc + self.input + self.update + self.forward + self.motors + self.save + self.main
     }
 }
 
@@ -443,7 +473,7 @@ impl Controller {
             cfg.params,
             &vec![Q15::ZERO; n_in.min(nn_q15::MAX_INPUTS) * n_out],
         )?;
-        let timing = MasterTiming::fast_mode(cfg.clock_hz)?;
+        let timing = firmware_i2c_timing(cfg.clock_hz)?;
         let cfg_fast = cfg.fast_forward;
         Ok(Self {
             ticks_per_step: ticks.round() as u64,
@@ -524,6 +554,12 @@ impl Controller {
     #[must_use]
     pub const fn steps(&self) -> u64 {
         self.steps
+    }
+
+    /// States of one tick interrupt (entry to RTE) as measured on this MCU, once one was taken.
+    #[must_use]
+    pub const fn isr_states(&self) -> Option<u64> {
+        self.isr_states
     }
 
     /// EEPROM bytes written per save (record bytes on the wire).
@@ -683,8 +719,9 @@ impl Controller {
                 fw.tick_handler();
                 self.isr_states = Some(fw.isr_states - isr_from);
                 report.ticks += 1;
-                // Main loop: MOV.L @TICKS:16,ER0 ; MOV.L @NEXT:16,ER1 ; CMP.L ; BLO.
-                fw.code(&[Insn::MovLAbs16, Insn::MovLAbs16, Insn::Reg, Insn::Bcc8]);
+                // main after SLEEP: MOV.L @ticks:24,ER2 ; SUB.L ER3,ER2 ; MOV.L ER2,ER2 ; BLT
+                // (ER3 holds next_step across the loop).
+                fw.code(&MAIN_TICK_TEST);
                 let busy = fw.bus.now() - asleep_from - slept + u64::from(SLEEP_STATES);
                 report.busy_states += busy;
                 let left = self.next_step_tick.saturating_sub(*fw.ticks);
@@ -702,7 +739,7 @@ impl Controller {
                     fw.next_tick_at = Some(last_at);
                     fw.tick_handler();
                     report.ticks += 1;
-                    fw.code(&[Insn::MovLAbs16, Insn::MovLAbs16, Insn::Reg, Insn::Bcc8]);
+                    fw.code(&MAIN_TICK_TEST);
                     report.busy_states += busy;
                 }
             }
@@ -746,17 +783,39 @@ impl Controller {
             let mut fw = Fw::new(bus, &mut ticks, true);
             fw.tick_period = tick_period;
             fw.next_tick_at = next_tick_at;
-            // Main loop: advance NEXT, call the A/D routine.
-            fw.code(&[Insn::ImmL, Insn::MovLAbs16]);
+            // The instructions below follow the firmware's listing (`firmware/build.sh
+            // --listing`): main's loop after its due test fell through, robot_step, ad_scan and
+            // motors_set, instruction by instruction, each I/O access at its place. Phases are
+            // counted as the firmware's profile counts them: a routine from its first
+            // instruction to its RTS; the calls belong to the caller (the main loop).
+            let main0 = Mark::new(&fw);
+            // main: NEXT += K (MOV.W @cfg.ticks_per_step:24 ; EXTU.L ; ADD.L ; MOV.L ER2,@next:24) ;
+            // JSR @robot_step. robot_step: SUBS ; PUSH.L ER4 ; MOV.L ER7,ER4 ; ADDS ; MOV.L ER4,ER0 ;
+            // JSR @ad_scan.
+            fw.code(&[
+                Insn::MovBwAbs24,
+                Insn::Reg,
+                Insn::Reg,
+                Insn::MovLAbs24,
+                Insn::JsrAbs24,
+                Insn::Reg,
+                Insn::PushPopL,
+                Insn::Reg,
+                Insn::Reg,
+                Insn::Reg,
+                Insn::JsrAbs24,
+            ]);
+            let mut main_states = main0.done(&fw);
 
-            // 1. A/D: scan the sensors' group (AN0-AN3 by default) once, poll ADF, stop, read
-            // and linearise.
+            // 1. ad_scan: one scan of the sensors' group (AN0-AN3 by default), ADF polled, the
+            // scan stopped, the four codes through the du table.
             let t = Mark::new(&fw);
             let group_ch = (self.cfg.sensor_channels[0] & 4) | 3;
-            fw.bus.internal(CALL_RETURN_STATES / 2);
-            fw.code(&[Insn::Reg]);
+            // MOV.B @cfg.channels:24,R2L ; AND.B #4 ; MOV.B R2L,R3L ; OR.B #3,R3L ; OR.B #H'3B,R2L ;
+            // MOV.B R2L,@ADCSR:8.
+            fw.code(&[Insn::MovBwAbs24, Insn::Reg, Insn::Reg, Insn::Reg, Insn::Reg]);
             fw.write8(ADCSR, ADCSR_ADST | ADCSR_SCAN | ADCSR_CKS | group_ch);
-            // 1: MOV.B @ADCSR:8,R0L ; BPL 1b — 2 + 3 + 4 states a poll, the read ending 5
+            // 1: MOV.B @ADCSR:8,R2L ; BGE 1b — 2 + 3 + 4 states a poll, the read ending 5
             // states in.
             const POLL_STATES: u64 = 9;
             const POLL_READ_END: u64 = 5;
@@ -782,21 +841,48 @@ impl Controller {
                     }
                 }
             }
+            // OR.B #H'18,R3L ; MOV.B R3L,@ADCSR:8 (ADF read as 1, written 0; ADST off) ; SUB.B.
             fw.code(&[Insn::Reg]);
             fw.write8(ADCSR, ADCSR_SCAN | ADCSR_CKS | group_ch);
+            fw.code(&[Insn::Reg]);
             let mut p = [0u8; 4];
             for (pk, &ch) in p.iter_mut().zip(&self.cfg.sensor_channels) {
-                // AN0/AN4 land in ADDRA, AN1/AN5 in ADDRB, and so on.
+                // SUB.L ; MOV.B ; MOV.L ; ADD.L ; MOV.B @(cfg.channels:24,ER2),R2L ; AND.L #3 ;
+                // SHLL.L ; ADD.L #ADDRAH ; MOV.B @ER2,R2L (AN0/AN4 in ADDRA, AN1/AN5 in ADDRB …).
+                fw.code(&[
+                    Insn::Reg,
+                    Insn::Reg,
+                    Insn::Reg,
+                    Insn::Reg,
+                    Insn::MovBwDisp24,
+                    Insn::ImmL,
+                    Insn::Reg,
+                    Insn::ImmL,
+                ]);
                 let code8 = fw.read8(ADDRAH + 2 * u32::from(ch & 3));
-                fw.bus
-                    .internal(states_of(&[Insn::Reg, Insn::Reg]) + MOVB_DISP24_STATES);
-                fw.code(&[Insn::MovBwAbs16]);
+                // EXTU.W ; EXTU.L ; MOV.B @(du_table:24,ER2),R2L ; MOV.B R2L,@ER3 ; ADD.B ;
+                // CMP.B #3 ; BLS.
+                fw.code(&[
+                    Insn::Reg,
+                    Insn::Reg,
+                    Insn::MovBwDisp24,
+                    Insn::MovBwInd,
+                    Insn::Reg,
+                    Insn::Reg,
+                    Insn::Bcc8,
+                ]);
                 *pk = sensors::DU_TABLE[usize::from(code8)];
             }
-            fw.bus.internal(CALL_RETURN_STATES / 2);
+            fw.code(&[Insn::Rts]);
             phases.adc = t.done(&fw);
 
-            // 2. The learner, charged phase by phase from its meter.
+            // robot_step: MOV.L ER4,ER0 ; JSR @learner_step.
+            let m = Mark::new(&fw);
+            fw.code(&[Insn::Reg, Insn::JsrAbs24]);
+            main_states += m.done(&fw);
+
+            // 2. The learner, charged phase by phase from its meter (re-derived from the
+            // firmware's learner routines, calls and returns included).
             let mut meter = H8Meter::new();
             let out = self.learner.step(&p, &mut meter);
             for (phase, slot) in [
@@ -805,46 +891,92 @@ impl Controller {
                 (Phase::Forward, &mut phases.forward),
             ] {
                 let t = Mark::new(&fw);
-                fw.bus.internal(CALL_RETURN_STATES / 2);
                 fw.lump(meter.states(phase));
                 *slot = t.done(&fw);
             }
 
-            // 3. Motors: the behaviour table's row into GRB1, GRB2 and port B.
+            // robot_step: MOV.B @cfg.flags:24,R2L ; BTST #1 ; BEQ — and in the random walk the
+            // draw (JSR @xorshift32 … JSR @__mulsi3 …, 332 states from the listing) — then
+            // MOV.B R0L,@behaviour:24 ; JSR @motors_set.
+            let m = Mark::new(&fw);
+            fw.code(&[Insn::MovBwAbs24, Insn::Reg, Insn::Bcc8]);
+            if forced.is_some() {
+                fw.lump(RANDOM_WALK_DRAW_STATES);
+            }
+            fw.code(&[Insn::MovBwAbs24, Insn::JsrAbs24]);
+            main_states += m.done(&fw);
+
+            // 3. motors_set: the behaviour table's row into GRB1, GRB2 and port B.
             let t = Mark::new(&fw);
-            fw.bus.internal(CALL_RETURN_STATES / 2);
+            // EXTU.W ; EXTU.L ; MOV.L ; SHLL.L ; ADD.L ; SHLL.L ; ADD.L #motor_table ;
+            // MOV.W @ER2,R3 ; MOV.W R3,@GRB1:16 ; MOV.W @(2,ER2),R3 ; MOV.W R3,@GRB2:16 ;
+            // MOV.B @(4,ER2),R2L ; MOV.B R2L,@PBDR:8 ; RTS.
             fw.code(&[
-                Insn::MovBwAbs16,
+                Insn::Reg,
                 Insn::Reg,
                 Insn::Reg,
                 Insn::Reg,
                 Insn::Reg,
                 Insn::Reg,
                 Insn::ImmL,
-                Insn::Reg,
-                Insn::MovBwPostInc,
+                Insn::MovBwInd,
             ]);
             let behaviour = forced.unwrap_or(out.behaviour);
             let (left, right, dir) = motor_row(behaviour);
             fw.write16(ITU1 + GRB, left);
-            fw.code(&[Insn::MovBwPostInc]);
+            fw.code(&[Insn::MovBwAbs16]);
             fw.write16(ITU2 + GRB, right);
-            fw.code(&[Insn::MovBwInd]);
+            fw.code(&[Insn::MovBwAbs16]);
             fw.write8(PBDR, dir);
             fw.code(&[Insn::Rts]);
             phases.motors = t.done(&fw);
 
-            // 4. The save, when due.
-            fw.code(&[Insn::MovBwAbs16, Insn::Reg, Insn::Bcc8]);
+            // 4. robot_step: MOV.W @cfg.save_every:24 ; BEQ ; MOV.W @save_count:24 ; ADDS ;
+            // CMP.W ; BCS ; when due SUB.W ; MOV.W R2,@save_count:24 ; JSR @record_save ; BRA,
+            // else MOV.W R2,@save_count:24.
+            let m = Mark::new(&fw);
+            fw.code(&[
+                Insn::MovBwAbs24,
+                Insn::Bcc8,
+                Insn::MovBwAbs24,
+                Insn::Reg,
+                Insn::Reg,
+                Insn::Bcc8,
+            ]);
             let saved = if due {
+                fw.code(&[Insn::Reg, Insn::MovBwAbs24, Insn::JsrAbs24]);
+                main_states += m.done(&fw);
                 let t = Mark::new(&fw);
                 let s = self.save(&mut fw)?;
                 phases.save = t.done(&fw);
+                let m = Mark::new(&fw);
+                fw.code(&[Insn::Bcc8]);
+                main_states += m.done(&fw);
                 Some(s)
             } else {
+                fw.code(&[Insn::MovBwAbs24]);
+                main_states += m.done(&fw);
                 None
             };
-            fw.code(&[Insn::MovBwAbs16, Insn::Bcc8]);
+            // robot_step: steps++ (MOV.L @steps:24 ; ADDS ; MOV.L) ; POP.L ER4 ; ADDS ; RTS.
+            // main: BRA ; MOV.L @ticks:24 ; MOV.L @next:24 ; SUB.L ; MOV.L ; BGE (not taken).
+            let m = Mark::new(&fw);
+            fw.code(&[
+                Insn::MovLAbs24,
+                Insn::Reg,
+                Insn::MovLAbs24,
+                Insn::PushPopL,
+                Insn::Reg,
+                Insn::Rts,
+                Insn::Bcc8,
+                Insn::MovLAbs24,
+                Insn::MovLAbs24,
+                Insn::Reg,
+                Insn::Reg,
+                Insn::Bcc8,
+            ]);
+            main_states += m.done(&fw);
+            phases.main = main_states;
             phases.isr = fw.isr_states;
             next_tick_at = fw.next_tick_at;
             (p, (out, behaviour), saved)
@@ -878,13 +1010,13 @@ impl Controller {
             sequence: self.next_sequence,
             payload,
         };
-        // The firmware builds the pages in its page buffer (EEPMOV.B from the weights) and
-        // computes the two CRCs over what it sends.
+        // record_save's own code (from the listing; the I²C routines run as the master below):
+        // the entry with the body CRC (two calls of crc16), each page gathered byte by byte
+        // into the page buffer and written, then the commit block with its CRC.
         let (commit, body) = self.persistence.layout().encode(&record)?;
-        fw.bus.internal(CALL_RETURN_STATES);
-        let pages = body.len().div_ceil(64);
-        fw.lump(pages as u64 * (14 + 8) + 4 * body.len() as u64 + 7 * 6);
-        fw.lump(crc16_states(&body[..body.len() - 2]) + crc16_states(&commit[..commit.len() - 2]));
+        fw.lump(SAVE_ENTRY_STATES + crc16_states(&body[..body.len() - 2], 2));
+        fw.lump(page_gather_states(body.len()));
+        fw.lump(SAVE_COMMIT_STATES + crc16_states(&commit[..commit.len() - 2], 1));
         let report = if let (Some(timelines), Some(isr), true) = (
             self.timelines.as_mut(),
             self.isr_states,
@@ -899,7 +1031,6 @@ impl Controller {
             let mut master = I2cMaster::new(&mut pins, self.timing);
             self.persistence.save(&mut master, &record)?
         };
-        fw.code(&[Insn::MovLAbs16, Insn::Reg, Insn::MovLAbs16]);
         self.next_sequence = self.next_sequence.wrapping_add(1);
         Ok(SaveSummary {
             sequence: report.sequence,
@@ -972,13 +1103,15 @@ pub fn fresh_weights(seed: u64, n: usize) -> Vec<Q15> {
         .collect()
 }
 
-/// States of the bitwise CRC-16/CCITT-FALSE routine in [`code`] over `bytes`: per byte the
-/// load, the XOR into the high byte and the bit counter (6 + 2 + 2), per bit the shift, the
-/// branch, the counter and the loop (2 + 4 + 2 + 4), plus 4 for each XOR with the polynomial,
-/// plus the byte loop (2 + 4). The XORs are counted by `eeprom`'s CRC, the one the records are
-/// checked with ([`eeprom::crc::crc16_update_counting`]).
+/// States of the firmware's `crc16` over `bytes` in `calls` calls (from the listing): 42 per
+/// call (PUSH.L, two moves; the final test, EXTU.L, POP.L, RTS), 148 per byte (the loop test,
+/// the load and the XOR into the high byte, the bit counter, eight bits of MOV.W, BGE, SHLL.W,
+/// ADD.B, BNE at 14 states, the byte loop's SUBS and BRA) and 14 more for each bit that XORs
+/// the polynomial (MOV.W, EXTU.L, SHLL.L, MOV.W, XOR.W #H'1021, BRA instead of SHLL.W). The
+/// XORs are counted by `eeprom`'s CRC, the one the records are checked with
+/// ([`eeprom::crc::crc16_update_counting`]).
 #[must_use]
-pub fn crc16_states(bytes: &[u8]) -> u64 {
+pub fn crc16_states(bytes: &[u8], calls: u64) -> u64 {
     let mut crc = eeprom::crc::CRC16_INIT;
     let mut xors = 0u64;
     for &b in bytes {
@@ -986,7 +1119,33 @@ pub fn crc16_states(bytes: &[u8]) -> u64 {
         crc = next;
         xors += u64::from(n);
     }
-    bytes.len() as u64 * (10 + 8 * 12 + 6) + 4 * xors + 4
+    42 * calls + bytes.len() as u64 * 148 + 14 * xors
+}
+
+/// record_save's entry up to the body's first page (from the listing): frame and registers
+/// (36), the chip from the sequence (24), `payload_bytes` with its `__mulsi3` (138), the
+/// header via `put_u32` (62), the length bytes (18), the two calls of `crc16` and their set-up
+/// (66, the routine itself in [`crc16_states`]), the CRC bytes and the body's length (30), the
+/// loop's first test (30).
+const SAVE_ENTRY_STATES: u64 = 404;
+/// record_save's commit block (from the listing): the magic, version and reserved byte (40),
+/// the sequence via `put_u32` (64), length and body CRC (44), the CRC call's set-up (24), its
+/// bytes (16), `write_page`'s call and its own code around the I²C routines (144), the
+/// sequence's increment (28) and the return (46).
+const SAVE_COMMIT_STATES: u64 = 420;
+
+/// record_save gathering a body of `body_len` bytes into pages and writing each (from the
+/// listing; the I²C routines apart): per page 50 to set up and 174 to call `write_page` and
+/// test its result; per byte 42 (the store, the counters, the loop tests) and 16 for a header
+/// byte, 36 for a weight byte, 56 for a CRC byte to fetch it; 12 fewer for the byte that
+/// fills a page (the loop leaves at its first test).
+#[must_use]
+pub fn page_gather_states(body_len: usize) -> u64 {
+    let len = body_len as u64;
+    let pages = len.div_ceil(64);
+    let full_pages = len / 64;
+    let payload = len - 8;
+    pages * (50 + 174) + len * 42 + 6 * 16 + payload * 36 + 2 * 56 - 12 * full_pages
 }
 
 /// The CRC routine's states for `n` bytes whose contents are not at hand (half the bits XOR the
