@@ -34,7 +34,7 @@ pub mod input;
 pub mod learner;
 pub mod net;
 
-pub use cost::{H8Meter, LEARNER_ROUTINES, Meter, NoopMeter, Op, Phase, Routine};
+pub use cost::{H8Meter, Meter, NoopMeter, Op, Phase};
 pub use error::{ConfigError, ParamError, ShapeError};
 pub use format::{Q7, Q15, Q22};
 pub use input::{InputLayout, MAX_HISTORY, SENSORS};
