@@ -85,7 +85,11 @@ fn the_firmware_fits_with_ram_rom_and_stack_measured() {
     assert_eq!(r.rom_used, image);
     let stack = r.stack_high_water.unwrap();
     // The model places the firmware's measured stack in its RAM map.
-    assert_eq!(stack, emu::board::model::MODEL_STACK_BYTES, "the firmware's stack changed");
+    assert_eq!(
+        stack,
+        emu::board::model::MODEL_STACK_BYTES,
+        "the firmware's stack changed"
+    );
     // The network's arrays as the firmware carved them: 2NM + 2N + 4M + 2M + N (even).
     let carved: u32 = r
         .ram

@@ -290,3 +290,107 @@ fn a_fault_halts_with_the_vector_named() {
         .to_string();
     assert!(e.contains("0x8B") && e.contains("vector 11"), "{e}");
 }
+
+/// Every setting of the model controller's configuration that concerns the controller reaches
+/// the firmware through the block: network shape, η, T, save period, step period, clock, A/D
+/// wiring and the weight seed (the firmware's fresh weights are the model's).
+#[test]
+fn the_model_controllers_settings_reach_the_firmware_through_the_block() {
+    use emu::board::model::{ControllerConfig, fresh_weights};
+    use nn_q15::{InputLayout, Params};
+    let mut cfg = ControllerConfig::corridor(0x1234_5678_9ABC_DEF0);
+    cfg.behaviours = 3;
+    cfg.layout = InputLayout::new(2, true).unwrap().with_spare(5);
+    cfg.params = Params::new(1000, 17).unwrap();
+    cfg.save_every_steps = 7;
+    cfg.step_period_s = 0.3;
+    cfg.clock_hz = 16_000_000;
+    cfg.sensor_channels = [7, 4, 5, 6];
+    let block = ConfigBlock::from_controller(&cfg).unwrap();
+    assert_eq!(
+        block,
+        ConfigBlock {
+            outputs: 3,
+            history: 2,
+            flags: emu::board::firmware::FLAG_BIAS,
+            spare: 5,
+            eta: 1000,
+            threshold: 17,
+            save_every: 7,
+            ticks_per_step: 30,
+            tick_counts: 20_000,
+            channels: [7, 4, 5, 6],
+            seed: 0x1234_5678 ^ 0x9ABC_DEF0,
+        }
+    );
+    assert_eq!(block.n_inputs(), cfg.n_inputs());
+
+    // The firmware boots with it: its network, parameters and fresh weights are the model's.
+    let (fw, mut mcu, mut cpu) = boot(NullBoard, Some(&block));
+    run_until(&mut cpu, &mut mcu, 2 * TICK_STATES).unwrap();
+    assert_eq!(status(&fw, &mcu), ConfigStatus::Used);
+    assert_eq!(
+        usize::from(peek_u16(&mcu, sym(&fw, "net_n_in"))),
+        cfg.n_inputs()
+    );
+    assert_eq!(peek_u16(&mcu, sym(&fw, "net_threshold")), 17);
+    let w = peek_u32(&mcu, sym(&fw, "net_w"));
+    let n = cfg.n_inputs() * 3;
+    let firmware_weights: Vec<i16> = (0..n as u32)
+        .map(|k| peek_u16(&mcu, w + 2 * k) as i16)
+        .collect();
+    let model_weights: Vec<i16> = fresh_weights(cfg.weight_seed, n)
+        .iter()
+        .map(|q| q.to_bits())
+        .collect();
+    assert_eq!(firmware_weights, model_weights);
+
+    // Settings the block cannot carry are named.
+    let mut bad = cfg.clone();
+    bad.save_every_steps = 70_000;
+    assert_eq!(
+        ConfigBlock::from_controller(&bad).unwrap_err().field,
+        "save_every_steps"
+    );
+    bad = cfg.clone();
+    bad.step_period_s = 0.455;
+    assert_eq!(
+        ConfigBlock::from_controller(&bad).unwrap_err().field,
+        "step_period_s"
+    );
+}
+
+/// A board that reads 1.0 V on AN7 only (about 30 cm) and 0 V elsewhere (nothing seen).
+struct OneChannel;
+
+impl Board for OneChannel {
+    fn analog_volts(&mut self, channel: u8, _now_states: u64) -> f64 {
+        if channel == 7 { 1.0 } else { 0.0 }
+    }
+    fn port2_pins(&mut self, _now_states: u64) -> u8 {
+        0xFF
+    }
+}
+
+#[test]
+fn the_sensors_are_read_from_the_configured_channels() {
+    for (channels, front_sees) in [
+        ([7, 4, 5, 6], true),
+        ([0, 1, 2, 3], false),
+        ([4, 7, 5, 6], false),
+    ] {
+        let block = ConfigBlock {
+            channels,
+            ..ConfigBlock::ARENA
+        };
+        let (fw, mut mcu, mut cpu) = boot(OneChannel, Some(&block));
+        run_until(&mut cpu, &mut mcu, TICK_STATES + 20_000).unwrap();
+        let x = peek_u32(&mcu, sym(&fw, "net_x"));
+        // x[0] = p(front) - 128: 255 du (far) reads 127.
+        let front = mcu.peek(x) as i8;
+        assert_eq!(front < 100, front_sees, "{channels:?}: x[0] = {front}");
+        if channels == [4, 7, 5, 6] {
+            assert!((mcu.peek(x + 1) as i8) < 100, "the rear sensor sits on AN7");
+        }
+    }
+}
