@@ -256,20 +256,16 @@ macro_rules! on_module {
                 $body
             }
             Module::Ports => {
-                let board = &mut $mcu.board;
                 let $p = &mut $mcu.ports;
                 let $outside = PortPins {
-                    port2: &mut |t| board.port2_pins(t),
+                    board: &mut $mcu.board,
                     i2c: &mut $mcu.i2c,
                     itu: &mut $mcu.itu,
                 };
                 $body
             }
             Module::Adc => {
-                let board = &mut $mcu.board;
-                let $p = &mut $mcu.adc;
-                let $outside: &mut dyn FnMut(u8, u64) -> f64 =
-                    &mut |ch, t| board.analog_volts(ch, t);
+                let ($p, $outside) = (&mut $mcu.adc, &mut $mcu.board);
                 $body
             }
             Module::Intc => {
@@ -281,33 +277,43 @@ macro_rules! on_module {
     };
 }
 
-/// `[$body; 5]` with `$p` bound to each module of `$mcu` in turn, by shared reference (for the
-/// questions that need nothing outside the module).
-macro_rules! each_module {
-    ($mcu:ident, |$p:ident| $body:expr) => {
-        [
-            {
-                let $p = &$mcu.itu;
-                $body
-            },
-            {
-                let $p = &$mcu.adc;
-                $body
-            },
-            {
-                let $p = &$mcu.sci;
-                $body
-            },
-            {
-                let $p = &$mcu.ports;
-                $body
-            },
-            {
-                let $p = &$mcu.intc;
-                $body
-            },
-        ]
-    };
+/// `$body` for each module of `$mcu` in turn, with `$p` bound to it by shared reference (for
+/// the questions that need nothing outside the module), the answers combined left to right
+/// with `$combine`. Unrolled, so that the answers of modules with nothing to say fold away.
+macro_rules! fold_modules {
+    ($mcu:ident, |$p:ident| $body:expr, $combine:expr) => {{
+        let combine = $combine;
+        let all = {
+            let $p = &$mcu.itu;
+            $body
+        };
+        let all = combine(all, {
+            let $p = &$mcu.adc;
+            $body
+        });
+        let all = combine(all, {
+            let $p = &$mcu.sci;
+            $body
+        });
+        let all = combine(all, {
+            let $p = &$mcu.ports;
+            $body
+        });
+        combine(all, {
+            let $p = &$mcu.intc;
+            $body
+        })
+    }};
+}
+
+/// The earlier of two instants, if any.
+#[inline]
+fn earliest(a: Option<u64>, b: Option<u64>) -> Option<u64> {
+    match (a, b) {
+        (Some(x), Some(y)) => Some(x.min(y)),
+        (x, None) => x,
+        (None, y) => y,
+    }
 }
 
 impl<B: Board> Mcu<B> {
@@ -505,7 +511,7 @@ impl<B: Board> Mcu<B> {
     pub fn sync(&mut self) {
         let now = self.now;
         for m in Module::ALL {
-            on_module!(self, m, |p, outside| Peripheral::sync(p, now, outside), ());
+            on_module!(self, m, |p, outside| Peripheral::sync::<B>(p, now, outside), ());
         }
         // Time never goes back here (max), so the bus cannot refuse.
         let _ = self.i2c.advance_to(now.max(self.i2c.now()));
@@ -518,20 +524,16 @@ impl<B: Board> Mcu<B> {
     #[must_use]
     pub fn next_event(&self) -> Option<u64> {
         let now = self.now;
-        each_module!(self, |p| Peripheral::next_event(p, now))
-            .into_iter()
-            .chain([self.i2c.next_event_states().filter(|&t| t > now)])
-            .flatten()
-            .min()
+        earliest(
+            fold_modules!(self, |p| Peripheral::next_event(p, now), earliest),
+            self.i2c.next_event_states().filter(|&t| t > now),
+        )
     }
 
     /// The earliest state after now at which an enabled interrupt request appears.
     fn next_irq_time(&self) -> Option<u64> {
         let now = self.now;
-        each_module!(self, |p| Peripheral::next_request(p, now))
-            .into_iter()
-            .flatten()
-            .min()
+        fold_modules!(self, |p| Peripheral::next_request(p, now), earliest)
     }
 
     /// What ITU channel `n`'s TIOCA output does now (channels out of range: neither driving nor
@@ -615,9 +617,7 @@ impl<B: Board> Mcu<B> {
     #[cold]
     fn refresh_irq(&self) -> Option<u8> {
         let now = self.now;
-        let requests = each_module!(self, |p| Peripheral::requests(p, now))
-            .into_iter()
-            .fold(0, |all, r| all | r);
+        let requests = fold_modules!(self, |p| Peripheral::requests(p, now), |a, b| a | b);
         let winner = self.intc.choose(requests);
         let valid_until = match self.next_irq_time() {
             Some(t) if t > now => t,
@@ -636,7 +636,7 @@ impl<B: Board> Mcu<B> {
         on_module!(
             self,
             Module::of(a),
-            |p, outside| Peripheral::read(p, a, now, outside),
+            |p, outside| Peripheral::read::<B>(p, a, now, outside),
             0
         )
     }
@@ -650,7 +650,7 @@ impl<B: Board> Mcu<B> {
         on_module!(
             self,
             module,
-            |p, outside| Peripheral::write(p, a, v, now, outside),
+            |p, outside| Peripheral::write::<B>(p, a, v, now, outside),
             ()
         );
     }

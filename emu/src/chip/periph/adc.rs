@@ -48,6 +48,7 @@
 use sensors::adc10_code;
 
 use super::Peripheral;
+use crate::chip::mcu::Board;
 
 /// Address of ADDRA (high byte; low byte at +1) (SPEC §3.2: H'FFFFE0).
 pub const ADDRA: u32 = 0xFF_FFE0;
@@ -378,28 +379,32 @@ impl Adc {
 }
 
 impl Peripheral for Adc {
-    /// The analog inputs: volts on a channel at an instant (the board's sensors).
-    type Outside<'a> = &'a mut dyn FnMut(u8, u64) -> f64;
+    /// The board, for the volts on a channel at a sampling instant (its sensors).
+    type Outside<'a, B: Board + 'a> = &'a mut B;
     const FIRST: u32 = ADDRA;
     const LAST: u32 = ADCR;
     const AFFECTS_IRQ: bool = true;
 
     /// Catches up (sampling the conversions that ended), then reads.
-    fn read(&mut self, addr: u32, now: u64, mut volts: Self::Outside<'_>) -> u8 {
-        Adc::sync(self, now, &mut volts);
+    #[inline]
+    fn read<B: Board>(&mut self, addr: u32, now: u64, board: &mut B) -> u8 {
+        Adc::sync(self, now, &mut |ch, t| board.analog_volts(ch, t));
         Adc::read(self, addr)
     }
 
     /// Catches up, then writes.
-    fn write(&mut self, addr: u32, value: u8, now: u64, mut volts: Self::Outside<'_>) {
-        Adc::sync(self, now, &mut volts);
+    #[inline]
+    fn write<B: Board>(&mut self, addr: u32, value: u8, now: u64, board: &mut B) {
+        Adc::sync(self, now, &mut |ch, t| board.analog_volts(ch, t));
         Adc::write(self, addr, value, now);
     }
 
-    fn sync(&mut self, now: u64, mut volts: Self::Outside<'_>) {
-        Adc::sync(self, now, &mut volts);
+    #[inline]
+    fn sync<B: Board>(&mut self, now: u64, board: &mut B) {
+        Adc::sync(self, now, &mut |ch, t| board.analog_volts(ch, t));
     }
 
+    #[inline]
     fn next_event(&self, now: u64) -> Option<u64> {
         Adc::next_event(self, now)
     }
@@ -409,10 +414,12 @@ impl Peripheral for Adc {
         Adc::requests(self, now)
     }
 
+    #[inline]
     fn next_request(&self, now: u64) -> Option<u64> {
         self.next_irq_time(now)
     }
 
+    #[inline]
     fn reset(&mut self) {
         *self = Adc::new();
     }

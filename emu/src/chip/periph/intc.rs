@@ -21,6 +21,7 @@
 //! the bus controller's BRCR at H'FFFFF3 read 0 and ignore writes.
 
 use super::Peripheral;
+use crate::chip::mcu::Board;
 
 /// Address of SYSCR, the system control register (SPEC §4.1: H'FFFFF2).
 pub const SYSCR: u32 = 0xFF_FFF2;
@@ -181,35 +182,42 @@ impl Intc {
 }
 
 impl Peripheral for Intc {
-    type Outside<'a> = ();
+    type Outside<'a, B: Board + 'a> = ();
     const FIRST: u32 = SYSCR;
     const LAST: u32 = IPRB;
     const AFFECTS_IRQ: bool = true;
 
-    fn read(&mut self, addr: u32, _now: u64, (): ()) -> u8 {
+    #[inline]
+    fn read<B: Board>(&mut self, addr: u32, _now: u64, (): ()) -> u8 {
         Intc::read(self, addr)
     }
 
-    fn write(&mut self, addr: u32, value: u8, _now: u64, (): ()) {
+    #[inline]
+    fn write<B: Board>(&mut self, addr: u32, value: u8, _now: u64, (): ()) {
         Intc::write(self, addr, value);
     }
 
-    fn sync(&mut self, _now: u64, (): ()) {}
+    #[inline]
+    fn sync<B: Board>(&mut self, _now: u64, (): ()) {}
 
+    #[inline]
     fn next_event(&self, _now: u64) -> Option<u64> {
         None
     }
 
     /// The controller requests nothing itself: it chooses among the sources' requests
     /// ([`Intc::choose`]).
+    #[inline]
     fn requests(&self, _now: u64) -> u64 {
         0
     }
 
+    #[inline]
     fn next_request(&self, _now: u64) -> Option<u64> {
         None
     }
 
+    #[inline]
     fn reset(&mut self) {
         *self = Intc::new();
     }

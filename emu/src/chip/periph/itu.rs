@@ -49,6 +49,7 @@
 //! 65 536 counts). Nothing is stepped per state.
 
 use super::Peripheral;
+use crate::chip::mcu::Board;
 
 /// Address of TSTR, timer start register (SPEC §4.1: H'FFFF60).
 pub const TSTR: u32 = 0xFF_FF60;
@@ -790,25 +791,27 @@ impl Itu {
 }
 
 impl Peripheral for Itu {
-    type Outside<'a> = ();
+    type Outside<'a, B: Board + 'a> = ();
     const FIRST: u32 = ITU_FIRST;
     const LAST: u32 = ITU_LAST;
     const AFFECTS_IRQ: bool = true;
 
     #[inline]
-    fn read(&mut self, addr: u32, now: u64, (): ()) -> u8 {
+    fn read<B: Board>(&mut self, addr: u32, now: u64, (): ()) -> u8 {
         Itu::read(self, addr, now)
     }
 
     #[inline]
-    fn write(&mut self, addr: u32, value: u8, now: u64, (): ()) {
+    fn write<B: Board>(&mut self, addr: u32, value: u8, now: u64, (): ()) {
         Itu::write(self, addr, value, now);
     }
 
-    fn sync(&mut self, now: u64, (): ()) {
+    #[inline]
+    fn sync<B: Board>(&mut self, now: u64, (): ()) {
         Itu::sync(self, now);
     }
 
+    #[inline]
     fn next_event(&self, now: u64) -> Option<u64> {
         Itu::next_event(self, now)
     }
@@ -818,10 +821,12 @@ impl Peripheral for Itu {
         Itu::requests(self, now)
     }
 
+    #[inline]
     fn next_request(&self, now: u64) -> Option<u64> {
         self.next_irq_time(now)
     }
 
+    #[inline]
     fn reset(&mut self) {
         *self = Itu::new();
     }

@@ -21,16 +21,19 @@ pub mod itu;
 pub mod ports;
 pub mod sci;
 
+use crate::chip::mcu::Board;
+
 /// One on-chip module as the MCU sees it.
 ///
 /// Times are MCU states since reset; `now` is the instant the bus cycle ends (or the instant
 /// the clock was brought to). A module never needs to be stepped: it works out what happened
 /// since it was last brought up to date when it is accessed or synchronised.
 pub trait Peripheral {
-    /// What the module sees outside itself during an access or a catch-up: `()` for a module
-    /// that sees nothing but the clock; the board's analog inputs for the A/D converter; the
-    /// pins around the ports.
-    type Outside<'a>;
+    /// What the module sees outside itself during an access or a catch-up, for a chip on board
+    /// `B`: `()` for a module that sees nothing but the clock; the board (its analog inputs)
+    /// for the A/D converter; the board's port-2 pins, the EEPROM bus and the ITU for the
+    /// ports. Generic over the board so that the board's answers are static calls.
+    type Outside<'a, B: Board + 'a>;
     /// First address of the module's register block: every access from here to [`Self::LAST`]
     /// is routed to it (addresses of the block it does not model read 0 or its own fill value
     /// and ignore writes).
@@ -49,11 +52,11 @@ pub trait Peripheral {
     }
 
     /// Reads the register at `addr` at `now`.
-    fn read(&mut self, addr: u32, now: u64, outside: Self::Outside<'_>) -> u8;
+    fn read<B: Board>(&mut self, addr: u32, now: u64, outside: Self::Outside<'_, B>) -> u8;
     /// Writes `value` to the register at `addr` at `now`.
-    fn write(&mut self, addr: u32, value: u8, now: u64, outside: Self::Outside<'_>);
+    fn write<B: Board>(&mut self, addr: u32, value: u8, now: u64, outside: Self::Outside<'_, B>);
     /// Brings the module up to `now` (the clock jumped without an access to it).
-    fn sync(&mut self, now: u64, outside: Self::Outside<'_>);
+    fn sync<B: Board>(&mut self, now: u64, outside: Self::Outside<'_, B>);
     /// The earliest state after `now` at which the module next needs attention (a counter
     /// event, a sampling instant, the end of a frame), if any.
     fn next_event(&self, now: u64) -> Option<u64>;

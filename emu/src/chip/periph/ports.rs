@@ -30,6 +30,7 @@ use eeprom::I2cBus;
 
 use super::Peripheral;
 use super::itu::Itu;
+use crate::chip::mcu::Board;
 
 /// Address of P2DDR, port 2 data direction register (write-only; SPEC §4.1: H'FFFFC1).
 pub const P2DDR: u32 = 0xFF_FFC1;
@@ -146,10 +147,9 @@ pub const PORTS_FIRST: u32 = 0xFF_FFC0;
 pub const PORTS_LAST: u32 = 0xFF_FFDB;
 
 /// What the ports see around them during an access.
-pub struct PortPins<'a> {
-    /// Levels of the port-2 pins from outside at an instant: 0 where something pulls the pin
-    /// low, 1 where nothing does (the board's bumpers).
-    pub port2: &'a mut dyn FnMut(u64) -> u8,
+pub struct PortPins<'a, B: Board> {
+    /// The board, for the levels of the port-2 pins ([`Board::port2_pins`]: the bumpers).
+    pub board: &'a mut B,
     /// The EEPROM bus on P4.7 (SDA) and P4.6 (SCL).
     pub i2c: &'a mut I2cBus,
     /// The ITU, whose TIOCA outputs share pins with ports A and B.
@@ -231,17 +231,18 @@ impl Ports {
 }
 
 impl Peripheral for Ports {
-    type Outside<'a> = PortPins<'a>;
+    type Outside<'a, B: Board + 'a> = PortPins<'a, B>;
     const FIRST: u32 = PORTS_FIRST;
     const LAST: u32 = PORTS_LAST;
     /// Port writes (I²C bit-banging, motor direction) request no interrupt.
     const AFFECTS_IRQ: bool = false;
 
-    fn read(&mut self, addr: u32, now: u64, pins: PortPins<'_>) -> u8 {
+    #[inline]
+    fn read<B: Board>(&mut self, addr: u32, now: u64, pins: PortPins<'_, B>) -> u8 {
         match addr {
             P2DDR | P4DDR | PADDR | PBDDR => DDR_READ_VALUE,
             P2DR => {
-                let released = (pins.port2)(now);
+                let released = pins.board.port2_pins(now);
                 self.p2.read_dr(self.p2.open_drain_levels(released))
             }
             P4DR => {
@@ -262,7 +263,8 @@ impl Peripheral for Ports {
         }
     }
 
-    fn write(&mut self, addr: u32, value: u8, now: u64, pins: PortPins<'_>) {
+    #[inline]
+    fn write<B: Board>(&mut self, addr: u32, value: u8, now: u64, pins: PortPins<'_, B>) {
         match addr {
             P2DDR => self.p2.ddr = value,
             P2DR => self.p2.dr = value,
@@ -285,20 +287,25 @@ impl Peripheral for Ports {
     }
 
     /// Nothing to catch up: the ports hold latches; what they read is asked at the read.
-    fn sync(&mut self, _now: u64, _pins: PortPins<'_>) {}
+    #[inline]
+    fn sync<B: Board>(&mut self, _now: u64, _pins: PortPins<'_, B>) {}
 
+    #[inline]
     fn next_event(&self, _now: u64) -> Option<u64> {
         None
     }
 
+    #[inline]
     fn requests(&self, _now: u64) -> u64 {
         0
     }
 
+    #[inline]
     fn next_request(&self, _now: u64) -> Option<u64> {
         None
     }
 
+    #[inline]
     fn reset(&mut self) {
         *self = Ports::new();
     }

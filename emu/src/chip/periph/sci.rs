@@ -18,6 +18,7 @@
 //! lazily from the clock value of each access, so the SCI needs no stepping.
 
 use super::Peripheral;
+use crate::chip::mcu::Board;
 
 /// Address of SMR (serial mode register) of SCI1 (SPEC §4.1).
 pub const SCI1_SMR: u32 = 0xFF_FFB8;
@@ -316,24 +317,28 @@ impl Sci {
 }
 
 impl Peripheral for Sci {
-    type Outside<'a> = ();
+    type Outside<'a, B: Board + 'a> = ();
     const FIRST: u32 = SCI1_SMR;
     const LAST: u32 = SCI1_RDR;
     const AFFECTS_IRQ: bool = true;
 
-    fn read(&mut self, addr: u32, now: u64, (): ()) -> u8 {
+    #[inline]
+    fn read<B: Board>(&mut self, addr: u32, now: u64, (): ()) -> u8 {
         Sci::read(self, addr, now)
     }
 
-    fn write(&mut self, addr: u32, value: u8, now: u64, (): ()) {
+    #[inline]
+    fn write<B: Board>(&mut self, addr: u32, value: u8, now: u64, (): ()) {
         Sci::write(self, addr, value, now);
     }
 
-    fn sync(&mut self, now: u64, (): ()) {
+    #[inline]
+    fn sync<B: Board>(&mut self, now: u64, (): ()) {
         Sci::sync(self, now);
     }
 
     /// The next frame edge that changes TDRE or TEND.
+    #[inline]
     fn next_event(&self, now: u64) -> Option<u64> {
         self.next_irq_time(now)
     }
@@ -345,6 +350,7 @@ impl Peripheral for Sci {
 
     /// [`Sci::next_irq_time`] while nothing is requested; once TXI or TEI is requested, SCI1
     /// raises nothing new before a register access.
+    #[inline]
     fn next_request(&self, now: u64) -> Option<u64> {
         if Peripheral::requests(self, now) == 0 {
             self.next_irq_time(now)
@@ -353,6 +359,7 @@ impl Peripheral for Sci {
         }
     }
 
+    #[inline]
     fn reset(&mut self) {
         *self = Sci::new();
     }
