@@ -511,7 +511,12 @@ impl<B: Board> Mcu<B> {
     pub fn sync(&mut self) {
         let now = self.now;
         for m in Module::ALL {
-            on_module!(self, m, |p, outside| Peripheral::sync::<B>(p, now, outside), ());
+            on_module!(
+                self,
+                m,
+                |p, outside| Peripheral::sync::<B>(p, now, outside),
+                ()
+            );
         }
         // Time never goes back here (max), so the bus cannot refuse.
         let _ = self.i2c.advance_to(now.max(self.i2c.now()));
