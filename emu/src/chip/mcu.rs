@@ -634,6 +634,7 @@ impl<B: Board> Mcu<B> {
         winner
     }
 
+    #[inline]
     fn io_read8(&mut self, a: u32) -> u8 {
         // Reads catch modules up but change no request (flags clear only by writes), so the
         // cached interrupt decision stays valid.
@@ -646,6 +647,7 @@ impl<B: Board> Mcu<B> {
         )
     }
 
+    #[inline]
     fn io_write8(&mut self, a: u32, v: u8) {
         let now = self.now;
         let module = Module::of(a);

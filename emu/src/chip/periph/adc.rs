@@ -194,6 +194,8 @@ pub struct Adc {
     run: Option<Run>,
     /// Conversions stored since reset (statistics).
     conversions: u64,
+    /// Runs started (ADST written 1 while idle) since reset.
+    starts: u64,
 }
 
 impl Default for Adc {
@@ -215,6 +217,7 @@ impl Adc {
             adcr: 0,
             run: None,
             conversions: 0,
+            starts: 0,
         }
     }
 
@@ -222,6 +225,20 @@ impl Adc {
     #[must_use]
     pub const fn busy(&self) -> bool {
         self.run.is_some()
+    }
+
+    /// Runs started since reset (each write of ADST = 1 to an idle converter): how an observer
+    /// outside the chip sees a program begin to sample its inputs.
+    #[must_use]
+    pub const fn starts(&self) -> u64 {
+        self.starts
+    }
+
+    /// ADDRA–ADDRD as the converter holds them (left-justified, register `n` = 0–3), without
+    /// the register read's side effects. Call after the MCU was synchronised.
+    #[must_use]
+    pub const fn data(&self, n: usize) -> u16 {
+        self.data[n & 3]
     }
 
     /// Conversions stored in ADDRA–D since reset.
@@ -357,6 +374,7 @@ impl Adc {
                 let start = value & ADCSR_ADST != 0;
                 match (self.run.is_some(), start) {
                     (false, true) => {
+                        self.starts += 1;
                         let scan = value & ADCSR_SCAN != 0;
                         let ch = value & ADCSR_CH;
                         self.run = Some(Run {
@@ -386,20 +404,17 @@ impl Peripheral for Adc {
     const AFFECTS_IRQ: bool = true;
 
     /// Catches up (sampling the conversions that ended), then reads.
-    #[inline]
     fn read<B: Board>(&mut self, addr: u32, now: u64, board: &mut B) -> u8 {
         Adc::sync(self, now, &mut |ch, t| board.analog_volts(ch, t));
         Adc::read(self, addr)
     }
 
     /// Catches up, then writes.
-    #[inline]
     fn write<B: Board>(&mut self, addr: u32, value: u8, now: u64, board: &mut B) {
         Adc::sync(self, now, &mut |ch, t| board.analog_volts(ch, t));
         Adc::write(self, addr, value, now);
     }
 
-    #[inline]
     fn sync<B: Board>(&mut self, now: u64, board: &mut B) {
         Adc::sync(self, now, &mut |ch, t| board.analog_volts(ch, t));
     }
