@@ -32,7 +32,7 @@ fn swarm(robots: usize, parallel: bool) -> Swarm {
     let mut s = Scenario::arena();
     s.robots = robots;
     s.steps = LIFE as u32;
-    let mut swarm = Swarm::new(&s, Condition::Learning, 0, false).expect("the swarm fits");
+    let mut swarm = Swarm::new(&s, Condition::Learning, 0, false, None).expect("the swarm fits");
     swarm.set_parallel(parallel);
     for _ in 0..WARM {
         swarm.step().expect("a step");

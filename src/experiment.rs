@@ -27,7 +27,7 @@ use sensors::{BumperSet, CollisionCounter, port2_pins};
 use world::{Arena, SensorMount, World, WorldParams};
 
 use crate::plot::Outline;
-use crate::robot::{Condition, Robot};
+use crate::robot::{Condition, Images, Robot};
 use crate::scenario::{ArenaKind, Scenario};
 use crate::seeds::world_seed;
 
@@ -51,6 +51,10 @@ pub struct StepMetrics {
     pub moved_m: f64,
     /// Corridor only: coefficient of variation of the gaps between neighbours at the step.
     pub gap_cv: Option<f64>,
+    /// Mean over robots of their MCU's CPU load over this step's period (percent): busy
+    /// states (the step, the tick interrupts, the main loop; not the time asleep) over the
+    /// period's states, as the robots' own clocks count them.
+    pub cpu_load_percent: f64,
 }
 
 /// Robot paths and outlines for the arena figure.
@@ -77,6 +81,8 @@ pub struct RunOutput {
     pub track: Option<Track>,
     /// EEPROM records written over the run (all robots).
     pub saves: u64,
+    /// Robots that died (with `--keep-going`), with why.
+    pub dead: Vec<(usize, String)>,
 }
 
 /// The arena of a scenario (the square scaled to keep the paper's density for other than 3
@@ -152,6 +158,11 @@ pub struct Swarm {
     parallel: bool,
     /// Every robot's centre at the latest step instant.
     last_xy: Vec<(f64, f64)>,
+    /// Go on when a robot's controller fails: the robot is dead from then on (its motors
+    /// coast; it is left out of the means).
+    keep_going: bool,
+    /// Why each dead robot died.
+    dead: Vec<Option<String>>,
 }
 
 impl Swarm {
@@ -164,11 +175,15 @@ impl Swarm {
         condition: Condition,
         repeat: u32,
         record_track: bool,
+        images: Option<&Images>,
     ) -> Result<Self> {
         let n = s.robots;
         let world = build_world(s, repeat)?;
         let robots: Vec<Robot> = (0..n)
-            .map(|i| Robot::new(s, condition, repeat, i as u32))
+            .map(|i| {
+                Robot::new(s, condition, repeat, i as u32, images)
+                    .with_context(|| format!("robot {i}"))
+            })
             .collect::<Result<_>>()?;
         let tracked = if record_track {
             n.min(TRACKED_ROBOTS)
@@ -199,7 +214,36 @@ impl Swarm {
             saves: 0,
             parallel: n >= PARALLEL_ROBOTS,
             last_xy: Vec::new(),
+            keep_going: false,
+            dead: vec![None; n],
         })
+    }
+
+    /// Whether a robot whose controller fails is marked dead and the run goes on (default:
+    /// the run stops with the error).
+    pub fn set_keep_going(&mut self, keep_going: bool) {
+        self.keep_going = keep_going;
+    }
+
+    /// The robots that died, with why.
+    #[must_use]
+    pub fn dead(&self) -> Vec<(usize, String)> {
+        self.dead
+            .iter()
+            .enumerate()
+            .filter_map(|(i, d)| d.clone().map(|d| (i, d)))
+            .collect()
+    }
+
+    /// A robot's failure: the run's error, or with `keep_going` the robot's death.
+    fn fail(&mut self, i: usize, e: anyhow::Error) -> Result<()> {
+        let e = e.context(format!("robot {i}"));
+        if self.keep_going {
+            self.dead[i] = Some(format!("{e:#}"));
+            Ok(())
+        } else {
+            Err(e)
+        }
     }
 
     /// The world the robots are in (poses, bumpers, wheel speeds), as of the latest step.
@@ -223,19 +267,29 @@ impl Swarm {
         let n = self.robots.len();
         let k = self.steps.len() as u32;
         let par = self.parallel;
-        let times: Vec<u64> = if par {
-            self.robots
-                .par_iter_mut()
-                .map(Robot::sleep)
-                .collect::<Result<_>>()?
-        } else {
-            self.robots
-                .iter_mut()
-                .map(Robot::sleep)
-                .collect::<Result<_>>()?
+        let dead = self.dead.clone();
+        let sleep = |(i, r): (usize, &mut Robot)| -> Option<Result<u64>> {
+            dead[i].is_none().then(|| r.sleep())
         };
-        let t_step_s = times.iter().copied().min().unwrap_or(0) as f64
-            / f64::from(self.scenario.timing.clock_hz);
+        let times: Vec<Option<Result<u64>>> = if par {
+            self.robots.par_iter_mut().enumerate().map(sleep).collect()
+        } else {
+            self.robots.iter_mut().enumerate().map(sleep).collect()
+        };
+        let mut live_times = Vec::with_capacity(n);
+        for (i, t) in times.into_iter().enumerate() {
+            match t {
+                Some(Ok(t)) => live_times.push(t),
+                Some(Err(e)) => self.fail(i, e)?,
+                None => {}
+            }
+        }
+        let times = live_times;
+        let t_step_s = match times.iter().copied().min() {
+            Some(t) => t as f64 / f64::from(self.scenario.timing.clock_hz),
+            // Every robot dead: the world goes on by the step period.
+            None => self.world.elapsed_s() + self.scenario.timing.step_period_s,
+        };
         let collided = advance_world(
             &mut self.world,
             t_step_s,
@@ -270,25 +324,56 @@ impl Swarm {
         } else {
             (0..n).map(sense).collect::<Result<_>>()?
         };
-        let results: Vec<(i16, bool)> = if par {
+        let dead = self.dead.clone();
+        let step = |(i, (r, d)): (usize, (&mut Robot, &[Option<f64>; 4]))| {
+            dead[i]
+                .is_none()
+                .then(|| r.step(*d).map(|rep| (rep, r.take_busy_states())))
+        };
+        let results: Vec<_> = if par {
             self.robots
                 .par_iter_mut()
                 .zip(distances.par_iter())
-                .map(|(r, d)| r.step(*d).map(|rep| (rep.d, rep.saved.is_some())))
-                .collect::<Result<_>>()?
+                .enumerate()
+                .map(step)
+                .collect()
         } else {
             self.robots
                 .iter_mut()
                 .zip(&distances)
-                .map(|(r, d)| r.step(*d).map(|rep| (rep.d, rep.saved.is_some())))
-                .collect::<Result<_>>()?
+                .enumerate()
+                .map(step)
+                .collect()
         };
+        let period_states =
+            self.scenario.timing.step_period_s * f64::from(self.scenario.timing.clock_hz);
+        let (mut sum_d, mut sum_load, mut live) = (0.0, 0.0, 0usize);
+        for (i, res) in results.into_iter().enumerate() {
+            match res {
+                Some(Ok((rep, busy))) => {
+                    self.saves += u64::from(rep.saved);
+                    sum_d += f64::from(rep.d);
+                    sum_load += busy as f64 / period_states * 100.0;
+                    live += 1;
+                }
+                Some(Err(e)) => self.fail(i, e)?,
+                None => {}
+            }
+        }
         for (i, r) in self.robots.iter_mut().enumerate() {
-            let (left, right) = r.wheels();
+            let (left, right) = if self.dead[i].is_some() {
+                let coast = world::WheelCommand {
+                    duty: 0.0,
+                    direction: world::Direction::Coast,
+                };
+                (coast, coast)
+            } else {
+                r.wheels()
+            };
             self.world.set_wheels(i, left, right)?;
         }
-        self.saves += results.iter().filter(|(_, saved)| *saved).count() as u64;
-        let mean_d = results.iter().map(|(d, _)| f64::from(*d)).sum::<f64>() / n as f64;
+        let live_f = live.max(1) as f64;
+        let mean_d = sum_d / live_f;
         let gap_cv = match self.scenario.arena {
             ArenaKind::Corridor => self.world.corridor_gap_cv()?,
             ArenaKind::Square => None,
@@ -298,6 +383,7 @@ impl Swarm {
             collisions_per_robot: 0.0,
             moved_m: 0.0,
             gap_cv,
+            cpu_load_percent: sum_load / live_f,
         });
         Ok(())
     }
@@ -339,12 +425,14 @@ impl Swarm {
             last.collisions_per_robot = collided as f64 / n as f64;
             last.moved_m = moved;
         }
+        let dead = self.dead();
         Ok(RunOutput {
             condition: self.condition,
             repeat: self.repeat,
             steps: self.steps,
             track: self.track,
             saves: self.saves,
+            dead,
         })
     }
 }
@@ -359,9 +447,12 @@ pub fn run_one(
     condition: Condition,
     repeat: u32,
     record_track: bool,
+    images: Option<&Images>,
+    keep_going: bool,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Result<RunOutput> {
-    let mut swarm = Swarm::new(s, condition, repeat, record_track)?;
+    let mut swarm = Swarm::new(s, condition, repeat, record_track, images)?;
+    swarm.set_keep_going(keep_going);
     for _ in 0..s.steps {
         swarm.step()?;
         progress(1);

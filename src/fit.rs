@@ -47,8 +47,8 @@ pub const ENDURANCE_CYCLES: f64 = 1_000_000.0;
 /// Longest boot the fit waits for before calling the image stuck: 10 s of MCU time.
 pub const BOOT_LIMIT_S: f64 = 10.0;
 
-/// Which controller the fit runs.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+/// Which controller a robot runs (the fit measures; the swarm runs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum ControllerKind {
     /// Machine code on the H8/300H core: the robot firmware or a user's image.

@@ -7,7 +7,10 @@
 //! derivation); adding a robot or a thread changes nobody else's numbers.
 
 use anyhow::{Context, Result};
-use emu::board::model::{Controller, ControllerConfig, StepReport};
+use emu::board::firmware::{
+    ConfigBlock, ConfigStatus, FLAG_RANDOM_WALK, Firmware, FirmwareController,
+};
+use emu::board::model::{Controller, ControllerConfig};
 use emu::board::wiring::{Bridge, MotorDrive};
 use emu::chip::mcu::{Board, Mcu, McuConfig};
 use emu::core::bus::Bus;
@@ -19,6 +22,7 @@ use sensors::{BumperSet, IrParams, IrSensor, port2_pins};
 use world::{Direction, WheelCommand};
 
 use crate::scenario::Scenario;
+
 use crate::seeds::robot_stream;
 
 /// The robot's hardware outside the chip: what the sensors see and the bumpers feel.
@@ -80,14 +84,92 @@ impl Condition {
     }
 }
 
+/// What runs on a robot's MCU.
+pub enum Brain {
+    /// The Rust model of the controller.
+    Model(Box<Controller>),
+    /// Machine code on the H8/300H core: the robot firmware or a user's image.
+    Firmware(Box<FirmwareController>),
+}
+
+/// What one step gave.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct StepResult {
+    /// D(t), the summed proximities the robot read (du).
+    pub d: i16,
+    /// Whether an EEPROM record was written in the step.
+    pub saved: bool,
+}
+
 /// One robot.
 pub struct Robot {
     /// The MCU with its board.
     pub mcu: Mcu<RobotBoard>,
     /// The controller running on it.
-    pub controller: Controller,
+    pub brain: Brain,
     walk: Option<ChaCha8Rng>,
     behaviours: usize,
+    /// Records (commit-page writes) counted so far, for the firmware's saves.
+    records: u64,
+    /// Busy states of the MCU since the last step began.
+    busy_states: u64,
+    /// Where the firmware reports what it made of its configuration block (`cfg_status`),
+    /// when it got one and has the symbol; checked once it has booted.
+    cfg_status: Option<u32>,
+}
+
+/// The images a swarm's firmware robots run, loaded once.
+#[derive(Clone, Debug)]
+pub struct Images {
+    /// The robot firmware.
+    pub robot: Firmware,
+    /// The user's image (`controller.image`) and the robots that run it (None: every one).
+    pub user: Option<(Firmware, Option<Vec<usize>>)>,
+}
+
+impl Images {
+    /// The images a scenario asks for (none for model robots).
+    ///
+    /// # Errors
+    /// An image or symbol file that cannot be read or parsed, naming it.
+    pub fn load(s: &Scenario) -> Result<Option<Images>> {
+        if s.controller.kind == crate::fit::ControllerKind::Model {
+            return Ok(None);
+        }
+        let robot = Firmware::robot().context("the built-in robot firmware")?;
+        let user = match &s.controller.image {
+            None => None,
+            Some(image) => {
+                let image = std::path::Path::new(image);
+                let symbols = s
+                    .controller
+                    .symbols
+                    .as_ref()
+                    .map(std::path::PathBuf::from)
+                    .or_else(|| {
+                        let p = image.with_extension("sym");
+                        p.exists().then_some(p)
+                    });
+                let fw = match symbols {
+                    Some(sym) => Firmware::load(image, &sym),
+                    None => Firmware::load_without_symbols(image),
+                }
+                .with_context(|| format!("`controller.image` = {}", image.display()))?;
+                Some((fw, s.controller.robots.clone()))
+            }
+        };
+        Ok(Some(Images { robot, user }))
+    }
+
+    /// The image robot `index` runs.
+    #[must_use]
+    pub fn for_robot(&self, index: usize) -> &Firmware {
+        match &self.user {
+            Some((fw, None)) => fw,
+            Some((fw, Some(robots))) if robots.contains(&index) => fw,
+            _ => &self.robot,
+        }
+    }
 }
 
 /// The controller configuration a scenario asks for.
@@ -109,11 +191,18 @@ pub fn controller_config(s: &Scenario, weight_seed: u64) -> Result<ControllerCon
 }
 
 impl Robot {
-    /// Robot `index` of `repeat` under `condition`, booted.
+    /// Robot `index` of `repeat` under `condition`, booted (the model) or reset (firmware:
+    /// it boots on its way to its first step).
     ///
     /// # Errors
     /// A configuration the controller or the sensors refuse.
-    pub fn new(s: &Scenario, condition: Condition, repeat: u32, index: u32) -> Result<Self> {
+    pub fn new(
+        s: &Scenario,
+        condition: Condition,
+        repeat: u32,
+        index: u32,
+        images: Option<&Images>,
+    ) -> Result<Self> {
         let stream = |k: u64, purpose: Purpose| robot_stream(s.seed, repeat, index, k, purpose);
         let ir = IrParams {
             clock_hz: s.timing.clock_hz,
@@ -154,38 +243,141 @@ impl Robot {
         if condition != Condition::Learning {
             cfg.params = Params::new(0, s.learner.threshold).context("learner.threshold")?;
         }
-        let mut controller = Controller::new(cfg)?;
-        controller.boot(&mut mcu)?;
-        let walk = (condition == Condition::RandomWalk)
-            .then(|| ChaCha8Rng::seed_from_u64(stream(0, Purpose::RandomWalk)));
-        Ok(Self {
+        let mut cfg_status = None;
+        let (brain, walk) = match images {
+            None => {
+                let mut controller = Controller::new(cfg)?;
+                controller.boot(&mut mcu)?;
+                let walk = (condition == Condition::RandomWalk)
+                    .then(|| ChaCha8Rng::seed_from_u64(stream(0, Purpose::RandomWalk)));
+                (Brain::Model(Box::new(controller)), walk)
+            }
+            Some(images) => {
+                let fw = images.for_robot(index as usize);
+                // The random walk is the firmware's own: it draws the behaviour with its
+                // xorshift32 (seeded from the weight seed) and obeys it.
+                let mut block = ConfigBlock::from_controller(&cfg)?;
+                if condition == Condition::RandomWalk {
+                    block.flags |= FLAG_RANDOM_WALK;
+                }
+                let block = fw.has_config_block().then_some(block);
+                cfg_status = block.and(fw.symbols.addr("cfg_status"));
+                let controller = FirmwareController::start(fw, &mut mcu, block.as_ref())
+                    .with_context(|| format!("robot {index}: {}", fw.name))?;
+                (Brain::Firmware(Box::new(controller)), None)
+            }
+        };
+        let mut robot = Self {
             mcu,
-            controller,
+            brain,
             walk,
             behaviours: s.learner.behaviours,
-        })
+            records: 0,
+            busy_states: 0,
+            cfg_status,
+        };
+        robot.records = robot.records_written();
+        Ok(robot)
     }
 
-    /// Sleeps until the next step is due; returns the MCU clock then (states).
+    /// EEPROM records written so far: writes of the record slot's commit page (page 0) on
+    /// either chip (SPEC §3.6's A/B records).
+    fn records_written(&self) -> u64 {
+        self.mcu
+            .i2c()
+            .devices()
+            .iter()
+            .map(|d| u64::from(d.write_counts().first().copied().unwrap_or(0)))
+            .sum()
+    }
+
+    /// Sleeps until the next step is due; returns the instant its sensing begins (states: the
+    /// write that starts the A/D converter). A firmware robot runs until it starts its A/D
+    /// conversion (booting first when it has just been reset); the model's instant is where
+    /// its transcription of the firmware makes that write.
     ///
     /// # Errors
-    /// The tick did not come (cannot happen with this controller).
+    /// The tick did not come (the model); the firmware stopped, halted, or has not started a
+    /// step within the watchdog's time (naming the PC); a configuration block the firmware
+    /// rejected.
     pub fn sleep(&mut self) -> Result<u64> {
-        self.controller.sleep_until_step(&mut self.mcu)?;
+        match &mut self.brain {
+            Brain::Model(c) => {
+                let r = c.sleep_until_step(&mut self.mcu)?;
+                self.busy_states += r.busy_states;
+                // The model's step begins sensing this much later (its ADST write), where a
+                // firmware robot's run stops.
+                return Ok(self.mcu.now() + emu::board::model::SENSING_OFFSET_STATES);
+            }
+            Brain::Firmware(c) => {
+                c.run_to_sensing(&mut self.mcu)?;
+                self.busy_states += c.take_busy();
+                // Booted: a configuration block the firmware rejected is an error.
+                if let Some(addr) = self.cfg_status.take()
+                    && let ConfigStatus::Rejected { field, code } =
+                        ConfigStatus::from_code(self.mcu.peek(addr))
+                {
+                    anyhow::bail!(
+                        "the firmware rejected its configuration block: {field} (cfg_status 0x{code:02X})"
+                    );
+                }
+            }
+        }
         Ok(self.mcu.now())
     }
 
     /// Runs the step with the distances the world's rays found.
     ///
     /// # Errors
-    /// A save that failed on the bus.
-    pub fn step(&mut self, distance_mm: [Option<f64>; 4]) -> Result<StepReport> {
+    /// A save that failed on the bus (the model); the firmware stopped, halted, or did not go
+    /// back to sleep within the watchdog's time.
+    pub fn step(&mut self, distance_mm: [Option<f64>; 4]) -> Result<StepResult> {
         self.mcu.board_mut().distance_mm = distance_mm;
-        let forced = self
-            .walk
-            .as_mut()
-            .map(|rng| Behaviour::ALL[rng.random_range(0..self.behaviours)]);
-        Ok(self.controller.step_with(&mut self.mcu, forced)?)
+        match &mut self.brain {
+            Brain::Model(c) => {
+                let forced = self
+                    .walk
+                    .as_mut()
+                    .map(|rng| Behaviour::ALL[rng.random_range(0..self.behaviours)]);
+                let t0 = self.mcu.now();
+                let r = c.step_with(&mut self.mcu, forced)?;
+                self.busy_states += self.mcu.now() - t0;
+                Ok(StepResult {
+                    d: r.d,
+                    saved: r.saved.is_some(),
+                })
+            }
+            Brain::Firmware(c) => {
+                c.run_to_sleep(&mut self.mcu)?;
+                self.busy_states += c.take_busy();
+                let records = self.records_written();
+                let saved = records != self.records;
+                self.records = records;
+                Ok(StepResult {
+                    d: self.sensed_d(),
+                    saved,
+                })
+            }
+        }
+    }
+
+    /// D as the firmware computes it from the A/D codes it read: the du table of the upper
+    /// byte of each sensor's result register.
+    fn sensed_d(&self) -> i16 {
+        let channels = self.mcu.board().channels;
+        channels
+            .iter()
+            .map(|&ch| {
+                let code8 = (self.mcu.adc().data(usize::from(ch & 3)) >> 8) as usize;
+                i16::from(sensors::DU_TABLE[code8])
+            })
+            .sum()
+    }
+
+    /// The MCU's busy states since the last call: the step's work, the tick interrupts and
+    /// the main loop around them (not the time asleep).
+    pub fn take_busy_states(&mut self) -> u64 {
+        std::mem::take(&mut self.busy_states)
     }
 
     /// The wheel commands the motor pins give now.

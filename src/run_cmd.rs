@@ -42,6 +42,19 @@ pub struct RunArgs {
     /// Output folder (default `out/<scenario>`, with `-<N>robots` when --robots is given).
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
+    /// The robots' controller: `firmware` (the robot firmware, machine code on the emulated
+    /// H8/300H) or `model` (its Rust model); overrides the scenario's `controller.kind`.
+    #[arg(long, value_enum, value_name = "KIND")]
+    pub controller: Option<crate::fit_cmd::ControllerArg>,
+    /// A firmware image of yours (.mot, with IMAGE.sym beside it when it has a configuration
+    /// block) for every robot (or the scenario's `controller.robots`); implies `--controller
+    /// firmware`.
+    #[arg(long, value_name = "IMAGE")]
+    pub firmware: Option<PathBuf>,
+    /// When a robot's controller fails (a faulty image: an undefined opcode, a fetch outside
+    /// memory, no step for 10 s), mark that robot dead and go on instead of stopping.
+    #[arg(long)]
+    pub keep_going: bool,
 }
 
 #[derive(Serialize)]
@@ -61,7 +74,22 @@ struct Summary<'a> {
 /// more robots than the arena holds.
 pub fn run(a: &RunArgs) -> Result<String> {
     let what = a.scenario.as_deref().unwrap_or("arena");
-    let s = Scenario::load(what)?.with_overrides(a.robots, a.steps, a.repeats, a.seed)?;
+    let mut s = Scenario::load(what)?;
+    if let Some(k) = a.controller {
+        s.controller.kind = match k {
+            crate::fit_cmd::ControllerArg::Firmware => crate::fit::ControllerKind::Firmware,
+            crate::fit_cmd::ControllerArg::Model => crate::fit::ControllerKind::Model,
+        };
+    }
+    if let Some(image) = &a.firmware {
+        if a.controller == Some(crate::fit_cmd::ControllerArg::Model) {
+            bail!("--firmware runs an image on the core: it cannot go with --controller model");
+        }
+        s.controller.kind = crate::fit::ControllerKind::Firmware;
+        s.controller.image = Some(image.display().to_string());
+    }
+    let s = s.with_overrides(a.robots, a.steps, a.repeats, a.seed)?;
+    let images = crate::robot::Images::load(&s)?;
     if a.threads == Some(0) {
         bail!("--threads 0: give at least 1 (or leave it out for all cores)");
     }
@@ -125,7 +153,9 @@ pub fn run(a: &RunArgs) -> Result<String> {
         jobs.par_iter()
             .map(|&(c, r)| {
                 let track = c == Condition::Learning && r == 0;
-                run_one(&s, c, r, track, &|k| bar.inc(k))
+                run_one(&s, c, r, track, images.as_ref(), a.keep_going, &|k| {
+                    bar.inc(k)
+                })
             })
             .collect::<Result<_>>()
     })?;
@@ -248,6 +278,16 @@ pub fn run(a: &RunArgs) -> Result<String> {
             }
         );
     }
+    for r in &runs {
+        for (i, why) in &r.dead {
+            let _ = writeln!(
+                t,
+                "DEAD  robot {i} in {} repeat {}: {why}",
+                r.condition.name(),
+                r.repeat
+            );
+        }
+    }
     let _ = writeln!(t);
     let _ = writeln!(t, "fit: {}", fit.verdict);
     let _ = writeln!(
@@ -283,6 +323,7 @@ fn write_metrics(path: &Path, runs: &[RunOutput]) -> Result<()> {
         "collisions_per_robot",
         "moved_m",
         "gap_cv",
+        "cpu_load_percent",
     ])?;
     for r in runs {
         for (k, m) in r.steps.iter().enumerate() {
@@ -294,6 +335,7 @@ fn write_metrics(path: &Path, runs: &[RunOutput]) -> Result<()> {
                 format!("{}", m.collisions_per_robot),
                 format!("{}", m.moved_m),
                 m.gap_cv.map(|v| format!("{v}")).unwrap_or_default(),
+                format!("{}", m.cpu_load_percent),
             ])?;
         }
     }

@@ -92,6 +92,35 @@ pub struct SensorSpec {
     pub channels: [u8; 4],
 }
 
+/// The robots' controller.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ControllerSpec {
+    /// `firmware` (the robot firmware, machine code on the emulated H8/300H) or `model` (the
+    /// Rust model of it, checked against it).
+    pub kind: crate::fit::ControllerKind,
+    /// A firmware image of the user's (Motorola S-records) for the robots in `robots` (every
+    /// robot when `robots` is absent); the others run the robot firmware. Firmware only.
+    pub image: Option<String>,
+    /// The image's symbol table (`h8300-hms-nm -n`); default: the image's path with `.sym`,
+    /// when that file exists. With the symbol `config_block` at H'000400 the image gets the
+    /// configuration block; without it the scenario's learner settings do not reach it.
+    pub symbols: Option<String>,
+    /// The robots (0-based) that run `image`.
+    pub robots: Option<Vec<usize>>,
+}
+
+impl Default for ControllerSpec {
+    fn default() -> Self {
+        Self {
+            kind: crate::fit::ControllerKind::Model,
+            image: None,
+            symbols: None,
+            robots: None,
+        }
+    }
+}
+
 /// Which controls run beside learning (SPEC §5).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -132,6 +161,8 @@ pub struct ScenarioFile {
     pub sensors: Option<SensorPatch>,
     /// Controls.
     pub controls: Option<ControlPatch>,
+    /// The controller.
+    pub controller: Option<ControllerPatch>,
 }
 
 macro_rules! patch {
@@ -158,6 +189,7 @@ patch!(TimingPatch for TimingSpec { step_period_s: f64, clock_hz: u32 });
 patch!(WorldPatch for WorldSpec { top_speed_m_per_s: f64, motor_time_constant_s: f64, motor_gain_spread: f64, wheel_track_m: f64, substep_s: f64, sensor_range_m: f64, sensor_setback_m: f64 });
 patch!(SensorPatch for SensorSpec { noise_sigma_v: f64, spike_probability: f64, spread: bool, channels: [u8; 4] });
 patch!(ControlPatch for ControlSpec { learning_off: bool, random_walk: bool });
+patch!(ControllerPatch for ControllerSpec { kind: crate::fit::ControllerKind, image: Option<String>, symbols: Option<String>, robots: Option<Vec<usize>> });
 
 /// A resolved, checked scenario.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -186,6 +218,8 @@ pub struct Scenario {
     pub sensors: SensorSpec,
     /// Controls.
     pub controls: ControlSpec,
+    /// The controller.
+    pub controller: ControllerSpec,
 }
 
 impl Default for LearnerSpec {
@@ -264,6 +298,7 @@ impl Scenario {
             world: WorldSpec::default(),
             sensors: SensorSpec::default(),
             controls: ControlSpec::default(),
+            controller: ControllerSpec::default(),
         }
     }
 
@@ -362,6 +397,9 @@ impl Scenario {
         }
         if let Some(p) = &file.controls {
             p.apply(&mut s.controls);
+        }
+        if let Some(p) = &file.controller {
+            p.apply(&mut s.controller);
         }
         s.check()?;
         Ok(s)
@@ -472,6 +510,27 @@ impl Scenario {
                 "`world.substep_s` = {} is longer than the step period {} s",
                 self.world.substep_s,
                 self.timing.step_period_s
+            );
+        }
+        let c = &self.controller;
+        if c.kind == crate::fit::ControllerKind::Model && (c.image.is_some() || c.robots.is_some())
+        {
+            bail!(
+                "`controller.image` and `controller.robots` need `controller.kind = \"firmware\"` (the model runs no image)"
+            );
+        }
+        if c.robots.is_some() && c.image.is_none() {
+            bail!(
+                "`controller.robots` names the robots that run `controller.image`: give the image too"
+            );
+        }
+        if let Some(robots) = &c.robots
+            && let Some(&bad) = robots.iter().find(|&&r| r >= self.robots)
+        {
+            bail!(
+                "`controller.robots` lists robot {bad}: valid are 0 to {} ({} robots)",
+                self.robots - 1,
+                self.robots
             );
         }
         Ok(())

@@ -332,6 +332,26 @@ impl Firmware {
         })
     }
 
+    /// An image without a symbol table (a user's image run in the swarm: it gets no
+    /// configuration block and no profile).
+    ///
+    /// # Errors
+    /// [`FirmwareError`] naming the file that could not be read or parsed.
+    pub fn load_without_symbols(image: &Path) -> Result<Firmware, FirmwareError> {
+        let bytes = std::fs::read(image).map_err(|source| FirmwareError::Read {
+            path: image.display().to_string(),
+            source,
+        })?;
+        Ok(Firmware {
+            image: srec::parse(&bytes).map_err(|source| FirmwareError::Srec {
+                path: image.display().to_string(),
+                source,
+            })?,
+            symbols: SymbolTable::default(),
+            name: image.display().to_string(),
+        })
+    }
+
     /// Bytes of the image (its ROM).
     #[must_use]
     pub fn rom_bytes(&self) -> usize {
@@ -428,5 +448,155 @@ pub fn halted(cpu: &Cpu) -> RunError {
         pc: cpu.pc(),
         status,
         why,
+    }
+}
+
+/// Longest a robot's firmware may go without beginning a step (starting the A/D converter) or
+/// without going back to sleep after one before the emulator calls it stuck: 10 s of MCU time,
+/// a watchdog's view (SPEC §3.5's steps come every 0.45–0.60 s).
+pub const WATCHDOG_S: f64 = 10.0;
+
+/// Why a robot's firmware cannot go on.
+#[derive(Debug, thiserror::Error)]
+pub enum StepError {
+    /// The core stopped or the firmware halted.
+    #[error(transparent)]
+    Run(#[from] RunError),
+    /// Nothing happened that a robot must do.
+    #[error(
+        "no {what} within {WATCHDOG_S} s of MCU time (at state {at}, PC H'{pc:06X}): the firmware must start the A/D converter every step and sleep between steps"
+    )]
+    Watchdog {
+        /// What did not happen.
+        what: &'static str,
+        /// When the watchdog gave up.
+        at: u64,
+        /// Where the CPU was.
+        pc: u32,
+    },
+}
+
+/// A robot's firmware on its MCU, run step by step for the swarm.
+///
+/// The swarm needs two instants of every step: when the robot begins to sense (the world must
+/// have placed it and computed what its sensors see) and when the step's work is done (its
+/// motor pins then drive the world). Both are read off the hardware, so any image that follows
+/// the robot's hardware contract works: a step begins when the firmware starts the A/D
+/// converter (ADST written 1: the first sample is taken 40 or 80 states later), and its work
+/// is done when the CPU next executes SLEEP. Between steps the CPU sleeps through the ticks,
+/// each woken by its interrupt and put back to sleep by the firmware. States the CPU spends
+/// asleep are idle; all others are busy (the robot's CPU load).
+#[derive(Clone, Debug)]
+pub struct FirmwareController {
+    cpu: Cpu,
+    /// A/D runs started so far (the converter's count).
+    adc_starts: u64,
+    busy: u64,
+    watchdog_states: u64,
+}
+
+impl FirmwareController {
+    /// Programs `fw` (and `block`, when given) into `mcu`'s flash and resets the CPU.
+    ///
+    /// # Errors
+    /// [`FirmwareError::Load`] when the image does not fit the flash.
+    pub fn start<B: Board>(
+        fw: &Firmware,
+        mcu: &mut Mcu<B>,
+        block: Option<&ConfigBlock>,
+    ) -> Result<Self, FirmwareError> {
+        let mut cpu = Cpu::new();
+        fw.install(mcu, &mut cpu, block)?;
+        Ok(FirmwareController {
+            cpu,
+            adc_starts: mcu.adc().starts(),
+            busy: 0,
+            watchdog_states: (WATCHDOG_S * f64::from(mcu.clock_hz())) as u64,
+        })
+    }
+
+    /// The CPU (registers, PC).
+    #[must_use]
+    pub fn cpu(&self) -> &Cpu {
+        &self.cpu
+    }
+
+    /// Busy states since the last call (or since start).
+    pub fn take_busy(&mut self) -> u64 {
+        std::mem::take(&mut self.busy)
+    }
+
+    /// One step of the CPU with idle time apart. Returns whether the CPU slept (executed
+    /// SLEEP) or woke in this step.
+    fn one<B: Board>(&mut self, mcu: &mut Mcu<B>, deadline: u64) -> Result<Event, RunError> {
+        use crate::core::bus::Bus;
+        if self.cpu.sleeping() {
+            mcu.sleep_until_irq(deadline);
+            if mcu.now() >= deadline {
+                return Ok(Event::Asleep);
+            }
+        }
+        let t0 = mcu.now();
+        let event = self.cpu.step(mcu, deadline)?;
+        match event {
+            Event::Halted => return Err(halted(&self.cpu)),
+            Event::Asleep => {}
+            Event::Executed | Event::Interrupt(_) => self.busy += mcu.now() - t0,
+        }
+        Ok(event)
+    }
+
+    /// Runs until the firmware starts the A/D converter (its step begins); returns the clock
+    /// then. The first sample is taken at least 40 states later, so the board's inputs can
+    /// still be set.
+    ///
+    /// # Errors
+    /// [`StepError`] when the core stops, the firmware halts, or no conversion starts within
+    /// [`WATCHDOG_S`].
+    pub fn run_to_sensing<B: Board>(&mut self, mcu: &mut Mcu<B>) -> Result<u64, StepError> {
+        use crate::core::bus::Bus;
+        let deadline = mcu.now() + self.watchdog_states;
+        loop {
+            if self.one(mcu, deadline)? == Event::Asleep && mcu.now() >= deadline {
+                return Err(StepError::Watchdog {
+                    what: "A/D conversion started (no step)",
+                    at: mcu.now(),
+                    pc: self.cpu.pc(),
+                });
+            }
+            let starts = mcu.adc().starts();
+            if starts != self.adc_starts {
+                self.adc_starts = starts;
+                return Ok(mcu.now());
+            }
+            if mcu.now() >= deadline {
+                return Err(StepError::Watchdog {
+                    what: "A/D conversion started (no step)",
+                    at: mcu.now(),
+                    pc: self.cpu.pc(),
+                });
+            }
+        }
+    }
+
+    /// Runs until the CPU executes SLEEP (the step's work is done).
+    ///
+    /// # Errors
+    /// As [`FirmwareController::run_to_sensing`]; the watchdog when the CPU does not sleep
+    /// within [`WATCHDOG_S`].
+    pub fn run_to_sleep<B: Board>(&mut self, mcu: &mut Mcu<B>) -> Result<(), StepError> {
+        use crate::core::bus::Bus;
+        let deadline = mcu.now() + self.watchdog_states;
+        while !self.cpu.sleeping() {
+            self.one(mcu, deadline)?;
+            if mcu.now() >= deadline && !self.cpu.sleeping() {
+                return Err(StepError::Watchdog {
+                    what: "SLEEP after the step's work",
+                    at: mcu.now(),
+                    pc: self.cpu.pc(),
+                });
+            }
+        }
+        Ok(())
     }
 }

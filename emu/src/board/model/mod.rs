@@ -143,6 +143,13 @@ pub fn firmware_i2c_timing(clock_hz: u32) -> Result<MasterTiming, eeprom::Eeprom
 /// tests check that the firmware still measures this.
 pub const MODEL_STACK_BYTES: u32 = 160;
 
+/// States from the end of [`Controller::sleep_until_step`] to the end of the ADST write that
+/// starts the step's A/D scan (the transcription in [`Controller::step_with`]: main's NEXT
+/// update and JSR, robot_step's prologue and JSR, 62; ad_scan's set-up, 16; the write, 5): the
+/// instant a firmware robot's step begins in the swarm, so that the world places model and
+/// firmware robots at the same instants.
+pub const SENSING_OFFSET_STATES: u64 = 62 + 16 + 5;
+
 /// main's test after each wake-up (from the listing): MOV.L @ticks:24,ER2 ; SUB.L ER3,ER2 ;
 /// MOV.L ER2,ER2 ; BLT back to SLEEP.
 const MAIN_TICK_TEST: [Insn; 4] = [Insn::MovLAbs24, Insn::Reg, Insn::Reg, Insn::Bcc8];

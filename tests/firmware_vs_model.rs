@@ -1,0 +1,78 @@
+//! Firmware robots and model robots side by side (issue 11 item 5): with identical sensor
+//! inputs the learner's state stays equal step for step, and the swarm's learning runs agree.
+
+use h8swarm::robot::{Brain, Condition, Images, Robot};
+use h8swarm::scenario::Scenario;
+
+fn scenario(corridor: bool) -> Scenario {
+    let mut s = if corridor {
+        Scenario::corridor()
+    } else {
+        Scenario::arena()
+    };
+    // Ideal, noiseless sensors: the same distances give the same codes whatever the instant.
+    s.sensors.spread = false;
+    s.sensors.noise_sigma_v = 0.0;
+    s.sensors.spike_probability = 0.0;
+    s
+}
+
+/// The weights a firmware robot holds, read from its RAM through the firmware's symbols.
+fn firmware_weights(r: &Robot, n: usize) -> Vec<i16> {
+    let fw = emu::board::firmware::Firmware::robot().unwrap();
+    let peek = |a: u32| r.mcu.peek(a);
+    let at = fw.symbols.addr("net_w").unwrap();
+    let w = (0..4).fold(0u32, |v, i| (v << 8) | u32::from(peek(at + i)));
+    (0..n as u32)
+        .map(|k| i16::from_be_bytes([peek(w + 2 * k), peek(w + 2 * k + 1)]))
+        .collect()
+}
+
+fn side_by_side(corridor: bool, condition: Condition, steps: u32) -> (u64, i64) {
+    let mut s = scenario(corridor);
+    s.controller.kind = h8swarm::fit::ControllerKind::Firmware;
+    let images = Images::load(&s).unwrap();
+    let mut fw = Robot::new(&s, condition, 0, 0, images.as_ref()).unwrap();
+    let mut model = Robot::new(&s, condition, 0, 0, None).unwrap();
+    let mut distance = [250.0f64, 600.0, 120.0, 900.0];
+    let mut seed = 12345u64;
+    let mut shift = 0i64;
+    let mut updates = 0u64;
+    for k in 0..steps {
+        let tf = fw.sleep().unwrap();
+        let tm = model.sleep().unwrap();
+        shift = tf as i64 - tm as i64;
+        for d in &mut distance {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            *d = (*d + (seed % 121) as f64 - 60.0).clamp(40.0, 1000.0);
+        }
+        let d = distance.map(Some);
+        let a = fw.step(d).unwrap();
+        let b = model.step(d).unwrap();
+        assert_eq!(a.d, b.d, "step {k}: D");
+        let Brain::Model(c) = &model.brain else {
+            unreachable!()
+        };
+        let wm: Vec<i16> = c.learner().weights().iter().map(|q| q.to_bits()).collect();
+        assert_eq!(firmware_weights(&fw, wm.len()), wm, "step {k}: weights");
+        let (wf, wmod) = (fw.wheels(), model.wheels());
+        assert_eq!(wf, wmod, "step {k}: the motors");
+        updates += u64::from(a.saved);
+    }
+    (updates, shift)
+}
+
+#[test]
+fn with_identical_inputs_the_learner_states_stay_equal_step_for_step() {
+    let (saves, shift) = side_by_side(false, Condition::Learning, 600);
+    assert_eq!(saves, 30, "a record every 20 steps, on both");
+    // The model boots faster, so its ticks (and steps) come a fixed time earlier.
+    assert_eq!(
+        shift, 10_232,
+        "the firmware's steps begin this many states after the model's"
+    );
+    side_by_side(true, Condition::Learning, 300);
+    side_by_side(false, Condition::LearningOff, 200);
+}
