@@ -27,6 +27,18 @@ static __inline__ void delay(u8 n)
 #define D_HOLD 2  /* START hold, START setup, STOP setup: >= 15 states */
 #define D_BUF 5   /* bus free after STOP: >= 33 states */
 
+/* Between two ACK polls the master leaves the bus alone for about 200 us: the chip's write
+ * cycle takes 3-5 ms (DS21203 t_WC), so polling back to back would spend the whole cycle on
+ * the bus (about 250 polls a page); with the pause a page takes 15-25 polls and ends at most
+ * 0.2 ms later. 833 iterations of DEC.W and BNE (6 states each) are 4 998 states at 25 MHz. */
+#define POLL_GAP 833
+
+/* n iterations of DEC.W #1 and BNE: 6 states each (n >= 1). */
+static __inline__ void delay16(u16 n)
+{
+    __asm__ __volatile__("1:\n\tdec.w #1,%0\n\tbne 1b" : "+r"(n) : : "cc");
+}
+
 static __inline__ void scl_low(void)
 {
     ddr |= SCL_BIT;
@@ -195,6 +207,7 @@ u16 i2c_ack_poll(u8 chip)
             stop_condition();
             return 0;
         }
+        delay16(POLL_GAP);
         repeated_start();
     }
 }

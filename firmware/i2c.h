@@ -8,9 +8,9 @@
 
 #include "h8.h"
 
-/* Most ACK polls after a page write before the save gives up (a poll takes ~30 us: 2 000 are
- * 60 ms, twelve times the 24LC256's 5 ms write cycle). */
-#define I2C_MAX_POLLS 2000
+/* Most ACK polls after a page write before the save gives up (a poll and the pause after it
+ * take about 250 us: 200 are 50 ms, ten times the 24LC256's 5 ms write cycle). */
+#define I2C_MAX_POLLS 200
 
 /* Releases both lines, clocks SCL until a slave holding SDA lets go (at most 9 clocks), and
  * sends a STOP. Returns 0, or 1 when SDA stays low. */

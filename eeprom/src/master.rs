@@ -105,6 +105,10 @@ pub struct MasterTiming {
     pub stop_setup_states: u64,
     /// Bus free after a STOP before the next START (T_BUF).
     pub bus_free_states: u64,
+    /// After an unanswered ACK poll, SCL low at least this long (from its last fall) before the
+    /// next poll's repeated START: a pause in which the master leaves the bus alone while the
+    /// chip's write cycle runs. 0 (the default): poll back to back.
+    pub poll_gap_states: u64,
 }
 
 impl MasterTiming {
@@ -134,6 +138,7 @@ impl MasterTiming {
             data_setup_states: clock.states_at_least(su_dat_ns),
             stop_setup_states: clock.states_at_least(su_sto_ns),
             bus_free_states: clock.states_at_least(buf_ns),
+            poll_gap_states: 0,
         }
     }
 
@@ -613,6 +618,7 @@ impl<P: I2cPins> I2cMaster<P> {
                 return Ok(poll);
             }
             if poll < max_polls {
+                self.settle_until(self.last_fall + self.timing.poll_gap_states);
                 self.repeated_start();
             }
         }

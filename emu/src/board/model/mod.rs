@@ -111,7 +111,7 @@ pub const MAX_STEP_PERIOD_S: f64 = 600.0;
 /// Amplitude of the fresh random weights: uniform in ±0.5 (±16384 in Q15).
 pub const INITIAL_WEIGHT_AMPLITUDE: i16 = 16384;
 /// Most ACK polls per page write before the save gives up (well past a 5 ms write cycle).
-pub const MAX_POLLS: u32 = 2000;
+pub const MAX_POLLS: u32 = 200;
 
 /// The firmware's I²C bus timing, from the listing of `firmware/i2c.c` (states between the
 /// edges its code makes; every one above DS21203's 400 kHz minima): SCL low 94 (a bit's low
@@ -134,6 +134,7 @@ pub fn firmware_i2c_timing(clock_hz: u32) -> Result<MasterTiming, eeprom::Eeprom
         data_setup_states: 41,
         stop_setup_states: 29,
         bus_free_states: 90,
+        poll_gap_states: POLL_GAP_STATES,
     })
 }
 
@@ -149,6 +150,12 @@ pub const MODEL_STACK_BYTES: u32 = 160;
 /// instant a firmware robot's step begins in the swarm, so that the world places model and
 /// firmware robots at the same instants.
 pub const SENSING_OFFSET_STATES: u64 = 62 + 16 + 5;
+
+/// The firmware's pause between ACK polls, from the NACK's SCL fall to the repeated START's
+/// first edge (from the listing): the return from `clock` and `write_byte` (54), the tests in
+/// `i2c_ack_poll` (14), `delay16(833)` (4 + 833 · 6 = 5 002), the call of `repeated_start` and
+/// its first pin write (41) — less the master's own pin operation (7).
+pub const POLL_GAP_STATES: u64 = 54 + 14 + 5002 + 41 - 7;
 
 /// main's test after each wake-up (from the listing): MOV.L @ticks:24,ER2 ; SUB.L ER3,ER2 ;
 /// MOV.L ER2,ER2 ; BLT back to SLEEP.
