@@ -494,6 +494,85 @@ fn divide_by_zero_sets_z_and_leaves_the_register() {
     assert_eq!(s.states, 24);
 }
 
+/// DIVXS.B/.W flags by the programming manual (2.2.26): "The N flag is set to 1 if the
+/// dividend and divisor have different signs, and cleared to 0 if they have the same sign. The
+/// N flag may therefore be set to 1 when the quotient is zero."; Z = 1 only for a zero
+/// divisor; H, V, C unchanged. Each case: (dividend, divisor, Rd/ERd after, N, Z).
+#[test]
+fn divxs_n_follows_the_operand_signs_even_for_a_zero_quotient() {
+    let n = |b: bool| if b { CCR_N } else { 0 };
+    let z = |b: bool| if b { CCR_Z } else { 0 };
+    // DIVXS.B R0L,R1: R1 (16 bits) / R0L (8 bits) -> R1H remainder, R1L quotient.
+    let byte_cases: [(i16, i8, u16, bool, bool); 14] = [
+        (-1, 5, 0xff00, true, false),       // quotient 0, remainder -1
+        (-3, 100, 0xfd00, true, false),     // quotient 0, remainder -3
+        (3, -100, 0x0300, true, false),     // quotient 0, remainder 3
+        (0, -5, 0x0000, true, false),       // 0 has the sign of a positive number
+        (0, 5, 0x0000, false, false),       // quotient 0, same signs
+        (-7, -2, 0xff03, false, false),     // 3 remainder -1
+        (7, -2, 0x01fd, true, false),       // -3 remainder 1
+        (-7, 2, 0xfffd, true, false),       // -3 remainder -1
+        (-128, 1, 0x0080, true, false),     // quotient -128 fits
+        (5, 0, 5, false, true),             // by zero: register unchanged
+        (-5, 0, 0xfffb, true, true),        // by zero, negative dividend
+        (1000, -1, 0x0018, true, false),    // overflow: low byte of -1000 = H'FC18
+        (-32768, -1, 0x0000, false, false), // overflow: 32768, low byte 0, same signs
+        (-32768, 1, 0x0000, true, false),   // overflow: low byte of -32768
+    ];
+    for (dividend, divisor, after, nf, zf) in byte_cases {
+        for keep in [0, CCR_H | CCR_V | CCR_C] {
+            let s = exec("divxs.b\tr0l,r1", &[0x01, 0xd0, 0x51, 0x81], |c, _| {
+                c.set_er(0, u32::from(divisor as u8));
+                c.set_er(1, 0xabcd_0000 | u32::from(dividend as u16));
+                c.set_ccr(CCR_I | keep | CCR_N | CCR_Z);
+            });
+            let case = format!("divxs.b {dividend} / {divisor}, H V C = {keep:#x}");
+            assert_eq!(s.cpu.er(1), 0xabcd_0000 | u32::from(after), "{case}");
+            assert_eq!(f(s.cpu.ccr()), keep | n(nf) | z(zf), "{case}");
+            assert_eq!(s.states, 16, "{case}");
+        }
+    }
+    // DIVXS.W R0,ER1: ER1 (32 bits) / R0 (16 bits) -> E1 remainder, R1 quotient.
+    let word_cases: [(i32, i16, u32, bool, bool); 12] = [
+        (-1, 5, 0xffff_0000, true, false),
+        (-3, 100, 0xfffd_0000, true, false),
+        (3, -100, 0x0003_0000, true, false),
+        (0, -5, 0, true, false),
+        (-100_000, -7, (-5i32 as u32) << 16 | 14_285, false, false),
+        (
+            100_000,
+            -7,
+            5 << 16 | (-14_285i32 as u32 & 0xffff),
+            true,
+            false,
+        ),
+        (-32_768, 1, 0x0000_8000, true, false),
+        (5, 0, 5, false, true),
+        (i32::MIN, 0, 0x8000_0000, true, true),
+        (i32::MAX, 1, 0x0000_ffff, false, false), // overflow: low word of the quotient
+        (i32::MIN, -1, 0, false, false),          // overflow: 2^31, low word 0
+        (-100_000, 1, 0x0000_7960, true, false),  // overflow: low word of -100000
+    ];
+    for (dividend, divisor, after, nf, zf) in word_cases {
+        for keep in [0, CCR_H | CCR_V | CCR_C] {
+            let s = exec("divxs.w\tr0,er1", &[0x01, 0xd0, 0x53, 0x01], |c, _| {
+                c.set_er(0, 0x1234_0000 | u32::from(divisor as u16));
+                c.set_er(1, dividend as u32);
+                c.set_ccr(CCR_I | keep | CCR_N | CCR_Z);
+            });
+            let case = format!("divxs.w {dividend} / {divisor}, H V C = {keep:#x}");
+            assert_eq!(s.cpu.er(1), after, "{case}");
+            assert_eq!(
+                s.cpu.er(0),
+                0x1234_0000 | u32::from(divisor as u16),
+                "{case}"
+            );
+            assert_eq!(f(s.cpu.ccr()), keep | n(nf) | z(zf), "{case}");
+            assert_eq!(s.states, 24, "{case}");
+        }
+    }
+}
+
 #[test]
 fn divide_overflow_keeps_the_low_quotient_bits() {
     // H'FFFF / 1 does not fit 8 bits (the manual's overflow example): quotient low byte, rest 0.

@@ -725,24 +725,21 @@ impl Cpu {
             (MulDivOp::Divxs, Size::Byte) => {
                 let divisor = i32::from(self.r8(rs) as i8);
                 let dividend = i32::from(self.r16(rd) as i16);
-                if divisor == 0 {
-                    self.nz_flags(dividend < 0, true);
-                } else {
+                // N: the signs differ (even when the quotient is 0); Z: the divisor is 0.
+                self.nz_flags((dividend < 0) != (divisor < 0), divisor == 0);
+                if divisor != 0 {
                     let q = dividend / divisor;
                     let r = dividend % divisor;
-                    self.nz_flags(q < 0, false);
                     self.set_r16(rd, ((r as u16 & 0xff) << 8) | (q as u16 & 0xff));
                 }
             }
             (MulDivOp::Divxs, _) => {
                 let divisor = i64::from(self.r16(rs) as i16);
                 let dividend = i64::from(self.er[usize::from(rd & 7)] as i32);
-                if divisor == 0 {
-                    self.nz_flags(dividend < 0, true);
-                } else {
+                self.nz_flags((dividend < 0) != (divisor < 0), divisor == 0);
+                if divisor != 0 {
                     let q = dividend / divisor;
                     let r = dividend % divisor;
-                    self.nz_flags(q < 0, false);
                     self.er[usize::from(rd & 7)] =
                         ((r as u32 & 0xffff) << 16) | (q as u32 & 0xffff);
                 }

@@ -15,10 +15,23 @@
 //! bus). The fetch cycles are still charged on every execution. Code in RAM is decoded every
 //! time. Call [`Cpu::flush_decode_cache`] if the ROM image is replaced.
 //!
+//! DIVXS.B/DIVXS.W flags (programming manual, 2.2.26 (1) and (2)). The condition-code table
+//! says "N: Set to 1 if the quotient is negative; otherwise cleared to 0. Z: Set to 1 if the
+//! divisor is zero; otherwise cleared to 0." (H, V, C unchanged), and the page's notes make N
+//! precise: "The N flag is set to 1 if the dividend and divisor have different signs, and
+//! cleared to 0 if they have the same sign. The N flag may therefore be set to 1 when the
+//! quotient is zero." This core follows the notes for both widths and every operand: N = the
+//! dividend's sign bit XOR the divisor's sign bit (so -1 / 5 and -3 / 100 give quotient 0 with
+//! N = 1, and 0 / -5 gives N = 1), Z = (divisor = 0). GDB's simulator and this core before
+//! issue 11 set N from the quotient (N = 0 for a zero quotient). DIVXU sets N from the
+//! divisor's top bit ("N: Set to 1 if the divisor is negative").
+//!
 //! Choices where the manual leaves the result open (documented behaviour of this core):
-//! - DIVXU/DIVXS by zero leave the destination register unchanged (flags as the manual says:
-//!   Z = 1, N from the divisor's sign for DIVXU and from the dividend's sign for DIVXS); on
-//!   overflow the low 8/16 bits of the quotient and the remainder are stored.
+//! - DIVXU/DIVXS by zero or with overflow: the manual says only "Valid results are not assured
+//!   if division by zero is attempted or an overflow occurs". By zero the destination register
+//!   is left unchanged (flags as above: Z = 1; N from the divisor's top bit, i.e. 0, for DIVXU
+//!   and from the signs, i.e. the dividend's sign, for DIVXS); on overflow the low 8/16 bits of
+//!   the quotient and of the remainder are stored, with the flags as above.
 //! - DAA/DAS leave H and V unchanged (the manual: "undetermined").
 //! - STC to memory writes the CCR to both bytes of the word.
 //! - `MOV Rn,@-ERn` with the same register stores the value before the decrement.
