@@ -29,7 +29,7 @@ export LC_ALL=C
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 cd "$here"
 
-PROGRAMS=(arith shifts muldiv bitops structs recursion funcptr switch q15learn)
+PROGRAMS=(arith shifts muldiv bitops structs recursion funcptr switch q15learn crcmacdiv)
 SUPPORT_C=(console.c)
 
 H8_PREFIX="${H8_PREFIX:-h8300-hms-}"
