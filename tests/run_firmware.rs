@@ -1,0 +1,218 @@
+//! `h8swarm run` with firmware robots: the same outputs, a user's image on some robots, a
+//! faulty image stopping the run (or, with --keep-going, one robot), determinism across threads.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use emu::core::srec::{Chunk, SrecImage, write_s3};
+
+fn h8swarm(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_h8swarm"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("h8swarm-runfw-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn metrics(dir: &Path) -> String {
+    std::fs::read_to_string(dir.join("metrics.csv")).unwrap()
+}
+
+/// An image whose reset vector points at `code` placed at H'000100.
+fn image(code: &[u8]) -> String {
+    let mut img = SrecImage {
+        header: None,
+        chunks: vec![
+            Chunk {
+                address: 0,
+                data: 0x100u32.to_be_bytes().to_vec(),
+            },
+            Chunk {
+                address: 0x100,
+                data: code.to_vec(),
+            },
+        ],
+        start: None,
+    };
+    img.start = Some(0x100);
+    write_s3(&img, 16)
+}
+
+#[test]
+fn firmware_robots_write_every_output_with_their_cpu_load_and_the_same_for_any_thread_count() {
+    let (a, b) = (tmp("t1"), tmp("t2"));
+    let base = [
+        "run",
+        "arena",
+        "--controller",
+        "firmware",
+        "--steps",
+        "120",
+        "--repeats",
+        "2",
+    ];
+    let out = h8swarm(&[&base[..], &["--threads", "1", "--out", a.to_str().unwrap()]].concat());
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for f in [
+        "metrics.csv",
+        "summary.json",
+        "fit.json",
+        "learning.png",
+        "learning.svg",
+        "arena.png",
+    ] {
+        assert!(a.join(f).exists(), "{f}");
+    }
+    let m = metrics(&a);
+    assert!(m.starts_with(
+        "condition,repeat,step,mean_d,collisions_per_robot,moved_m,gap_cv,cpu_load_percent"
+    ));
+    // Every step's CPU load: the ticks and the step at least (about 0.1 %), a save about 5 %.
+    let loads: Vec<f64> = m
+        .lines()
+        .skip(1)
+        .map(|l| l.rsplit(',').next().unwrap().parse().unwrap())
+        .collect();
+    assert!(loads.iter().all(|&l| l > 0.05 && l < 10.0), "{loads:?}");
+    assert!(loads.iter().any(|&l| l > 4.0), "a step with a save");
+    let out = h8swarm(&[&base[..], &["--threads", "2", "--out", b.to_str().unwrap()]].concat());
+    assert!(out.status.success());
+    assert_eq!(m, metrics(&b), "1 and 2 threads give the same metrics");
+    let _ = std::fs::remove_dir_all(&a);
+    let _ = std::fs::remove_dir_all(&b);
+}
+
+#[test]
+fn a_users_image_on_chosen_robots_and_a_faulty_one_named() {
+    let dir = tmp("user");
+    // The robot firmware under another name, on robot 1 only: the same metrics as all-robot
+    // firmware.
+    let mine = dir.join("mine.mot");
+    std::fs::copy("firmware/robot.mot", &mine).unwrap();
+    std::fs::copy("firmware/robot.sym", dir.join("mine.sym")).unwrap();
+    let scenario = dir.join("s.toml");
+    std::fs::write(
+        &scenario,
+        format!(
+            "base = \"arena\"\nsteps = 60\nrepeats = 1\nwindow = 10\n[controller]\nkind = \"firmware\"\nimage = \"{}\"\nrobots = [1]\n",
+            mine.display()
+        ),
+    )
+    .unwrap();
+    let (x, y) = (dir.join("x"), dir.join("y"));
+    let out = h8swarm(&[
+        "run",
+        scenario.to_str().unwrap(),
+        "--out",
+        x.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let out = h8swarm(&[
+        "run",
+        "arena",
+        "--controller",
+        "firmware",
+        "--steps",
+        "60",
+        "--repeats",
+        "1",
+        "--out",
+        y.to_str().unwrap(),
+    ]);
+    assert!(out.status.success());
+    assert_eq!(metrics(&x), metrics(&y));
+
+    // An image that spins without ever starting the A/D converter: the watchdog names the
+    // robot and the PC; with --keep-going the robot dies and the run goes on.
+    let spin = dir.join("spin.mot");
+    std::fs::write(&spin, image(&[0x40, 0xFE])).unwrap(); // BRA . at H'000100
+    let z = dir.join("z");
+    let out = h8swarm(&[
+        "run",
+        "arena",
+        "--firmware",
+        spin.to_str().unwrap(),
+        "--steps",
+        "5",
+        "--repeats",
+        "1",
+        "--out",
+        z.to_str().unwrap(),
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("robot 0") && err.contains("PC H'000100") && err.contains("A/D"),
+        "{err}"
+    );
+
+    // An undefined opcode, named with its bytes; with --keep-going every robot dies.
+    let bad = dir.join("bad.mot");
+    std::fs::write(&bad, image(&[0x01, 0x50])).unwrap();
+    let out = h8swarm(&[
+        "run",
+        "arena",
+        "--firmware",
+        bad.to_str().unwrap(),
+        "--steps",
+        "5",
+        "--repeats",
+        "1",
+        "--keep-going",
+        "--out",
+        z.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("DEAD  robot 2 in learning repeat 0")
+            && text.contains("undefined opcode at PC H'000100: 01 50"),
+        "{text}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_rejected_configuration_block_is_an_error() {
+    let dir = tmp("reject");
+    let scenario = dir.join("s.toml");
+    // A save period the scenario allows but the firmware's 16-bit field cannot carry.
+    std::fs::write(&scenario, "base = \"arena\"\nsteps = 5\nrepeats = 1\nwindow = 5\n[learner]\nsave_every = 70000\n[controller]\nkind = \"firmware\"\n").unwrap();
+    let out = h8swarm(&[
+        "run",
+        scenario.to_str().unwrap(),
+        "--out",
+        dir.join("o").to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("save_every_steps = 70000") && err.contains("configuration block"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
