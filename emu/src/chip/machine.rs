@@ -123,4 +123,9 @@ impl Bus for Machine {
     fn sleep_until_irq(&mut self, deadline: u64) -> bool {
         self.0.sleep_until_irq(deadline)
     }
+
+    #[inline]
+    fn code_generation(&self) -> Option<u64> {
+        self.0.code_generation()
+    }
 }

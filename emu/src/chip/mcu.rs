@@ -56,7 +56,7 @@ use crate::chip::periph::intc::Intc;
 use crate::chip::periph::itu::{self, Itu, PwmWave};
 use crate::chip::periph::ports::{PortPins, Ports};
 use crate::chip::periph::sci::Sci;
-use crate::core::bus::Bus;
+use crate::core::bus::{Bus, fresh_code_generation};
 use crate::core::memmap::{
     ADDRESS_MASK, Area, IO_ACCESS_STATES, RAM_BYTES, RAM_START, ROM_BYTES, ROM_END,
 };
@@ -176,6 +176,8 @@ pub struct Mcu<B: Board> {
     now: u64,
     clock_hz: u32,
     rom: Option<Box<[u8; ROM_BYTES as usize]>>,
+    /// The flash's [`Bus::code_generation`] token: a fresh one at every write to the flash.
+    rom_generation: u64,
     ram: Option<Box<[u8; RAM_BYTES as usize]>>,
     sci: Sci,
     itu: Itu,
@@ -339,6 +341,7 @@ impl<B: Board> Mcu<B> {
             now: 0,
             clock_hz: config.clock_hz,
             rom: None,
+            rom_generation: fresh_code_generation(),
             ram: None,
             sci: Sci::new(),
             itu: Itu::new(),
@@ -423,7 +426,10 @@ impl<B: Board> Mcu<B> {
         self.ram.is_some()
     }
 
+    /// The flash, for writing (loading an image, poking): every caller may change it, so the
+    /// CPU's decoded copies of it are out of date from here on.
     fn rom_mut(&mut self) -> &mut [u8; ROM_BYTES as usize] {
+        self.rom_generation = fresh_code_generation();
         self.rom.get_or_insert_with(new_erased_flash)
     }
 
@@ -797,6 +803,13 @@ impl<B: Board> Bus for Mcu<B> {
         } else {
             self.refresh_irq()
         }
+    }
+
+    /// Fetching from flash or RAM touches no device, and the token changes at every write to
+    /// the flash ([`Mcu::load_image`], [`Mcu::poke`]).
+    #[inline]
+    fn code_generation(&self) -> Option<u64> {
+        Some(self.rom_generation)
     }
 
     fn sleep_until_irq(&mut self, deadline: u64) -> bool {

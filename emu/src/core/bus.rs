@@ -5,6 +5,8 @@
 //! or machine code run by the H8/300H core) cannot touch the hardware without paying for it.
 //! Internal operation states (the manual's N·S_N) are charged with [`Bus::internal`].
 
+use std::sync::atomic::{AtomicU64, Ordering};
+
 /// A bus on the H8/3052F's 24-bit address space with a clock in states.
 ///
 /// Conventions shared by every implementation:
@@ -33,4 +35,31 @@ pub trait Bus {
     /// SLEEP: advances the clock until an interrupt request is pending or the clock reaches
     /// `deadline`, whichever is first. Returns whether an interrupt is pending.
     fn sleep_until_irq(&mut self, deadline: u64) -> bool;
+
+    /// A token for the flash contents, which lets the CPU decode ROM instructions once and
+    /// charge their fetches without reading them ([`crate::core::cpu`]'s fast path).
+    ///
+    /// `Some(token)` is the bus's promise that
+    /// - a word read from ROM or RAM has no effect but advancing the clock by the area's word
+    ///   states ([`crate::core::memmap::Area::word_states`]): no device sees an instruction
+    ///   fetch, so the CPU may charge it with [`Bus::internal`] instead;
+    /// - the token changes whenever a byte of the flash changes, and two buses whose flash
+    ///   differs never show the same token (draw tokens from [`fresh_code_generation`]).
+    ///
+    /// `None` (the default) promises nothing, and the CPU fetches every instruction word
+    /// through [`Bus::read16`] (as a probe that counts or intercepts bus cycles needs).
+    fn code_generation(&self) -> Option<u64> {
+        None
+    }
+}
+
+/// The source of [`Bus::code_generation`] tokens: one process-wide counter, so a token is
+/// never reused, whichever bus draws it.
+static NEXT_CODE_GENERATION: AtomicU64 = AtomicU64::new(1);
+
+/// A token no bus has shown before (for [`Bus::code_generation`]): draw one whenever the flash
+/// may have changed.
+#[must_use]
+pub fn fresh_code_generation() -> u64 {
+    NEXT_CODE_GENERATION.fetch_add(1, Ordering::Relaxed)
 }

@@ -6,14 +6,16 @@ use super::decode::{
     AluOp, BitNum, BitOp, BitTarget, Decoded, Instr, JumpTarget, MulDivOp, Operand, Size, UnaryOp,
 };
 use super::timing as t;
-use super::{CCR_C, CCR_H, CCR_I, CCR_N, CCR_V, CCR_Z, Cpu, CpuError, Event, RunState};
+use super::{
+    CCR_C, CCR_H, CCR_I, CCR_N, CCR_V, CCR_Z, Cpu, CpuError, Event, LAST_IN_COPY, RunState,
+};
 use crate::core::bus::Bus;
 use crate::core::memmap::{ADDRESS_MASK, Area};
 
 /// Size parameters used by the flag computations.
 #[derive(Clone, Copy)]
-struct Sz {
-    mask: u32,
+pub(super) struct Sz {
+    pub(super) mask: u32,
     msb: u32,
     /// Mask of the bits below the half-carry position (bit 3, 11 or 27 carries out of it).
     half: u32,
@@ -21,7 +23,7 @@ struct Sz {
 }
 
 #[inline(always)]
-const fn sz(size: Size) -> Sz {
+pub(super) const fn sz(size: Size) -> Sz {
     match size {
         Size::Byte => Sz {
             mask: 0xff,
@@ -47,6 +49,34 @@ const fn sz(size: Size) -> Sz {
 const NZVC: u8 = CCR_N | CCR_Z | CCR_V | CCR_C;
 const HNZVC: u8 = CCR_H | NZVC;
 const NZV: u8 = CCR_N | CCR_Z | CCR_V;
+
+/// Whether branch condition `cc` (0–15, the Bcc field) holds for the flags in `ccr`
+/// (programming manual, Bcc page: the condition table).
+#[inline(always)]
+pub(super) const fn cond_holds(cc: u8, ccr: u8) -> bool {
+    let c = ccr & CCR_C != 0;
+    let v = ccr & CCR_V != 0;
+    let z = ccr & CCR_Z != 0;
+    let n = ccr & CCR_N != 0;
+    match cc & 15 {
+        0 => true,
+        1 => false,
+        2 => !(c || z),
+        3 => c || z,
+        4 => !c,
+        5 => c,
+        6 => !z,
+        7 => z,
+        8 => !v,
+        9 => v,
+        10 => !n,
+        11 => n,
+        12 => n == v,
+        13 => n != v,
+        14 => !z && n == v,
+        _ => z || n != v,
+    }
+}
 
 /// The absolute address of `@aa:8` in advanced mode (H'FFFF00 + aa).
 #[inline(always)]
@@ -100,7 +130,7 @@ impl Cpu {
     }
 
     #[inline(always)]
-    fn reg(&self, size: Size, r: u8) -> u32 {
+    pub(super) fn reg(&self, size: Size, r: u8) -> u32 {
         match size {
             Size::Byte => u32::from(self.r8(r)),
             Size::Word => u32::from(self.r16(r)),
@@ -109,7 +139,7 @@ impl Cpu {
     }
 
     #[inline(always)]
-    fn set_reg(&mut self, size: Size, r: u8, v: u32) {
+    pub(super) fn set_reg(&mut self, size: Size, r: u8, v: u32) {
         match size {
             Size::Byte => self.set_r8(r, v as u8),
             Size::Word => self.set_r16(r, v as u16),
@@ -120,13 +150,13 @@ impl Cpu {
     // ----- flags -----------------------------------------------------------------------
 
     #[inline(always)]
-    fn set_flags(&mut self, affected: u8, values: u8) {
+    pub(super) fn set_flags(&mut self, affected: u8, values: u8) {
         self.ccr = (self.ccr & !affected) | (values & affected);
     }
 
     /// N and Z of `v`, V cleared (MOV, logic operations, NOT, EXTS/EXTU).
     #[inline(always)]
-    fn flags_nzv0(&mut self, s: Sz, v: u32) {
+    pub(super) fn flags_nzv0(&mut self, s: Sz, v: u32) {
         let mut f = 0;
         if v & s.msb != 0 {
             f |= CCR_N;
@@ -139,7 +169,7 @@ impl Cpu {
 
     /// a + b + c with H, N, Z, V, C.
     #[inline(always)]
-    fn add_flags(&mut self, s: Sz, a: u32, b: u32, c: u32, keep_z: bool) -> u32 {
+    pub(super) fn add_flags(&mut self, s: Sz, a: u32, b: u32, c: u32, keep_z: bool) -> u32 {
         let wide = u64::from(a) + u64::from(b) + u64::from(c);
         let r = (wide as u32) & s.mask;
         let mut f = 0;
@@ -168,7 +198,7 @@ impl Cpu {
 
     /// a - b - c with H, N, Z, V, C (borrows).
     #[inline(always)]
-    fn sub_flags(&mut self, s: Sz, a: u32, b: u32, c: u32, keep_z: bool) -> u32 {
+    pub(super) fn sub_flags(&mut self, s: Sz, a: u32, b: u32, c: u32, keep_z: bool) -> u32 {
         let r = a.wrapping_sub(b).wrapping_sub(c) & s.mask;
         let mut f = 0;
         if (b & s.half) + c > (a & s.half) {
@@ -194,14 +224,14 @@ impl Cpu {
     }
 
     #[inline(always)]
-    fn carry(&self) -> u32 {
+    pub(super) fn carry(&self) -> u32 {
         u32::from(self.ccr & CCR_C)
     }
 
     // ----- memory ----------------------------------------------------------------------
 
     #[inline(always)]
-    fn read_mem<B: Bus>(bus: &mut B, size: Size, a: u32) -> u32 {
+    pub(super) fn read_mem<B: Bus>(bus: &mut B, size: Size, a: u32) -> u32 {
         match size {
             Size::Byte => u32::from(bus.read8(a)),
             Size::Word => u32::from(bus.read16(a)),
@@ -214,7 +244,7 @@ impl Cpu {
     }
 
     #[inline(always)]
-    fn write_mem<B: Bus>(bus: &mut B, size: Size, a: u32, v: u32) {
+    pub(super) fn write_mem<B: Bus>(bus: &mut B, size: Size, a: u32, v: u32) {
         match size {
             Size::Byte => bus.write8(a, v as u8),
             Size::Word => bus.write16(a, v as u16),
@@ -228,7 +258,7 @@ impl Cpu {
     /// The effective address of a memory operand, with the side effects of `@ERn+`/`@-ERn`
     /// (register update and N = 2 internal states).
     #[inline(always)]
-    fn ea<B: Bus>(&mut self, bus: &mut B, op: Operand, bytes: u32) -> u32 {
+    pub(super) fn ea<B: Bus>(&mut self, bus: &mut B, op: Operand, bytes: u32) -> u32 {
         match op {
             Operand::Ind(r) => self.er[usize::from(r & 7)],
             Operand::PostInc(r) => {
@@ -258,7 +288,7 @@ impl Cpu {
 
     /// Reads a source operand of any kind.
     #[inline(always)]
-    fn read_operand<B: Bus>(&mut self, bus: &mut B, size: Size, op: Operand) -> u32 {
+    pub(super) fn read_operand<B: Bus>(&mut self, bus: &mut B, size: Size, op: Operand) -> u32 {
         match op {
             Operand::Reg(r) => self.reg(size, r),
             Operand::Imm(v) => v & sz(size).mask,
@@ -271,7 +301,7 @@ impl Cpu {
 
     /// Writes a destination operand of any kind (immediates are ignored).
     #[inline(always)]
-    fn write_operand<B: Bus>(&mut self, bus: &mut B, size: Size, op: Operand, v: u32) {
+    pub(super) fn write_operand<B: Bus>(&mut self, bus: &mut B, size: Size, op: Operand, v: u32) {
         match op {
             Operand::Reg(r) => self.set_reg(size, r, v),
             Operand::Imm(_) => {}
@@ -285,33 +315,12 @@ impl Cpu {
     // ----- control flow helpers --------------------------------------------------------
 
     #[inline(always)]
-    fn cond(&self, cc: u8) -> bool {
-        let c = self.ccr & CCR_C != 0;
-        let v = self.ccr & CCR_V != 0;
-        let z = self.ccr & CCR_Z != 0;
-        let n = self.ccr & CCR_N != 0;
-        match cc & 15 {
-            0 => true,
-            1 => false,
-            2 => !(c || z),
-            3 => c || z,
-            4 => !c,
-            5 => c,
-            6 => !z,
-            7 => z,
-            8 => !v,
-            9 => v,
-            10 => !n,
-            11 => n,
-            12 => n == v,
-            13 => n != v,
-            14 => !z && n == v,
-            _ => z || n != v,
-        }
+    pub(super) fn cond(&self, cc: u8) -> bool {
+        cond_holds(cc, self.ccr)
     }
 
     #[inline(always)]
-    fn jump_to(&mut self, target: u32) {
+    pub(super) fn jump_to(&mut self, target: u32) {
         self.pc = target & ADDRESS_MASK & !1;
     }
 
@@ -325,7 +334,22 @@ impl Cpu {
         let next = pc.wrapping_add(d.len_bytes()) & ADDRESS_MASK;
         self.pc = next;
         self.instructions += 1;
-        self.last = d;
+        self.last_copy = d;
+        self.last_index = LAST_IN_COPY;
+        self.exec_instr(bus, d, pc, next)
+    }
+
+    /// The operation of instruction `d` at `pc` once PC holds `next` (the address after it)
+    /// and the instruction is counted: shared by the reference path and, for the forms it has
+    /// no handler of its own for, the fast path.
+    #[inline]
+    pub(super) fn exec_instr<B: Bus>(
+        &mut self,
+        bus: &mut B,
+        d: Decoded,
+        pc: u32,
+        next: u32,
+    ) -> Result<Event, CpuError> {
         match d.instr {
             Instr::Nop => {}
             Instr::Mov { size, src, dst } => {
@@ -334,74 +358,15 @@ impl Cpu {
                 self.flags_nzv0(sz(size), v);
             }
             Instr::Alu { op, size, src, rd } => {
-                let s = sz(size);
                 let b = match src {
                     Operand::Reg(r) => self.reg(size, r),
-                    Operand::Imm(v) => v & s.mask,
+                    Operand::Imm(v) => v & sz(size).mask,
                     _ => 0,
                 };
-                let a = self.reg(size, rd);
-                match op {
-                    AluOp::Add => {
-                        let r = self.add_flags(s, a, b, 0, false);
-                        self.set_reg(size, rd, r);
-                    }
-                    AluOp::Addx => {
-                        let c = self.carry();
-                        let r = self.add_flags(s, a, b, c, true);
-                        self.set_reg(size, rd, r);
-                    }
-                    AluOp::Sub => {
-                        let r = self.sub_flags(s, a, b, 0, false);
-                        self.set_reg(size, rd, r);
-                    }
-                    AluOp::Subx => {
-                        let c = self.carry();
-                        let r = self.sub_flags(s, a, b, c, true);
-                        self.set_reg(size, rd, r);
-                    }
-                    AluOp::Cmp => {
-                        self.sub_flags(s, a, b, 0, false);
-                    }
-                    AluOp::And | AluOp::Or | AluOp::Xor => {
-                        let r = match op {
-                            AluOp::And => a & b,
-                            AluOp::Or => a | b,
-                            _ => a ^ b,
-                        };
-                        self.set_reg(size, rd, r);
-                        self.flags_nzv0(s, r);
-                    }
-                }
+                self.alu(op, size, b, rd);
             }
-            Instr::Inc { size, amount, rd } | Instr::Dec { size, amount, rd } => {
-                let s = sz(size);
-                let a = self.reg(size, rd);
-                let b = u32::from(amount);
-                let inc = matches!(d.instr, Instr::Inc { .. });
-                let r = if inc {
-                    a.wrapping_add(b) & s.mask
-                } else {
-                    a.wrapping_sub(b) & s.mask
-                };
-                let overflow = if inc {
-                    (a ^ r) & (b ^ r) & s.msb != 0
-                } else {
-                    (a ^ b) & (a ^ r) & s.msb != 0
-                };
-                let mut f = 0;
-                if r & s.msb != 0 {
-                    f |= CCR_N;
-                }
-                if r == 0 {
-                    f |= CCR_Z;
-                }
-                if overflow {
-                    f |= CCR_V;
-                }
-                self.set_flags(NZV, f);
-                self.set_reg(size, rd, r);
-            }
+            Instr::Inc { size, amount, rd } => self.inc_dec(true, size, amount, rd),
+            Instr::Dec { size, amount, rd } => self.inc_dec(false, size, amount, rd),
             Instr::Adds { amount, rd } => {
                 let e = &mut self.er[usize::from(rd & 7)];
                 *e = e.wrapping_add(u32::from(amount));
@@ -562,7 +527,77 @@ impl Cpu {
         Ok(Event::Executed)
     }
 
-    fn unary(&mut self, op: UnaryOp, size: Size, rd: u8) {
+    /// `op.size b,Rd` for the two-operand ALU operations, `b` the source value (masked).
+    #[inline(always)]
+    pub(super) fn alu(&mut self, op: AluOp, size: Size, b: u32, rd: u8) {
+        let s = sz(size);
+        let a = self.reg(size, rd);
+        match op {
+            AluOp::Add => {
+                let r = self.add_flags(s, a, b, 0, false);
+                self.set_reg(size, rd, r);
+            }
+            AluOp::Addx => {
+                let c = self.carry();
+                let r = self.add_flags(s, a, b, c, true);
+                self.set_reg(size, rd, r);
+            }
+            AluOp::Sub => {
+                let r = self.sub_flags(s, a, b, 0, false);
+                self.set_reg(size, rd, r);
+            }
+            AluOp::Subx => {
+                let c = self.carry();
+                let r = self.sub_flags(s, a, b, c, true);
+                self.set_reg(size, rd, r);
+            }
+            AluOp::Cmp => {
+                self.sub_flags(s, a, b, 0, false);
+            }
+            AluOp::And | AluOp::Or | AluOp::Xor => {
+                let r = match op {
+                    AluOp::And => a & b,
+                    AluOp::Or => a | b,
+                    _ => a ^ b,
+                };
+                self.set_reg(size, rd, r);
+                self.flags_nzv0(s, r);
+            }
+        }
+    }
+
+    /// INC (`inc` true) or DEC by `amount` (1 or 2).
+    #[inline(always)]
+    pub(super) fn inc_dec(&mut self, inc: bool, size: Size, amount: u8, rd: u8) {
+        let s = sz(size);
+        let a = self.reg(size, rd);
+        let b = u32::from(amount);
+        let r = if inc {
+            a.wrapping_add(b) & s.mask
+        } else {
+            a.wrapping_sub(b) & s.mask
+        };
+        let overflow = if inc {
+            (a ^ r) & (b ^ r) & s.msb != 0
+        } else {
+            (a ^ b) & (a ^ r) & s.msb != 0
+        };
+        let mut f = 0;
+        if r & s.msb != 0 {
+            f |= CCR_N;
+        }
+        if r == 0 {
+            f |= CCR_Z;
+        }
+        if overflow {
+            f |= CCR_V;
+        }
+        self.set_flags(NZV, f);
+        self.set_reg(size, rd, r);
+    }
+
+    #[inline(always)]
+    pub(super) fn unary(&mut self, op: UnaryOp, size: Size, rd: u8) {
         let s = sz(size);
         let a = self.reg(size, rd);
         let c_in = self.carry();
@@ -676,7 +711,7 @@ impl Cpu {
         self.set_r8(rd, r);
     }
 
-    fn muldiv<B: Bus>(&mut self, bus: &mut B, op: MulDivOp, size: Size, rs: u8, rd: u8) {
+    pub(super) fn muldiv<B: Bus>(&mut self, bus: &mut B, op: MulDivOp, size: Size, rs: u8, rd: u8) {
         bus.internal(if size == Size::Byte {
             t::N_MULDIV_BYTE
         } else {
@@ -748,12 +783,12 @@ impl Cpu {
     }
 
     #[inline(always)]
-    fn nz_flags(&mut self, n: bool, z: bool) {
+    pub(super) fn nz_flags(&mut self, n: bool, z: bool) {
         let f = if n { CCR_N } else { 0 } | if z { CCR_Z } else { 0 };
         self.set_flags(CCR_N | CCR_Z, f);
     }
 
-    fn bit<B: Bus>(&mut self, bus: &mut B, op: BitOp, bit: BitNum, target: BitTarget) {
+    pub(super) fn bit<B: Bus>(&mut self, bus: &mut B, op: BitOp, bit: BitNum, target: BitTarget) {
         let n = match bit {
             BitNum::Imm(n) => n & 7,
             BitNum::Reg(r) => self.r8(r) & 7,

@@ -10,10 +10,26 @@
 //! [`Bus::internal`]. An instruction therefore costs `I·S_I + J·S_J + K·S_K + L·S_L + M·S_M +
 //! N·S_N` states (programming manual, Appendix A).
 //!
-//! Speed: instructions fetched from ROM are decoded once and kept in a predecode cache indexed
-//! by address (ROM cannot change while a program runs: the flash is not writable through the
-//! bus). The fetch cycles are still charged on every execution. Code in RAM is decoded every
-//! time. Call [`Cpu::flush_decode_cache`] if the ROM image is replaced.
+//! Speed: two paths run the same instructions to the same states.
+//! - The reference path ([`Cpu::step_reference`]) is the plain one: every instruction word is
+//!   fetched through [`Bus::read16`] (ROM instructions are decoded once and kept in a cache
+//!   indexed by address, but their fetch cycles still go through the bus), and the decoded
+//!   [`decode::Instr`] is executed by one generic executor.
+//! - The fast path ([`Cpu::step`], unless [`Cpu::set_fast_path`] turned it off) runs when the
+//!   bus shows a [`Bus::code_generation`] token, i.e. promises that fetching from ROM or RAM
+//!   has no effect but the clock: each ROM instruction is decoded once into a handler of its
+//!   own form (`fast`: register moves and ALU operations by size and source, loads and stores
+//!   by size, branches with their target, condition mask and prefetch states precomputed,
+//!   calls and returns), its fetch cycles are charged as one [`Bus::internal`] lump of
+//!   `words × ROM word states`, and the handler does the operation with the reference path's
+//!   own helpers (flags, operands, memory) and the same bus accesses in the same order. Forms
+//!   without a handler of their own, code in RAM and everything around sleep mode go through
+//!   the reference executor. Interrupts are checked before every instruction on both paths.
+//!
+//! The decode caches are emptied whenever the bus's token changes (the flash was written:
+//! loading an image, poking), and by [`Cpu::flush_decode_cache`]. Tests run random programs,
+//! the C programs and the robot firmware both ways and compare the complete state after every
+//! instruction.
 //!
 //! DIVXS.B/DIVXS.W flags (programming manual, 2.2.26 (1) and (2)). The condition-code table
 //! says "N: Set to 1 if the quotient is negative; otherwise cleared to 0. Z: Set to 1 if the
@@ -50,6 +66,7 @@
 pub mod decode;
 pub mod disasm;
 mod exec;
+mod fast;
 pub mod timing;
 
 use crate::core::bus::Bus;
@@ -149,7 +166,13 @@ const EMPTY_SLOT: Decoded = Decoded {
     words: 0,
 };
 
-/// The H8/300H CPU: registers, run state and the predecode cache.
+/// States of one instruction-word fetch from ROM (what the fast path charges per word).
+const ROM_FETCH_STATES: u32 = Area::Rom.word_states();
+
+/// `Cpu::last_index` when the last instruction is in `last_copy`, not in the cache.
+const LAST_IN_COPY: u32 = u32::MAX;
+
+/// The H8/300H CPU: registers, run state and the decode caches.
 #[derive(Clone, Debug)]
 pub struct Cpu {
     er: [u32; 8],
@@ -158,11 +181,21 @@ pub struct Cpu {
     state: RunState,
     /// Set by LDC/ANDC/ORC/XORC: no interrupt is accepted before the next instruction.
     irq_inhibit: bool,
-    /// Predecoded ROM instructions, indexed by address / 2; grows on demand.
+    /// Decoded ROM instructions, indexed by address / 2; grows on demand.
     cache: Vec<Decoded>,
+    /// The fast path's handlers of the same instructions, same index; grows on demand.
+    fast: Vec<fast::Slot>,
+    /// The bus's [`Bus::code_generation`] token the caches were filled under (0: none; the
+    /// tokens of [`crate::core::bus::fresh_code_generation`] start at 1).
+    code_generation: u64,
+    /// Whether [`Cpu::step`] may take the fast path.
+    fast_path: bool,
     instructions: u64,
-    /// The instruction executed last (for traces).
-    last: Decoded,
+    /// Where the instruction executed last is kept (for traces and the profiler): its index
+    /// in `cache` (the fast path), or [`LAST_IN_COPY`] for `last_copy`.
+    last_index: u32,
+    /// The instruction executed last on the reference path.
+    last_copy: Decoded,
 }
 
 impl Default for Cpu {
@@ -202,8 +235,12 @@ impl Cpu {
             state: RunState::Running,
             irq_inhibit: false,
             cache: Vec::new(),
+            fast: Vec::new(),
+            code_generation: 0,
+            fast_path: true,
             instructions: 0,
-            last: EMPTY_SLOT,
+            last_index: LAST_IN_COPY,
+            last_copy: EMPTY_SLOT,
         }
     }
 
@@ -268,8 +305,27 @@ impl Cpu {
 
     /// The instruction executed last (a NOP of length 0 before the first).
     #[must_use]
-    pub const fn last_executed(&self) -> Decoded {
-        self.last
+    pub fn last_executed(&self) -> Decoded {
+        if self.last_index == LAST_IN_COPY {
+            self.last_copy
+        } else {
+            self.cache
+                .get(self.last_index as usize)
+                .copied()
+                .unwrap_or(EMPTY_SLOT)
+        }
+    }
+
+    /// Turns the fast path of [`Cpu::step`] on (the default) or off. Off, `step` is
+    /// [`Cpu::step_reference`]. Both give the same states, bus accesses and results.
+    pub fn set_fast_path(&mut self, on: bool) {
+        self.fast_path = on;
+    }
+
+    /// Whether [`Cpu::step`] may take the fast path.
+    #[must_use]
+    pub const fn fast_path(&self) -> bool {
+        self.fast_path
     }
 
     /// Whether SLEEP has halted the program (SPEC §7).
@@ -284,9 +340,27 @@ impl Cpu {
         self.state == RunState::Sleeping
     }
 
-    /// Forgets every predecoded instruction (call after replacing the ROM image).
+    /// Forgets every predecoded instruction. A bus that shows a [`Bus::code_generation`]
+    /// token has the caches emptied whenever its flash changes; with another bus, call this
+    /// after replacing the ROM image.
     pub fn flush_decode_cache(&mut self) {
+        self.last_copy = self.last_executed();
+        self.last_index = LAST_IN_COPY;
         self.cache.clear();
+        self.fast.clear();
+    }
+
+    /// Empties the caches if the bus's flash token changed since they were filled.
+    #[inline]
+    fn check_code_generation<B: Bus>(&mut self, bus: &B) -> Option<u64> {
+        let token = bus.code_generation();
+        if let Some(t) = token
+            && t != self.code_generation
+        {
+            self.flush_decode_cache();
+            self.code_generation = t;
+        }
+        token
     }
 
     /// Decodes the instruction at `pc` through the bus without executing it, charging its fetch
@@ -356,11 +430,109 @@ impl Cpu {
     /// Runs one step: accepts a pending interrupt, or executes one instruction, or (in sleep
     /// mode) waits for an interrupt until the clock reaches `deadline`.
     ///
+    /// Takes the fast path (see the module docs) when it is on and the bus shows a
+    /// [`Bus::code_generation`] token; otherwise this is [`Cpu::step_reference`].
+    ///
     /// # Errors
     /// [`CpuError`] on an undefined opcode, a fetch outside ROM/RAM or an unsupported
     /// instruction; the CPU state is left as it was before the instruction (PC at it).
     #[inline]
     pub fn step<B: Bus>(&mut self, bus: &mut B, deadline: u64) -> Result<Event, CpuError> {
+        if !self.fast_path
+            || self.state != RunState::Running
+            || self.check_code_generation(bus).is_none()
+        {
+            return self.step_reference(bus, deadline);
+        }
+        self.step_fast(bus)
+    }
+
+    /// Runs steps until the clock reaches `deadline` or a step reports anything but
+    /// [`Event::Executed`] (an interrupt accepted, the program halted, the CPU asleep past the
+    /// deadline), and returns that step's event, or [`Event::Executed`] once the clock has
+    /// reached `deadline` (at once, running nothing, if it already had).
+    ///
+    /// The same as calling [`Cpu::step`] with `deadline` while the clock is below it and the
+    /// steps report [`Event::Executed`] (same states, bus accesses and results), with the
+    /// fast path's dispatch kept in one loop.
+    ///
+    /// # Errors
+    /// As [`Cpu::step`].
+    pub fn run<B: Bus>(&mut self, bus: &mut B, deadline: u64) -> Result<Event, CpuError> {
+        while bus.now() < deadline {
+            let event = if !self.fast_path
+                || self.state != RunState::Running
+                || self.check_code_generation(bus).is_none()
+            {
+                self.step_reference(bus, deadline)?
+            } else {
+                self.step_fast(bus)?
+            };
+            if event != Event::Executed {
+                return Ok(event);
+            }
+        }
+        Ok(Event::Executed)
+    }
+
+    /// One step on the fast path: the CPU is running, the path is on and the caches match the
+    /// bus's token.
+    #[inline(always)]
+    fn step_fast<B: Bus>(&mut self, bus: &mut B) -> Result<Event, CpuError> {
+        if self.irq_inhibit {
+            self.irq_inhibit = false;
+        } else if let Some(v) = bus.pending_irq()
+            && self.accepts(v)
+        {
+            self.interrupt(bus, v);
+            return Ok(Event::Interrupt(v));
+        }
+        let pc = self.pc;
+        let idx = (pc >> 1) as usize;
+        if let Some(&slot) = self.fast.get(idx)
+            && slot.words != 0
+        {
+            // The words of a cached ROM instruction: no device sees their fetch (the bus's
+            // promise), so they cost their states as one lump.
+            bus.internal(u32::from(slot.words) * ROM_FETCH_STATES);
+            return self.exec_fast(bus, slot, pc, idx);
+        }
+        self.fast_miss(bus, pc, idx)
+    }
+
+    /// The fast path at an address whose handler is not cached yet: decodes through the bus
+    /// (charging the fetches as the reference path does), caches a ROM instruction's handler
+    /// and runs it; code in RAM (or straddling the end of ROM) runs on the reference executor.
+    #[inline(never)]
+    fn fast_miss<B: Bus>(&mut self, bus: &mut B, pc: u32, idx: usize) -> Result<Event, CpuError> {
+        let d = self.decode_through_bus(bus)?;
+        if Area::of(pc) == Area::Rom && Area::of(pc + d.len_bytes() - 1) == Area::Rom {
+            if self.cache.len() <= idx {
+                self.cache.resize(idx + 1, EMPTY_SLOT);
+            }
+            if self.fast.len() <= idx {
+                self.fast.resize(idx + 1, fast::Slot::EMPTY);
+            }
+            let slot = fast::Slot::new(d, pc);
+            self.cache[idx] = d;
+            self.fast[idx] = slot;
+            return self.exec_fast(bus, slot, pc, idx);
+        }
+        self.execute(bus, d)
+    }
+
+    /// One step on the reference path: every instruction word fetched through
+    /// [`Bus::read16`], the generic executor. [`Cpu::step`] with the fast path off, and the
+    /// yardstick the fast path is tested and benchmarked against.
+    ///
+    /// # Errors
+    /// As [`Cpu::step`].
+    pub fn step_reference<B: Bus>(
+        &mut self,
+        bus: &mut B,
+        deadline: u64,
+    ) -> Result<Event, CpuError> {
+        self.check_code_generation(bus);
         match self.state {
             RunState::Running => {}
             RunState::Halted => return Ok(Event::Halted),
