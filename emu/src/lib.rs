@@ -13,8 +13,17 @@
 //!    (running an image to its halt, with console, trace and statistics). It knows the core
 //!    and no robot.
 //! 3. [`board`] — the robot around the chip: [`board::wiring`] (which robot part sits on which
-//!    pin; the motor pins as H-bridge inputs), [`board::ram`] (the on-chip RAM as a budget of
-//!    placed items) and [`board::model`] (the Rust model of the controller the robot runs).
+//!    pin; the motor pins read as H-bridge inputs), [`board::ram`] (the on-chip RAM as a budget
+//!    of placed items), the robot's firmware ([`board::firmware`] with its [`board::symbols`],
+//!    [`board::profile`] and [`board::oncore`]) and [`board::model`] (the Rust model of the
+//!    controller the robot runs, checked against the firmware). It knows the chip and the core.
+//!
+//! The arrows point one way by construction: the core reaches everything through
+//! [`core::bus::Bus`], which carries no firmware shortcut (the model's two go through its own
+//! [`board::model::ModelBus`], implemented for the chip); the chip numbers its own pins and
+//! leaves what they drive to [`board::wiring`]; and every on-chip module is a
+//! [`chip::periph::Peripheral`] that declares the I/O block it owns, so the chip dispatches by
+//! those blocks.
 //!
 //! Machine code (`h8swarm emu`) and the Rust model of the controller run on the same
 //! [`chip::mcu::Mcu`]: same bus, same peripherals, same timing.

@@ -2,7 +2,7 @@
 //!
 //! Every random draw in h8swarm comes from a seeded generator of its own (ARCHITECTURE: split
 //! per robot and per purpose, never a global RNG). This crate is the one rule that names those
-//! streams: the seed of a stream is [`derive`]`(parent, index, purpose)`, where
+//! streams: the seed of a stream is [`derive()`]`(parent, index, purpose)`, where
 //! - `parent` is the seed of what the stream belongs to (the run's master seed at the top);
 //! - `index` tells apart the members of one family (robot i of a repeat, sensor k of a robot,
 //!   the EEPROM chip at address 0x50 or 0x51);
@@ -56,7 +56,7 @@ pub const GOLDEN_GAMMA: u64 = 0x9E37_79B9_7F4A_7C15;
 
 /// What a random stream is for: the register of every stream in the project (see the crate
 /// documentation for the tree they form). The discriminant is the purpose's code in
-/// [`derive`]; codes are never reused.
+/// [`derive()`]; codes are never reused.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[repr(u64)]
 pub enum Purpose {

@@ -1,11 +1,11 @@
 //! How the Rust controller pays for what it does on the emulated MCU.
 //!
 //! The controller is a program running on the H8/3052F, written in Rust instead of H8 code. It
-//! reaches the hardware only through [`Bus`] register reads and writes, each charged by the area
-//! it touches (3 states per byte of on-chip I/O, SPEC §4.1); the instruction fetches of the
-//! instructions that make those accesses are charged as ROM fetch cycles (2 states per word);
-//! register-only code is charged from its instruction sequence ([`nn_q15::cost::Insn`]); the
-//! learner's arithmetic is charged from `nn_q15`'s H8 meter. Between charges the controller
+//! reaches the hardware only through [`crate::core::bus::Bus`] register reads and writes, each
+//! charged by the area it touches (3 states per byte of on-chip I/O, SPEC §4.1); the instruction
+//! fetches of the instructions that make those accesses are charged as ROM fetch cycles (2 states
+//! per word); register-only code is charged from its instruction sequence ([`nn_q15::cost::Insn`]);
+//! the learner's arithmetic is charged from `nn_q15`'s H8 meter. Between charges the controller
 //! takes the tick interrupt when it is pending, as the chip would with interrupts enabled, and
 //! keeps the states spent in it apart so that every phase is measured without it.
 
