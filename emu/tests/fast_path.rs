@@ -651,35 +651,89 @@ fn crcmacdiv() -> srec::SrecImage {
     srec::parse(&std::fs::read(path).expect("crcmacdiv.mot")).expect("parses")
 }
 
-#[test]
-fn run_is_step_in_a_loop() {
-    let image = crcmacdiv();
-    let mut ma = Machine::with_image(&image).expect("loads");
-    let mut mb = ma.clone();
-    let (mut ca, mut cb) = (Cpu::new(), Cpu::new());
-    ca.reset(&mut ma);
-    cb.reset(&mut mb);
-    let mut deadline = 0;
-    loop {
-        deadline += 12_345;
-        let ea = ca.run(&mut ma, deadline);
+/// Runs `ca` with [`Cpu::run`] and `cb` with [`Cpu::step`] in a loop to the same deadlines,
+/// `chunk` states apart, until `until`, a halt or an error; compares the events, the states
+/// and the RAM at every deadline. Returns the number of [`Cpu::run`] calls.
+fn run_vs_steps<B: Board>(
+    (ca, ma): (&mut Cpu, &mut Mcu<B>),
+    (cb, mb): (&mut Cpu, &mut Mcu<B>),
+    chunk: u64,
+    until: u64,
+) -> Result<u64, String> {
+    let mut deadline = ma.now();
+    let mut calls = 0;
+    while deadline < until {
+        deadline = (deadline + chunk).min(until);
+        let ea = ca.run(ma, deadline);
+        calls += 1;
         let eb = loop {
             if mb.now() >= deadline {
                 break Ok(Event::Executed);
             }
-            match cb.step(&mut mb, deadline) {
+            match cb.step(mb, deadline) {
                 Ok(Event::Executed) => {}
                 other => break other,
             }
         };
-        assert_eq!(ea, eb);
-        assert_eq!(snapshot(&ca, ma.now()), snapshot(&cb, mb.now()));
-        if ea == Ok(Event::Halted) {
-            break;
+        if ea != eb {
+            return Err(format!("run to {deadline}: {ea:?} vs {eb:?}"));
         }
-        assert!(deadline < 100_000_000, "crcmacdiv halts");
+        let (sa, sb) = (snapshot(ca, ma.now()), snapshot(cb, mb.now()));
+        if sa != sb {
+            return Err(format!("run to {deadline}: {sa:?} vs {sb:?}"));
+        }
+        if let Some(x) = ram_differs(ma, mb) {
+            return Err(format!("run to {deadline}: RAM differs at H'{x:06X}"));
+        }
+        match ea {
+            Ok(Event::Halted) | Err(_) => break,
+            // An interrupt or a wait: go on to the same deadline.
+            Ok(Event::Interrupt(_)) | Ok(Event::Asleep) => deadline = ma.now().min(deadline),
+            Ok(Event::Executed) => {}
+        }
     }
-    assert_eq!(ram_differs(&ma, &mb), None);
+    Ok(calls)
+}
+
+#[test]
+fn run_is_step_in_a_loop() {
+    let image = crcmacdiv();
+    let mut ma = Machine::with_image(&image).expect("loads").into_mcu();
+    let mut mb = ma.clone();
+    let (mut ca, mut cb) = (Cpu::new(), Cpu::new());
+    ca.reset(&mut ma);
+    cb.reset(&mut mb);
+    run_vs_steps((&mut ca, &mut ma), (&mut cb, &mut mb), 12_345, 100_000_000)
+        .unwrap_or_else(|e| panic!("crcmacdiv: {e}"));
+    assert!(ca.halted(), "crcmacdiv ran to its halt");
+    // The firmware: interrupts, sleep, I/O.
+    let fw = Firmware::robot().expect("the committed firmware");
+    let mut ma = Mcu::new(McuConfig::default(), NullBoard).expect("default MCU");
+    let mut ca = Cpu::new();
+    let block = ConfigBlock {
+        save_every: 2,
+        ticks_per_step: 10,
+        ..ConfigBlock::ARENA
+    };
+    fw.install(&mut ma, &mut ca, Some(&block))
+        .expect("installs");
+    let (mut mb, mut cb) = (ma.clone(), ca.clone());
+    let until = u64::from(ma.clock_hz());
+    let calls = run_vs_steps((&mut ca, &mut ma), (&mut cb, &mut mb), 9_999, until)
+        .unwrap_or_else(|e| panic!("firmware: {e}"));
+    assert!(calls > 2_500, "{calls}");
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    #[test]
+    fn run_is_step_in_a_loop_on_random_programs(p in program(), chunk in 1u64..5_000) {
+        let (mut ca, mut ma) = install(&p);
+        let (mut cb, mut mb) = install(&p);
+        let r = run_vs_steps((&mut ca, &mut ma), (&mut cb, &mut mb), chunk, 60_000);
+        prop_assert!(r.is_ok(), "{}", r.unwrap_err());
+    }
 }
 
 #[test]

@@ -26,6 +26,9 @@ pub(super) struct Slot {
     pub(super) next: u32,
     /// Length in words (0: an empty slot).
     pub(super) words: u8,
+    /// Whether the handler always leaves PC at `next` and the run state as it was (no
+    /// branch, no [`Op::Generic`]).
+    pub(super) sequential: bool,
 }
 
 /// A pre-decoded instruction form. Register numbers are those of [`Instr`] (byte and word
@@ -362,15 +365,31 @@ impl Slot {
         op: Op::Generic,
         next: 0,
         words: 0,
+        sequential: false,
     };
 
     /// The handler of instruction `d` at `pc` (in ROM).
     pub(super) fn new(d: Decoded, pc: u32) -> Slot {
         let next = pc.wrapping_add(d.len_bytes()) & ADDRESS_MASK;
+        let op = op_of(d.instr, next);
+        let sequential = !matches!(
+            op,
+            Op::Generic
+                | Op::Bcc8 { .. }
+                | Op::Bcc16 { .. }
+                | Op::Bsr8 { .. }
+                | Op::Bsr16 { .. }
+                | Op::JmpAbs { .. }
+                | Op::JsrAbs { .. }
+                | Op::JmpReg { .. }
+                | Op::JsrReg { .. }
+                | Op::Rts
+        );
         Slot {
-            op: op_of(d.instr, next),
+            op,
             next,
             words: d.words,
+            sequential,
         }
     }
 }
@@ -594,21 +613,21 @@ macro_rules! alu_i {
 }
 
 impl Cpu {
-    /// Runs the cached instruction `slot` at `pc` (cache index `idx`) whose words have been
-    /// charged.
+    /// Runs the cached instruction at `pc` (cache index `idx`, a filled slot) whose words have
+    /// been charged; `next` is the address after it.
     #[inline(always)]
     pub(super) fn exec_fast<B: Bus>(
         &mut self,
         bus: &mut B,
-        slot: Slot,
         pc: u32,
         idx: usize,
+        next: u32,
     ) -> Result<Event, CpuError> {
-        let next = slot.next;
         self.pc = next;
         self.instructions += 1;
         self.last_index = idx as u32;
-        match slot.op {
+        // Matched in place: each handler reads only its own fields.
+        match self.fast[idx].op {
             Op::Generic => {
                 let d = self.cache[idx];
                 return self.exec_instr(bus, d, pc, next);
