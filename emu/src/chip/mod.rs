@@ -4,7 +4,7 @@
 //!
 //! The chip knows the core and nothing above it: the robot outside is a [`mcu::Board`] that
 //! answers for the input pins, and what the output pins drive is read by the board layer
-//! ([`crate::board::wiring`]).
+//! (`emu::board::wiring`).
 
 pub mod machine;
 pub mod mcu;

@@ -3,7 +3,7 @@
 //! disassembly) and the S-record loader for `.mot` images.
 //!
 //! The core knows nothing of the chip around it: it reaches memory and peripherals only
-//! through [`bus::Bus`], so any implementation of the bus (the H8/3052F of [`crate::chip`], a
+//! through [`bus::Bus`], so any implementation of the bus (the H8/3052F of the chip layer, a
 //! test's probe) can run it.
 
 pub mod bus;
