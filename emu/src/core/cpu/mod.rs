@@ -431,6 +431,22 @@ impl Cpu {
         v == VECTOR_NMI || self.ccr & CCR_I == 0
     }
 
+    /// Before an instruction: ends the one-instruction delay after LDC/ANDC/ORC/XORC, or
+    /// accepts a pending interrupt the mask lets through (its exception handling runs) and
+    /// returns its vector.
+    #[inline(always)]
+    fn take_interrupt<B: Bus>(&mut self, bus: &mut B) -> Option<u8> {
+        if self.irq_inhibit {
+            self.irq_inhibit = false;
+        } else if let Some(v) = bus.pending_irq()
+            && self.accepts(v)
+        {
+            self.interrupt(bus, v);
+            return Some(v);
+        }
+        None
+    }
+
     /// Runs one step: accepts a pending interrupt, or executes one instruction, or (in sleep
     /// mode) waits for an interrupt until the clock reaches `deadline`.
     ///
@@ -495,12 +511,7 @@ impl Cpu {
             // not a reload of the one just stored.
             let mut pc = self.pc;
             loop {
-                if self.irq_inhibit {
-                    self.irq_inhibit = false;
-                } else if let Some(v) = bus.pending_irq()
-                    && self.accepts(v)
-                {
-                    self.interrupt(bus, v);
+                if let Some(v) = self.take_interrupt(bus) {
                     return Ok(Event::Interrupt(v));
                 }
                 let idx = (pc >> 1) as usize;
@@ -546,12 +557,7 @@ impl Cpu {
     /// bus's token.
     #[inline(always)]
     fn step_fast<B: Bus>(&mut self, bus: &mut B) -> Result<Event, CpuError> {
-        if self.irq_inhibit {
-            self.irq_inhibit = false;
-        } else if let Some(v) = bus.pending_irq()
-            && self.accepts(v)
-        {
-            self.interrupt(bus, v);
+        if let Some(v) = self.take_interrupt(bus) {
             return Ok(Event::Interrupt(v));
         }
         let pc = self.pc;
@@ -618,12 +624,7 @@ impl Cpu {
                 self.state = RunState::Running;
             }
         }
-        if self.irq_inhibit {
-            self.irq_inhibit = false;
-        } else if let Some(v) = bus.pending_irq()
-            && self.accepts(v)
-        {
-            self.interrupt(bus, v);
+        if let Some(v) = self.take_interrupt(bus) {
             return Ok(Event::Interrupt(v));
         }
         let d = self.fetch_decode(bus)?;
