@@ -3,7 +3,8 @@
 //! step the complete state must be equal: the step's event (or error), ER0–ER7, CCR, PC,
 //! the clock, the instruction count, the instruction executed last, the run state, every
 //! write (address, value, instant) and every read of I/O or unmapped addresses with the
-//! instant it happened, and (every 64 steps and at the end) all 8 KB of RAM.
+//! instant it happened. The RAM changes only by those writes, so it is equal after every step
+//! too; all 8 KB are also compared every 64 steps and at the end.
 //!
 //! The programs: random instruction sequences from the decoder's valid encodings with loops,
 //! calls (BSR, JSR @aa:24, JSR @ERn, a subroutine in RAM), conditional branches, EEPMOV, an
