@@ -5,9 +5,13 @@
 //! MCU boots at time 0 and its controller ticks every 10 ms, so all robots step at the same
 //! instants. At each step instant:
 //! 1. every MCU sleeps up to the instant (ticks emulated);
-//! 2. the world catches up in sub-steps of `world.substep_s` under the motor commands of the
-//!    previous step, and every sub-step's bumpers are sampled: a released→pressed edge of any
-//!    bumper is a collision (SPEC §3.4), counted for the behaviour that was running;
+//! 2. the world catches up under the motor commands of the previous step, in clock states (one
+//!    clock rules it all: the world counts the states the MCUs count): the interval is cut
+//!    into the fewest equal sub-steps of at most `world.substep_s` (lengths differing by at most
+//!    one state, so no sliver of a sub-step arises), and every sub-step's bumpers feed each
+//!    robot's [`ContactMeter`]: a collision is the start of a bumper contact that lasts at least
+//!    one sub-step of the nominal length, counted for the behaviour that was running, and the
+//!    time in contact is summed (see [`crate::collisions`]);
 //! 3. every robot's four rays are cast, its controller runs the step on its MCU (the A/D
 //!    samples the sensor models at the rays' distances), and its motor pins become the wheel
 //!    commands of its body.
@@ -23,8 +27,9 @@
 
 use anyhow::{Context, Result};
 use rayon::prelude::*;
-use sensors::{BumperSet, CollisionCounter, port2_pins};
-use world::{Arena, SensorMount, World, WorldParams};
+use world::{Arena, SensorMount, SubstepPlan, World, WorldParams};
+
+use crate::collisions::{ContactMeter, StuckDetector};
 
 use crate::plot::Outline;
 use crate::robot::{Condition, Images, Robot};
@@ -43,6 +48,12 @@ pub struct StepMetrics {
     pub mean_d: f64,
     /// Collisions per robot during this step's behaviour.
     pub collisions_per_robot: f64,
+    /// Mean over robots of the fraction of this step's behaviour spent with a bumper pressed
+    /// (time in contact, weighted by sub-step length).
+    pub contact_fraction: f64,
+    /// Fraction of the robots stuck at the end of this step's behaviour: moved less than 1 mm
+    /// over the last 100 steps while their motors drove (see [`crate::collisions`]).
+    pub stuck_fraction: f64,
     /// Mean over robots of how far the body's centre moved during this step's behaviour
     /// (straight-line distance between the two step instants), metres: 0 for a robot held
     /// against a wall or another body, about 0.07 m for a free one driving straight in the
@@ -107,6 +118,7 @@ pub fn world_params(s: &Scenario) -> WorldParams {
         motor_gain_spread: s.world.motor_gain_spread,
         wheel_track_m: s.world.wheel_track_m,
         max_substep_s: s.world.substep_s,
+        clock_hz: u64::from(s.timing.clock_hz),
         sensor_max_range_m: s.world.sensor_range_m,
         sensor_mounts: SensorMount::default_mounts(
             world::params::BODY_LENGTH_M,
@@ -149,7 +161,12 @@ pub struct Swarm {
     repeat: u32,
     world: World,
     robots: Vec<Robot>,
-    counters: Vec<CollisionCounter>,
+    meters: Vec<ContactMeter>,
+    stuck: Vec<StuckDetector>,
+    /// Whether each robot's motors drove through the step being run.
+    drove: Vec<bool>,
+    /// The step period in clock states.
+    period_states: u64,
     steps: Vec<StepMetrics>,
     track: Option<Track>,
     tracked: usize,
@@ -206,7 +223,10 @@ impl Swarm {
             repeat,
             world,
             robots,
-            counters: vec![CollisionCounter::new(); n],
+            meters: vec![ContactMeter::new(nominal_substep_states(s)); n],
+            stuck: vec![StuckDetector::default(); n],
+            drove: vec![false; n],
+            period_states: period_states(s),
             steps: Vec::with_capacity(s.steps as usize),
             track,
             tracked,
@@ -285,23 +305,13 @@ impl Swarm {
             }
         }
         let times = live_times;
-        let t_step_s = match times.iter().copied().min() {
-            Some(t) => t as f64 / f64::from(self.scenario.timing.clock_hz),
+        let t_step = match times.iter().copied().min() {
+            Some(t) => t,
             // Every robot dead: the world goes on by the step period.
-            None => self.world.elapsed_s() + self.scenario.timing.step_period_s,
+            None => self.world.elapsed_states() + self.period_states,
         };
-        let collided = advance_world(
-            &mut self.world,
-            t_step_s,
-            self.scenario.world.substep_s,
-            &mut self.counters,
-            par,
-        )?;
-        let moved = self.moved()?;
-        if let Some(last) = self.steps.last_mut() {
-            last.collisions_per_robot = collided as f64 / n as f64;
-            last.moved_m = moved;
-        }
+        let t_step_s = t_step as f64 / f64::from(self.scenario.timing.clock_hz);
+        self.close_step(t_step)?;
         if let Some(t) = self.track.as_mut() {
             record(
                 &self.world,
@@ -370,6 +380,14 @@ impl Swarm {
             } else {
                 r.wheels()
             };
+            let drives = |w: &world::WheelCommand| {
+                w.duty > 0.0
+                    && matches!(
+                        w.direction,
+                        world::Direction::Forward | world::Direction::Reverse
+                    )
+            };
+            self.drove[i] = drives(&left) || drives(&right);
             self.world.set_wheels(i, left, right)?;
         }
         let live_f = live.max(1) as f64;
@@ -381,6 +399,8 @@ impl Swarm {
         self.steps.push(StepMetrics {
             mean_d,
             collisions_per_robot: 0.0,
+            contact_fraction: 0.0,
+            stuck_fraction: 0.0,
             moved_m: 0.0,
             gap_cv,
             cpu_load_percent: sum_load / live_f,
@@ -388,21 +408,48 @@ impl Swarm {
         Ok(())
     }
 
-    /// The mean distance the robots' centres moved since the previous call (0 on the first),
-    /// remembering where they are now.
-    fn moved(&mut self) -> Result<f64> {
+    /// Advances the world to `t_states` (the behaviour of the latest step runs to its end)
+    /// and completes that step's metrics: collisions, contact time, distance moved, stuck
+    /// robots.
+    fn close_step(&mut self, t_states: u64) -> Result<()> {
+        let dt = t_states.saturating_sub(self.world.elapsed_states());
+        let (collided, contact_states) =
+            advance_world(&mut self.world, t_states, &mut self.meters, self.parallel)?;
+        let n = self.robots.len();
+        let (moved, stuck) = self.moved()?;
+        if let Some(last) = self.steps.last_mut() {
+            last.collisions_per_robot = collided as f64 / n as f64;
+            last.contact_fraction = if dt == 0 {
+                0.0
+            } else {
+                contact_states as f64 / (dt as f64 * n as f64)
+            };
+            last.moved_m = moved;
+            last.stuck_fraction = stuck as f64 / n as f64;
+        }
+        Ok(())
+    }
+
+    /// The mean distance the robots' centres moved since the previous call (0 on the first)
+    /// and how many robots are stuck, remembering where they are now.
+    fn moved(&mut self) -> Result<(f64, usize)> {
         let n = self.robots.len();
         let mut sum = 0.0;
+        let mut stuck = 0;
         let first = self.last_xy.is_empty();
         self.last_xy.resize(n, (0.0, 0.0));
         for (i, xy) in self.last_xy.iter_mut().enumerate() {
             let p = self.world.pose(i)?;
             if !first {
-                sum += (p.x_m - xy.0).hypot(p.y_m - xy.1);
+                let d = (p.x_m - xy.0).hypot(p.y_m - xy.1);
+                sum += d;
+                if self.stuck[i].record(d, self.drove[i] && self.dead[i].is_none()) {
+                    stuck += 1;
+                }
             }
             *xy = (p.x_m, p.y_m);
         }
-        Ok(sum / n as f64)
+        Ok((sum / n as f64, stuck))
     }
 
     /// Lets the last behaviour run its full period (its collisions counted) and returns the
@@ -411,20 +458,8 @@ impl Swarm {
     /// # Errors
     /// A world failure.
     pub fn finish(mut self) -> Result<RunOutput> {
-        let end_s = self.world.elapsed_s() + self.scenario.timing.step_period_s;
-        let collided = advance_world(
-            &mut self.world,
-            end_s,
-            self.scenario.world.substep_s,
-            &mut self.counters,
-            self.parallel,
-        )?;
-        let n = self.robots.len();
-        let moved = self.moved()?;
-        if let Some(last) = self.steps.last_mut() {
-            last.collisions_per_robot = collided as f64 / n as f64;
-            last.moved_m = moved;
-        }
+        let end = self.world.elapsed_states() + self.period_states;
+        self.close_step(end)?;
         let dead = self.dead();
         Ok(RunOutput {
             condition: self.condition,
@@ -460,34 +495,48 @@ pub fn run_one(
     swarm.finish()
 }
 
-/// Advances the world to `target_s` in sub-steps of at most `substep_s`, sampling every robot's
-/// bumpers after each; returns the collisions (released→pressed edges) counted.
+/// The step period in clock states.
+#[must_use]
+pub fn period_states(s: &Scenario) -> u64 {
+    (s.timing.step_period_s * f64::from(s.timing.clock_hz)).round() as u64
+}
+
+/// The nominal sub-step of a scenario, in clock states: the step period cut into the fewest
+/// equal sub-steps of at most `world.substep_s` (the shorter length when they differ by one
+/// state). A collision must last this long to count.
+#[must_use]
+pub fn nominal_substep_states(s: &Scenario) -> u64 {
+    let max = (s.world.substep_s * f64::from(s.timing.clock_hz)).round() as u64;
+    let period = period_states(s);
+    let plan = SubstepPlan::new(period, max);
+    period / plan.substeps().max(1)
+}
+
+/// Advances the world to `target_states` in its sub-steps, feeding every robot's bumpers
+/// after each to its meter; returns the collisions counted and the robot-states in contact.
 fn advance_world(
     world: &mut World,
-    target_s: f64,
-    substep_s: f64,
-    counters: &mut [CollisionCounter],
+    target_states: u64,
+    meters: &mut [ContactMeter],
     par: bool,
-) -> Result<u64> {
-    let mut collisions = 0u64;
-    loop {
-        let left = target_s - world.elapsed_s();
-        if left <= 1e-12 {
-            break;
-        }
-        let dt = left.min(substep_s);
+) -> Result<(u64, u64)> {
+    let (mut collisions, mut contact) = (0u64, 0u64);
+    let dt = target_states.saturating_sub(world.elapsed_states());
+    for len in world.substep_plan(dt) {
         if par {
-            world.advance_par(dt)?;
+            world.advance_states_par(len);
         } else {
-            world.advance(dt)?;
+            world.advance_states(len);
         }
-        for (i, c) in counters.iter_mut().enumerate() {
-            let [front, rear, left, right] = world.bumpers(i)?;
-            c.sample(port2_pins(BumperSet::from_flags(front, rear, left, right)));
-            collisions += c.take_collisions();
+        for (i, m) in meters.iter_mut().enumerate() {
+            let pressed = world.bumpers(i)?.iter().any(|&b| b);
+            m.sample(pressed, len);
+            let (c, t) = m.take();
+            collisions += c;
+            contact += t;
         }
     }
-    Ok(collisions)
+    Ok((collisions, contact))
 }
 
 fn record(world: &World, t: &mut Track, tracked: usize, snapshot: bool, time_s: f64) -> Result<()> {
@@ -504,4 +553,64 @@ fn record(world: &World, t: &mut Track, tracked: usize, snapshot: bool, time_s: 
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use world::{Behaviour, Pose};
+
+    /// The picosecond case: a robot pushing the end wall of the corridor for 500 steps of
+    /// 0.6 s. Time is whole states, the sub-steps cut every step exactly, and the push is one
+    /// collision, not one every other step (with float time, a final sub-step of ~1 ps
+    /// released the bumper and every step from about 429 on counted a new collision).
+    #[test]
+    fn a_robot_held_against_a_wall_counts_one_collision_over_500_steps() {
+        let s = Scenario::corridor();
+        let mut w = World::from_poses(
+            Arena::paper_corridor(),
+            world_params(&s),
+            &[Pose {
+                x_m: 2.5,
+                y_m: 0.11,
+                heading_rad: 0.0,
+            }],
+            1,
+        )
+        .unwrap();
+        let (l, r) = Behaviour::Forward.wheels();
+        w.set_wheels(0, l, r).unwrap();
+        let period = period_states(&s);
+        assert_eq!(period, 15_000_000);
+        let nominal = nominal_substep_states(&s);
+        assert_eq!(nominal, 500_000, "0.6 s in 30 sub-steps of 20 ms");
+        let mut meters = vec![ContactMeter::new(nominal)];
+        let mut collisions = Vec::new();
+        let mut t = 0u64;
+        for _ in 0..500 {
+            t += period;
+            for len in w.substep_plan(t - w.elapsed_states()) {
+                assert_eq!(len, nominal, "no sliver of a sub-step");
+            }
+            let (c, contact) = advance_world(&mut w, t, &mut meters, false).unwrap();
+            collisions.push((c, contact));
+        }
+        assert_eq!(w.elapsed_states(), 500 * period, "no drift");
+        let total: u64 = collisions.iter().map(|c| c.0).sum();
+        assert_eq!(total, 1, "one push, one collision");
+        // From the step it arrives (2.5 m → 2.885 m at 0.15 m/s: about 4 steps) it is in
+        // contact the whole step.
+        assert!(collisions[10..].iter().all(|&(_, c)| c == period));
+    }
+
+    #[test]
+    fn the_arena_step_is_cut_into_23_substeps_a_state_apart() {
+        let s = Scenario::arena();
+        assert_eq!(period_states(&s), 11_250_000);
+        assert_eq!(nominal_substep_states(&s), 489_130);
+        let plan: Vec<u64> = SubstepPlan::new(11_250_000, 500_000).collect();
+        assert_eq!(plan.len(), 23);
+        assert_eq!(plan.iter().sum::<u64>(), 11_250_000);
+        assert!(plan.iter().all(|&l| l == 489_130 || l == 489_131));
+    }
 }

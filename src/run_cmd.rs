@@ -253,6 +253,21 @@ pub fn run(a: &RunArgs) -> Result<String> {
             fmt_est(&mm(&c.first.moved_m)),
             fmt_est(&mm(&c.last.moved_m))
         );
+        let pct = |e: &Estimate| Estimate {
+            mean: e.mean * 100.0,
+            lo: e.lo.map(|v| v * 100.0),
+            hi: e.hi.map(|v| v * 100.0),
+            n: e.n,
+        };
+        let _ = writeln!(
+            t,
+            "{:<14} contact time {} -> {} %; stuck robot-steps {} -> {} %",
+            "",
+            fmt_est(&pct(&c.first.contact_fraction)),
+            fmt_est(&pct(&c.last.contact_fraction)),
+            fmt_est(&pct(&c.first.stuck_fraction)),
+            fmt_est(&pct(&c.last.stuck_fraction))
+        );
         if let (Some(f), Some(l)) = (&c.first.gap_cv, &c.last.gap_cv) {
             let _ = writeln!(t, "{:<14} gap CV {} -> {}", "", fmt_est(f), fmt_est(l));
         }
@@ -266,16 +281,12 @@ pub fn run(a: &RunArgs) -> Result<String> {
     for c in &checked {
         let _ = writeln!(
             t,
-            "{} {} ({:.3} vs {:.3}{})",
+            "{} {} ({:.3} vs {:.3}: {})",
             if c.holds { "HOLDS " } else { "FAILS " },
             c.claim,
             c.values[0],
             c.values[1],
-            if c.clear {
-                ", intervals apart"
-            } else {
-                ", intervals overlap"
-            }
+            c.verdict
         );
     }
     for r in &runs {
@@ -321,6 +332,8 @@ fn write_metrics(path: &Path, runs: &[RunOutput]) -> Result<()> {
         "step",
         "mean_d",
         "collisions_per_robot",
+        "contact_fraction",
+        "stuck_fraction",
         "moved_m",
         "gap_cv",
         "cpu_load_percent",
@@ -333,6 +346,8 @@ fn write_metrics(path: &Path, runs: &[RunOutput]) -> Result<()> {
                 k.to_string(),
                 format!("{}", m.mean_d),
                 format!("{}", m.collisions_per_robot),
+                format!("{}", m.contact_fraction),
+                format!("{}", m.stuck_fraction),
                 format!("{}", m.moved_m),
                 m.gap_cv.map(|v| format!("{v}")).unwrap_or_default(),
                 format!("{}", m.cpu_load_percent),

@@ -1,18 +1,20 @@
 //! Windows, means over repeats with 95 % intervals, and the paper's claims checked against them.
 
 use serde::Serialize;
+use statrs::distribution::{ContinuousCDF, StudentsT};
 
 use crate::experiment::RunOutput;
 use crate::robot::Condition;
 
-/// Two-sided 95 % quantiles of Student's t for 1 … 30 degrees of freedom (the standard table,
-/// e.g. NIST/SEMATECH e-Handbook of Statistical Methods, Table 1.3.6.7.2); beyond 30 the normal
-/// 1.960 is used.
-const T_975: [f64; 30] = [
-    12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228, 2.201, 2.179, 2.160,
-    2.145, 2.131, 2.120, 2.110, 2.101, 2.093, 2.086, 2.080, 2.074, 2.069, 2.064, 2.060, 2.056,
-    2.052, 2.048, 2.045, 2.042,
-];
+/// The two-sided 95 % quantile of Student's t with `dof` degrees of freedom (its 97.5 %
+/// point), exact for any `dof` ≥ 1 (statrs' inverse CDF), so intervals do not jump at 30
+/// degrees of freedom as a printed table's normal 1.960 does.
+#[must_use]
+pub fn t_975(dof: usize) -> f64 {
+    StudentsT::new(0.0, 1.0, dof.max(1) as f64)
+        .map(|t| t.inverse_cdf(0.975))
+        .unwrap_or(f64::NAN)
+}
 
 /// Mean over repeats with its 95 % interval (Student's t; none with a single repeat).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -46,7 +48,7 @@ impl Estimate {
             };
         }
         let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1) as f64;
-        let t = T_975.get(n - 2).copied().unwrap_or(1.960);
+        let t = t_975(n - 1);
         let half = t * (var / n as f64).sqrt();
         Estimate {
             mean,
@@ -60,6 +62,12 @@ impl Estimate {
     #[must_use]
     pub fn clearly_below(&self, other: &Estimate) -> bool {
         matches!((self.hi, other.lo), (Some(h), Some(l)) if h < l)
+    }
+
+    /// Whether the two intervals do not overlap (either way round).
+    #[must_use]
+    pub fn apart_from(&self, other: &Estimate) -> bool {
+        self.clearly_below(other) || other.clearly_below(self)
     }
 }
 
@@ -76,6 +84,11 @@ pub struct WindowStats {
     pub collisions_per_robot: Estimate,
     /// Mean distance a robot's centre moved per step over the window, metres.
     pub moved_m: Estimate,
+    /// Fraction of the window's time a robot spent with a bumper pressed (contact time).
+    pub contact_fraction: Estimate,
+    /// Fraction of the window's robot-steps that were stuck (moved < 1 mm over the last 100
+    /// steps while driving).
+    pub stuck_fraction: Estimate,
     /// Corridor: mean gap CV over the window.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub gap_cv: Option<Estimate>,
@@ -92,17 +105,45 @@ pub struct ConditionStats {
     pub last: WindowStats,
 }
 
-/// A claim of the paper checked against the numbers.
+/// A claim of the paper checked against the numbers: "a below b".
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Claim {
     /// What is claimed.
     pub claim: String,
     /// Whether the means go the claimed way.
     pub holds: bool,
-    /// Whether the 95 % intervals separate as well.
-    pub clear: bool,
-    /// The two values compared (means).
+    /// Whether the two 95 % intervals are apart (do not overlap), whichever way.
+    pub apart: bool,
+    /// In words: "holds, intervals apart", "holds in the means, intervals overlap", "fails:
+    /// the opposite, intervals overlap" or "fails: the opposite, intervals apart".
+    pub verdict: String,
+    /// The two values compared (means), in the claim's order.
     pub values: [f64; 2],
+    /// Their 95 % intervals (none with a single repeat).
+    pub intervals: [[Option<f64>; 2]; 2],
+}
+
+impl Claim {
+    /// The claim "`a` below `b`" checked.
+    #[must_use]
+    pub fn below(claim: &str, a: &Estimate, b: &Estimate) -> Claim {
+        let holds = a.mean < b.mean;
+        let apart = a.apart_from(b);
+        let verdict = match (holds, apart) {
+            (true, true) => "holds, intervals apart",
+            (true, false) => "holds in the means, intervals overlap",
+            (false, false) => "fails: the opposite in the means, intervals overlap",
+            (false, true) => "fails: the opposite, intervals apart",
+        };
+        Claim {
+            claim: claim.to_string(),
+            holds,
+            apart,
+            verdict: verdict.to_string(),
+            values: [a.mean, b.mean],
+            intervals: [[a.lo, a.hi], [b.lo, b.hi]],
+        }
+    }
 }
 
 /// Window statistics of the runs of one condition over steps `from..to`.
@@ -131,6 +172,8 @@ pub fn window(runs: &[&RunOutput], from: u32, to: u32) -> WindowStats {
         mean_d: Estimate::of(&per_run(&|m| m.mean_d, true)),
         collisions_per_robot: Estimate::of(&per_run(&|m| m.collisions_per_robot, false)),
         moved_m: Estimate::of(&per_run(&|m| m.moved_m, true)),
+        contact_fraction: Estimate::of(&per_run(&|m| m.contact_fraction, true)),
+        stuck_fraction: Estimate::of(&per_run(&|m| m.stuck_fraction, true)),
         gap_cv: gap,
     }
 }
@@ -154,8 +197,9 @@ pub fn conditions(runs: &[RunOutput], steps: u32, win: u32) -> Vec<ConditionStat
 }
 
 /// The paper's claims (SPEC §5 and issue 5): collisions in the last window below the first and
-/// below the learning-off control's last; mean D higher at the end; in the corridor the gap CV
-/// falling.
+/// below the controls' last; the same for contact time (which no sub-step length can fake);
+/// mean D higher at the end and above learning off's; in the corridor the gap CV falling and
+/// below learning off's.
 #[must_use]
 pub fn claims(stats: &[ConditionStats]) -> Vec<Claim> {
     let find = |c: Condition| stats.iter().find(|s| s.condition == c);
@@ -163,12 +207,7 @@ pub fn claims(stats: &[ConditionStats]) -> Vec<Claim> {
     let Some(learn) = find(Condition::Learning) else {
         return out;
     };
-    let below = |claim: &str, a: &Estimate, b: &Estimate| Claim {
-        claim: claim.to_string(),
-        holds: a.mean < b.mean,
-        clear: a.clearly_below(b),
-        values: [a.mean, b.mean],
-    };
+    let below = Claim::below;
     out.push(below(
         "collisions per robot: last window below the first (learning)",
         &learn.last.collisions_per_robot,
@@ -189,6 +228,25 @@ pub fn claims(stats: &[ConditionStats]) -> Vec<Claim> {
         ));
     }
     out.push(below(
+        "contact time: last window below the first (learning)",
+        &learn.last.contact_fraction,
+        &learn.first.contact_fraction,
+    ));
+    if let Some(off) = find(Condition::LearningOff) {
+        out.push(below(
+            "contact time in the last window: learning below learning off",
+            &learn.last.contact_fraction,
+            &off.last.contact_fraction,
+        ));
+    }
+    if let Some(walk) = find(Condition::RandomWalk) {
+        out.push(below(
+            "contact time in the last window: learning below the random walk",
+            &learn.last.contact_fraction,
+            &walk.last.contact_fraction,
+        ));
+    }
+    out.push(below(
         "mean D: first window below the last (learning: the robots keep farther from obstacles)",
         &learn.first.mean_d,
         &learn.last.mean_d,
@@ -206,6 +264,13 @@ pub fn claims(stats: &[ConditionStats]) -> Vec<Claim> {
             last,
             first,
         ));
+        if let Some(off_cv) = find(Condition::LearningOff).and_then(|o| o.last.gap_cv.as_ref()) {
+            out.push(below(
+                "corridor gap CV in the last window: learning below learning off",
+                last,
+                off_cv,
+            ));
+        }
     }
     out
 }
@@ -215,12 +280,46 @@ mod tests {
     use super::*;
 
     #[test]
+    fn t_quantiles_are_exact_past_thirty_degrees_of_freedom() {
+        // Reference values (NIST/SEMATECH e-Handbook, Table 1.3.6.7.2).
+        for (dof, t) in [
+            (1, 12.706),
+            (4, 2.776),
+            (19, 2.093),
+            (30, 2.042),
+            (40, 2.021),
+            (100, 1.984),
+        ] {
+            assert!((t_975(dof) - t).abs() < 5e-4, "{dof}: {}", t_975(dof));
+        }
+        // No jump to 1.960 past 30: monotone towards it.
+        assert!(t_975(31) < t_975(30) && t_975(31) > t_975(32) && t_975(1000) > 1.96);
+    }
+
+    #[test]
+    fn claims_say_which_way_they_fail() {
+        let lo = Estimate::of(&[1.0, 1.1, 0.9]);
+        let hi = Estimate::of(&[5.0, 5.1, 4.9]);
+        let c = Claim::below("x", &hi, &lo);
+        assert!(!c.holds && c.apart);
+        assert_eq!(c.verdict, "fails: the opposite, intervals apart");
+        let c = Claim::below("x", &lo, &hi);
+        assert_eq!(c.verdict, "holds, intervals apart");
+        let wide = Estimate::of(&[0.0, 10.0, 3.0]);
+        assert_eq!(
+            Claim::below("x", &lo, &wide).verdict,
+            "holds in the means, intervals overlap"
+        );
+    }
+
+    #[test]
     fn intervals_use_students_t() {
         let e = Estimate::of(&[1.0, 2.0, 3.0, 4.0, 5.0]);
         assert_eq!(e.mean, 3.0);
         // s = sqrt(2.5), t(4) = 2.776: half width 2.776 · sqrt(2.5 / 5) = 1.963.
         let half = e.hi.unwrap() - 3.0;
-        assert!((half - 2.776 * 0.5f64.sqrt()).abs() < 1e-12);
+        assert!((half - t_975(4) * 0.5f64.sqrt()).abs() < 1e-12);
+        assert!((t_975(4) - 2.776).abs() < 5e-4);
         assert_eq!(Estimate::of(&[7.0]).lo, None);
         assert!(Estimate::of(&[1.0, 1.01]).clearly_below(&Estimate::of(&[2.0, 2.01])));
         // Two repeats leave t = 12.706: these overlap.

@@ -274,6 +274,31 @@ pub fn arc_step(c: f64, s: f64, v: f64, omega: f64, dt: f64) -> (f64, f64, f64, 
     (dx, dy, nc * k, ns * k)
 }
 
+/// One exact step of a rigid body with a constant body-frame velocity (`along` the heading,
+/// `across` it to the left) and turn rate `omega` for `dt`, from heading (c, s): returns
+/// (Δx, Δy, new c, new s). With `across = 0` it is [`arc_step`].
+#[inline]
+pub fn arc_step_twist(
+    c: f64,
+    s: f64,
+    along: f64,
+    across: f64,
+    omega: f64,
+    dt: f64,
+) -> (f64, f64, f64, f64) {
+    let phi = omega * dt;
+    let (sin_p, cos_p, sinc, cosc) = arc_factors(phi);
+    // Body-frame displacement: the integral of R(ωt)·(along, across) over dt.
+    let bx = (along * sinc - across * cosc) * dt;
+    let by = (along * cosc + across * sinc) * dt;
+    let dx = c * bx - s * by;
+    let dy = s * bx + c * by;
+    let nc = c * cos_p - s * sin_p;
+    let ns = s * cos_p + c * sin_p;
+    let k = 1.5 - 0.5 * (nc * nc + ns * ns);
+    (dx, dy, nc * k, ns * k)
+}
+
 /// The bumper side for a direction towards an obstacle given in the body frame
 /// (x forward, y left): the larger component wins; equal ones go to front/rear.
 /// Returns 0 front, 1 rear, 2 left, 3 right.

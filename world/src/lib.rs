@@ -12,7 +12,7 @@
 //! let (l, r) = Behaviour::TurnLeftForward.wheels();
 //! w.set_wheels(0, l, r)?;
 //! for _ in 0..45 {
-//!     w.advance(0.010)?; // one 0.45 s behaviour step in 10 ms sub-steps
+//!     w.advance_states(250_000); // one 0.45 s step, 10 ms = 250 000 states at a time
 //! }
 //! let d_mm = w.sense(0, FRONT)?; // Some(distance) or None beyond 1.5 m
 //! let pressed = w.bumpers(0)?;   // [front, rear, left, right]
@@ -43,35 +43,47 @@
 //!   which in a 203:1 gearbox is large; a longer value can be set).
 //! - **Kinematics**: differential drive with wheel track 160 mm (our choice, the paper gives
 //!   none: 56 mm Tamiya wheels inside the 180 mm body). Per sub-step the body follows the exact
-//!   arc for the sub-step's *mean* wheel speeds (the exact integral of the lag), so the heading
-//!   change is exact, straight-line distance is exact, and constant wheel speeds give the same
-//!   path whatever the sub-step length (to rounding).
-//! - **Time**: [`World::advance`] splits a call into equal sub-steps of at most
-//!   `max_substep_s` (default 20 ms, at most 100 ms so bodies cannot pass through each
-//!   other); robots are processed in index order.
-//! - **Collisions** (robot–wall, robot–robot) are resolved after the move, in robot index
-//!   order (each robot: walls, then its pairs with higher-index robots), for a fixed number of
-//!   passes (default 32, stopping early after a clean pass: see
-//!   [`params::COLLISION_ITERATIONS`] for why so many). The first pass resolves the
-//!   contacts present after the move; each later pass re-tests only the pairs with a robot
-//!   moved by the pass before (the others were clean and have not moved), so a clean pass
-//!   proves that nothing overlaps. An overlap is removed by pushing along the
-//!   minimum-translation vector of the separating-axis test, a robot pair sharing it equally
-//!   (equal masses), to a gap of [`CONTACT_SKIN_M`] (1 nm); a robot held by a wall, or by a
-//!   robot held by a wall, does not give way, so the other takes the whole push. The model is kinematic (no
-//!   momentum: a 0.5 kg robot on 203:1 gear motors moves at its wheel speed), so removing the
-//!   displacement into the contact *is* cancelling the velocity component into it; the wheels
-//!   keep turning (they slip against the floor) and [`World::wheel_speeds`] still shows the
-//!   motor's speed. Contacts do not rotate bodies. If a robot still overlaps after the passes,
-//!   its rotation for the sub-step is dropped (it slides without turning, e.g. wedged across
-//!   the narrow corridor) and the passes rerun; a robot that still overlaps keeps its previous
-//!   pose (blocked), and so in turn does any robot pushed into it. The previous state had no
-//!   overlap, so **no body ever penetrates a wall or another body after a sub-step**.
-//! - **Bumpers** (SPEC §3.4): a switch is pressed when its robot overlapped something during
-//!   the latest sub-step, on the side given by the contact normal in the body frame: the
-//!   larger of the forward and sideways components wins (a corner contact goes to the face the
-//!   normal points at most; exact diagonals go to front/rear). A robot resting against a wall
-//!   without pushing does not hold its switch (the switch spring lifts it off).
+//!   arc for the sub-step's *mean* wheel speeds (the exact integral of the lag) when it touches
+//!   nothing, so the heading change is exact, straight-line distance is exact, and constant
+//!   wheel speeds give the same path whatever the sub-step length (to rounding).
+//! - **Time** is counted in whole clock states (`clock_hz`, default the MCU's 25 MHz: one clock
+//!   rules it all, the world counts the states the robots' MCUs count). [`World::advance_states`]
+//!   cuts an interval into [`World::substep_plan`]'s fewest equal sub-steps of at most
+//!   `max_substep_s` (default 20 ms; lengths differing by one state at most, adding up exactly),
+//!   so there is no floating-point accumulation of time and no sliver of a sub-step. Robots are
+//!   processed in index order. [`World::advance`] takes seconds, rounded to states (for tests).
+//! - **Bodies are rigid and pushed by their wheels**, not placed: a robot has mass 0.5 kg
+//!   (SPEC §1) and the inertia of a uniform box; each of its two drive wheels grips the floor
+//!   and makes the body's velocity at the wheel equal the wheel's rim speed along it and zero
+//!   across it, with a force of at most `μ_floor · m·g/2` (default μ 0.6, about 1.5 N per
+//!   wheel); past that it slips. The 203:1 gear motors could push harder at stall, so a
+//!   blocked robot pushes with its traction and its wheels slip ([`World::wheel_speeds`] still
+//!   shows the motors' speed). A robot touching nothing follows its wheels exactly.
+//! - **Contacts** (robot–wall, robot–robot; [`SolverStats`] counts what they did): at the start
+//!   of each sub-step every candidate pair and wall gives a contact manifold (reference-face
+//!   clipping, one or two points, Box2D's method) when it is within the *speculative distance*
+//!   (the farthest two bodies can close in a sub-step under their wheels, plus 25 %). A contact
+//!   binds when the robots' own wheels would close it; the robots in binding contacts, and in
+//!   turn every robot touching one of them, are solved together by sequential impulses
+//!   (projected Gauss–Seidel, Catto 2005) on their velocities: the wheels' friction-limited
+//!   grip, the contacts' normal impulses (push, never pull; a gap may close to the 10 nm skin,
+//!   no further) and Coulomb friction along them (μ 0.3 robot–robot and robot–wall), warm-started
+//!   from half the previous sub-step's impulses. So bodies push each other (two equal tractions
+//!   balance), slide along walls and each other when friction allows, and turn under an
+//!   off-centre contact (a robot driving into a wall at an angle turns square to it and stays,
+//!   wheels slipping, as a differential-drive robot does). Poses follow the exact motion of the
+//!   solved velocities. What the linearised solve leaves of an overlap (a turning corner) is
+//!   removed by position sweeps that push along the contact normal with rotation, weighted by
+//!   mass and inertia; if `position_iterations` sweeps do not clear a cluster, its robots stop
+//!   early in the sub-step: they move the largest fraction 1, 1/2, …, 0 of their motion at
+//!   which nothing overlaps (a time of impact, never a jump back). **After every sub-step no
+//!   body overlaps a wall or another body** (tests check it over thousands of crowded
+//!   sub-steps). There is no reset anywhere.
+//! - **Bumpers** (SPEC §3.4): a switch is pressed in a sub-step when a contact carried at least
+//!   `bumper_force_n` (default 0.1 N), on the face its normal points at in the body frame (the
+//!   larger of the forward and sideways components wins; exact diagonals go to front/rear); a
+//!   robot resting against a wall without pushing does not hold its switch. A press is a force,
+//!   so it does not depend on the sub-step's length.
 //! - **Sensors** (SPEC §3.1): by default four, at the middle of the front, rear, left and right
 //!   sides, facing out (indices [`FRONT`], [`REAR`], [`LEFT`], [`RIGHT`]); mounts, rays per
 //!   sensor (a cone) and range are parameters. [`World::sense`] casts from the mount against
@@ -93,10 +105,10 @@
 //! - **Randomness**: only from the seed: placement and each robot's motor gains have their own
 //!   streams, derived by the project's one rule (`seeding::derive(seed, robot, MotorGain)`,
 //!   `derive(seed, 0, Placement)`), so adding a robot changes no other robot's gains.
-//! - **Threads**: [`World::advance_par`] runs the per-robot phases (motors and kinematics,
-//!   candidate search, the first pass's overlap tests) on rayon's pool in fixed chunks merged
-//!   in index order; the pushes run on one thread in index order. Results are bit-identical to
-//!   [`World::advance`] whatever the thread count.
+//! - **Threads**: [`World::advance_states_par`] runs the per-robot phases (motors, free
+//!   motion, candidate search, contact search) on rayon's pool in fixed chunks merged in index
+//!   order; the contact solve runs on one thread in a fixed order. Results are bit-identical to
+//!   [`World::advance_states`] whatever the thread count.
 //! - **Corridor metric**: [`World::corridor_gaps_m`] gives the free gaps between neighbouring
 //!   robots along the corridor (sorted by centre x; gap = shortest distance between the two
 //!   outlines, which for robots facing along the corridor is face to face; the gaps to the end
@@ -107,11 +119,13 @@
 #![deny(missing_docs)]
 
 pub mod arena;
+mod contact;
 pub mod error;
 pub mod geometry;
 mod grid;
 pub mod motor;
 pub mod params;
+mod solver;
 mod world;
 
 pub use arena::{Arena, ArenaKind, Segment};
@@ -119,6 +133,6 @@ pub use error::WorldError;
 pub use motor::{Behaviour, Direction, WheelCommand};
 pub use params::{SensorMount, WorldParams};
 pub use world::{
-    BROAD_PHASE_MARGIN_M, CONTACT_SKIN_M, FRONT, LEFT, MAX_ROBOTS, Pose, REAR, RIGHT, World,
-    coefficient_of_variation,
+    BROAD_PHASE_MARGIN_M, CONTACT_SKIN_M, FRONT, LEFT, MAX_ROBOTS, Pose, REAR, RIGHT, SolverStats,
+    SubstepPlan, World, coefficient_of_variation,
 };

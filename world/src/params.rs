@@ -41,15 +41,34 @@ pub const MAX_ADVANCE_S: f64 = 3600.0;
 pub const SENSOR_MAX_RANGE_M: f64 = 1.5;
 /// Default placement clearance between bodies, and between bodies and walls: 50 mm (our choice).
 pub const PLACEMENT_CLEARANCE_M: f64 = 0.050;
-/// Default number of collision-resolution passes per sub-step (our choice). A chain of three
-/// bodies (one squeezed between two) converges only by a factor of about 4 per pass under the
-/// equal-share pushes, so a few millimetres of overlap need some 11–14 passes to reach the
-/// 1 nm contact skin; 32 leaves room for longer chains. Later passes only revisit the
-/// contacts the previous pass moved, so unused passes cost nothing, and a sub-step whose
-/// passes do not end clean falls back to blocking the robots involved (see the crate docs):
-/// with 4 passes, as before, learning robots jammed in threes were blocked whole and 1 000
-/// robots ran 35 % slower.
-pub const COLLISION_ITERATIONS: u32 = 32;
+/// Default number of Gauss–Seidel sweeps of the velocity solver per sub-step (our choice):
+/// the impulses of a contact cluster converge geometrically; 12 sweeps leave chains of up to
+/// five bodies within a few per cent of the exact impulses, and what the velocities leave of an
+/// overlap is removed by the position correction.
+pub const SOLVER_ITERATIONS: u32 = 12;
+/// Default number of position-correction sweeps over the overlaps the velocity solve leaves
+/// (our choice): each sweep removes an overlap along its normal with rotation; a cluster that
+/// is still not clear after them stops its robots' motion early (see the crate docs).
+pub const POSITION_ITERATIONS: u32 = 16;
+/// Standard gravity, m/s² (for the wheels' normal force).
+pub const GRAVITY_M_PER_S2: f64 = 9.806_65;
+/// Robot mass: 0.5 kg (SPEC §1, paper §2: without batteries, the only figure the paper gives).
+pub const MASS_KG: f64 = 0.5;
+/// Default tyre–floor friction coefficient: 0.6 (our choice: rubber on a hard floor is
+/// 0.5–0.8). The traction of a blocked robot, μ·m·g ≈ 2.9 N, is far below what the 203:1
+/// gear motors can exert at stall (several N per wheel), so a blocked robot's wheels slip.
+pub const MU_FLOOR: f64 = 0.6;
+/// Default body–body friction coefficient: 0.3 (our choice: plastic on plastic).
+pub const MU_ROBOT: f64 = 0.3;
+/// Default body–wall friction coefficient: 0.3 (our choice: plastic on a painted board).
+pub const MU_WALL: f64 = 0.3;
+/// Default force a contact must carry to hold a micro-switch bumper pressed: 0.1 N (our
+/// choice; a robot driving into an obstacle pushes with its whole traction, about 2.9 N, a
+/// body merely resting against one with none).
+pub const BUMPER_FORCE_N: f64 = 0.1;
+/// Default clock that counts the world's time: φ = 25 MHz, one state = 40 ns (SPEC §4.1): the
+/// world advances in whole MCU states, the clock the robots' MCUs count.
+pub const CLOCK_HZ: u64 = 25_000_000;
 /// Most rays a sensor cone may use (our limit).
 pub const MAX_RAYS_PER_SENSOR: u32 = 16;
 /// Widest accepted sensor cone half-angle: 0.5 rad (our limit; the Sharp beam is a few degrees).
@@ -117,7 +136,8 @@ pub struct WorldParams {
     pub motor_gain_spread: f64,
     /// Distance between the two wheels' contact lines, metres.
     pub wheel_track_m: f64,
-    /// Longest internal sub-step; longer `advance` calls are split into equal sub-steps, seconds.
+    /// Longest internal sub-step, seconds (rounded to whole clock states); a longer advance is
+    /// split into equal sub-steps of whole states (lengths differing by at most one state).
     pub max_substep_s: f64,
     /// Sensor mounts; sensor index `k` is `sensor_mounts[k]`.
     pub sensor_mounts: Vec<SensorMount>,
@@ -129,8 +149,22 @@ pub struct WorldParams {
     pub sensor_max_range_m: f64,
     /// Minimum gap between bodies, and between bodies and walls, at random placement, metres.
     pub placement_clearance_m: f64,
-    /// Collision-resolution passes per sub-step.
-    pub collision_iterations: u32,
+    /// Mass of a robot, kg.
+    pub mass_kg: f64,
+    /// Tyre–floor friction coefficient (traction limit of each drive wheel: μ·m·g/2).
+    pub mu_floor: f64,
+    /// Body–body friction coefficient.
+    pub mu_robot: f64,
+    /// Body–wall friction coefficient.
+    pub mu_wall: f64,
+    /// Force a contact must carry to hold a bumper pressed, N.
+    pub bumper_force_n: f64,
+    /// Gauss–Seidel sweeps of the velocity solver per sub-step.
+    pub solver_iterations: u32,
+    /// Position-correction sweeps per sub-step.
+    pub position_iterations: u32,
+    /// The clock the world's time is counted in (MCU states per second).
+    pub clock_hz: u64,
 }
 
 impl Default for WorldParams {
@@ -150,7 +184,14 @@ impl Default for WorldParams {
             cone_half_angle_rad: 0.0,
             sensor_max_range_m: SENSOR_MAX_RANGE_M,
             placement_clearance_m: PLACEMENT_CLEARANCE_M,
-            collision_iterations: COLLISION_ITERATIONS,
+            mass_kg: MASS_KG,
+            mu_floor: MU_FLOOR,
+            mu_robot: MU_ROBOT,
+            mu_wall: MU_WALL,
+            bumper_force_n: BUMPER_FORCE_N,
+            solver_iterations: SOLVER_ITERATIONS,
+            position_iterations: POSITION_ITERATIONS,
+            clock_hz: CLOCK_HZ,
         }
     }
 }
@@ -306,11 +347,59 @@ impl WorldParams {
             10.0,
             "a distance in 0..=10 m",
         )?;
-        if self.collision_iterations == 0 || self.collision_iterations > 64 {
+        for (name, v) in [
+            ("solver_iterations", self.solver_iterations),
+            ("position_iterations", self.position_iterations),
+        ] {
+            if v == 0 || v > 256 {
+                return Err(WorldError::Parameter {
+                    name,
+                    value: f64::from(v),
+                    valid: "a count in 1..=256",
+                });
+            }
+        }
+        check_range(
+            "mass_kg",
+            self.mass_kg,
+            0.01,
+            100.0,
+            "a mass in 0.01..=100 kg",
+        )?;
+        check_range(
+            "mu_floor",
+            self.mu_floor,
+            0.05,
+            2.0,
+            "a coefficient in 0.05..=2",
+        )?;
+        check_range(
+            "mu_robot",
+            self.mu_robot,
+            0.0,
+            2.0,
+            "a coefficient in 0..=2",
+        )?;
+        check_range("mu_wall", self.mu_wall, 0.0, 2.0, "a coefficient in 0..=2")?;
+        check_range(
+            "bumper_force_n",
+            self.bumper_force_n,
+            0.0,
+            100.0,
+            "a force in 0..=100 N",
+        )?;
+        if self.clock_hz < 1_000 || self.clock_hz > 1_000_000_000 {
             return Err(WorldError::Parameter {
-                name: "collision_iterations",
-                value: f64::from(self.collision_iterations),
-                valid: "a count in 1..=64",
+                name: "clock_hz",
+                value: self.clock_hz as f64,
+                valid: "a clock in 1 kHz..=1 GHz",
+            });
+        }
+        if (self.max_substep_s * self.clock_hz as f64).round() < 1.0 {
+            return Err(WorldError::Parameter {
+                name: "max_substep_s",
+                value: self.max_substep_s,
+                valid: "at least one clock state",
             });
         }
         Ok(())

@@ -6,21 +6,25 @@ use rayon::prelude::*;
 use seeding::Purpose;
 
 use crate::arena::{Arena, ArenaKind};
+use crate::contact::{Manifold, box_box, box_walls};
 use crate::error::WorldError;
-use crate::geometry::{Obb, arc_step, obb_distance, obb_overlap, ray_obb, ray_walls, side_of};
+use crate::geometry::{
+    Obb, arc_step, arc_step_twist, obb_distance, obb_overlap, ray_obb, ray_walls, side_of,
+};
 use crate::grid::Grid;
 use crate::motor::{Direction, LagCoefficients, MODE_BRAKE, MODE_COAST, MODE_DRIVE, WheelCommand};
 use crate::params::{MAX_ADVANCE_S, WorldParams};
+use crate::solver::{BodyConst, Contact, WALL, solve_velocities};
 
-/// Collisions are resolved to this gap (1 nm) so that resolved bodies do not touch.
-pub const CONTACT_SKIN_M: f64 = 1e-9;
-/// Broad-phase margin (a Verlet skin): pairs of bodies whose bounding circles are closer than
-/// this, and bodies closer than this to a wall, are narrow-phase candidates; the grid and the
-/// candidate lists are kept until some robot has moved half of it since they were built
-/// (our choice: 200 mm, about 67 sub-steps of 10 ms at 0.15 m/s).
+/// Overlaps are corrected to this gap (10 nm), so that corrected bodies do not touch even
+/// after rounding, and far below anything a sensor or a metric resolves.
+pub const CONTACT_SKIN_M: f64 = 1e-8;
+/// Smallest broad-phase margin (a Verlet skin): pairs of bodies whose bounding circles are
+/// closer than the margin, and bodies closer than it to a wall, are contact candidates; the
+/// grid and the candidate lists are kept until some robot has moved half the margin less the
+/// speculative contact distance since they were built (our choice: 200 mm, about 60 sub-steps
+/// of 10 ms at 0.15 m/s; larger when fast robots and long sub-steps need it).
 pub const BROAD_PHASE_MARGIN_M: f64 = 0.2;
-/// How far a robot may move from where the broad phase filed it before it is rebuilt.
-const DRIFT_LIMIT_M: f64 = 0.5 * BROAD_PHASE_MARGIN_M;
 /// Robots per chunk in the parallel phases (fixed, so results never depend on thread count).
 const PAR_CHUNK: usize = 512;
 /// Most robots a world may hold (indices are stored as `u32`).
@@ -47,11 +51,11 @@ pub struct Pose {
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
-struct BodyPose {
-    x: f64,
-    y: f64,
-    c: f64,
-    s: f64,
+pub(crate) struct BodyPose {
+    pub(crate) x: f64,
+    pub(crate) y: f64,
+    pub(crate) c: f64,
+    pub(crate) s: f64,
 }
 
 impl BodyPose {
@@ -75,10 +79,6 @@ impl BodyPose {
         self.x - ex < 0.0 || self.x + ex > w || self.y - ey < 0.0 || self.y + ey > h
     }
 }
-
-/// The wheel-speed difference below which a wheel is taken to have reached its target speed:
-/// 1e-12 m/s, a picometre per second, far below anything the model resolves.
-const SPEED_SNAP_M_S: f64 = 1e-12;
 
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 struct Motion {
@@ -104,11 +104,104 @@ struct Candidates {
     walls: Vec<u32>,
 }
 
-const TOUCHED: u8 = 1;
-const REVERTED: u8 = 2;
-const VIOLATOR: u8 = 4;
-/// Held by a wall (or by a robot held by a wall) during this sub-step: takes no share of a push.
-const PINNED: u8 = 8;
+/// A solved contact's identity, point count and (normal, friction) impulses per point.
+type WarmStart = ((u32, u32, u8), u8, [[f64; 2]; 2]);
+
+/// In a binding contact this sub-step (or in contact with such a robot): solved, not moved
+/// freely.
+const ACTIVE: u8 = 1;
+/// The share of the previous sub-step's impulses a solve starts from. Less than 1 because a
+/// wheel pushing a body that is held (a braked robot against a wall) is statically
+/// indeterminate: a full warm start would keep a push that nothing sustains any more, while a
+/// half lets it decay in a few sub-steps, and a sustained push is rebuilt by a sweep or two.
+const WARM_START: f64 = 0.5;
+/// Listed in `World::active`.
+const LISTED: u8 = 2;
+/// In some contact (binding or not): checked for overlap after the move.
+const CHECK: u8 = 4;
+/// A contact binds when the robots' own wheels would bring a point to within this of touching
+/// (0.1 mm: the linear estimate misses the chord of a turning corner's arc by at most about
+/// R·(ω·h)²/2 ≈ 13 µm at 20 ms).
+const BIND_MARGIN_M: f64 = 1e-4;
+
+/// What the contact solver did, counted over the world's life (for evaluation: these are
+/// not used by the simulation).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct SolverStats {
+    /// Sub-steps taken.
+    pub substeps: u64,
+    /// Contacts (robot–robot and robot–wall manifolds, speculative ones included) solved.
+    pub contacts: u64,
+    /// Robot-sub-steps in a contact (solved rather than moved freely).
+    pub active_robot_substeps: u64,
+    /// Gauss–Seidel sweeps of the velocity solver run (over all sub-steps).
+    pub solver_sweeps: u64,
+    /// Sub-steps whose velocity solve left an overlap for the position correction.
+    pub overlap_substeps: u64,
+    /// Position-correction sweeps run.
+    pub position_sweeps: u64,
+    /// Robot-sub-steps stopped early because the position correction did not clear them.
+    pub stopped_robot_substeps: u64,
+}
+
+/// The sub-steps of one advance, in clock states (see [`World::substep_plan`]): an iterator
+/// of lengths that add up to the advance exactly and differ by at most one state.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SubstepPlan {
+    /// Sub-steps left.
+    left: u64,
+    /// Sub-steps still to be one state longer.
+    long_left: u64,
+    /// The shorter length, states.
+    short_states: u64,
+}
+
+impl SubstepPlan {
+    /// The plan for `dt_states` in sub-steps of at most `max_states` (at least 1).
+    pub fn new(dt_states: u64, max_states: u64) -> SubstepPlan {
+        let max_states = max_states.max(1);
+        let k = dt_states.div_ceil(max_states);
+        if k == 0 {
+            return SubstepPlan {
+                left: 0,
+                long_left: 0,
+                short_states: 0,
+            };
+        }
+        SubstepPlan {
+            left: k,
+            long_left: dt_states % k,
+            short_states: dt_states / k,
+        }
+    }
+
+    /// Number of sub-steps.
+    pub fn substeps(&self) -> u64 {
+        self.left
+    }
+}
+
+impl Iterator for SubstepPlan {
+    type Item = u64;
+
+    fn next(&mut self) -> Option<u64> {
+        if self.left == 0 {
+            return None;
+        }
+        self.left -= 1;
+        if self.long_left > 0 {
+            self.long_left -= 1;
+            Some(self.short_states + 1)
+        } else {
+            Some(self.short_states)
+        }
+    }
+
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        let n = usize::try_from(self.left).unwrap_or(usize::MAX);
+        (n, Some(n))
+    }
+}
 
 /// The physical world of one run: an arena, robots with motors, bumpers and sensors.
 ///
@@ -126,27 +219,51 @@ pub struct World {
     gains: Vec<[f64; 2]>,
     pose: Vec<BodyPose>,
     motion: Vec<Motion>,
+    /// Pose at the start of the current sub-step.
     prev: Vec<BodyPose>,
-    kin: Vec<[f64; 2]>,
+    /// World-frame velocity (vx, vy, ω): the wheels' twist for a free robot, the solved one
+    /// for a robot in contact (kept as momentum into the next sub-step).
+    vel: Vec<[f64; 3]>,
+    /// Mean wheel speeds (left, right) over the current sub-step, m/s.
+    wmean: Vec<[f64; 2]>,
+    /// Accumulated wheel impulses of the latest solve (left along, left across, right …).
+    wheel_imp: Vec<[f64; 4]>,
     bumpers: Vec<u8>,
     grid: Grid,
     cand: Candidates,
-    /// The candidates that involve a robot moved since the sub-step's first pass.
-    hot: Candidates,
-    /// Resolution epoch: one per pass or stage, counted over the whole run.
+    /// Broad-phase margin in use, metres.
+    margin_m: f64,
+    /// Drift from the filed position that triggers a rebuild, metres.
+    drift_limit_m: f64,
+    /// The sub-step's contacts, walls first, then pairs, in candidate order.
+    contacts: Vec<Contact>,
+    chunk_contacts: Vec<Vec<Contact>>,
+    /// The robots solved this sub-step, in index order.
+    active: Vec<u32>,
+    /// The solved contacts' impulses of the previous sub-step, sorted by contact identity
+    /// (the warm start of the next solve).
+    warm: Vec<WarmStart>,
+    /// Per robot, the sub-step in which it was last solved (its wheel impulses warm-start the
+    /// next solve only if that was the previous sub-step).
+    solved_at: Vec<u64>,
+    /// The robots in some contact this sub-step (solved or not), in index order.
+    checked: Vec<u32>,
+    /// Overlaps found by the latest check.
+    overlaps: Candidates,
+    /// Correction epoch: one per sweep, counted over the whole run.
     epoch: u64,
-    /// Per robot, the epoch in which it last moved in collision resolution.
+    /// Per robot, the epoch in which it last moved in the contact phases.
     last_move: Vec<u64>,
-    /// Whether the next pass must go over all candidates (after the kinematics or a rebuild).
-    full_pass_pending: bool,
     chunk_cands: Vec<Candidates>,
     flags: Vec<u8>,
-    touched: Vec<u32>,
-    violators: Vec<u32>,
-    lag: LagCoefficients,
+    body: BodyConst,
+    /// Lag coefficients for the two sub-step lengths of the latest plan (length in states).
+    lag_cache: [(u64, LagCoefficients); 2],
     mounts: Vec<MountRays>,
-    elapsed_s: f64,
+    max_substep_states: u64,
+    elapsed_states: u64,
     substeps: u64,
+    stats: SolverStats,
 }
 
 /// The generator for one purpose and one index (robot index, or 0 for world-wide purposes):
@@ -233,10 +350,20 @@ impl World {
                 [l, r]
             })
             .collect();
+        let max_substep_states = (params.max_substep_s * params.clock_hz as f64).round() as u64;
+        // The speculative distance of the longest sub-step (see `speculative_m`) must fit in
+        // the margin with room for drift.
+        let vmax = params.top_speed_m_per_s * (1.0 + params.motor_gain_spread);
+        let spec_max = 2.5
+            * vmax
+            * (1.0 + 2.0 * radius_m / params.wheel_track_m)
+            * (max_substep_states as f64 / params.clock_hz as f64);
+        let margin_m = BROAD_PHASE_MARGIN_M.max(4.0 * spec_max);
+        let drift_limit_m = 0.5 * (margin_m - spec_max);
         let grid = Grid::new(
             arena.width_m(),
             arena.height_m(),
-            2.0 * radius_m + BROAD_PHASE_MARGIN_M,
+            2.0 * radius_m + margin_m,
             n,
         );
         let mounts = params
@@ -264,10 +391,19 @@ impl World {
             })
             .collect();
         let lag = LagCoefficients::new(
-            params.max_substep_s,
+            max_substep_states as f64 / params.clock_hz as f64,
             params.motor_time_constant_s,
             params.brake_time_constant_s,
             params.coast_time_constant_s,
+        );
+        let body = BodyConst::new(
+            params.mass_kg,
+            params.body_length_m,
+            params.body_width_m,
+            params.wheel_track_m,
+            params.mu_floor,
+            params.mu_robot,
+            params.mu_wall,
         );
         let n_chunks = n.div_ceil(PAR_CHUNK);
         let mut w = World {
@@ -286,24 +422,34 @@ impl World {
                 n
             ],
             prev: poses.clone(),
-            kin: vec![[0.0; 2]; n],
+            vel: vec![[0.0; 3]; n],
+            wmean: vec![[0.0; 2]; n],
+            wheel_imp: vec![[0.0; 4]; n],
             pose: poses,
             bumpers: vec![0; n],
             grid,
             cand: Candidates::default(),
-            hot: Candidates::default(),
+            margin_m,
+            drift_limit_m,
+            contacts: Vec::new(),
+            chunk_contacts: Vec::new(),
+            active: Vec::new(),
+            warm: Vec::new(),
+            solved_at: vec![u64::MAX; n],
+            checked: Vec::new(),
+            overlaps: Candidates::default(),
             epoch: 1,
             last_move: vec![0; n],
-            full_pass_pending: false,
             chunk_cands: vec![Candidates::default(); n_chunks],
             flags: vec![0; n],
-            touched: Vec::new(),
-            violators: Vec::new(),
-            lag,
+            body,
+            lag_cache: [(max_substep_states, lag), (0, lag)],
             mounts,
             params,
-            elapsed_s: 0.0,
+            max_substep_states,
+            elapsed_states: 0,
             substeps: 0,
+            stats: SolverStats::default(),
         };
         w.rebuild_broad_phase(false);
         Ok(w)
@@ -331,9 +477,19 @@ impl World {
         self.seed
     }
 
-    /// Simulated time advanced so far, seconds.
+    /// Simulated time advanced so far, seconds (from [`World::elapsed_states`]).
     pub fn elapsed_s(&self) -> f64 {
-        self.elapsed_s
+        self.elapsed_states as f64 / self.params.clock_hz as f64
+    }
+
+    /// Simulated time advanced so far, in clock states (`params.clock_hz`).
+    pub fn elapsed_states(&self) -> u64 {
+        self.elapsed_states
+    }
+
+    /// What the contact solver has done so far (an evaluation aid).
+    pub fn solver_stats(&self) -> SolverStats {
+        self.stats
     }
 
     /// Side of the broad-phase grid cells, metres (diagnostic).
@@ -464,78 +620,227 @@ impl World {
 
     // ----- time ----------------------------------------------------------------------------------
 
-    /// Advances every robot by `dt_s` seconds, in sub-steps of at most `max_substep_s`
-    /// (equal pieces), on the calling thread.
+    /// Advances every robot by `dt_s` seconds, rounded to whole clock states (see
+    /// [`World::advance_states`]), on the calling thread. A convenience for tests and tools:
+    /// the experiment counts its time in states and calls [`World::advance_states`].
+    ///
+    /// Errors: `dt_s` not positive, less than one state, or beyond an hour.
     pub fn advance(&mut self, dt_s: f64) -> Result<(), WorldError> {
-        self.advance_impl(dt_s, false)
+        let states = self.states_of(dt_s)?;
+        self.advance_states_impl(states, false);
+        Ok(())
     }
 
-    /// As [`World::advance`], with the per-robot phases (motors and kinematics, broad-phase
-    /// candidates, the first collision pass's overlap tests) split over rayon's current
-    /// thread pool. Results are bit-identical to
-    /// [`World::advance`] whatever the number of threads: the parallel work is per robot into
-    /// fixed chunks, merged in index order; collision resolution runs in index order on one
-    /// thread.
+    /// As [`World::advance`], with the per-robot phases on rayon's current pool (see
+    /// [`World::advance_states_par`]).
     pub fn advance_par(&mut self, dt_s: f64) -> Result<(), WorldError> {
-        self.advance_impl(dt_s, true)
+        let states = self.states_of(dt_s)?;
+        self.advance_states_impl(states, true);
+        Ok(())
     }
 
-    fn advance_impl(&mut self, dt_s: f64, parallel: bool) -> Result<(), WorldError> {
-        if dt_s.is_nan() || dt_s <= 0.0 || dt_s > MAX_ADVANCE_S {
+    fn states_of(&self, dt_s: f64) -> Result<u64, WorldError> {
+        let states = (dt_s * self.params.clock_hz as f64).round();
+        if dt_s.is_nan() || states < 1.0 || dt_s > MAX_ADVANCE_S {
             return Err(WorldError::TimeStep {
                 value_s: dt_s,
                 max_s: MAX_ADVANCE_S,
             });
         }
-        let pieces = (dt_s / self.params.max_substep_s).ceil().max(1.0);
-        let sub_s = dt_s / pieces;
-        if self.lag.dt_s != sub_s {
-            self.lag = LagCoefficients::new(
-                sub_s,
-                self.params.motor_time_constant_s,
-                self.params.brake_time_constant_s,
-                self.params.coast_time_constant_s,
-            );
-        }
-        for _ in 0..pieces as u64 {
-            self.substep(sub_s, parallel);
-        }
-        Ok(())
+        Ok(states as u64)
     }
 
-    fn substep(&mut self, dt: f64, parallel: bool) {
+    /// Advances every robot by `dt_states` clock states (one clock rules it all: the world
+    /// counts the time the robots' MCUs count). The interval is split into
+    /// [`World::substep_plan`]'s equal sub-steps; time is kept as an integer, so no drift and no
+    /// sliver of a sub-step can arise. Zero states do nothing.
+    pub fn advance_states(&mut self, dt_states: u64) {
+        self.advance_states_impl(dt_states, false);
+    }
+
+    /// As [`World::advance_states`], with the per-robot phases (motors, free robots' motion,
+    /// broad-phase candidates, contact search) split over rayon's current thread pool in fixed
+    /// chunks merged in index order; the contact solve runs on one thread in a fixed order.
+    /// Results are bit-identical to [`World::advance_states`] whatever the number of threads.
+    pub fn advance_states_par(&mut self, dt_states: u64) {
+        self.advance_states_impl(dt_states, true);
+    }
+
+    /// How an advance of `dt_states` is cut into sub-steps: `k = ⌈dt / max⌉` pieces (max =
+    /// `max_substep_s` in states), the first `dt mod k` of them one state longer than the rest,
+    /// so they add up to `dt` exactly and differ by at most one state.
+    pub fn substep_plan(&self, dt_states: u64) -> SubstepPlan {
+        SubstepPlan::new(dt_states, self.max_substep_states)
+    }
+
+    /// The longest sub-step, in clock states (`max_substep_s` rounded).
+    pub fn max_substep_states(&self) -> u64 {
+        self.max_substep_states
+    }
+
+    fn advance_states_impl(&mut self, dt_states: u64, parallel: bool) {
+        for len in self.substep_plan(dt_states) {
+            self.substep(len, parallel);
+        }
+    }
+
+    /// The lag coefficients for a sub-step of `len` states (the two lengths of a plan cached).
+    fn lag_for(&mut self, len: u64) -> LagCoefficients {
+        if let Some(&(_, l)) = self.lag_cache.iter().find(|(k, _)| *k == len) {
+            return l;
+        }
+        let l = LagCoefficients::new(
+            len as f64 / self.params.clock_hz as f64,
+            self.params.motor_time_constant_s,
+            self.params.brake_time_constant_s,
+            self.params.coast_time_constant_s,
+        );
+        self.lag_cache.swap(0, 1);
+        self.lag_cache[0] = (len, l);
+        l
+    }
+
+    /// The largest distance two bodies' points can close in a sub-step of `h` seconds under
+    /// their own wheels (each point of a body moves at most `v_max·(1 + 2R/track)`), with a
+    /// margin of 25 % for pushes: contacts nearer than this are handed to the solver.
+    fn speculative_m(&self, h: f64) -> f64 {
+        let vmax = self.params.top_speed_m_per_s * (1.0 + self.params.motor_gain_spread);
+        2.5 * vmax * (1.0 + 2.0 * self.radius_m / self.params.wheel_track_m) * h
+    }
+
+    fn substep(&mut self, len: u64, parallel: bool) {
+        let h = len as f64 / self.params.clock_hz as f64;
         let drive = Drive {
-            lag: self.lag,
+            lag: self.lag_for(len),
             inv_track: 1.0 / self.params.wheel_track_m,
-            dt,
-            drift_limit2: DRIFT_LIMIT_M * DRIFT_LIMIT_M,
+            h,
         };
-        let stale = if parallel && self.pose.len() > PAR_CHUNK {
+        // 1. Motors: the wheel speeds over the sub-step.
+        if parallel && self.pose.len() > PAR_CHUNK {
+            self.motion
+                .par_chunks_mut(PAR_CHUNK)
+                .zip(self.wmean.par_chunks_mut(PAR_CHUNK))
+                .zip(self.prev.par_chunks_mut(PAR_CHUNK))
+                .zip(self.pose.par_chunks(PAR_CHUNK))
+                .for_each(|(((m, w), pr), p)| drive.motors(m, w, pr, p));
+        } else {
+            drive.motors(
+                &mut self.motion,
+                &mut self.wmean,
+                &mut self.prev,
+                &self.pose,
+            );
+        }
+        self.bumpers.fill(0);
+        // 2. Contacts at the start of the sub-step, gaps up to the speculative distance.
+        let spec = self.speculative_m(h);
+        self.find_contacts(spec, h, parallel);
+        // 3. Robots touching nothing follow their wheels exactly; the others are solved.
+        let flags = &self.flags;
+        let moved_free = |p: &mut [BodyPose], v: &mut [[f64; 3]], w: &[[f64; 2]], f: &[u8]| {
+            drive.free(p, v, w, f)
+        };
+        if parallel && self.pose.len() > PAR_CHUNK {
             self.pose
                 .par_chunks_mut(PAR_CHUNK)
-                .zip(self.motion.par_chunks_mut(PAR_CHUNK))
-                .zip(self.prev.par_chunks_mut(PAR_CHUNK))
-                .zip(self.kin.par_chunks_mut(PAR_CHUNK))
-                .zip(self.grid.build_xy.par_chunks(PAR_CHUNK))
-                .map(|((((p, m), pr), k), b)| drive.chunk(p, m, pr, k, b))
-                .reduce(|| false, |a, b| a | b)
+                .zip(self.vel.par_chunks_mut(PAR_CHUNK))
+                .zip(self.wmean.par_chunks(PAR_CHUNK))
+                .zip(flags.par_chunks(PAR_CHUNK))
+                .for_each(|(((p, v), w), f)| moved_free(p, v, w, f));
         } else {
-            drive.chunk(
-                &mut self.pose,
-                &mut self.motion,
-                &mut self.prev,
-                &mut self.kin,
-                &self.grid.build_xy,
+            moved_free(&mut self.pose, &mut self.vel, &self.wmean, flags);
+        }
+        if !self.active.is_empty() {
+            // Warm start from the previous sub-step's impulses of the same contacts and wheels.
+            for ct in self.contacts.iter_mut() {
+                if let Ok(k) = self.warm.binary_search_by(|w| w.0.cmp(&ct.id()))
+                    && self.warm[k].1 == ct.count
+                {
+                    for (p, [ln, lt]) in ct.pts.iter_mut().zip(self.warm[k].2) {
+                        p.ln = WARM_START * ln;
+                        p.lt = WARM_START * lt;
+                    }
+                }
+            }
+            for &i in &self.active {
+                let i = i as usize;
+                if self.solved_at[i] == self.substeps.wrapping_sub(1) {
+                    for x in &mut self.wheel_imp[i] {
+                        *x *= WARM_START;
+                    }
+                } else {
+                    self.wheel_imp[i] = [0.0; 4];
+                }
+                self.solved_at[i] = self.substeps;
+            }
+            self.stats.solver_sweeps += u64::from(solve_velocities(
+                &self.active,
+                &mut self.contacts,
+                &self.pose,
+                &mut self.vel,
+                &self.wmean,
+                &mut self.wheel_imp,
+                &self.body,
+                h,
+                self.params.solver_iterations,
+            ));
+            for k in 0..self.active.len() {
+                let i = self.active[k] as usize;
+                let p = &mut self.pose[i];
+                let v = &mut self.vel[i];
+                let along = v[0] * p.c + v[1] * p.s;
+                let across = -v[0] * p.s + v[1] * p.c;
+                let (dx, dy, c, s) = arc_step_twist(p.c, p.s, along, across, v[2], h);
+                p.x += dx;
+                p.y += dy;
+                p.c = c;
+                p.s = s;
+                v[0] = along * c - across * s;
+                v[1] = along * s + across * c;
+            }
+        }
+        self.warm.clear();
+        self.warm.extend(self.contacts.iter().map(|ct| {
+            (
+                ct.id(),
+                ct.count,
+                [[ct.pts[0].ln, ct.pts[0].lt], [ct.pts[1].ln, ct.pts[1].lt]],
             )
-        };
-        self.bumpers.fill(0);
+        }));
+        self.warm.sort_unstable_by_key(|w| w.0);
+        if !self.checked.is_empty() {
+            // 4. What the linearised solve left of an overlap is corrected.
+            self.clear_overlaps();
+            // 5. A bumper is pressed by a contact that carried force.
+            let threshold = self.params.bumper_force_n * h;
+            for k in 0..self.contacts.len() {
+                let ct = self.contacts[k];
+                if ct.normal_impulse() > threshold {
+                    self.press(ct.a as usize, ct.nx, ct.ny);
+                    if ct.b != WALL {
+                        self.press(ct.b as usize, -ct.nx, -ct.ny);
+                    }
+                }
+            }
+            self.stats.active_robot_substeps += self.active.len() as u64;
+            self.stats.contacts += self.contacts.len() as u64;
+            for &i in &self.checked {
+                self.flags[i as usize] = 0;
+            }
+        }
+        // 6. The broad phase is rebuilt once some robot has drifted too far.
+        let lim2 = self.drift_limit_m * self.drift_limit_m;
+        let stale = self
+            .pose
+            .iter()
+            .zip(&self.grid.build_xy)
+            .any(|(b, [x0, y0])| (b.x - x0) * (b.x - x0) + (b.y - y0) * (b.y - y0) > lim2);
         if stale {
             self.rebuild_broad_phase(parallel);
         }
-        self.full_pass_pending = true;
-        self.resolve_collisions(parallel);
-        self.elapsed_s += dt;
+        self.elapsed_states += len;
         self.substeps += 1;
+        self.stats.substeps += 1;
     }
 
     // ----- collisions ----------------------------------------------------------------------------
@@ -544,20 +849,23 @@ impl World {
     fn rebuild_broad_phase(&mut self, parallel: bool) {
         let pose = &self.pose;
         self.grid.build(pose.iter().map(|b| (b.x, b.y)));
-        let reach = 2.0 * self.radius_m + BROAD_PHASE_MARGIN_M;
+        let reach = 2.0 * self.radius_m + self.margin_m;
         let ctx = CandidateCtx {
             pose,
             grid: &self.grid,
             reach2: reach * reach,
-            radius_m: self.radius_m,
+            wall_reach: self.radius_m + self.margin_m,
             w: self.arena.width_m(),
             h: self.arena.height_m(),
         };
         self.cand.pairs.clear();
         self.cand.walls.clear();
-        self.full_pass_pending = true;
         if parallel && pose.len() > PAR_CHUNK {
-            self.chunk_cands
+            let n_chunks = pose.len().div_ceil(PAR_CHUNK);
+            if self.chunk_cands.len() < n_chunks {
+                self.chunk_cands.resize_with(n_chunks, Candidates::default);
+            }
+            self.chunk_cands[..n_chunks]
                 .par_iter_mut()
                 .enumerate()
                 .for_each(|(k, out)| {
@@ -567,7 +875,7 @@ impl World {
                     let hi = (lo + PAR_CHUNK).min(ctx.pose.len());
                     ctx.find(lo, hi, out);
                 });
-            for c in &self.chunk_cands {
+            for c in &self.chunk_cands[..n_chunks] {
                 self.cand.pairs.extend_from_slice(&c.pairs);
                 self.cand.walls.extend_from_slice(&c.walls);
             }
@@ -576,91 +884,363 @@ impl World {
         }
     }
 
-    /// Pushes overlapping bodies apart (fixed passes, robot index order), then makes sure no
-    /// body penetrates: robots still overlapping lose this sub-step's rotation, and if that
-    /// does not clear them, their whole move (and so on for robots pushed into them).
-    fn resolve_collisions(&mut self, parallel: bool) {
-        if self.cand.pairs.is_empty() && self.cand.walls.is_empty() {
-            return;
-        }
-        if !self.settle(parallel) {
-            self.find_violators();
-        }
-        if !self.violators.is_empty() {
-            // Stage 2: keep the translation, block the rotation.
-            self.epoch += 1;
-            for k in 0..self.violators.len() {
-                let i = self.violators[k] as usize;
-                let p = self.prev[i];
-                self.pose[i] = BodyPose {
-                    x: self.kin[i][0],
-                    y: self.kin[i][1],
-                    c: p.c,
-                    s: p.s,
-                };
-                self.touch(i);
+    /// The contacts of the sub-step: every candidate wall or pair whose manifold has a point
+    /// within `spec` metres, in the candidates' order (walls first, then pairs); marks the
+    /// robots in them active and lists those in index order.
+    fn find_contacts(&mut self, spec: f64, h: f64, parallel: bool) {
+        let probe = Probe {
+            pose: &self.pose,
+            hx: self.hx,
+            hy: self.hy,
+            reach2: (2.0 * self.radius_m + spec) * (2.0 * self.radius_m + spec),
+            w: self.arena.width_m(),
+            h: self.arena.height_m(),
+            spec,
+            body: &self.body,
+        };
+        self.contacts.clear();
+        let n_pairs = self.cand.pairs.len();
+        let n_walls = self.cand.walls.len();
+        if parallel && n_pairs + n_walls > PAR_CHUNK {
+            let chunks = n_pairs.max(n_walls).div_ceil(PAR_CHUNK);
+            if self.chunk_contacts.len() < 2 * chunks {
+                self.chunk_contacts.resize_with(2 * chunks, Vec::new);
             }
-            self.refresh_if_drifted(parallel);
-            if self.settle(parallel) {
-                self.clear_violators();
-            } else {
-                self.find_violators();
+            let cand = &self.cand;
+            self.chunk_contacts[..2 * chunks]
+                .par_iter_mut()
+                .enumerate()
+                .for_each(|(k, out)| {
+                    out.clear();
+                    let lo = (k / 2) * PAR_CHUNK;
+                    if k % 2 == 0 {
+                        probe.walls(
+                            &cand.walls[lo.min(n_walls)..(lo + PAR_CHUNK).min(n_walls)],
+                            out,
+                        );
+                    } else {
+                        probe.pairs(
+                            &cand.pairs[lo.min(n_pairs)..(lo + PAR_CHUNK).min(n_pairs)],
+                            out,
+                        );
+                    }
+                });
+            for c in self.chunk_contacts[..2 * chunks].iter().step_by(2) {
+                self.contacts.extend_from_slice(c);
             }
-            // Stage 3: undo the move of every robot still overlapping, until none does. The
-            // previous state was free of overlaps, so this ends within n rounds.
-            while !self.violators.is_empty() {
-                self.epoch += 1;
-                let mut reverted_any = false;
-                for k in 0..self.violators.len() {
-                    let i = self.violators[k] as usize;
-                    if self.flags[i] & REVERTED == 0 {
-                        self.flags[i] |= REVERTED;
-                        self.pose[i] = self.prev[i];
-                        self.touch(i);
-                        reverted_any = true;
+            for c in self.chunk_contacts[1..2 * chunks].iter().step_by(2) {
+                self.contacts.extend_from_slice(c);
+            }
+        } else {
+            probe.walls(&self.cand.walls, &mut self.contacts);
+            probe.pairs(&self.cand.pairs, &mut self.contacts);
+        }
+        // Which contacts bind: those that the robots' own wheels would close (to within
+        // BIND_MARGIN_M, which covers the chord of a turning corner's arc). A robot in a binding
+        // contact is solved, and so, in turn, is every robot in a contact with a solved one
+        // (its motion is no longer its wheels'); the rest follow their wheels exactly, and
+        // their contacts are checked for overlap after the move.
+        self.active.clear();
+        self.checked.clear();
+        let inv_track = 1.0 / self.params.wheel_track_m;
+        let twist = |i: usize| -> [f64; 3] {
+            let w = self.wmean[i];
+            let v = 0.5 * (w[0] + w[1]);
+            let p = self.pose[i];
+            [v * p.c, v * p.s, (w[1] - w[0]) * inv_track]
+        };
+        for ct in &self.contacts {
+            let a = ct.a as usize;
+            let wall = ct.b == WALL;
+            let ua = twist(a);
+            let ub = if wall { [0.0; 3] } else { twist(ct.b as usize) };
+            let (ca, cb) = (
+                self.pose[a],
+                if wall {
+                    self.pose[a]
+                } else {
+                    self.pose[ct.b as usize]
+                },
+            );
+            let binds = ct.pts[..usize::from(ct.count)].iter().any(|p| {
+                let _ = (ca, cb);
+                let rvx = (ub[0] - ub[2] * p.rb[1]) - (ua[0] - ua[2] * p.ra[1]);
+                let rvy = (ub[1] + ub[2] * p.rb[0]) - (ua[1] + ua[2] * p.ra[0]);
+                p.sep + (rvx * ct.nx + rvy * ct.ny) * h < BIND_MARGIN_M
+            });
+            for i in [ct.a, ct.b] {
+                if i != WALL && self.flags[i as usize] & CHECK == 0 {
+                    self.flags[i as usize] |= CHECK;
+                    self.checked.push(i);
+                }
+            }
+            if binds {
+                for i in [ct.a, ct.b] {
+                    if i != WALL {
+                        self.flags[i as usize] |= ACTIVE;
                     }
                 }
-                if !reverted_any {
+            }
+        }
+        loop {
+            let mut grew = false;
+            for ct in &self.contacts {
+                if ct.b == WALL {
+                    continue;
+                }
+                let (fa, fb) = (self.flags[ct.a as usize], self.flags[ct.b as usize]);
+                if (fa ^ fb) & ACTIVE != 0 {
+                    self.flags[ct.a as usize] |= ACTIVE;
+                    self.flags[ct.b as usize] |= ACTIVE;
+                    grew = true;
+                }
+            }
+            if !grew {
+                break;
+            }
+        }
+        let flags = &self.flags;
+        self.contacts
+            .retain(|ct| flags[ct.a as usize] & ACTIVE != 0);
+        for ct in &self.contacts {
+            for i in [ct.a, ct.b] {
+                if i != WALL && self.flags[i as usize] & LISTED == 0 {
+                    self.flags[i as usize] |= LISTED;
+                    self.active.push(i);
+                }
+            }
+        }
+        self.active.sort_unstable();
+        self.checked.sort_unstable();
+    }
+
+    /// Removes the overlaps the velocity solve left (a rotation is linearised in it; a cluster
+    /// may not have converged): position sweeps over the overlapping pairs and walls, each
+    /// pushing the bodies apart along the contact normal with rotation, weighted by mass and
+    /// inertia, to [`CONTACT_SKIN_M`]; after every sweep the candidates of the robots it moved
+    /// are tested again. What is still overlapping after `position_iterations` sweeps stops
+    /// early: its robots move only the largest fraction (1/2, 1/4, …, 0) of this sub-step's
+    /// motion at which nothing overlaps (a time of impact: no body jumps anywhere, it is only
+    /// kept from going on), and so do robots whose motion ends in those robots.
+    fn clear_overlaps(&mut self) {
+        self.epoch += 1;
+        let mut since = self.epoch;
+        for k in 0..self.checked.len() {
+            let i = self.checked[k] as usize;
+            self.last_move[i] = self.epoch;
+        }
+        let mut first = true;
+        for _ in 0..self.params.position_iterations {
+            self.collect_overlaps(since);
+            if self.overlaps.pairs.is_empty() && self.overlaps.walls.is_empty() {
+                return;
+            }
+            if first {
+                self.stats.overlap_substeps += 1;
+                first = false;
+            }
+            self.stats.position_sweeps += 1;
+            self.epoch += 1;
+            since = self.epoch;
+            let list = core::mem::take(&mut self.overlaps);
+            for &i in &list.walls {
+                self.correct_wall(i as usize);
+            }
+            for &[i, j] in &list.pairs {
+                self.correct_pair(i as usize, j as usize);
+            }
+            self.overlaps = list;
+        }
+        self.collect_overlaps(since);
+        if !self.overlaps.pairs.is_empty() || !self.overlaps.walls.is_empty() {
+            self.stop_early();
+        }
+    }
+
+    /// The candidates with a robot moved at or after epoch `since` that overlap now, into
+    /// `overlaps`.
+    fn collect_overlaps(&mut self, since: u64) {
+        self.overlaps.pairs.clear();
+        self.overlaps.walls.clear();
+        let moved = &self.last_move;
+        let (w, h) = (self.arena.width_m(), self.arena.height_m());
+        for &i in &self.cand.walls {
+            if moved[i as usize] >= since
+                && self.pose[i as usize].crosses_walls(self.hx, self.hy, w, h)
+            {
+                self.overlaps.walls.push(i);
+            }
+        }
+        let reach2 = 4.0 * self.radius_m * self.radius_m;
+        for &[i, j] in &self.cand.pairs {
+            if moved[i as usize] < since && moved[j as usize] < since {
+                continue;
+            }
+            let (a, b) = (self.pose[i as usize], self.pose[j as usize]);
+            if (b.x - a.x) * (b.x - a.x) + (b.y - a.y) * (b.y - a.y) >= reach2 {
+                continue;
+            }
+            if obb_overlap(&self.obb(i as usize), &self.obb(j as usize), 0.0).is_some() {
+                self.overlaps.pairs.push([i, j]);
+            }
+        }
+    }
+
+    /// Moves and turns robot `i` by a position impulse (px, py) applied at lever arm r.
+    #[inline]
+    fn nudge(&mut self, i: usize, px: f64, py: f64, r: [f64; 2]) {
+        let b = &mut self.pose[i];
+        b.x += px * self.body.inv_m;
+        b.y += py * self.body.inv_m;
+        let dtheta = (r[0] * py - r[1] * px) * self.body.inv_i;
+        if dtheta != 0.0 {
+            let (sn, cs) = dtheta.sin_cos();
+            let (c, s) = (b.c * cs - b.s * sn, b.s * cs + b.c * sn);
+            let k = 1.5 - 0.5 * (c * c + s * s);
+            b.c = c * k;
+            b.s = s * k;
+        }
+        self.last_move[i] = self.epoch;
+    }
+
+    /// One position correction of robot `i` against the walls: per wall in contact, the
+    /// deepest point is pushed out to the skin, then the manifold is taken again (a corner
+    /// pushed out turns the body, which moves the other corner).
+    fn correct_wall(&mut self, i: usize) {
+        let skin = CONTACT_SKIN_M;
+        for _ in 0..4 {
+            let mut deepest: Option<(Manifold, usize)> = None;
+            box_walls(
+                &self.obb(i),
+                self.arena.width_m(),
+                self.arena.height_m(),
+                skin,
+                |m| {
+                    for k in 0..m.count {
+                        if deepest.is_none_or(|(d, dk)| m.points[k].sep < d.points[dk].sep) {
+                            deepest = Some((m, k));
+                        }
+                    }
+                },
+            );
+            let Some((m, k)) = deepest else {
+                return;
+            };
+            let p = m.points[k];
+            let c = p.sep - skin;
+            if c >= 0.0 {
+                return;
+            }
+            self.press(i, m.nx, m.ny);
+            let b = self.pose[i];
+            let r = [p.x - b.x, p.y - b.y];
+            let rn = r[0] * m.ny - r[1] * m.nx;
+            let kn = self.body.inv_m + self.body.inv_i * rn * rn;
+            // The wall does not give way: the body takes the whole push, into the arena.
+            let lambda = -c / kn;
+            self.nudge(i, -lambda * m.nx, -lambda * m.ny, r);
+        }
+    }
+
+    /// One position correction of the pair (i, j): the deepest point of their manifold is
+    /// pushed apart to the skin, shared by mass and inertia, then the manifold is taken again
+    /// for the other point.
+    fn correct_pair(&mut self, i: usize, j: usize) {
+        let skin = CONTACT_SKIN_M;
+        for _ in 0..2 {
+            let Some(m) = box_box(&self.obb(i), &self.obb(j), skin) else {
+                return;
+            };
+            let k = if m.count == 2 && m.points[1].sep < m.points[0].sep {
+                1
+            } else {
+                0
+            };
+            let p = m.points[k];
+            let c = p.sep - skin;
+            if c >= 0.0 {
+                return;
+            }
+            self.press(i, m.nx, m.ny);
+            self.press(j, -m.nx, -m.ny);
+            let (a, b) = (self.pose[i], self.pose[j]);
+            let ra = [p.x - a.x, p.y - a.y];
+            let rb = [p.x - b.x, p.y - b.y];
+            let rna = ra[0] * m.ny - ra[1] * m.nx;
+            let rnb = rb[0] * m.ny - rb[1] * m.nx;
+            let kn = 2.0 * self.body.inv_m + self.body.inv_i * (rna * rna + rnb * rnb);
+            let lambda = -c / kn;
+            self.nudge(i, -lambda * m.nx, -lambda * m.ny, ra);
+            self.nudge(j, lambda * m.nx, lambda * m.ny, rb);
+        }
+    }
+
+    /// The last resort when position sweeps leave an overlap: the robots involved (and, in
+    /// turn, any robot whose end pose overlaps their stopped poses) move only a fraction of
+    /// this sub-step's motion, the largest of 1, 1/2, …, 1/1024, 0 at which nothing they touch
+    /// overlaps. Their start poses were free of overlaps, so this ends.
+    fn stop_early(&mut self) {
+        let mut group: Vec<u32> = Vec::new();
+        let mut ends: Vec<BodyPose> = Vec::new();
+        let add = |i: u32, group: &mut Vec<u32>, ends: &mut Vec<BodyPose>, pose: &[BodyPose]| {
+            if !group.contains(&i) {
+                group.push(i);
+                ends.push(pose[i as usize]);
+            }
+        };
+        for &i in &self.overlaps.walls {
+            add(i, &mut group, &mut ends, &self.pose);
+        }
+        for &[i, j] in &self.overlaps.pairs {
+            add(i, &mut group, &mut ends, &self.pose);
+            add(j, &mut group, &mut ends, &self.pose);
+        }
+        loop {
+            let mut fraction = 1.0;
+            let mut clear = false;
+            for _ in 0..=11 {
+                fraction = if fraction > 1.0 / 1024.0 {
+                    fraction * 0.5
+                } else {
+                    0.0
+                };
+                self.epoch += 1;
+                for (k, &i) in group.iter().enumerate() {
+                    let i = i as usize;
+                    self.pose[i] = interpolate(self.prev[i], ends[k], fraction);
+                    self.last_move[i] = self.epoch;
+                }
+                self.collect_overlaps(self.epoch);
+                if self.overlaps.pairs.is_empty() && self.overlaps.walls.is_empty() {
+                    clear = true;
                     break;
                 }
-                self.refresh_if_drifted(parallel);
-                self.find_violators();
+                if fraction == 0.0 {
+                    break;
+                }
+            }
+            if clear {
+                break;
+            }
+            // At fraction 0 the group is where it started, free of overlaps among itself: what
+            // still overlaps is a robot outside the group ending in it, which joins the group.
+            let before = group.len();
+            for &i in &self.overlaps.walls {
+                add(i, &mut group, &mut ends, &self.pose);
+            }
+            for k in 0..self.overlaps.pairs.len() {
+                let [i, j] = self.overlaps.pairs[k];
+                add(i, &mut group, &mut ends, &self.pose);
+                add(j, &mut group, &mut ends, &self.pose);
+            }
+            if group.len() == before {
+                break;
             }
         }
-        for &i in &self.touched {
-            self.flags[i as usize] = 0;
+        for &i in &group {
+            self.vel[i as usize] = [0.0; 3];
         }
-        self.touched.clear();
-        self.violators.clear();
-    }
-
-    /// Resolution passes until a clean pass on a current candidate list (at most a few
-    /// rebuilds); returns whether the last pass was clean, i.e. nothing overlaps.
-    fn settle(&mut self, parallel: bool) -> bool {
-        for _ in 0..3 {
-            let clean = self.resolve_passes(parallel);
-            if !self.refresh_if_drifted(parallel) {
-                return clean;
-            }
-        }
-        false
-    }
-
-    fn clear_violators(&mut self) {
-        for &i in &self.violators {
-            self.flags[i as usize] &= !VIOLATOR;
-        }
-        self.violators.clear();
-    }
-
-    /// Records that robot `i` moved (or is about to be moved) in the current epoch.
-    #[inline]
-    fn touch(&mut self, i: usize) {
-        self.last_move[i] = self.epoch;
-        if self.flags[i] & TOUCHED == 0 {
-            self.flags[i] |= TOUCHED;
-            self.touched.push(i as u32);
-        }
+        self.stats.stopped_robot_substeps += group.len() as u64;
     }
 
     /// Presses the bumper of robot `i` that faces the world direction (fx, fy).
@@ -671,40 +1251,6 @@ impl World {
         self.bumpers[i] |= 1 << side;
     }
 
-    /// Resolves robot `i` against the walls; returns whether it had to move.
-    fn resolve_wall(&mut self, i: usize) -> bool {
-        let (ex, ey) = self.obb(i).aabb_half_extents();
-        let (w, h) = (self.arena.width_m(), self.arena.height_m());
-        let mut b = self.pose[i];
-        let mut hit = false;
-        if b.x - ex < 0.0 {
-            b.x = ex + CONTACT_SKIN_M;
-            self.press(i, -1.0, 0.0);
-            hit = true;
-        }
-        if b.x + ex > w {
-            b.x = w - ex - CONTACT_SKIN_M;
-            self.press(i, 1.0, 0.0);
-            hit = true;
-        }
-        if b.y - ey < 0.0 {
-            b.y = ey + CONTACT_SKIN_M;
-            self.press(i, 0.0, -1.0);
-            hit = true;
-        }
-        if b.y + ey > h {
-            b.y = h - ey - CONTACT_SKIN_M;
-            self.press(i, 0.0, 1.0);
-            hit = true;
-        }
-        if hit {
-            self.pose[i] = b;
-            self.touch(i);
-            self.flags[i] |= PINNED;
-        }
-        hit
-    }
-
     fn wall_penetration(&self, i: usize) -> bool {
         self.pose[i].crosses_walls(
             self.hx,
@@ -712,219 +1258,6 @@ impl World {
             self.arena.width_m(),
             self.arena.height_m(),
         )
-    }
-
-    /// Resolves the pair (i, j); returns whether they overlapped.
-    fn resolve_pair(&mut self, i: usize, j: usize) -> bool {
-        let (a, b) = (self.pose[i], self.pose[j]);
-        let (dx, dy) = (b.x - a.x, b.y - a.y);
-        if dx * dx + dy * dy >= 4.0 * self.radius_m * self.radius_m {
-            return false;
-        }
-        let Some(o) = obb_overlap(&self.obb(i), &self.obb(j), 0.0) else {
-            return false;
-        };
-        // Equal bodies share the push; a body held by a wall (directly or through a chain of
-        // bodies) does not give way, so the other takes all of it and is held in turn. The MTV
-        // removes the motion into the contact.
-        let total = o.depth_m + CONTACT_SKIN_M;
-        let pinned_i = self.flags[i] & PINNED != 0;
-        let pinned_j = self.flags[j] & PINNED != 0;
-        let (push_i, push_j) = match (pinned_i, pinned_j) {
-            (true, false) => {
-                self.flags[j] |= PINNED;
-                (0.0, total)
-            }
-            (false, true) => {
-                self.flags[i] |= PINNED;
-                (total, 0.0)
-            }
-            _ => (0.5 * total, 0.5 * total),
-        };
-        self.pose[i].x -= o.nx * push_i;
-        self.pose[i].y -= o.ny * push_i;
-        self.pose[j].x += o.nx * push_j;
-        self.pose[j].y += o.ny * push_j;
-        self.press(i, o.nx, o.ny);
-        self.press(j, -o.nx, -o.ny);
-        self.touch(i);
-        self.touch(j);
-        true
-    }
-
-    /// Up to `collision_iterations` passes over the candidates in robot index order (each
-    /// robot: walls, then its pairs with higher-index robots); stops early after a clean pass
-    /// and returns whether there was one (then nothing overlaps).
-    ///
-    /// The first pass after the kinematics (or after a broad-phase rebuild) goes over every
-    /// candidate; a later pass only over the candidates with a robot moved by the previous
-    /// pass (or by a stage of `resolve_collisions`): the others were clean when last checked
-    /// and neither robot has moved since.
-    fn resolve_passes(&mut self, parallel: bool) -> bool {
-        for _ in 0..self.params.collision_iterations {
-            if self.full_pass_pending {
-                self.full_pass_pending = false;
-                self.detect_overlaps(parallel);
-            } else {
-                self.filter_hot(self.epoch);
-            }
-            self.epoch += 1;
-            let list = core::mem::take(&mut self.hot);
-            let any = self.pass(&list);
-            self.hot = list;
-            if !any {
-                return true;
-            }
-        }
-        false
-    }
-
-    /// The candidates that overlap now, into `hot` in the candidates' order: the first pass
-    /// of a sub-step (or after a rebuild) resolves exactly these, in index order. A pair that
-    /// only comes to overlap during that pass has a robot moved by it, so the next pass takes
-    /// it. The test only reads the poses, so it runs per chunk of candidates on rayon's pool
-    /// when `parallel`, with the same result.
-    fn detect_overlaps(&mut self, parallel: bool) {
-        let probe = Probe {
-            pose: &self.pose,
-            hx: self.hx,
-            hy: self.hy,
-            reach2: 4.0 * self.radius_m * self.radius_m,
-            w: self.arena.width_m(),
-            h: self.arena.height_m(),
-        };
-        self.hot.pairs.clear();
-        self.hot.walls.clear();
-        let n_pairs = self.cand.pairs.len();
-        let n_walls = self.cand.walls.len();
-        if parallel && n_pairs + n_walls > PAR_CHUNK {
-            let chunks = n_pairs.max(n_walls).div_ceil(PAR_CHUNK);
-            if self.chunk_cands.len() < chunks {
-                self.chunk_cands.resize_with(chunks, Candidates::default);
-            }
-            let cand = &self.cand;
-            self.chunk_cands[..chunks]
-                .par_iter_mut()
-                .enumerate()
-                .for_each(|(k, out)| {
-                    out.pairs.clear();
-                    out.walls.clear();
-                    let lo = k * PAR_CHUNK;
-                    let pairs = &cand.pairs[lo.min(n_pairs)..(lo + PAR_CHUNK).min(n_pairs)];
-                    let walls = &cand.walls[lo.min(n_walls)..(lo + PAR_CHUNK).min(n_walls)];
-                    probe.collect(pairs, walls, out);
-                });
-            for c in &self.chunk_cands[..chunks] {
-                self.hot.pairs.extend_from_slice(&c.pairs);
-            }
-            for c in &self.chunk_cands[..chunks] {
-                self.hot.walls.extend_from_slice(&c.walls);
-            }
-        } else {
-            probe.collect(&self.cand.pairs, &self.cand.walls, &mut self.hot);
-        }
-    }
-
-    /// One pass over `list` in robot index order; returns whether anything overlapped.
-    fn pass(&mut self, list: &Candidates) -> bool {
-        let mut any = false;
-        let (mut pw, mut pp) = (0, 0);
-        loop {
-            let wi = list.walls.get(pw).map_or(u32::MAX, |&i| i);
-            let pi = list.pairs.get(pp).map_or(u32::MAX, |p| p[0]);
-            let i = wi.min(pi);
-            if i == u32::MAX {
-                break;
-            }
-            if wi == i {
-                any |= self.resolve_wall(i as usize);
-                pw += 1;
-            }
-            while pp < list.pairs.len() && list.pairs[pp][0] == i {
-                any |= self.resolve_pair(i as usize, list.pairs[pp][1] as usize);
-                pp += 1;
-            }
-        }
-        any
-    }
-
-    /// The candidates with a robot moved at or after `since` (all of them if a full pass is
-    /// pending), into `hot`, in the candidates' order.
-    fn filter_hot(&mut self, since: u64) {
-        self.hot.walls.clear();
-        self.hot.pairs.clear();
-        if self.full_pass_pending {
-            self.hot.walls.extend_from_slice(&self.cand.walls);
-            self.hot.pairs.extend_from_slice(&self.cand.pairs);
-            return;
-        }
-        let moved = &self.last_move;
-        self.hot.walls.extend(
-            self.cand
-                .walls
-                .iter()
-                .filter(|&&i| moved[i as usize] >= since),
-        );
-        self.hot.pairs.extend(
-            self.cand
-                .pairs
-                .iter()
-                .filter(|p| moved[p[0] as usize] >= since || moved[p[1] as usize] >= since),
-        );
-    }
-
-    /// Rebuilds the broad phase if a robot moved more than half the margin since the build;
-    /// returns whether it did.
-    fn refresh_if_drifted(&mut self, parallel: bool) -> bool {
-        let lim2 = DRIFT_LIMIT_M * DRIFT_LIMIT_M;
-        let drifted = self.touched.iter().any(|&i| {
-            let b = self.pose[i as usize];
-            let [x0, y0] = self.grid.build_xy[i as usize];
-            (b.x - x0) * (b.x - x0) + (b.y - y0) * (b.y - y0) > lim2
-        });
-        if drifted {
-            self.rebuild_broad_phase(parallel);
-        }
-        drifted
-    }
-
-    /// Lists (in index order) every robot that penetrates a wall or another body, and presses
-    /// the bumpers of those contacts.
-    fn find_violators(&mut self) {
-        self.clear_violators();
-        // Only candidates with a robot moved in the latest pass or stage can overlap (see
-        // `resolve_passes`).
-        self.filter_hot(self.epoch);
-        self.full_pass_pending = false;
-        for k in 0..self.hot.walls.len() {
-            let i = self.hot.walls[k] as usize;
-            if self.wall_penetration(i) {
-                self.flags[i] |= VIOLATOR;
-            }
-        }
-        for k in 0..self.hot.pairs.len() {
-            let [i, j] = self.hot.pairs[k];
-            let (i, j) = (i as usize, j as usize);
-            if let Some(o) = obb_overlap(&self.obb(i), &self.obb(j), 0.0) {
-                self.press(i, o.nx, o.ny);
-                self.press(j, -o.nx, -o.ny);
-                self.flags[i] |= VIOLATOR;
-                self.flags[j] |= VIOLATOR;
-            }
-        }
-        // Collect the flagged robots in index order.
-        let mut list = core::mem::take(&mut self.violators);
-        for &i in self.hot.walls.iter().chain(self.hot.pairs.iter().flatten()) {
-            if self.flags[i as usize] & VIOLATOR != 0 {
-                list.push(i);
-            }
-        }
-        list.sort_unstable();
-        list.dedup();
-        for &i in &list {
-            self.touch(i as usize);
-        }
-        self.violators = list;
     }
 
     /// The first overlapping pair (lower index first) with its depth, by brute force over the
@@ -940,6 +1273,27 @@ impl World {
             }
         }
         best
+    }
+
+    /// The deepest overlap between any two bodies or a body and a wall now, metres (0 when
+    /// nothing overlaps), by brute force over the broad-phase candidates: a check, not used by
+    /// the simulation.
+    pub fn deepest_overlap_m(&self) -> f64 {
+        let mut deepest: f64 = 0.0;
+        for &[i, j] in &self.cand.pairs {
+            if let Some(o) = obb_overlap(&self.obb(i as usize), &self.obb(j as usize), 0.0) {
+                deepest = deepest.max(o.depth_m);
+            }
+        }
+        let (w, h) = (self.arena.width_m(), self.arena.height_m());
+        for i in 0..self.pose.len() {
+            let b = self.pose[i];
+            let (ex, ey) = self.obb(i).aabb_half_extents();
+            for d in [ex - b.x, b.x + ex - w, ey - b.y, b.y + ey - h] {
+                deepest = deepest.max(d);
+            }
+        }
+        deepest
     }
 
     // ----- sensing -------------------------------------------------------------------------------
@@ -982,7 +1336,7 @@ impl World {
         };
         // Cells whose robots (filed by their centre at the last build, which may have moved
         // up to half the margin since) can reach the segment.
-        let pad = self.radius_m + DRIFT_LIMIT_M;
+        let pad = self.radius_m + self.drift_limit_m;
         let (ex, ey) = (ox + dx * t_max, oy + dy * t_max);
         let c0 = self.grid.col(ox.min(ex) - pad);
         let c1 = self.grid.col(ox.max(ex) + pad);
@@ -1100,39 +1454,31 @@ fn outside(robot: usize, p: &Pose, arena: &Arena) -> WorldError {
     }
 }
 
-/// What the motor and kinematics phase needs for one sub-step.
+/// What the motor and free-motion phases need for one sub-step.
 #[derive(Clone, Copy)]
 struct Drive {
     lag: LagCoefficients,
     inv_track: f64,
-    dt: f64,
-    drift_limit2: f64,
+    h: f64,
 }
 
+/// The wheel-speed difference below which a wheel is taken to have reached its target speed:
+/// 1e-12 m/s, a picometre per second, far below anything the model resolves.
+const SPEED_SNAP_M_S: f64 = 1e-12;
+
 impl Drive {
-    /// Motors and kinematics for a slice of robots: wheel speeds follow their targets with the
-    /// exact first-order lag, and the body moves along the exact arc of the sub-step's mean
-    /// wheel speeds (exact heading change and, for straight motion, exact distance). Returns
-    /// whether some robot is now farther than the drift limit from where the broad phase last
-    /// filed it.
-    fn chunk(
+    /// Motors for a slice of robots: wheel speeds follow their targets with the exact
+    /// first-order lag; `wmean` gets each wheel's mean speed over the sub-step (the exact
+    /// integral of the lag) and `prev` the pose at its start.
+    fn motors(
         &self,
-        pose: &mut [BodyPose],
         motion: &mut [Motion],
+        wmean: &mut [[f64; 2]],
         prev: &mut [BodyPose],
-        kin: &mut [[f64; 2]],
-        build_xy: &[[f64; 2]],
-    ) -> bool {
-        let mut stale = false;
-        for ((((p, m), pr), k), b) in pose
-            .iter_mut()
-            .zip(motion.iter_mut())
-            .zip(prev.iter_mut())
-            .zip(kin.iter_mut())
-            .zip(build_xy)
-        {
+        pose: &[BodyPose],
+    ) {
+        for (((m, mean), pr), p) in motion.iter_mut().zip(wmean).zip(prev).zip(pose) {
             *pr = *p;
-            let mut mean = [0.0; 2];
             for (w, mean_w) in mean.iter_mut().enumerate() {
                 let l = self.lag.by_mode[usize::from(m.mode[w]).min(2)];
                 let mut diff = m.speed[w] - m.target[w];
@@ -1145,51 +1491,90 @@ impl Drive {
                 *mean_w = m.target[w] + diff * l.mean_factor;
                 m.speed[w] = m.target[w] + diff * l.decay;
             }
-            let v = 0.5 * (mean[0] + mean[1]);
-            let omega = (mean[1] - mean[0]) * self.inv_track;
-            let (dx, dy, c, s) = arc_step(p.c, p.s, v, omega, self.dt);
+        }
+    }
+
+    /// Robots touching nothing (no `ACTIVE` flag) follow their wheels: the exact arc of the
+    /// sub-step's mean wheel speeds (exact heading change and, for straight motion, exact
+    /// distance); their velocity becomes the wheels' twist.
+    fn free(&self, pose: &mut [BodyPose], vel: &mut [[f64; 3]], wmean: &[[f64; 2]], flags: &[u8]) {
+        for (((p, v), w), &f) in pose.iter_mut().zip(vel).zip(wmean).zip(flags) {
+            if f & ACTIVE != 0 {
+                continue;
+            }
+            let along = 0.5 * (w[0] + w[1]);
+            let omega = (w[1] - w[0]) * self.inv_track;
+            let (dx, dy, c, s) = arc_step(p.c, p.s, along, omega, self.h);
             p.x += dx;
             p.y += dy;
             p.c = c;
             p.s = s;
-            *k = [p.x, p.y];
-            let (ddx, ddy) = (p.x - b[0], p.y - b[1]);
-            stale |= ddx * ddx + ddy * ddy > self.drift_limit2;
+            *v = [along * c, along * s, omega];
         }
-        stale
     }
 }
 
-/// What the overlap detection reads.
+/// What the contact search reads.
 struct Probe<'a> {
     pose: &'a [BodyPose],
     hx: f64,
     hy: f64,
-    /// Squared distance between centres beyond which bodies cannot touch.
+    /// Squared distance between centres beyond which bodies cannot come within `spec`.
     reach2: f64,
     w: f64,
     h: f64,
+    spec: f64,
+    body: &'a BodyConst,
 }
 
 impl Probe<'_> {
-    /// Appends the overlapping pairs and the robots penetrating a wall, in the given order.
-    fn collect(&self, pairs: &[[u32; 2]], walls: &[u32], out: &mut Candidates) {
+    /// Appends the wall contacts of the robots `walls`, in order.
+    fn walls(&self, walls: &[u32], out: &mut Vec<Contact>) {
         for &i in walls {
-            if self.pose[i as usize].crosses_walls(self.hx, self.hy, self.w, self.h) {
-                out.walls.push(i);
+            let b = self.pose[i as usize];
+            let (ex, ey) = b.obb(self.hx, self.hy).aabb_half_extents();
+            let near = b.x - ex <= self.spec
+                || b.x + ex >= self.w - self.spec
+                || b.y - ey <= self.spec
+                || b.y + ey >= self.h - self.spec;
+            if !near {
+                continue;
             }
+            box_walls(&b.obb(self.hx, self.hy), self.w, self.h, self.spec, |m| {
+                out.push(Contact::new(i, WALL, &m, (b.x, b.y), (0.0, 0.0), self.body));
+            });
         }
+    }
+
+    /// Appends the contacts of the candidate pairs, in order.
+    fn pairs(&self, pairs: &[[u32; 2]], out: &mut Vec<Contact>) {
         for &[i, j] in pairs {
             let (a, b) = (self.pose[i as usize], self.pose[j as usize]);
             let (dx, dy) = (b.x - a.x, b.y - a.y);
             if dx * dx + dy * dy >= self.reach2 {
                 continue;
             }
-            let (oa, ob) = (a.obb(self.hx, self.hy), b.obb(self.hx, self.hy));
-            if obb_overlap(&oa, &ob, 0.0).is_some() {
-                out.pairs.push([i, j]);
+            if let Some(m) = box_box(
+                &a.obb(self.hx, self.hy),
+                &b.obb(self.hx, self.hy),
+                self.spec,
+            ) {
+                out.push(Contact::new(i, j, &m, (a.x, a.y), (b.x, b.y), self.body));
             }
         }
+    }
+}
+
+/// The pose a fraction `f` of the way from `a` to `b` (position linearly, heading by the
+/// shorter rotation).
+fn interpolate(a: BodyPose, b: BodyPose, f: f64) -> BodyPose {
+    let dtheta = (a.c * b.s - a.s * b.c).atan2(a.c * b.c + a.s * b.s);
+    let (sn, cs) = (f * dtheta).sin_cos();
+    BodyPose {
+        x: a.x + f * (b.x - a.x),
+        y: a.y + f * (b.y - a.y),
+        c: a.c * cs - a.s * sn,
+        s: a.s * cs + a.c * sn,
     }
 }
 
@@ -1198,7 +1583,8 @@ struct CandidateCtx<'a> {
     pose: &'a [BodyPose],
     grid: &'a Grid,
     reach2: f64,
-    radius_m: f64,
+    /// A robot whose centre is nearer a wall than this is a wall candidate.
+    wall_reach: f64,
     w: f64,
     h: f64,
 }
@@ -1212,7 +1598,7 @@ impl CandidateCtx<'_> {
         for i in lo..hi {
             let b = self.pose[i];
             // By the bounding circle, so that turning cannot bring a body to a wall unseen.
-            let e = self.radius_m + BROAD_PHASE_MARGIN_M;
+            let e = self.wall_reach;
             if b.x - e < 0.0 || b.x + e > self.w || b.y - e < 0.0 || b.y + e > self.h {
                 out.walls.push(i as u32);
             }
