@@ -1,25 +1,23 @@
 #!/usr/bin/env bash
-# Reproduces every figure of the README's "The swarm experiment": the paper's two settings with
-# the defaults (5 repeats), the arena with 10 and 100 robots, both settings with 20 repeats, and
-# the change that makes the arena's claims hold. Each run's folder holds metrics.csv,
-# summary.json, the plots and fit.json; the claims and window means are printed.
+# Reproduces the README's "The swarm experiment": the paper's two settings (arena, corridor)
+# with seeds 1-5 x 20 repeats each, for both sensor mountings (the default 8 cm set-back and
+# the body surface), then the claims table over the seeds (scripts/claims-table.py).
 #
-#   scripts/paper-runs.sh [OUT]      (default OUT: out/paper; about 2 minutes on 2 cores)
+#   scripts/paper-runs.sh [OUT] [THREADS]   (default OUT: out/paper, THREADS: 2)
+#
+# About 15 minutes on this 2-core machine with model robots.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${1:-out/paper}
+threads=${2:-2}
 cargo build --release --quiet
-run() {
-    local name=$1
-    shift
-    echo "## $name: h8swarm run $*"
-    cargo run --release --quiet -- run "$@" --out "$out/$name" | sed -n '/^wall/p;/^condition/,/^fit:/p'
-    echo
-}
-run arena arena
-run corridor corridor
-run arena-10 arena --robots 10
-run arena-100 arena --robots 100
-run arena-20rep arena --repeats 20
-run corridor-20rep corridor --repeats 20
-run arena-history0-20rep scenarios/arena-history0.toml --repeats 20
+bin=${CARGO_TARGET_DIR:-target}/release/h8swarm
+for scenario in arena corridor scenarios/arena-surface.toml scenarios/corridor-surface.toml; do
+    name=$(basename "$scenario" .toml)
+    for seed in 1 2 3 4 5; do
+        echo "## $name seed $seed"
+        "$bin" run "$scenario" --repeats 20 --seed "$seed" --threads "$threads" \
+            --out "$out/$name-seed$seed" | sed -n '/^wall/p;/^HOLDS\|^FAILS/p'
+    done
+done
+python3 scripts/claims-table.py "$out"

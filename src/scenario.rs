@@ -71,9 +71,10 @@ pub struct WorldSpec {
     /// Farthest distance a sensor ray reports, metres.
     pub sensor_range_m: f64,
     /// How far each IR sensor sits inside the body, back from the middle of its side along
-    /// its axis, metres (0 = on the side, SPEC §3.1; at most 0.08). Setting a GP2D12-class
-    /// sensor back by its 8 cm fold-back zone is the datasheet's remedy for the ambiguous
-    /// reading at contact.
+    /// its axis, metres (0 = on the side; at most 0.08). Default 0.08: a GP2D12-class sensor
+    /// reads unambiguously only from 8 cm (its curve folds back nearer, SPEC §3.1), so set back
+    /// by 8 cm an obstacle touching the body reads as near as the curve allows (the peak,
+    /// about 3.2 V), where on the surface it would read as 28–42 cm.
     pub sensor_setback_m: f64,
 }
 
@@ -245,7 +246,10 @@ impl Default for WorldSpec {
             // sampled 22 times per 0.45 s step.
             substep_s: world::params::MAX_SUBSTEP_S,
             sensor_range_m: world::params::SENSOR_MAX_RANGE_M,
-            sensor_setback_m: 0.0,
+            // Set back by the end of the sensor's fold-back zone (SPEC §3.1: the curve peaks at
+            // 8 cm and falls again nearer), so that an obstacle touching the body reads as near
+            // as the curve allows instead of folding back to a far reading.
+            sensor_setback_m: sensors::curve::FAR_BRANCH_MIN_MM / 1000.0,
         }
     }
 }
