@@ -19,8 +19,11 @@
 //!    controller the robot runs, checked against the firmware). It knows the chip and the core.
 //!
 //! The arrows point one way by construction: the core reaches everything through
-//! [`core::bus::Bus`], which carries no firmware shortcut (the model's two go through its own
-//! [`board::model::ModelBus`], implemented for the chip); the chip numbers its own pins and
+//! [`core::bus::Bus`], which carries no firmware shortcut (its promises are about the chip:
+//! which fetches touch no device, until when the interrupt decision and a register's reads
+//! stay as they are, which the core's fast path and loop fast-forwarding use; the model's
+//! transaction-level save goes through its own [`board::model::ModelBus`], implemented for the
+//! chip); the chip numbers its own pins and
 //! leaves what they drive to [`board::wiring`]; and every on-chip module is a
 //! [`chip::periph::Peripheral`] that declares the I/O block it owns, so the chip dispatches by
 //! those blocks.
@@ -29,8 +32,10 @@
 //! [`chip::mcu::Mcu`]: same bus, same peripherals, same timing.
 //!
 //! # Choices where the spec and the manuals are silent
-//! - Timing: every fetch and data access goes through [`core::bus::Bus`] and is charged by the
-//!   area it touches; internal states and the branch-target prefetch of one-word branches come from
+//! - Timing: every fetch and data access is charged through [`core::bus::Bus`] by the area it
+//!   touches (the core's fast path charges a cached ROM instruction's fetches as one lump of
+//!   the same states, and its loop fast-forwarding charges skipped iterations in closed form:
+//!   the same clock either way, see [`core::cpu`]); internal states and the branch-target prefetch of one-word branches come from
 //!   [`core::cpu::timing`] (programming manual Appendix A). Interrupt entry costs the priority
 //!   decision (1 state for on-chip sources, 2 for NMI/IRQ) + 16 states; the "wait for the end of
 //!   the current instruction" of the hardware manual's Table 5-5 overlaps the instruction,

@@ -278,7 +278,28 @@ enum Piece {
     StartTimer(u16),
     /// `sleep`: halts with interrupts masked, else waits for the next interrupt.
     Sleep,
+    /// A delay loop for the core's fast-forwarding: `mov #init,rd; 1: op rd; bne 1b` with op
+    /// (by `kind` modulo 5) ADD #amount, SUB #amount (word, long), INC, DEC (by 1 or 2),
+    /// on a byte, word or long register other than the stack pointer.
+    Countdown {
+        size: u8,
+        kind: u8,
+        rd: u8,
+        init: u32,
+        amount: u32,
+    },
+    /// A poll loop on RAM: `mov.b @TOGGLE:8,r1l; 1: mov.b @TOGGLE:8,r0l; cmp.b r0l,r1l; beq 1b`
+    /// (the interrupt handler toggles TOGGLE's bit 0).
+    PollRam,
+    /// A poll loop on the A/D converter: start channel `ch` (single mode), then
+    /// `1: mov.b @ADCSR:8,r0l; bpl 1b` until ADF.
+    PollAdc(u8),
+    /// `1: bra 1b`: spins until an interrupt (for ever with interrupts masked).
+    Spin,
 }
+
+/// The RAM byte whose bit 0 the interrupt handler toggles (above the stack).
+const TOGGLE: u32 = 0xFF_FF08;
 
 /// A small assembler for the pieces (each encoding is checked against the decoder).
 struct Asm {
@@ -339,6 +360,58 @@ impl Asm {
             self.emit(&[0x5c, 0x00, h, l], "bsr");
         }
     }
+    /// [`Piece::Countdown`].
+    fn countdown(&mut self, size: u8, kind: u8, rd: u8, init: u32, amount: u32) {
+        // Byte and word registers 0-15 (7 and 15 are parts of ER7), longs 0-6.
+        let (size, rd) = match size % 3 {
+            0 => (
+                0,
+                [0u8, 1, 2, 3, 4, 5, 6, 8, 9, 10, 11, 12, 13, 14][usize::from(rd) % 14],
+            ),
+            1 => (
+                1,
+                [0u8, 1, 2, 3, 4, 5, 6, 8, 9, 10, 11, 12, 13, 14][usize::from(rd) % 14],
+            ),
+            _ => (2, rd % 7),
+        };
+        let by2 = amount & 1 == 1;
+        match size {
+            0 => self.emit(&[0xf0 | rd, init as u8], "mov.b"),
+            1 => {
+                let [h, l] = (init as u16).to_be_bytes();
+                self.emit(&[0x79, rd, h, l], "mov.w");
+            }
+            _ => self.mov_l(rd, init),
+        }
+        let top = self.here();
+        match (size, kind % 5) {
+            (0, 0 | 1) => self.emit(&[0x80 | rd, amount as u8], "add.b"),
+            (0, 2) => self.emit(&[0x0a, rd], "inc"),
+            (0, _) => self.emit(&[0x1a, rd], "dec"),
+            (1, 0) => {
+                let [h, l] = (amount as u16).to_be_bytes();
+                self.emit(&[0x79, 0x10 | rd, h, l], "add.w");
+            }
+            (1, 1) => {
+                let [h, l] = (amount as u16).to_be_bytes();
+                self.emit(&[0x79, 0x30 | rd, h, l], "sub.w");
+            }
+            (1, 2) => self.emit(&[0x0b, if by2 { 0xd0 } else { 0x50 } | rd], "inc"),
+            (1, _) => self.emit(&[0x1b, if by2 { 0xd0 } else { 0x50 } | rd], "dec"),
+            (_, 0) => {
+                let [a, b, c, d] = amount.to_be_bytes();
+                self.emit(&[0x7a, 0x10 | rd, a, b, c, d], "add.l");
+            }
+            (_, 1) => {
+                let [a, b, c, d] = amount.to_be_bytes();
+                self.emit(&[0x7a, 0x30 | rd, a, b, c, d], "sub.l");
+            }
+            (_, 2) => self.emit(&[0x0b, if by2 { 0xf0 } else { 0x70 } | rd], "inc"),
+            (_, _) => self.emit(&[0x1b, if by2 { 0xf0 } else { 0x70 } | rd], "dec"),
+        }
+        self.branch(6, top); // bne
+    }
+
     fn piece(&mut self, p: &Piece, subs: usize) {
         match p {
             Piece::Straight(raw) => self.straight(raw),
@@ -346,7 +419,7 @@ impl Asm {
                 self.emit(&[0x79, 0x06, 0x00, *n], "mov.w");
                 let top = self.here();
                 self.straight(raw);
-                self.emit(&[0x1b, 0x56], "dec.w");
+                self.emit(&[0x1b, 0x56], "dec");
                 self.branch(6, top); // bne
             }
             Piece::Skip(cond, raw) => {
@@ -388,6 +461,32 @@ impl Asm {
                 self.emit(&[0x06, 0x7f], "andc"); // unmask
             }
             Piece::Sleep => self.emit(&[0x01, 0x80], "sleep"),
+            Piece::Countdown {
+                size,
+                kind,
+                rd,
+                init,
+                amount,
+            } => self.countdown(*size, *kind, *rd, *init, *amount),
+            Piece::PollRam => {
+                let t = TOGGLE as u8;
+                self.emit(&[0x29, t], "mov.b"); // @TOGGLE:8,r1l
+                let top = self.here();
+                self.emit(&[0x28, t], "mov.b"); // @TOGGLE:8,r0l
+                self.emit(&[0x1c, 0x89], "cmp.b"); // r0l,r1l
+                self.branch(7, top); // beq
+            }
+            Piece::PollAdc(ch) => {
+                self.emit(&[0xf8, 0x20 | (ch & 7)], "mov.b"); // ADST, channel
+                self.emit(&[0x38, 0xe8], "mov.b"); // r0l,@ADCSR:8
+                let top = self.here();
+                self.emit(&[0x28, 0xe8], "mov.b"); // @ADCSR:8,r0l
+                self.branch(10, top); // bpl
+            }
+            Piece::Spin => {
+                let top = self.here();
+                self.branch(0, top);
+            }
         }
     }
 }
@@ -420,7 +519,18 @@ fn piece() -> impl Strategy<Value = Piece> {
         1 => any::<u8>().prop_map(Piece::Ldc),
         1 => (20u16..400).prop_map(Piece::StartTimer),
         1 => Just(Piece::Sleep),
+        2 => (any::<u8>(), any::<u8>(), any::<u8>(), countdown_init(), prop_oneof![Just(1u32), Just(2), Just(0xFF), Just(0xFFFE), Just(0xFFFF_FFFF), any::<u32>()])
+            .prop_map(|(size, kind, rd, init, amount)| Piece::Countdown { size, kind, rd, init, amount }),
+        1 => Just(Piece::PollRam),
+        1 => (0u8..8).prop_map(Piece::PollAdc),
+        1 => Just(Piece::Spin),
     ]
+}
+
+/// A delay loop's start: mostly small counts, some of any size (which then run into the
+/// deadline).
+fn countdown_init() -> impl Strategy<Value = u32> {
+    prop_oneof![3 => 0u32..3_000, 1 => any::<u32>()]
 }
 
 /// Initial ER0–ER5: mostly RAM addresses (so memory operands hit RAM), some I/O, some any.
@@ -474,6 +584,7 @@ fn install(p: &Program) -> (Cpu, Mcu<NullBoard>) {
     }
     let mut h = Asm::new(HANDLER);
     h.emit(&[0x7f, 0x67, 0x72, 0x00], "bclr"); // TSR0.IMFA: the timer's request served
+    h.emit(&[0x7f, TOGGLE as u8, 0x71, 0x00], "bnot"); // for PollRam
     h.straight(&p.handler);
     h.emit(&[0x56, 0x70], "rte");
     m.poke(HANDLER, &h.code);
@@ -725,8 +836,111 @@ fn run_is_step_in_a_loop() {
     assert!(calls > 2_500, "{calls}");
 }
 
+/// A program of the given main-loop pieces, with one empty subroutine and handler.
+fn program_of(main: Vec<Piece>) -> Program {
+    Program {
+        main,
+        subs: vec![Vec::new()],
+        ram_sub: Vec::new(),
+        handler: Vec::new(),
+        regs: [RAM_START; 6],
+    }
+}
+
+#[test]
+fn run_fast_forwards_each_kind_of_loop_to_the_state_stepping_reaches() {
+    let countdown = |size, kind, rd, init, amount| Piece::Countdown {
+        size,
+        kind,
+        rd,
+        init,
+        amount,
+    };
+    let cases: Vec<(&str, Vec<Piece>)> = vec![
+        ("dec.w from 833", vec![countdown(1, 4, 3, 833, 0)]),
+        ("dec.w #2 from 0 (wraps)", vec![countdown(1, 4, 9, 0, 1)]),
+        ("add.b #-1", vec![countdown(0, 0, 10, 200, 0xFF)]),
+        ("add.b #3 (odd step)", vec![countdown(0, 0, 2, 7, 3)]),
+        (
+            "inc.l #2 from odd (never zero)",
+            vec![countdown(2, 2, 4, 5, 1)],
+        ),
+        ("sub.l", vec![countdown(2, 1, 1, 1_000_000, 10)]),
+        (
+            "add.w under a timer",
+            vec![Piece::StartTimer(97), countdown(1, 0, 5, 40_000, 0xFFFF)],
+        ),
+        (
+            "RAM poll under a timer",
+            vec![Piece::StartTimer(300), Piece::PollRam],
+        ),
+        ("A/D poll", vec![Piece::PollAdc(3), Piece::PollAdc(6)]),
+        (
+            "spin under a timer",
+            vec![Piece::StartTimer(250), Piece::Spin],
+        ),
+    ];
+    for (name, main) in cases {
+        for chunk in [997, 20_011] {
+            let p = program_of(main.clone());
+            let (mut ca, mut ma) = install(&p);
+            let (mut cb, mut mb) = install(&p);
+            run_vs_steps((&mut ca, &mut ma), (&mut cb, &mut mb), chunk, 400_000)
+                .unwrap_or_else(|e| panic!("{name}, chunk {chunk}: {e}"));
+            assert!(
+                ca.skipped_instructions() > ca.instructions() / 4,
+                "{name}, chunk {chunk}: {} of {} instructions skipped",
+                ca.skipped_instructions(),
+                ca.instructions()
+            );
+            assert_eq!(cb.skipped_instructions(), 0);
+        }
+    }
+}
+
+#[test]
+fn with_fast_forwarding_off_run_executes_every_instruction() {
+    let p = program_of(vec![Piece::Countdown {
+        size: 1,
+        kind: 4,
+        rd: 3,
+        init: 30_000,
+        amount: 0,
+    }]);
+    let (mut ca, mut ma) = install(&p);
+    let (mut cb, mut mb) = install(&p);
+    ca.set_fast_forward(false);
+    let (ea, eb) = (ca.run(&mut ma, 100_000), cb.run(&mut mb, 100_000));
+    assert_eq!(ea, eb);
+    assert_eq!(snapshot(&ca, ma.now()), snapshot(&cb, mb.now()));
+    assert_eq!(ca.skipped_instructions(), 0);
+    assert!(cb.skipped_instructions() > 10_000);
+}
+
+/// The random programs' fast-forwarding, printed (`-- --nocapture`): how much of a fixed set
+/// of programs' run was skipped, which must be some (the test above cannot pass vacuously).
+#[test]
+fn random_programs_have_loops_to_fast_forward() {
+    let mut runner = proptest::test_runner::TestRunner::deterministic();
+    let (mut skipped, mut total) = (0, 0);
+    for _ in 0..64 {
+        let p = program()
+            .new_tree(&mut runner)
+            .expect("a program")
+            .current();
+        let (mut ca, mut ma) = install(&p);
+        let (mut cb, mut mb) = install(&p);
+        run_vs_steps((&mut ca, &mut ma), (&mut cb, &mut mb), 3_001, 60_000)
+            .unwrap_or_else(|e| panic!("{e}"));
+        skipped += ca.skipped_instructions();
+        total += ca.instructions();
+    }
+    println!("64 random programs: {skipped} of {total} instructions fast-forwarded");
+    assert!(skipped > 0 && skipped < total);
+}
+
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(64))]
+    #![proptest_config(ProptestConfig::with_cases(256))]
 
     #[test]
     fn run_is_step_in_a_loop_on_random_programs(p in program(), chunk in 1u64..5_000) {

@@ -526,9 +526,21 @@ impl FirmwareController {
         std::mem::take(&mut self.busy)
     }
 
-    /// One step of the CPU with idle time apart. Returns whether the CPU slept (executed
-    /// SLEEP) or woke in this step.
-    fn one<B: Board>(&mut self, mcu: &mut Mcu<B>, deadline: u64) -> Result<Event, RunError> {
+    /// Turns the core's loop fast-forwarding on (the default) or off ([`Cpu::set_fast_forward`]):
+    /// the same states at the same instants either way.
+    pub fn set_fast_forward(&mut self, on: bool) {
+        self.cpu.set_fast_forward(on);
+    }
+
+    /// Runs the CPU until `stop` holds after an instruction, the CPU goes to sleep (SLEEP
+    /// executed), an interrupt is accepted, or the clock reaches `deadline`; a sleeping CPU
+    /// first sleeps until an interrupt wakes it (idle time). Busy states are counted apart.
+    fn run<B: Board>(
+        &mut self,
+        mcu: &mut Mcu<B>,
+        deadline: u64,
+        mut stop: impl FnMut(&Mcu<B>) -> bool,
+    ) -> Result<Event, RunError> {
         use crate::core::bus::Bus;
         if self.cpu.sleeping() {
             mcu.sleep_until_irq(deadline);
@@ -537,7 +549,9 @@ impl FirmwareController {
             }
         }
         let t0 = mcu.now();
-        let event = self.cpu.step(mcu, deadline)?;
+        let event = self
+            .cpu
+            .run_until(mcu, deadline, |cpu, m| cpu.sleeping() || stop(m))?;
         match event {
             Event::Halted => return Err(halted(&self.cpu)),
             Event::Asleep => {}
@@ -556,16 +570,11 @@ impl FirmwareController {
     pub fn run_to_sensing<B: Board>(&mut self, mcu: &mut Mcu<B>) -> Result<u64, StepError> {
         use crate::core::bus::Bus;
         let deadline = mcu.now() + self.watchdog_states;
+        let before = self.adc_starts;
         loop {
-            if self.one(mcu, deadline)? == Event::Asleep && mcu.now() >= deadline {
-                return Err(StepError::Watchdog {
-                    what: "A/D conversion started (no step)",
-                    at: mcu.now(),
-                    pc: self.cpu.pc(),
-                });
-            }
+            self.run(mcu, deadline, |m| m.adc().starts() != before)?;
             let starts = mcu.adc().starts();
-            if starts != self.adc_starts {
+            if starts != before {
                 self.adc_starts = starts;
                 return Ok(mcu.now());
             }
@@ -588,7 +597,7 @@ impl FirmwareController {
         use crate::core::bus::Bus;
         let deadline = mcu.now() + self.watchdog_states;
         while !self.cpu.sleeping() {
-            self.one(mcu, deadline)?;
+            self.run(mcu, deadline, |_| false)?;
             if mcu.now() >= deadline && !self.cpu.sleeping() {
                 return Err(StepError::Watchdog {
                     what: "SLEEP after the step's work",

@@ -128,4 +128,14 @@ impl Bus for Machine {
     fn code_generation(&self) -> Option<u64> {
         self.0.code_generation()
     }
+
+    #[inline]
+    fn irq_stable_until(&self) -> u64 {
+        self.0.irq_stable_until()
+    }
+
+    #[inline]
+    fn reads_stable_until(&self, addr: u32) -> Option<u64> {
+        self.0.reads_stable_until(addr)
+    }
 }

@@ -51,7 +51,7 @@ use std::cell::Cell;
 use eeprom::{DeviceConfig, EepromError, I2cBus, PowerCutOutcome};
 
 use crate::chip::periph::Peripheral;
-use crate::chip::periph::adc::Adc;
+use crate::chip::periph::adc::{ADCR, ADDRA, Adc};
 use crate::chip::periph::intc::Intc;
 use crate::chip::periph::itu::{self, Itu, PwmWave};
 use crate::chip::periph::ports::{PortPins, Ports};
@@ -810,6 +810,32 @@ impl<B: Board> Bus for Mcu<B> {
     #[inline]
     fn code_generation(&self) -> Option<u64> {
         Some(self.rom_generation)
+    }
+
+    /// The cached interrupt decision's end: the next instant a module raises a request
+    /// ([`Mcu::next_event`]'s requesting part); writes to I/O empty the cache.
+    #[inline]
+    fn irq_stable_until(&self) -> u64 {
+        if self.now >= self.irq_valid_until.get() {
+            self.refresh_irq();
+        }
+        self.irq_valid_until.get()
+    }
+
+    /// ROM and RAM change only by writes (no DMA here): for ever. The A/D converter's
+    /// registers change only at its own events (a sample, a conversion's end): until the
+    /// next. Re-reading any of these changes nothing more than the first read did (reading
+    /// ADCSR with ADF = 1 arms the flag's clearing once; reading ADDRnH latches the same low
+    /// byte). Every other register: unknown.
+    fn reads_stable_until(&self, addr: u32) -> Option<u64> {
+        let a = addr & ADDRESS_MASK;
+        match Area::of(a) {
+            Area::Rom | Area::Ram => Some(u64::MAX),
+            Area::Io if (ADDRA..=ADCR).contains(&a) => {
+                Some(self.adc.next_event(self.now).unwrap_or(u64::MAX))
+            }
+            _ => None,
+        }
     }
 
     fn sleep_until_irq(&mut self, deadline: u64) -> bool {

@@ -51,6 +51,25 @@ pub trait Bus {
     fn code_generation(&self) -> Option<u64> {
         None
     }
+
+    /// An instant before which [`Bus::pending_irq`] keeps its present answer as long as the
+    /// program writes nothing (time alone changes no request before it), for the core's
+    /// loop fast-forwarding ([`crate::core::cpu`]). The default, [`Bus::now`], promises
+    /// nothing, and no loop is skipped.
+    fn irq_stable_until(&self) -> u64 {
+        self.now()
+    }
+
+    /// An instant before which every read of `addr` returns what a read now returns and has
+    /// no effect beyond what one read has (re-reading changes nothing), as long as the program
+    /// writes nothing: ROM and RAM for ever, a peripheral register until that module's next
+    /// event, if the bus knows it. For the core's poll-loop fast-forwarding and the model
+    /// controller's ADF poll. `None` (the default): unknown, and no loop reading `addr` is
+    /// skipped.
+    fn reads_stable_until(&self, addr: u32) -> Option<u64> {
+        let _ = addr;
+        None
+    }
 }
 
 /// The source of [`Bus::code_generation`] tokens: one process-wide counter, so a token is

@@ -53,27 +53,18 @@ use nn_q15::{
 
 use crate::board::ram::{RamMap, RamOverflow};
 use crate::chip::mcu::{Board, Mcu};
-use crate::chip::periph::adc::ADCSR as ADCSR_ADDR;
 use crate::core::bus::Bus;
-use crate::core::memmap::ADDRESS_MASK;
 use fast::SaveTimelines;
 use fw::{FETCH_STATES, Fw, FwPins, SLEEP_STATES};
 use regs::*;
 
-/// What the model asks of the MCU besides the bus: the two facts its emulation shortcuts
-/// ([`ControllerConfig::fast_forward`]) need, which no program on the chip could ask and the
-/// core's [`Bus`] therefore does not carry. Implemented for [`Mcu`]; a bus that answers
-/// neither (the defaults, as a test's wrapper around an MCU may) runs the model register by
-/// register and I²C pin by pin, with the same results.
+/// What the model asks of the MCU besides the bus: the EEPROM bus for its transaction-level
+/// save ([`ControllerConfig::fast_forward`]), which no program on the chip could reach and
+/// the core's [`Bus`] therefore does not carry (the ADF poll's shortcut uses
+/// [`Bus::reads_stable_until`], as the core's loop fast-forwarding does). Implemented for
+/// [`Mcu`]; a bus that answers neither (the defaults, as a test's wrapper around an MCU may)
+/// runs the model register by register and I²C pin by pin, with the same results.
 pub trait ModelBus: Bus {
-    /// An instant before which every read of `addr` returns what a read now would, and has no
-    /// side effect, if the MCU knows one (the end of the running A/D conversion for ADCSR): the
-    /// model's ADF polling loop lets the time up to it pass without reading. `None`: unknown.
-    fn reads_stable_until(&self, addr: u32) -> Option<u64> {
-        let _ = addr;
-        None
-    }
-
     /// The EEPROM bus behind port 4, for the fast save that acts on the chips at transaction
     /// level with exactly the pin-level outcome ([`fast`]). `None`: pin-level access only.
     fn eeprom_bus(&mut self) -> Option<&mut eeprom::I2cBus> {
@@ -82,14 +73,6 @@ pub trait ModelBus: Bus {
 }
 
 impl<B: Board> ModelBus for Mcu<B> {
-    fn reads_stable_until(&self, addr: u32) -> Option<u64> {
-        // ADCSR changes only at the A/D converter's own events (a conversion's end sets ADF);
-        // reading it with ADF = 0 arms nothing.
-        (addr & ADDRESS_MASK == ADCSR_ADDR)
-            .then(|| self.adc().next_event(self.now()))
-            .flatten()
-    }
-
     fn eeprom_bus(&mut self) -> Option<&mut eeprom::I2cBus> {
         Some(self.i2c_mut())
     }
@@ -848,8 +831,10 @@ impl Controller {
                 // the same; let them pass unread, unless the tick could come meanwhile.
                 if self.cfg.fast_forward
                     && v & ADCSR_ADF == 0
-                    && let (Some(event), Some(tick)) =
-                        (fw.bus.reads_stable_until(ADCSR), fw.next_tick_at)
+                    && let (Some(event), Some(tick)) = (
+                        fw.bus.reads_stable_until(ADCSR).filter(|&e| e != u64::MAX),
+                        fw.next_tick_at,
+                    )
                 {
                     let now = fw.now();
                     let skip = event
@@ -1100,7 +1085,8 @@ pub fn motor_row(b: Behaviour) -> (u16, u16, u8) {
     }
 }
 
-/// States of one fresh weight from xorshift32 (the routine in [`code`]): three shift-and-XOR
+/// States of one fresh weight from xorshift32 (an estimate of `fresh_weights` in the firmware's
+/// `robot.c`; the boot is not calibrated against the firmware): three shift-and-XOR
 /// rounds (13, 17 and 5 one-bit shifts of a long), the 15-bit extraction (17 shifts), the
 /// offset, the store and the loop: (13 + 17 + 5 + 17) · 2 + 3 · (2 + 2) + 2 + 2 + 4 + 4 + 2 + 6.
 pub const XORSHIFT_WEIGHT_STATES: u64 =

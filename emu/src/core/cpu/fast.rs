@@ -29,6 +29,9 @@ pub(super) struct Slot {
     /// Whether the handler always leaves PC at `next` and the run state as it was (no
     /// branch, no [`Op::Generic`]).
     pub(super) sequential: bool,
+    /// Whether this is a Bcc whose target is at or before it: a loop's back edge, where
+    /// [`super::ffwd`] looks for loops to fast-forward.
+    pub(super) back_edge: bool,
 }
 
 /// A pre-decoded instruction form. Register numbers are those of [`Instr`] (byte and word
@@ -340,7 +343,7 @@ pub(super) enum Op {
 
 /// The bits of [`Op::Bcc8`]'s `mask`: bit f set when condition `cc` holds for flags
 /// N Z V C = f (the low nibble of CCR).
-const fn cond_mask(cc: u8) -> u16 {
+pub(super) const fn cond_mask(cc: u8) -> u16 {
     let mut m = 0u16;
     let mut f = 0u8;
     while f < 16 {
@@ -366,6 +369,7 @@ impl Slot {
         next: 0,
         words: 0,
         sequential: false,
+        back_edge: false,
     };
 
     /// The handler of instruction `d` at `pc` (in ROM).
@@ -385,11 +389,16 @@ impl Slot {
                 | Op::JsrReg { .. }
                 | Op::Rts
         );
+        let back_edge = match op {
+            Op::Bcc8 { target, .. } | Op::Bcc16 { target, .. } => target <= pc,
+            _ => false,
+        };
         Slot {
             op,
             next,
             words: d.words,
             sequential,
+            back_edge,
         }
     }
 }

@@ -29,6 +29,16 @@
 //!   what: it carries PC from one instruction to the next in a local, so that after an
 //!   instruction that can only go on to the next the CPU need not wait for the PC it just
 //!   stored (the store-to-load latency is the fast path's longest chain).
+//! - [`Cpu::run_until`] (and `run`) also fast-forward loops (`ffwd`, on unless
+//!   [`Cpu::set_fast_forward`] turns it off): a delay loop (INC/DEC/ADD/SUB #imm on one
+//!   register and a BNE back) is advanced to its last iteration in closed form, and a loop
+//!   whose watched iteration wrote nothing, came back to its head with every register and CCR
+//!   unchanged and read only what the bus promises stays the same ([`Bus::reads_stable_until`]:
+//!   ROM, RAM, the A/D converter until its next event) is skipped to where something can change:
+//!   the deadline, the next possible interrupt request ([`Bus::irq_stable_until`]), the end of
+//!   its reads' promises. The skipped iterations' states and instructions are counted
+//!   ([`Cpu::skipped_instructions`]); registers, flags, clock and memory are what stepping
+//!   reaches at the same instruction boundary. [`Cpu::step`] never skips.
 //!
 //! The decode caches are emptied whenever the bus's token changes (the flash was written:
 //! loading an image, poking), and by [`Cpu::flush_decode_cache`]. Tests run random programs,
@@ -71,6 +81,7 @@ pub mod decode;
 pub mod disasm;
 mod exec;
 mod fast;
+mod ffwd;
 pub mod timing;
 
 use crate::core::bus::Bus;
@@ -194,6 +205,12 @@ pub struct Cpu {
     code_generation: u64,
     /// Whether [`Cpu::step`] may take the fast path.
     fast_path: bool,
+    /// Whether [`Cpu::run_until`] fast-forwards loops ([`ffwd`]).
+    fast_forward: bool,
+    /// What [`ffwd`] knows about each back edge, same index as `fast`.
+    loops: Vec<ffwd::Loop>,
+    /// Instructions fast-forwarded so far.
+    skipped: u64,
     instructions: u64,
     /// Where the instruction executed last is kept (for traces and the profiler): its index
     /// in `cache` (the fast path), or [`LAST_IN_COPY`] for `last_copy`.
@@ -242,6 +259,9 @@ impl Cpu {
             fast: Vec::new(),
             code_generation: 0,
             fast_path: true,
+            fast_forward: true,
+            loops: Vec::new(),
+            skipped: 0,
             instructions: 0,
             last_index: LAST_IN_COPY,
             last_copy: EMPTY_SLOT,
@@ -352,6 +372,7 @@ impl Cpu {
         self.last_index = LAST_IN_COPY;
         self.cache.clear();
         self.fast.clear();
+        self.loops.clear();
     }
 
     /// Empties the caches if the bus's flash token changed since they were filled.
@@ -491,17 +512,44 @@ impl Cpu {
     /// deadline), and returns that step's event, or [`Event::Executed`] once the clock has
     /// reached `deadline` (at once, running nothing, if it already had).
     ///
-    /// The same as calling [`Cpu::step`] with `deadline` while the clock is below it and the
-    /// steps report [`Event::Executed`] (same states, bus accesses and results), faster on the
-    /// fast path: PC goes from one instruction to the next in a local.
+    /// [`Cpu::run_until`] with no stop condition: see there for what it shares with stepping.
     ///
     /// # Errors
     /// As [`Cpu::step`].
     pub fn run<B: Bus>(&mut self, bus: &mut B, deadline: u64) -> Result<Event, CpuError> {
+        self.run_until(bus, deadline, |_, _| false)
+    }
+
+    /// [`Cpu::run`] that also returns ([`Event::Executed`]) after any executed instruction
+    /// after which `stop(cpu, bus)` holds (entering sleep mode with `|cpu, _| cpu.sleeping()`,
+    /// an I/O effect with a condition on the bus).
+    ///
+    /// The same as calling [`Cpu::step`] with `deadline` while the clock is below it, the steps
+    /// report [`Event::Executed`] and `stop` does not hold: same states, bus accesses and
+    /// results at the instant it returns. It is faster in two ways. On the fast path PC goes
+    /// from one instruction to the next in a local. And with loop fast-forwarding on
+    /// ([`Cpu::set_fast_forward`], the default) a delay loop or a poll loop whose next
+    /// iterations are known is advanced in closed form to exactly the state stepping would
+    /// reach (the `ffwd` module: which loops, and the bounds: the deadline, the next possible
+    /// interrupt request, the reads' stability). A skipped stretch touches no device and
+    /// changes no run state, and `stop` is not asked inside it: a condition on registers,
+    /// time or instruction counts needs fast-forwarding off.
+    ///
+    /// # Errors
+    /// As [`Cpu::step`].
+    pub fn run_until<B: Bus, F: FnMut(&Cpu, &B) -> bool>(
+        &mut self,
+        bus: &mut B,
+        deadline: u64,
+        mut stop: F,
+    ) -> Result<Event, CpuError> {
         while bus.now() < deadline {
             if !self.fast_ready(bus) {
                 let event = self.step_not_ready(bus, deadline)?;
                 if event != Event::Executed {
+                    return Ok(event);
+                }
+                if stop(self, bus) {
                     return Ok(event);
                 }
                 continue;
@@ -515,23 +563,36 @@ impl Cpu {
                     return Ok(Event::Interrupt(v));
                 }
                 let idx = (pc >> 1) as usize;
-                let event = if let Some(slot) = self.fast.get(idx)
+                if let Some(slot) = self.fast.get(idx)
                     && slot.words != 0
                 {
-                    let (words, next, sequential) = (slot.words, slot.next, slot.sequential);
+                    let (words, next, sequential, back_edge) =
+                        (slot.words, slot.next, slot.sequential, slot.back_edge);
                     bus.internal(u32::from(words) * ROM_FETCH_STATES);
                     let event = self.exec_fast(bus, pc, idx, next)?;
+                    if event != Event::Executed {
+                        return Ok(event);
+                    }
+                    if stop(self, bus) {
+                        return Ok(event);
+                    }
                     if sequential {
                         pc = next;
-                        event
                     } else if self.state == RunState::Running {
                         pc = self.pc;
-                        event
+                        if back_edge && pc <= (idx as u32) << 1 && self.fast_forward {
+                            match self.loop_back(bus, idx, deadline, &mut stop)? {
+                                ffwd::Outcome::Continue => {}
+                                ffwd::Outcome::Event(event) => return Ok(event),
+                                ffwd::Outcome::Stop => return Ok(Event::Executed),
+                            }
+                            if self.state != RunState::Running {
+                                break;
+                            }
+                            pc = self.pc;
+                        }
                     } else {
                         // Asleep or halted: the outer loop takes the reference path.
-                        if event != Event::Executed {
-                            return Ok(event);
-                        }
                         break;
                     }
                 } else {
@@ -540,10 +601,10 @@ impl Cpu {
                     if event != Event::Executed {
                         return Ok(event);
                     }
+                    if stop(self, bus) {
+                        return Ok(event);
+                    }
                     break;
-                };
-                if event != Event::Executed {
-                    return Ok(event);
                 }
                 if bus.now() >= deadline || bus.code_generation() != Some(self.code_generation) {
                     break;
