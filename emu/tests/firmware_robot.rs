@@ -394,3 +394,78 @@ fn the_sensors_are_read_from_the_configured_channels() {
         }
     }
 }
+
+/// What a firmware robot's run leaves, for comparing two runs.
+#[derive(Debug, PartialEq)]
+struct Trace {
+    sensing: Vec<u64>,
+    busy: Vec<u64>,
+    regs: [u32; 8],
+    pc: u32,
+    ccr: u8,
+    instructions: u64,
+    ram: Vec<u8>,
+    write_counts: Vec<Vec<u32>>,
+    violations: Vec<u64>,
+}
+
+fn controller_trace(fast_forward: bool, steps: usize) -> (Trace, u64) {
+    use emu::board::firmware::FirmwareController;
+    use emu::core::memmap::{RAM_BYTES, RAM_START};
+    let fw = firmware();
+    let mut mcu = Mcu::new(McuConfig::default(), Wandering).unwrap();
+    let block = ConfigBlock {
+        save_every: 3,
+        ..ConfigBlock::ARENA
+    };
+    let mut c = FirmwareController::start(&fw, &mut mcu, Some(&block)).unwrap();
+    c.set_fast_forward(fast_forward);
+    let (mut sensing, mut busy) = (Vec::new(), Vec::new());
+    for _ in 0..steps {
+        sensing.push(c.run_to_sensing(&mut mcu).unwrap());
+        c.run_to_sleep(&mut mcu).unwrap();
+        busy.push(c.take_busy());
+    }
+    let cpu = c.cpu();
+    let trace = Trace {
+        sensing,
+        busy,
+        regs: cpu.regs(),
+        pc: cpu.pc(),
+        ccr: cpu.ccr(),
+        instructions: cpu.instructions(),
+        ram: (0..RAM_BYTES).map(|i| mcu.peek(RAM_START + i)).collect(),
+        write_counts: mcu
+            .i2c()
+            .devices()
+            .iter()
+            .map(|d| d.write_counts().to_vec())
+            .collect(),
+        violations: mcu
+            .i2c()
+            .devices()
+            .iter()
+            .map(|d| d.timing_violation_count())
+            .collect(),
+    };
+    (trace, cpu.skipped_instructions())
+}
+
+#[test]
+fn the_robot_runs_alike_with_loop_fast_forwarding_on_and_off() {
+    // 120 steps with a save every 3: delay loops (the I2C bit timing, ACK polling's pauses)
+    // and the ADF poll are skipped on one side, executed on the other.
+    let (on, skipped) = controller_trace(true, 120);
+    let (off, none) = controller_trace(false, 120);
+    assert_eq!(none, 0);
+    assert!(
+        skipped > on.instructions / 4,
+        "{skipped} of {} instructions skipped",
+        on.instructions
+    );
+    assert!(
+        on.write_counts.iter().flatten().any(|&n| n > 0),
+        "records were saved"
+    );
+    assert_eq!(on, off);
+}
