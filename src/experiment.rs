@@ -38,6 +38,9 @@ use crate::seeds::world_seed;
 
 /// Swarms at least this large step their robots in parallel inside a run.
 pub const PARALLEL_ROBOTS: usize = 64;
+/// The arena figure shows the paths of the first and the last this many steps (the outlines
+/// are recorded at the start and the end of each).
+pub const SNAPSHOT_STEPS: usize = 200;
 /// At most this many robots' paths are recorded for the arena figure.
 pub const TRACKED_ROBOTS: usize = 40;
 
@@ -230,7 +233,11 @@ impl Swarm {
             steps: Vec::with_capacity(s.steps as usize),
             track,
             tracked,
-            snapshots: [0, s.steps / 3, 2 * s.steps / 3, s.steps.saturating_sub(1)],
+            snapshots: {
+                let k = SNAPSHOT_STEPS as u32;
+                let last = s.steps.saturating_sub(1);
+                [0, k.min(last), s.steps.saturating_sub(k), last]
+            },
             saves: 0,
             parallel: n >= PARALLEL_ROBOTS,
             last_xy: Vec::new(),

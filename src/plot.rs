@@ -122,6 +122,20 @@ pub struct LearningFigure {
     pub d: Vec<Series>,
     /// Series of the right panel: collisions per robot per window.
     pub collisions: Vec<Series>,
+    /// Further panels (at most two, e.g. contact time and the corridor's gap CV), drawn in a
+    /// second row under the first two; none keeps the paper's two-panel figure.
+    pub more: Vec<Panel>,
+}
+
+/// A further panel of the learning figure.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Panel {
+    /// Caption over the panel.
+    pub caption: String,
+    /// Label of its y axis.
+    pub y_label: String,
+    /// Its series (checked like the first two panels').
+    pub series: Vec<Series>,
 }
 
 /// The paper's Fig. 8: the arena from above with every robot's trajectory and its outline at a
@@ -310,10 +324,16 @@ const CURVE_WIDTH_PX: u32 = 3;
 pub fn learning_figure(fig: &LearningFigure, png: &Path, svg: &Path) -> Result<(), PlotError> {
     validate_panel("D", &fig.d)?;
     validate_panel("collisions", &fig.collisions)?;
+    for p in fig.more.iter().take(2) {
+        validate_panel("further", &p.series)?;
+    }
     check_png_name(png)?;
     register_font()?;
     let styles = CurveStyles::new(fig);
-    let (w, h) = LEARNING_SIZE_PX;
+    let (w, mut h) = LEARNING_SIZE_PX;
+    if !fig.more.is_empty() {
+        h += LEARNING_SIZE_PX.1 - LEARNING_TITLE_PX - 60;
+    }
     let rows = legend_rows(&styles, w as i32 - 60).map_err(|e| draw_error(png, e))?;
     let extra_rows = rows.len().saturating_sub(1) as u32;
     let size = (w, h + extra_rows * LEGEND_ROW_PX);
@@ -397,7 +417,8 @@ struct CurveStyles {
 impl CurveStyles {
     fn new(fig: &LearningFigure) -> Self {
         let mut entries: Vec<(String, RGBColor, bool)> = Vec::new();
-        for s in fig.d.iter().chain(&fig.collisions) {
+        let more = fig.more.iter().take(2).flat_map(|p| p.series.iter());
+        for s in fig.d.iter().chain(&fig.collisions).chain(more) {
             if !entries.iter().any(|(l, _, _)| *l == s.label) {
                 let colour = CURVE_PALETTE[entries.len() % CURVE_PALETTE.len()];
                 entries.push((s.label.clone(), colour, s.dashed));
@@ -468,7 +489,27 @@ fn draw_learning<DB: DrawingBackend>(
         ((w / 2) as i32, (LEARNING_TITLE_PX / 2) as i32 + 4),
     )?;
 
-    let (left, right) = panels.split_horizontally(w / 2);
+    let (top, bottom) = if fig.more.is_empty() {
+        (panels, None)
+    } else {
+        let (_, ph) = panels.dim_in_pixel();
+        let (t, b) = panels.split_vertically(ph / 2);
+        (t, Some(b))
+    };
+    if let Some(bottom) = bottom {
+        let (bl, br) = bottom.split_horizontally(w / 2);
+        for (area, p) in [bl, br].iter().zip(fig.more.iter().take(2)) {
+            draw_panel(
+                area,
+                &p.caption,
+                &fig.x_label,
+                &p.y_label,
+                &p.series,
+                styles,
+            )?;
+        }
+    }
+    let (left, right) = top.split_horizontally(w / 2);
     draw_panel(
         &left,
         "Mean summed sensor distance D",
@@ -717,6 +758,42 @@ pub fn arena_figure(fig: &ArenaFigure, png: &Path) -> Result<(), PlotError> {
         root.present().map_err(|e| draw_error(png, e))?;
     }
     write_png(png, size, &rgb)
+}
+
+/// Draws several arena figures side by side into one `png` (e.g. the paths of early and of
+/// late learning, each with its own title and legend), their tops aligned, on white.
+pub fn arena_figure_panels(figs: &[ArenaFigure], png: &Path) -> Result<(), PlotError> {
+    if figs.is_empty() {
+        return Err(PlotError::NothingToDraw);
+    }
+    check_png_name(png)?;
+    register_font()?;
+    let mut images = Vec::with_capacity(figs.len());
+    for fig in figs {
+        let headings = validate_arena(fig)?;
+        let layout = ArenaLayout::new(fig, &headings);
+        let size = layout.size_px;
+        let mut rgb = vec![0u8; (size.0 as usize) * (size.1 as usize) * 3];
+        {
+            let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
+            draw_arena(&root, fig, &layout).map_err(|e| draw_error(png, e))?;
+            root.present().map_err(|e| draw_error(png, e))?;
+        }
+        images.push((size, rgb));
+    }
+    let width: u32 = images.iter().map(|(s, _)| s.0).sum();
+    let height: u32 = images.iter().map(|(s, _)| s.1).max().unwrap_or(1);
+    let mut out = vec![255u8; width as usize * height as usize * 3];
+    let mut x0 = 0usize;
+    for ((w, h), rgb) in &images {
+        let (w, h) = (*w as usize, *h as usize);
+        for row in 0..h {
+            let dst = (row * width as usize + x0) * 3;
+            out[dst..dst + w * 3].copy_from_slice(&rgb[row * w * 3..(row + 1) * w * 3]);
+        }
+        x0 += w;
+    }
+    write_png(png, (width, height), &out)
 }
 
 /// Checks the arena figure; returns each outline's heading normalised to unit length.

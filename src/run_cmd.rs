@@ -14,7 +14,9 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::experiment::{RunOutput, build_world, run_one};
-use crate::plot::{ArenaFigure, LearningFigure, Series, arena_figure, learning_figure};
+use crate::plot::{
+    ArenaFigure, LearningFigure, Panel, Series, arena_figure_panels, learning_figure,
+};
 use crate::robot::{Condition, controller_config};
 use crate::scenario::Scenario;
 use crate::summary::{Claim, ConditionStats, Estimate, claims, conditions};
@@ -200,7 +202,7 @@ pub fn run(a: &RunArgs) -> Result<String> {
     );
     learning_figure(&learning(&s, &runs), &png, &svg)?;
     if let Some(track) = runs.iter().find_map(|r| r.track.as_ref()) {
-        arena_figure(&arena(&s, track), &arena_png)?;
+        arena_figure_panels(&arena(&s, track), &arena_png)?;
     }
 
     let robot_steps = jobs.len() as f64 * f64::from(s.steps) * s.robots as f64;
@@ -359,92 +361,128 @@ fn write_metrics(path: &Path, runs: &[RunOutput]) -> Result<()> {
     Ok(())
 }
 
-/// The learning figure: per condition, mean D per window and collisions per robot per window,
-/// mean over repeats with its 95 % band (or the range with fewer than two repeats).
+/// The learning figure: per condition, mean D per window and collisions per robot per window
+/// (the paper's two panels), then contact time (percent of the window) and, in the corridor,
+/// the gap CV (elsewhere the stuck robot-steps, percent): mean over repeats with its 95 % band
+/// (or the mean alone with fewer than two repeats).
 fn learning(s: &Scenario, runs: &[RunOutput]) -> LearningFigure {
+    use crate::experiment::StepMetrics;
     let win = s.window.max(1) as usize;
-    let mut d = Vec::new();
-    let mut coll = Vec::new();
-    for c in Condition::ALL {
-        let of_c: Vec<&RunOutput> = runs.iter().filter(|r| r.condition == c).collect();
-        if of_c.is_empty() {
-            continue;
-        }
-        let windows = s.steps as usize / win;
-        let (mut xs, mut dm, mut dl, mut dh, mut cm, mut cl, mut ch) =
-            (vec![], vec![], vec![], vec![], vec![], vec![], vec![]);
-        for w in 0..windows {
-            let range = w * win..(w + 1) * win;
-            let ds: Vec<f64> = of_c
-                .iter()
-                .map(|r| r.steps[range.clone()].iter().map(|m| m.mean_d).sum::<f64>() / win as f64)
-                .collect();
-            let cs: Vec<f64> = of_c
-                .iter()
-                .map(|r| {
-                    r.steps[range.clone()]
+    let windows = s.steps as usize / win;
+    let of =
+        |c: Condition| -> Vec<&RunOutput> { runs.iter().filter(|r| r.condition == c).collect() };
+    // One series per condition of a per-step metric, summed or averaged over each window.
+    let panel =
+        |f: &dyn Fn(&StepMetrics) -> f64, sum: bool, scale: f64, floor0: bool| -> Vec<Series> {
+            let mut out = Vec::new();
+            for c in Condition::ALL {
+                let of_c = of(c);
+                if of_c.is_empty() {
+                    continue;
+                }
+                let (mut xs, mut m, mut lo, mut hi) = (vec![], vec![], vec![], vec![]);
+                for w in 0..windows {
+                    let range = w * win..(w + 1) * win;
+                    let vals: Vec<f64> = of_c
                         .iter()
-                        .map(|m| m.collisions_per_robot)
-                        .sum::<f64>()
-                })
-                .collect();
-            xs.push((w * win + win / 2) as f64);
-            let (e, f) = (Estimate::of(&ds), Estimate::of(&cs));
-            dm.push(e.mean);
-            dl.push(e.lo.unwrap_or(e.mean));
-            dh.push(e.hi.unwrap_or(e.mean));
-            cm.push(f.mean);
-            cl.push(f.lo.unwrap_or(f.mean).max(0.0));
-            ch.push(f.hi.unwrap_or(f.mean));
-        }
-        let label = match c {
-            Condition::Learning => "learning".to_string(),
-            Condition::LearningOff => "learning off (η = 0)".to_string(),
-            Condition::RandomWalk => "random walk".to_string(),
+                        .map(|r| {
+                            let t: f64 = r.steps[range.clone()].iter().map(f).sum();
+                            scale * if sum { t } else { t / win as f64 }
+                        })
+                        .collect();
+                    let e = Estimate::of(&vals);
+                    xs.push((w * win + win / 2) as f64);
+                    m.push(e.mean);
+                    let l = e.lo.unwrap_or(e.mean);
+                    lo.push(if floor0 { l.max(0.0) } else { l });
+                    hi.push(e.hi.unwrap_or(e.mean));
+                }
+                out.push(Series {
+                    label: match c {
+                        Condition::Learning => "learning".to_string(),
+                        Condition::LearningOff => "learning off (η = 0)".to_string(),
+                        Condition::RandomWalk => "random walk".to_string(),
+                    },
+                    dashed: c != Condition::Learning,
+                    x: xs,
+                    mean: m,
+                    lo,
+                    hi,
+                });
+            }
+            out
         };
-        let dashed = c != Condition::Learning;
-        d.push(Series {
-            label: label.clone(),
-            dashed,
-            x: xs.clone(),
-            mean: dm,
-            lo: dl,
-            hi: dh,
-        });
-        coll.push(Series {
-            label,
-            dashed,
-            x: xs,
-            mean: cm,
-            lo: cl,
-            hi: ch,
-        });
-    }
+    let mut more = vec![Panel {
+        caption: "Contact time (a bumper pressed)".to_string(),
+        y_label: "% of the window".to_string(),
+        series: panel(&|m| m.contact_fraction, false, 100.0, true),
+    }];
+    let corridor = runs
+        .iter()
+        .all(|r| r.steps.iter().all(|m| m.gap_cv.is_some()));
+    more.push(if corridor {
+        Panel {
+            caption: "Gap CV between neighbours (evenly spaced: low)".to_string(),
+            y_label: "coefficient of variation".to_string(),
+            series: panel(&|m| m.gap_cv.unwrap_or(0.0), false, 1.0, true),
+        }
+    } else {
+        Panel {
+            caption: "Stuck robots (< 1 mm in 100 steps, driving)".to_string(),
+            y_label: "% of robot-steps".to_string(),
+            series: panel(&|m| m.stuck_fraction, false, 100.0, true),
+        }
+    });
     LearningFigure {
         title: format!(
             "h8swarm {}: {} robots, {} repeats, windows of {} steps ({} s per step)",
             s.name, s.robots, s.repeats, s.window, s.timing.step_period_s
         ),
         x_label: "learning step".to_string(),
-        d,
-        collisions: coll,
+        d: panel(&|m| m.mean_d, false, 1.0, false),
+        collisions: panel(&|m| m.collisions_per_robot, true, 1.0, true),
+        more,
     }
 }
 
-fn arena(s: &Scenario, t: &crate::experiment::Track) -> ArenaFigure {
-    ArenaFigure {
-        title: format!(
-            "h8swarm {}: {} robots learning{} (repeat 0)",
-            s.name,
-            s.robots,
-            if t.paths.len() < s.robots {
-                format!(", paths of the first {}", t.paths.len())
-            } else {
-                String::new()
-            }
-        ),
-        walls: t.walls.clone(),
-        paths: t.paths.clone(),
-        outlines: t.outlines.clone(),
-    }
+/// The arena figure as the paper's Fig. 8 shows learning: the first and the last
+/// [`crate::experiment::SNAPSHOT_STEPS`] steps' paths in two panels, with the outlines at the
+/// start and the end of each.
+fn arena(s: &Scenario, t: &crate::experiment::Track) -> Vec<ArenaFigure> {
+    let k = crate::experiment::SNAPSHOT_STEPS.min(s.steps as usize);
+    let n = s.steps as usize;
+    let first_of = |from: usize, to: usize| -> ArenaFigure {
+        let paths = t
+            .paths
+            .iter()
+            .map(|p| p[from.min(p.len())..to.min(p.len())].to_vec())
+            .collect();
+        let t0 = from as f64 * s.timing.step_period_s;
+        let t1 = to as f64 * s.timing.step_period_s;
+        let outlines = t
+            .outlines
+            .iter()
+            .filter(|o| o.time_s >= t0 - 1.0 && o.time_s <= t1 + 1.0)
+            .cloned()
+            .collect();
+        ArenaFigure {
+            title: format!(
+                "{} {} steps ({:.0}-{:.0} s), {} robots{}",
+                if from == 0 { "first" } else { "last" },
+                to - from,
+                t0,
+                t1,
+                s.robots,
+                if t.paths.len() < s.robots {
+                    format!(", paths of the first {}", t.paths.len())
+                } else {
+                    String::new()
+                }
+            ),
+            walls: t.walls.clone(),
+            paths,
+            outlines,
+        }
+    };
+    vec![first_of(0, k), first_of(n - k, n)]
 }

@@ -53,6 +53,7 @@ fn learning() -> LearningFigure {
             series("learning off", true, 100, 0.08, |x| 0.7 + 0.03 * wiggle(x)),
             series("random walk", true, 100, 0.08, |x| 0.95 - 0.03 * wiggle(x)),
         ],
+        more: Vec::new(),
     }
 }
 
@@ -650,6 +651,7 @@ mod sweeps {
                 collisions: (0..rng.random_range(1..4))
                     .map(|_| random_series(&mut rng))
                     .collect(),
+                more: Vec::new(),
             };
             let result = learning_figure(&fig, &dir.join("fig.png"), &dir.join("fig.svg"));
             assert!(result.is_ok(), "case {case}: {result:?}");
@@ -676,4 +678,35 @@ mod sweeps {
             }
         }
     }
+}
+
+#[test]
+fn four_panels_and_side_by_side_arenas_are_drawn() {
+    let dir = out_dir("four_panels");
+    let mut fig = learning();
+    fig.more = vec![
+        h8swarm::plot::Panel {
+            caption: "Contact time".into(),
+            y_label: "% of the window".into(),
+            series: fig.d.clone(),
+        },
+        h8swarm::plot::Panel {
+            caption: "Gap CV".into(),
+            y_label: "CV".into(),
+            series: fig.collisions.clone(),
+        },
+    ];
+    let (png, svg) = (dir.join("fig.png"), dir.join("fig.svg"));
+    learning_figure(&fig, &png, &svg).expect("draw");
+    let (w, h) = png_size(&std::fs::read(&png).unwrap());
+    assert_eq!(w, LEARNING_SIZE_PX.0);
+    assert!(h > LEARNING_SIZE_PX.1 + 400, "a second row: {h}");
+    let panels = dir.join("arena.png");
+    h8swarm::plot::arena_figure_panels(&[arena(3, 1.8, 200), arena(3, 1.8, 200)], &panels)
+        .expect("draw panels");
+    let (pw, _) = png_size(&std::fs::read(&panels).unwrap());
+    let single = dir.join("one.png");
+    arena_figure(&arena(3, 1.8, 200), &single).expect("draw one");
+    let (sw, _) = png_size(&std::fs::read(&single).unwrap());
+    assert_eq!(pw, 2 * sw);
 }
