@@ -382,7 +382,7 @@ impl Cpu {
             if rec.bus.now() >= deadline {
                 return Ok((Outcome::Continue, false));
             }
-                let event = self.step_fast(&mut rec)?;
+            let event = self.step_fast(&mut rec)?;
             if event != Event::Executed {
                 return Ok((Outcome::Event(event), false));
             }
