@@ -22,3 +22,4 @@ pub mod run_cmd;
 pub mod scenario;
 pub mod seeds;
 pub mod summary;
+pub mod sweep;

@@ -39,6 +39,8 @@ enum Command {
     /// Does the learner fit the H8/3052F? RAM, ROM, states per phase, EEPROM, measured on the
     /// emulated MCU (SPEC §6).
     Fit(fit_cmd::FitArgs),
+    /// Parameter sweeps: plan a grid as a Slurm job array, run its tasks, merge the results.
+    Sweep(h8swarm::sweep::SweepArgs),
 }
 
 #[derive(Args, Debug)]
@@ -137,6 +139,7 @@ fn main() -> ExitCode {
         }
         Some(Command::Fit(args)) => fit(&args),
         Some(Command::Run(args)) => run(&args),
+        Some(Command::Sweep(args)) => sweep(&args),
         None => run(&run_cmd::RunArgs::default()),
     };
     match result {
@@ -230,6 +233,18 @@ fn cost(args: &CostArgs) -> Result<(), Failure> {
 
 fn fit(args: &fit_cmd::FitArgs) -> Result<(), Failure> {
     let text = fit_cmd::run(args).map_err(Failure::Input)?;
+    io::stdout()
+        .lock()
+        .write_all(text.as_bytes())
+        .or_else(write_failure)
+}
+
+fn sweep(args: &h8swarm::sweep::SweepArgs) -> Result<(), Failure> {
+    use h8swarm::sweep::SweepError;
+    let text = h8swarm::sweep::command(args).map_err(|e| match e {
+        SweepError::Input(m) => Failure::Input(anyhow::anyhow!(m)),
+        SweepError::Tool(m) => Failure::Tool(anyhow::anyhow!(m)),
+    })?;
     io::stdout()
         .lock()
         .write_all(text.as_bytes())

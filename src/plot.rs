@@ -1227,8 +1227,8 @@ fn draw_arena_legend<DB: DrawingBackend>(
 // Shared helpers
 // ---------------------------------------------------------------------------------------------
 
-/// Registers the embedded font once per process.
-fn register_font() -> Result<(), PlotError> {
+/// Registers the embedded font once per process (the sweep's figures use it too).
+pub(crate) fn register_font() -> Result<(), PlotError> {
     static REGISTERED: OnceLock<bool> = OnceLock::new();
     let ok = *REGISTERED.get_or_init(|| {
         plotters::style::register_font(FONT_FAMILY, FontStyle::Normal, DEJAVU_SANS_TTF).is_ok()
@@ -1252,7 +1252,7 @@ fn check_png_name(path: &Path) -> Result<(), PlotError> {
 }
 
 /// Encodes an RGB buffer drawn in memory into `path` as PNG.
-fn write_png(path: &Path, size: (u32, u32), rgb: &[u8]) -> Result<(), PlotError> {
+pub(crate) fn write_png(path: &Path, size: (u32, u32), rgb: &[u8]) -> Result<(), PlotError> {
     // Open the file ourselves first: the encoder reports I/O failures only as debug text.
     std::fs::File::create(path).map_err(|e| write_error(path, e))?;
     let mut file = BitMapBackend::new(path, size);

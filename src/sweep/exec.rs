@@ -1,0 +1,275 @@
+//! `h8swarm sweep run`: one task's share of the points (or all of them).
+//!
+//! Each point is run by `h8swarm run`'s own code ([`crate::run_cmd::run`]) into a temporary
+//! folder `points/.tmp-ID-HOST-PID`, which gets the point's `scenario.toml` first and its
+//! `status.json` last, and is then renamed to `points/ID` in one step: `points/ID` either does
+//! not exist or is complete. A point whose folder holds `status.json` with `"status": "ok"`
+//! and the planned `scenario.toml` is finished and skipped; anything else (no folder, a failed
+//! point, a folder of another scenario, a temporary folder left by a task that was killed) is
+//! removed and run again. A point depends only on its scenario, so its files are the same byte
+//! for byte whichever task runs it and with how many threads (`run.txt`, the console text with
+//! its wall time, is the exception).
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use serde::{Deserialize, Serialize};
+
+use super::plan::{PlanLine, read_plan};
+use super::{SweepError, write_atomic};
+use crate::run_cmd::{RunArgs, run};
+
+/// `status.json` of a point's folder.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Status {
+    /// The point's id.
+    pub id: String,
+    /// `ok` or `failed`.
+    pub status: String,
+    /// Why it failed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub error: Option<String>,
+}
+
+/// What became of a point in a task.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Outcome {
+    /// Already finished: skipped.
+    Skipped,
+    /// Run now, successfully.
+    Done,
+    /// Run now, and it failed (the reason is in its `status.json`).
+    Failed(String),
+}
+
+/// The state of a point's folder.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum PointState {
+    /// No folder.
+    Missing,
+    /// Finished.
+    Ok,
+    /// Ran and failed, with why.
+    Failed(String),
+    /// A folder that is neither: no or a bad `status.json`, or another scenario.
+    Broken(String),
+}
+
+/// The state of `line`'s folder under `points`.
+#[must_use]
+pub fn point_state(points: &Path, line: &PlanLine) -> PointState {
+    let dir = points.join(&line.id);
+    if !dir.exists() {
+        return PointState::Missing;
+    }
+    let status: Status = match std::fs::read_to_string(dir.join("status.json"))
+        .ok()
+        .and_then(|t| serde_json::from_str(&t).ok())
+    {
+        Some(s) => s,
+        None => return PointState::Broken("no readable status.json".into()),
+    };
+    let planned = toml::to_string(&line.scenario).unwrap_or_default();
+    match std::fs::read_to_string(dir.join("scenario.toml")) {
+        Ok(t) if t == planned => {}
+        _ => return PointState::Broken("its scenario.toml is not the planned one".into()),
+    }
+    match (status.id == line.id, status.status.as_str()) {
+        (true, "ok") => PointState::Ok,
+        (true, "failed") => PointState::Failed(status.error.unwrap_or_default()),
+        _ => PointState::Broken(format!("status.json says {:?}", status.status)),
+    }
+}
+
+fn io_err(what: &str, p: &Path, e: &std::io::Error) -> SweepError {
+    SweepError::tool(format!("cannot {what} `{}`: {e}", p.display()))
+}
+
+/// Runs one point into `points/ID` (atomically); `threads` as `h8swarm run --threads`.
+///
+/// # Errors
+/// A folder that cannot be written or renamed (tool). A point that fails to run is not an
+/// error here: it is recorded in its folder and returned as [`Outcome::Failed`].
+pub fn run_point(
+    points: &Path,
+    line: &PlanLine,
+    threads: Option<usize>,
+) -> Result<Outcome, SweepError> {
+    if point_state(points, line) == PointState::Ok {
+        return Ok(Outcome::Skipped);
+    }
+    let final_dir = points.join(&line.id);
+    // Leftovers of this point: a broken or failed folder, temporary folders of killed tasks.
+    let stale_prefix = format!(".tmp-{}-", line.id);
+    if let Ok(entries) = std::fs::read_dir(points) {
+        for e in entries.flatten() {
+            if e.file_name().to_string_lossy().starts_with(&stale_prefix) {
+                let p = e.path();
+                std::fs::remove_dir_all(&p).map_err(|e| io_err("remove", &p, &e))?;
+            }
+        }
+    }
+    if final_dir.exists() {
+        std::fs::remove_dir_all(&final_dir).map_err(|e| io_err("remove", &final_dir, &e))?;
+    }
+    let host = super::spec::sanitize(
+        &std::env::var("HOSTNAME")
+            .or_else(|_| std::env::var("SLURMD_NODENAME"))
+            .unwrap_or_else(|_| "host".into()),
+        32,
+    );
+    let tmp = points.join(format!("{stale_prefix}{host}-{}", std::process::id()));
+    std::fs::create_dir_all(&tmp).map_err(|e| io_err("create", &tmp, &e))?;
+    let scenario_path = tmp.join("scenario.toml");
+    write_atomic(&scenario_path, line.point().scenario_toml()?.as_bytes())?;
+    let args = RunArgs {
+        scenario: Some(scenario_path.display().to_string()),
+        threads,
+        out: Some(tmp.clone()),
+        ..RunArgs::default()
+    };
+    let (status, outcome) = match run(&args) {
+        Ok(text) => {
+            write_atomic(&tmp.join("run.txt"), text.as_bytes())?;
+            (
+                Status {
+                    id: line.id.clone(),
+                    status: "ok".into(),
+                    error: None,
+                },
+                Outcome::Done,
+            )
+        }
+        Err(e) => {
+            // The temporary folder's name means nothing to a reader: say what was run.
+            let why = format!("{e:#}").replace(&tmp.display().to_string(), &line.id);
+            (
+                Status {
+                    id: line.id.clone(),
+                    status: "failed".into(),
+                    error: Some(why.clone()),
+                },
+                Outcome::Failed(why),
+            )
+        }
+    };
+    let json = serde_json::to_string_pretty(&status)
+        .map_err(|e| SweepError::tool(format!("writing status.json: {e}")))?
+        + "\n";
+    write_atomic(&tmp.join("status.json"), json.as_bytes())?;
+    if let Err(e) = std::fs::rename(&tmp, &final_dir) {
+        // Another task finished the same point first: keep its folder if it is complete.
+        let _ = std::fs::remove_dir_all(&tmp);
+        if point_state(points, line) != PointState::Ok {
+            return Err(io_err("rename the finished point into", &final_dir, &e));
+        }
+    }
+    Ok(outcome)
+}
+
+/// Which task `sweep run` serves: `--task`, else `SLURM_ARRAY_TASK_ID`, else every task.
+///
+/// # Errors
+/// A `SLURM_ARRAY_TASK_ID` that is not a whole number.
+pub fn task_from(task: Option<usize>) -> Result<Option<usize>, SweepError> {
+    if task.is_some() {
+        return Ok(task);
+    }
+    match std::env::var("SLURM_ARRAY_TASK_ID") {
+        Ok(v) => v.trim().parse::<usize>().map(Some).map_err(|_| {
+            SweepError::input(format!(
+                "SLURM_ARRAY_TASK_ID = {v:?} is not a task number: submit sweep.sbatch as a job array, or give --task"
+            ))
+        }),
+        Err(_) => Ok(None),
+    }
+}
+
+/// Threads: `--threads`, else `SLURM_CPUS_PER_TASK`, else all cores.
+#[must_use]
+pub fn threads_from(threads: Option<usize>) -> Option<usize> {
+    threads.or_else(|| {
+        std::env::var("SLURM_CPUS_PER_TASK")
+            .ok()
+            .and_then(|v| v.trim().parse::<usize>().ok())
+            .filter(|&n| n > 0)
+    })
+}
+
+/// Runs task `task`'s points (every point when `None`) of the sweep in `dir`; returns what to
+/// print and whether every point is finished.
+///
+/// # Errors
+/// Not a sweep folder, a task out of range, `--threads 0` (input); a folder that cannot be
+/// written (tool).
+pub fn run_task(
+    dir: &Path,
+    task: Option<usize>,
+    threads: Option<usize>,
+) -> Result<(String, bool), SweepError> {
+    let (plan, lines) = read_plan(dir)?;
+    if threads == Some(0) {
+        return Err(SweepError::input(
+            "--threads 0: give at least 1 (or leave it out for SLURM_CPUS_PER_TASK or all cores)",
+        ));
+    }
+    let task = task_from(task)?;
+    if let Some(t) = task
+        && t >= plan.tasks
+    {
+        return Err(SweepError::input(format!(
+            "task {t} is out of range: the plan in `{}` has tasks 0 to {}",
+            dir.display(),
+            plan.tasks.saturating_sub(1)
+        )));
+    }
+    let threads = threads_from(threads);
+    let points: PathBuf = dir.join("points");
+    std::fs::create_dir_all(&points).map_err(|e| io_err("create", &points, &e))?;
+    let share: Vec<&PlanLine> = lines
+        .iter()
+        .filter(|l| task.is_none_or(|t| l.task == t))
+        .collect();
+    let mut t = String::new();
+    let _ = writeln!(
+        t,
+        "h8swarm sweep run `{}`: {}, {} points",
+        plan.sweep,
+        task.map_or_else(
+            || format!("all {} tasks", plan.tasks),
+            |k| format!("task {k} of 0-{}", plan.tasks.saturating_sub(1))
+        ),
+        share.len()
+    );
+    let (mut done, mut skipped, mut failed) = (0, 0, 0);
+    for line in share {
+        let started = Instant::now();
+        let outcome = run_point(&points, line, threads)?;
+        let line_text = match &outcome {
+            Outcome::Skipped => {
+                skipped += 1;
+                format!("{} finished before: skipped", line.id)
+            }
+            Outcome::Done => {
+                done += 1;
+                format!(
+                    "{} done in {:.1} s",
+                    line.id,
+                    started.elapsed().as_secs_f64()
+                )
+            }
+            Outcome::Failed(why) => {
+                failed += 1;
+                format!("{} FAILED: {why}", line.id)
+            }
+        };
+        // One line per point as it ends, for Slurm's log (standard output holds the totals).
+        eprintln!("{line_text}");
+    }
+    let _ = writeln!(
+        t,
+        "{done} run, {skipped} skipped (finished before), {failed} failed"
+    );
+    Ok((t, failed == 0))
+}

@@ -1,0 +1,393 @@
+//! `h8swarm sweep merge`: every point's claims and first/last-window statistics in one table.
+//!
+//! Written to `DIR/merged/` (or `--out`):
+//! * `sweep.csv`: one row per planned point, in order, finished or not. Columns: `index`,
+//!   `id`, `status` (`ok`, `failed`, `missing`: never run or still running, `broken`: a folder
+//!   that is neither finished nor failed), one column per swept key, `seed`; then for every
+//!   condition and window of the points' summary.json the mean and 95 % interval of each
+//!   statistic (`learning.last.collisions_per_robot.mean`, `….lo`, `….hi`); then for every claim
+//!   (column names from its text, `claim.<words>.…`): `holds`, `apart` (intervals apart), `a`
+//!   and `b` (the two means compared: the claim is "a below b") and `effect` = b − a (positive
+//!   when the claim holds); last `error`. A point that did not finish has empty cells.
+//! * `sweep.json`: the same rows (objects keyed by column), the column order, the claims' full
+//!   texts, and the lists of failed, missing and broken points.
+//! * `plots/`: each claim's effect against the swept keys (see [`super::figures`]).
+//!
+//! The table is a pure function of the points' folders: the same bytes however the points were
+//! split into tasks or where they ran.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use serde_json::{Map, Value, json};
+
+use super::SweepError;
+use super::exec::{PointState, point_state};
+use super::figures::{ClaimSeries, claim_figures};
+use super::plan::read_plan;
+
+/// The statistics of a window in the order the table lists them (others follow, sorted).
+const STAT_ORDER: [&str; 6] = [
+    "mean_d",
+    "collisions_per_robot",
+    "contact_fraction",
+    "stuck_fraction",
+    "moved_m",
+    "gap_cv",
+];
+
+/// A claim's words as a column name: lower case, runs of anything but letters and digits as
+/// one `_`, at most 72 characters.
+#[must_use]
+pub fn claim_slug(text: &str) -> String {
+    let mut out = String::new();
+    for c in text.chars().flat_map(char::to_lowercase) {
+        if c.is_ascii_alphanumeric() {
+            out.push(c);
+        } else if !out.is_empty() && !out.ends_with('_') {
+            out.push('_');
+        }
+    }
+    let mut out: String = out.chars().take(72).collect();
+    while out.ends_with('_') {
+        out.pop();
+    }
+    if out.is_empty() { "claim".into() } else { out }
+}
+
+/// Columns in order of first appearance.
+#[derive(Default)]
+struct Columns {
+    order: Vec<String>,
+    seen: BTreeSet<String>,
+}
+
+impl Columns {
+    fn add(&mut self, c: &str) {
+        if self.seen.insert(c.to_string()) {
+            self.order.push(c.to_string());
+        }
+    }
+}
+
+fn toml_to_json(v: &toml::Value) -> Value {
+    serde_json::to_value(v).unwrap_or(Value::Null)
+}
+
+fn num(v: f64) -> Value {
+    serde_json::Number::from_f64(v).map_or(Value::Null, Value::Number)
+}
+
+/// A cell as CSV text.
+fn csv_cell(v: Option<&Value>) -> String {
+    match v {
+        None | Some(Value::Null) => String::new(),
+        Some(Value::String(s)) => s.clone(),
+        Some(other) => other.to_string(),
+    }
+}
+
+/// What `merge` found.
+#[derive(Debug, Default)]
+pub struct Merged {
+    /// Column names in order.
+    pub columns: Vec<String>,
+    /// One row per point.
+    pub rows: Vec<Map<String, Value>>,
+    /// Points that ran and failed, with why.
+    pub failed: Vec<(String, String)>,
+    /// Points with no folder.
+    pub missing: Vec<String>,
+    /// Points whose folder is neither finished nor failed, with why.
+    pub broken: Vec<(String, String)>,
+    /// The claims: column slug and full text, in order of first appearance.
+    pub claims: Vec<(String, String)>,
+}
+
+/// Reads every point of the sweep in `dir` into the table.
+///
+/// # Errors
+/// Not a sweep folder (input); a finished point whose summary.json cannot be read (tool).
+pub fn collect(
+    dir: &Path,
+) -> Result<(super::plan::Plan, Vec<super::plan::PlanLine>, Merged), SweepError> {
+    let (plan, lines) = read_plan(dir)?;
+    let points = dir.join("points");
+    let mut cols = Columns::default();
+    for c in ["index", "id", "status"] {
+        cols.add(c);
+    }
+    for a in &plan.axes {
+        for k in &a.keys {
+            cols.add(k);
+        }
+    }
+    cols.add("seed");
+    let mut m = Merged::default();
+    let mut stat_cols = Columns::default();
+    let mut claim_slugs: BTreeMap<String, String> = BTreeMap::new();
+    let mut claim_cols = Columns::default();
+    for line in &lines {
+        let mut row = Map::new();
+        row.insert("index".into(), json!(line.index));
+        row.insert("id".into(), json!(line.id));
+        for (a, &c) in plan.axes.iter().zip(&line.coords) {
+            for (k, v) in a.keys.iter().zip(a.values.get(c).into_iter().flatten()) {
+                row.insert(k.clone(), toml_to_json(v));
+            }
+        }
+        row.insert("seed".into(), json!(line.seed));
+        let status = match point_state(&points, line) {
+            PointState::Ok => "ok",
+            PointState::Missing => {
+                m.missing.push(line.id.clone());
+                "missing"
+            }
+            PointState::Failed(why) => {
+                row.insert("error".into(), json!(why));
+                m.failed.push((line.id.clone(), why));
+                "failed"
+            }
+            PointState::Broken(why) => {
+                row.insert("error".into(), json!(why));
+                m.broken.push((line.id.clone(), why));
+                "broken"
+            }
+        };
+        row.insert("status".into(), json!(status));
+        if status == "ok" {
+            let path = points.join(&line.id).join("summary.json");
+            let summary: Value = std::fs::read_to_string(&path)
+                .ok()
+                .and_then(|t| serde_json::from_str(&t).ok())
+                .ok_or_else(|| {
+                    SweepError::tool(format!(
+                        "point {} is finished but `{}` cannot be read as JSON",
+                        line.id,
+                        path.display()
+                    ))
+                })?;
+            for c in summary["conditions"].as_array().into_iter().flatten() {
+                let cond = c["condition"].as_str().unwrap_or("condition");
+                for w in ["first", "last"] {
+                    let Some(win) = c[w].as_object() else {
+                        continue;
+                    };
+                    let mut keys: Vec<&String> = STAT_ORDER
+                        .iter()
+                        .filter_map(|k| win.get_key_value(*k).map(|(k, _)| k))
+                        .collect();
+                    let mut rest: Vec<&String> = win
+                        .keys()
+                        .filter(|k| !STAT_ORDER.contains(&k.as_str()))
+                        .collect();
+                    rest.sort();
+                    keys.extend(rest);
+                    for k in keys {
+                        let Some(est) = win[k].as_object() else {
+                            continue;
+                        };
+                        if !est.contains_key("mean") {
+                            continue;
+                        }
+                        for part in ["mean", "lo", "hi"] {
+                            let col = format!("{cond}.{w}.{k}.{part}");
+                            stat_cols.add(&col);
+                            row.insert(col, est.get(part).cloned().unwrap_or(Value::Null));
+                        }
+                    }
+                }
+            }
+            for c in summary["claims"].as_array().into_iter().flatten() {
+                let text = c["claim"].as_str().unwrap_or_default().to_string();
+                let slug = match claim_slugs.get(&text) {
+                    Some(s) => s.clone(),
+                    None => {
+                        let base = claim_slug(&text);
+                        let mut slug = base.clone();
+                        let mut n = 2;
+                        while claim_slugs.values().any(|s| *s == slug) {
+                            slug = format!("{base}_{n}");
+                            n += 1;
+                        }
+                        claim_slugs.insert(text.clone(), slug.clone());
+                        m.claims.push((slug.clone(), text.clone()));
+                        slug
+                    }
+                };
+                let a = c["values"][0].as_f64();
+                let b = c["values"][1].as_f64();
+                let cells = [
+                    ("holds", c["holds"].clone()),
+                    ("apart", c["apart"].clone()),
+                    ("a", a.map_or(Value::Null, num)),
+                    ("b", b.map_or(Value::Null, num)),
+                    (
+                        "effect",
+                        match (a, b) {
+                            (Some(a), Some(b)) => num(b - a),
+                            _ => Value::Null,
+                        },
+                    ),
+                ];
+                for (part, v) in cells {
+                    let col = format!("claim.{slug}.{part}");
+                    claim_cols.add(&col);
+                    row.insert(col, v);
+                }
+            }
+        }
+        m.rows.push(row);
+    }
+    for c in stat_cols.order.iter().chain(&claim_cols.order) {
+        cols.add(c);
+    }
+    cols.add("error");
+    m.columns = cols.order;
+    Ok((plan, lines, m))
+}
+
+/// Leftover temporary folders under `points/` (tasks running now, or killed).
+fn temporaries(points: &Path) -> Vec<String> {
+    let mut out: Vec<String> = std::fs::read_dir(points)
+        .into_iter()
+        .flatten()
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with(".tmp-"))
+        .collect();
+    out.sort();
+    out
+}
+
+/// Merges the sweep in `dir` into `out` (default `DIR/merged`); returns what to print and
+/// whether every point finished.
+///
+/// # Errors
+/// Not a sweep folder (input); an output that cannot be written (tool).
+pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepError> {
+    let (plan, lines, m) = collect(dir)?;
+    let out: PathBuf = out.map_or_else(|| dir.join("merged"), Path::to_path_buf);
+    let plots = out.join("plots");
+    if plots.exists() {
+        std::fs::remove_dir_all(&plots)
+            .map_err(|e| SweepError::tool(format!("cannot clear `{}`: {e}", plots.display())))?;
+    }
+    std::fs::create_dir_all(&plots)
+        .map_err(|e| SweepError::tool(format!("cannot create `{}`: {e}", plots.display())))?;
+
+    // The CSV, rendered in memory, then written in one step.
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let csv_err = |e: csv::Error| SweepError::tool(format!("writing sweep.csv: {e}"));
+    w.write_record(&m.columns).map_err(csv_err)?;
+    for row in &m.rows {
+        w.write_record(m.columns.iter().map(|c| csv_cell(row.get(c))))
+            .map_err(csv_err)?;
+    }
+    let bytes = w
+        .into_inner()
+        .map_err(|e| SweepError::tool(format!("writing sweep.csv: {e}")))?;
+    let csv_path = out.join("sweep.csv");
+    super::write_atomic(&csv_path, &bytes)?;
+
+    let ok = m.rows.iter().filter(|r| r["status"] == "ok").count();
+    let doc = json!({
+        "sweep": plan.sweep,
+        "points": plan.points,
+        "ok": ok,
+        "failed": m.failed.iter().map(|(id, why)| json!({"id": id, "error": why})).collect::<Vec<_>>(),
+        "missing": m.missing,
+        "broken": m.broken.iter().map(|(id, why)| json!({"id": id, "why": why})).collect::<Vec<_>>(),
+        "axes": plan.axes.iter().map(|a| json!({
+            "keys": a.keys,
+            "values": a.values.iter().map(|v| v.iter().map(toml_to_json).collect::<Vec<_>>()).collect::<Vec<_>>(),
+        })).collect::<Vec<_>>(),
+        "seeds": plan.seeds,
+        "claims": m.claims.iter().map(|(slug, text)| json!({"column": format!("claim.{slug}"), "claim": text})).collect::<Vec<_>>(),
+        "columns": m.columns,
+        "rows": m.rows,
+    });
+    let json_path = out.join("sweep.json");
+    let text = serde_json::to_string_pretty(&doc)
+        .map_err(|e| SweepError::tool(format!("writing sweep.json: {e}")))?
+        + "\n";
+    super::write_atomic(&json_path, text.as_bytes())?;
+
+    // Each claim's effect per point, for the figures.
+    let series: Vec<ClaimSeries> = m
+        .claims
+        .iter()
+        .map(|(slug, text)| ClaimSeries {
+            slug: slug.clone(),
+            text: text.clone(),
+            per_point: m
+                .rows
+                .iter()
+                .map(|r| {
+                    let e = r.get(&format!("claim.{slug}.effect"))?.as_f64()?;
+                    let h = r.get(&format!("claim.{slug}.holds"))?.as_bool()?;
+                    Some((e, h))
+                })
+                .collect(),
+        })
+        .collect();
+    let coords: Vec<Vec<usize>> = lines.iter().map(|l| l.coords.clone()).collect();
+    let figures = claim_figures(&plan.axes, &coords, &series, &plots)?;
+
+    let mut t = String::new();
+    let _ = writeln!(
+        t,
+        "h8swarm sweep merge `{}`: {} points, {} ok, {} failed, {} missing, {} broken",
+        plan.sweep,
+        plan.points,
+        ok,
+        m.failed.len(),
+        m.missing.len(),
+        m.broken.len()
+    );
+    for (id, why) in &m.failed {
+        let _ = writeln!(t, "FAILED  {id}: {why}");
+    }
+    for id in &m.missing {
+        let _ = writeln!(t, "MISSING {id}");
+    }
+    for (id, why) in &m.broken {
+        let _ = writeln!(t, "BROKEN  {id}: {why} (the next `sweep run` redoes it)");
+    }
+    for tmp in temporaries(&dir.join("points")) {
+        let _ = writeln!(
+            t,
+            "RUNNING points/{tmp} (a task at work, or left by a killed one)"
+        );
+    }
+    for (slug, text) in &m.claims {
+        let col = format!("claim.{slug}.holds");
+        let with: Vec<bool> = m
+            .rows
+            .iter()
+            .filter_map(|r| r.get(&col).and_then(Value::as_bool))
+            .collect();
+        let _ = writeln!(
+            t,
+            "holds in {:>3} of {:>3} points: {text}",
+            with.iter().filter(|h| **h).count(),
+            with.len()
+        );
+    }
+    let _ = writeln!(
+        t,
+        "wrote {} ({} rows x {} columns) and {}; {} figures in {}",
+        csv_path.display(),
+        m.rows.len(),
+        m.columns.len(),
+        json_path.display(),
+        figures.len(),
+        plots.display()
+    );
+    if !plan.axes.is_empty() && figures.is_empty() && ok > 0 {
+        let _ = writeln!(t, "(no claim had values to draw)");
+    }
+    let complete = m.failed.is_empty() && m.missing.is_empty() && m.broken.is_empty();
+    Ok((t, complete))
+}

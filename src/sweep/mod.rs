@@ -1,0 +1,167 @@
+//! `h8swarm sweep`: parameter sweeps split, run and merged on Slurm (or on one machine with
+//! the same files).
+//!
+//! * `h8swarm sweep plan SWEEP.toml --out DIR` ([`plan`]): expands the sweep file ([`spec`]) to
+//!   its points, each a full scenario, and writes the run list, the plan and a job-array
+//!   script `DIR/sweep.sbatch` whose requests come from the points' robots and steps.
+//! * `h8swarm sweep run DIR [--task I]` ([`exec`]): runs task I's points (from
+//!   `SLURM_ARRAY_TASK_ID` under Slurm; every point without either), each into its own folder
+//!   atomically, skipping those finished before, so a requeued or resubmitted task loses
+//!   nothing and redoes only what is missing or broken.
+//! * `h8swarm sweep merge DIR` ([`merge`]): one table of every point's claims and first/last
+//!   window statistics (CSV and JSON), figures of each claim's effect against the swept keys
+//!   ([`figures`]), and the failed and missing points listed.
+//!
+//! A point's results depend only on its scenario (its master seed included: every stream is
+//! derived from it by [`crate::seeds`]), so the merged table is the same byte for byte however
+//! the points are split into tasks, in what order they run, and on which machine.
+//!
+//! Exit status: 2 for bad input (a malformed sweep file, an unknown key, an empty grid, a task
+//! out of range, a folder that is not a sweep's), 1 when the tool fails (a folder that cannot be
+//! written) or, for `run`, when a point failed (it is recorded, and `merge` lists it).
+
+pub mod exec;
+pub mod figures;
+pub mod merge;
+pub mod plan;
+pub mod spec;
+
+use std::path::{Path, PathBuf};
+
+use clap::{Args, Subcommand};
+
+/// Why a sweep command stopped: the two exit statuses.
+#[derive(Debug, thiserror::Error)]
+pub enum SweepError {
+    /// Bad input (exit status 2).
+    #[error("{0}")]
+    Input(String),
+    /// The tool failed (exit status 1).
+    #[error("{0}")]
+    Tool(String),
+}
+
+impl SweepError {
+    /// Bad input.
+    pub fn input(msg: impl Into<String>) -> Self {
+        Self::Input(msg.into())
+    }
+
+    /// The tool failed.
+    pub fn tool(msg: impl Into<String>) -> Self {
+        Self::Tool(msg.into())
+    }
+}
+
+/// Writes `bytes` to `path` through a temporary file beside it and a rename, so a reader
+/// never sees half a file.
+///
+/// # Errors
+/// The file cannot be written (tool).
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), SweepError> {
+    let name = path
+        .file_name()
+        .map_or_else(|| "file".into(), |n| n.to_string_lossy().into_owned());
+    let tmp = path.with_file_name(format!(".{name}.tmp-{}", std::process::id()));
+    std::fs::write(&tmp, bytes)
+        .and_then(|()| std::fs::rename(&tmp, path))
+        .map_err(|e| {
+            let _ = std::fs::remove_file(&tmp);
+            SweepError::tool(format!("cannot write `{}`: {e}", path.display()))
+        })
+}
+
+/// Options of `h8swarm sweep`.
+#[derive(Args, Debug, Clone)]
+pub struct SweepArgs {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: SweepCommand,
+}
+
+/// The sweep's three steps.
+#[derive(Subcommand, Debug, Clone)]
+pub enum SweepCommand {
+    /// Expand a sweep file into DIR: the run list (points.jsonl), plan.json and sweep.sbatch,
+    /// a Slurm job array that runs it.
+    Plan {
+        /// The sweep file (.toml): base scenario, grid, seeds, Slurm settings.
+        sweep: PathBuf,
+        /// The sweep folder.
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
+        /// The h8swarm binary the job runs (default: this one).
+        #[arg(long, value_name = "PATH")]
+        bin: Option<PathBuf>,
+    },
+    /// Run one array task's points (--task, else SLURM_ARRAY_TASK_ID), or every point;
+    /// finished points are skipped.
+    Run {
+        /// The sweep folder.
+        dir: PathBuf,
+        /// The task (0 to tasks − 1; see plan.json).
+        #[arg(long, value_name = "I")]
+        task: Option<usize>,
+        /// Worker threads per point (default: SLURM_CPUS_PER_TASK, else all cores). The
+        /// results do not depend on it.
+        #[arg(long)]
+        threads: Option<usize>,
+    },
+    /// Merge every point's claims and window statistics into DIR/merged (sweep.csv,
+    /// sweep.json, plots/), listing failed and missing points.
+    Merge {
+        /// The sweep folder.
+        dir: PathBuf,
+        /// Output folder (default DIR/merged).
+        #[arg(long, value_name = "OUT")]
+        out: Option<PathBuf>,
+        /// Exit with status 1 unless every point finished.
+        #[arg(long)]
+        require_complete: bool,
+    },
+}
+
+/// Runs a sweep command; returns the text to print.
+///
+/// # Errors
+/// [`SweepError::Input`] for bad input, [`SweepError::Tool`] when the tool fails (and, for
+/// `run`, when a point failed; the text of the run is in the message).
+pub fn command(args: &SweepArgs) -> Result<String, SweepError> {
+    match &args.command {
+        SweepCommand::Plan { sweep, out, bin } => {
+            let text = std::fs::read_to_string(sweep).map_err(|e| {
+                SweepError::input(format!(
+                    "cannot read sweep file `{}`: {e} (give a .toml sweep file)",
+                    sweep.display()
+                ))
+            })?;
+            let s = spec::parse(&text, sweep)?;
+            plan::write_plan(&s, &text, out, bin.as_deref())
+        }
+        SweepCommand::Run { dir, task, threads } => {
+            let (text, ok) = exec::run_task(dir, *task, *threads)?;
+            if ok {
+                Ok(text)
+            } else {
+                Err(SweepError::tool(format!(
+                    "{}some points failed (each says why in its status.json; `h8swarm sweep merge` lists them)",
+                    text
+                )))
+            }
+        }
+        SweepCommand::Merge {
+            dir,
+            out,
+            require_complete,
+        } => {
+            let (text, complete) = merge::merge(dir, out.as_deref())?;
+            if *require_complete && !complete {
+                Err(SweepError::tool(format!(
+                    "{text}the sweep is not complete (--require-complete)"
+                )))
+            } else {
+                Ok(text)
+            }
+        }
+    }
+}

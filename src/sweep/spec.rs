@@ -1,0 +1,651 @@
+//! The sweep file and the points it expands to.
+//!
+//! ```toml
+//! name = "eta-history"          # optional; default: the file's name without .toml
+//! base = "arena"                # `arena`, `corridor` or a scenario file (relative to this file)
+//! seeds = [1, 2, 3]             # master seeds (or a count: `seeds = 3` is [1, 2, 3])
+//!
+//! [set]                         # fixed changes to the base, for every point
+//! steps = 2000
+//! repeats = 5
+//!
+//! [grid]                        # one axis per key: every combination is a point
+//! "learner.eta" = [0.001, 0.01]
+//! learner.history = [0, 1, 2]   # dotted keys may also be written as TOML tables
+//!
+//! [[zip]]                       # one axis whose keys move together (equal-length lists)
+//! steps = [1000, 2000]
+//! window = [100, 200]
+//!
+//! [slurm]                       # all optional: see `SlurmSpec`
+//! points_per_task = 2
+//! max_parallel = 50
+//! ```
+//!
+//! Keys are the scenario's own (`robots`, `steps`, `learner.eta`, `world.substep_s`, …, as
+//! `h8swarm run`'s summary.json lists them under `scenario`); `name`, `base` and `seed` are
+//! the sweep's. Points are the Cartesian product of the axes (the first axis varies slowest)
+//! with the seeds innermost, numbered from 0 in that order. A point's id is its number and its
+//! values, reduced to the characters `[A-Za-z0-9.+-]`, so no value can reach outside the sweep
+//! folder. Every point's scenario is checked as `h8swarm run` checks a scenario file, before
+//! anything is written.
+
+use std::collections::BTreeSet;
+use std::fmt::Write as _;
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use crate::scenario::{Scenario, ScenarioFile};
+
+use super::SweepError;
+
+/// The most points a sweep may have (a Slurm array's size is bounded by the cluster's
+/// `MaxArraySize`, 1 001 by default, but several points may share a task).
+pub const MAX_POINTS: usize = 1_000_000;
+
+/// Longest id, characters (the number, then the values shortened).
+pub const MAX_ID_CHARS: usize = 96;
+
+/// Slurm settings of a sweep (all optional).
+#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct SlurmSpec {
+    /// Points run one after the other by one array task (default 1).
+    pub points_per_task: Option<usize>,
+    /// At most this many array tasks at once: the `%L` of `--array=0-K%L` (default 100).
+    pub max_parallel: Option<usize>,
+    /// CPUs per task (default: computed from the points, at most `max_cpus`).
+    pub cpus_per_task: Option<usize>,
+    /// Upper bound of the computed CPUs per task (default 8).
+    pub max_cpus: Option<usize>,
+    /// Memory per task in MB (default: computed from the points' robots and steps).
+    pub mem_mb: Option<u64>,
+    /// Time limit per task, as Slurm writes it (`MM`, `HH:MM:SS`, `D-HH`); default: computed.
+    pub time: Option<String>,
+    /// Partition (`--partition`).
+    pub partition: Option<String>,
+    /// Account (`--account`).
+    pub account: Option<String>,
+    /// Further `sbatch` options, one per entry (e.g. `"--qos=long"`).
+    pub extra: Option<Vec<String>>,
+}
+
+/// The sweep file as written.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SweepFile {
+    name: Option<String>,
+    base: Option<String>,
+    seeds: Option<toml::Value>,
+    set: Option<toml::Table>,
+    grid: Option<toml::Table>,
+    zip: Option<Vec<toml::Table>>,
+    slurm: Option<SlurmSpec>,
+}
+
+/// One axis of the grid: one key (a `[grid]` entry) or several that move together (a `[[zip]]`
+/// table).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Axis {
+    /// The dotted scenario keys.
+    pub keys: Vec<String>,
+    /// The axis' values: for each position, one value per key.
+    pub values: Vec<Vec<toml::Value>>,
+}
+
+impl Axis {
+    /// The axis' name: its keys joined by `+`.
+    #[must_use]
+    pub fn name(&self) -> String {
+        self.keys.join("+")
+    }
+
+    /// The label of position `i`: its values (joined by `, ` for a zipped axis).
+    #[must_use]
+    pub fn label(&self, i: usize) -> String {
+        self.values[i]
+            .iter()
+            .map(value_text)
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+}
+
+/// A parsed, checked sweep.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Sweep {
+    /// The sweep's name (safe for file names).
+    pub name: String,
+    /// The axes, in order (the first varies slowest).
+    pub axes: Vec<Axis>,
+    /// The master seeds (innermost).
+    pub seeds: Vec<u64>,
+    /// The Slurm settings.
+    pub slurm: SlurmSpec,
+    /// Every point, in order.
+    pub points: Vec<Point>,
+}
+
+/// One point of a sweep: a full scenario.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Point {
+    /// Its number, from 0.
+    pub index: usize,
+    /// Its id: the number and the values, safe as a folder name.
+    pub id: String,
+    /// Its position on each axis.
+    pub coords: Vec<usize>,
+    /// Its master seed.
+    pub seed: u64,
+    /// The full scenario, as a TOML table (what `scenario.toml` in its folder holds).
+    pub scenario: toml::Table,
+}
+
+impl Point {
+    /// The scenario as TOML text.
+    ///
+    /// # Errors
+    /// A table TOML cannot write (not for one built by [`parse`]).
+    pub fn scenario_toml(&self) -> Result<String, SweepError> {
+        toml::to_string(&self.scenario)
+            .map_err(|e| SweepError::tool(format!("writing point {}'s scenario: {e}", self.id)))
+    }
+
+    /// The checked scenario.
+    ///
+    /// # Errors
+    /// A value out of range (naming the key).
+    pub fn resolve(&self) -> Result<Scenario, SweepError> {
+        let text = self.scenario_toml()?;
+        Scenario::from_toml(&text)
+            .map_err(|e| SweepError::input(format!("point {} ({}): {e:#}", self.index, self.id)))
+    }
+}
+
+/// A value as a label: strings bare, everything else as TOML writes it.
+#[must_use]
+pub fn value_text(v: &toml::Value) -> String {
+    match v {
+        toml::Value::String(s) => s.clone(),
+        toml::Value::Array(a) => format!(
+            "[{}]",
+            a.iter().map(value_text).collect::<Vec<_>>().join(", ")
+        ),
+        other => other.to_string(),
+    }
+}
+
+/// `text` reduced to `[A-Za-z0-9.+-]` (others become `_`; runs of `_` or of `.` become one),
+/// at most `max` characters; never empty, never starting with `.` or `_`, never holding `..`.
+#[must_use]
+pub fn sanitize(text: &str, max: usize) -> String {
+    let mut out = String::new();
+    for c in text.chars() {
+        let c = if c.is_ascii_alphanumeric() || matches!(c, '.' | '+' | '-') {
+            c
+        } else {
+            '_'
+        };
+        // Runs of `_` become one, and of `.` one (so no `..` survives).
+        if (c == '_' || c == '.') && out.ends_with(c) {
+            continue;
+        }
+        if out.len() >= max {
+            break;
+        }
+        out.push(c);
+    }
+    let out = out.trim_start_matches(['.', '_']).to_string();
+    if out.is_empty() { "x".to_string() } else { out }
+}
+
+/// Flattens nested tables into dotted keys, keeping the leaves (non-table values).
+fn flatten(prefix: &str, t: &toml::Table, out: &mut Vec<(String, toml::Value)>) {
+    for (k, v) in t {
+        let key = if prefix.is_empty() {
+            k.clone()
+        } else {
+            format!("{prefix}.{k}")
+        };
+        match v {
+            toml::Value::Table(inner) => flatten(&key, inner, out),
+            other => out.push((key, other.clone())),
+        }
+    }
+}
+
+/// Sets `key` (dotted) in `table`, creating tables on the way.
+fn set_key(table: &mut toml::Table, key: &str, value: toml::Value) -> Result<(), String> {
+    let mut parts: Vec<&str> = key.split('.').collect();
+    let last = parts.pop().unwrap_or_default();
+    let mut t = table;
+    for p in parts {
+        let entry = t
+            .entry(p.to_string())
+            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+        t = match entry {
+            toml::Value::Table(inner) => inner,
+            _ => return Err(format!("`{p}` is a value, not a table")),
+        };
+    }
+    t.insert(last.to_string(), value);
+    Ok(())
+}
+
+fn get_key<'a>(table: &'a toml::Table, key: &str) -> Option<&'a toml::Value> {
+    let mut parts = key.split('.').peekable();
+    let mut t = table;
+    while let Some(p) = parts.next() {
+        let v = t.get(p)?;
+        if parts.peek().is_none() {
+            return Some(v);
+        }
+        t = v.as_table()?;
+    }
+    None
+}
+
+/// The keys a point may set, checked against the scenario: the base's own leaves, or an
+/// optional key the scenario file format accepts (e.g. `controller.image`).
+struct Keys {
+    base: toml::Table,
+    leaves: Vec<String>,
+}
+
+impl Keys {
+    fn new(base: &Scenario) -> Result<Self, SweepError> {
+        let table = toml::Table::try_from(base)
+            .map_err(|e| SweepError::tool(format!("the base scenario as TOML: {e}")))?;
+        let mut leaves = Vec::new();
+        flatten("", &table, &mut leaves);
+        let mut leaves: Vec<String> = leaves.into_iter().map(|(k, _)| k).collect();
+        leaves.retain(|k| k != "name" && k != "seed");
+        Ok(Self {
+            base: table,
+            leaves,
+        })
+    }
+
+    /// Checks `key` (from `where_`); a sweep's own key or an unknown one is an error.
+    fn check(&self, key: &str, where_: &str) -> Result<(), SweepError> {
+        let valid = || {
+            format!(
+                "valid keys are {} (and the optional controller.image, controller.symbols, controller.robots)",
+                self.leaves.join(", ")
+            )
+        };
+        if key == "seed" {
+            return Err(SweepError::input(format!(
+                "{where_}: `seed` is the sweep's own axis: give the master seeds as `seeds = [..]` at the top of the sweep file"
+            )));
+        }
+        if key == "name" || key == "base" {
+            return Err(SweepError::input(format!(
+                "{where_}: `{key}` belongs at the top of the sweep file, not in a grid or set"
+            )));
+        }
+        if key.is_empty() || key.split('.').any(str::is_empty) {
+            return Err(SweepError::input(format!(
+                "{where_}: `{key}` is not a key: {}",
+                valid()
+            )));
+        }
+        if self.leaves.iter().any(|k| k == key) {
+            return Ok(());
+        }
+        // Not in the base's table: an optional key (absent when unset) is still valid if the
+        // scenario file format accepts it.
+        let mut probe = toml::Table::new();
+        let known = set_key(&mut probe, key, toml::Value::Boolean(false)).is_ok()
+            && match toml::to_string(&probe) {
+                Ok(text) => match toml::from_str::<ScenarioFile>(&text) {
+                    Ok(_) => true,
+                    Err(e) => !e.to_string().contains("unknown field"),
+                },
+                Err(_) => false,
+            };
+        if known {
+            Ok(())
+        } else {
+            Err(SweepError::input(format!(
+                "{where_}: unknown key `{key}`: {}",
+                valid()
+            )))
+        }
+    }
+
+    /// `v` for `key`, with an integer given for a real-valued key taken as that real (`eta =
+    /// 0` for `eta = 0.0`).
+    fn coerce(&self, key: &str, v: toml::Value) -> toml::Value {
+        match (get_key(&self.base, key), v) {
+            (Some(toml::Value::Float(_)), toml::Value::Integer(i)) => toml::Value::Float(i as f64),
+            (_, v) => v,
+        }
+    }
+}
+
+fn list<'a>(v: &'a toml::Value, where_: &str) -> Result<&'a Vec<toml::Value>, SweepError> {
+    match v {
+        toml::Value::Array(a) if !a.is_empty() => Ok(a),
+        toml::Value::Array(_) => Err(SweepError::input(format!(
+            "{where_} is an empty list: give at least one value, like [0.001, 0.01]"
+        ))),
+        other => Err(SweepError::input(format!(
+            "{where_} = {other} is not a list: give the values to sweep as a list, like [0.001, 0.01]"
+        ))),
+    }
+}
+
+/// Parses and checks a sweep file's text; `file` names it in messages and anchors a relative
+/// `base` path.
+///
+/// # Errors
+/// Bad TOML, an unknown or misplaced key, an empty or unequal list, a bad seed, too many
+/// points, a point whose scenario is out of range: each naming the file, the key or the point,
+/// and what is valid.
+pub fn parse(text: &str, file: &Path) -> Result<Sweep, SweepError> {
+    let where_ = format!("sweep file `{}`", file.display());
+    let f: SweepFile = toml::from_str(text)
+        .map_err(|e| SweepError::input(format!("{where_}: {}", e.to_string().trim_end())))?;
+
+    let base_name = f.base.clone().unwrap_or_else(|| "arena".to_string());
+    let base = if base_name == "arena" || base_name == "corridor" {
+        Scenario::builtin(&base_name)
+    } else {
+        let p = Path::new(&base_name);
+        let p = if p.is_relative() {
+            file.parent().unwrap_or(Path::new("")).join(p)
+        } else {
+            p.to_path_buf()
+        };
+        Scenario::load(&p.display().to_string())
+    }
+    .map_err(|e| SweepError::input(format!("{where_}: key `base` = \"{base_name}\": {e:#}")))?;
+    let keys = Keys::new(&base)?;
+
+    let name = f.name.clone().unwrap_or_else(|| {
+        file.file_stem()
+            .map_or_else(|| "sweep".to_string(), |s| s.to_string_lossy().into_owned())
+    });
+    let name = sanitize(&name, 48);
+
+    // The fixed changes.
+    let mut table = keys.base.clone();
+    let mut set = Vec::new();
+    if let Some(t) = &f.set {
+        flatten("", t, &mut set);
+    }
+    for (k, v) in set {
+        keys.check(&k, &format!("{where_}, [set]"))?;
+        let v = keys.coerce(&k, v);
+        set_key(&mut table, &k, v)
+            .map_err(|e| SweepError::input(format!("{where_}, [set] `{k}`: {e}")))?;
+    }
+
+    // The axes.
+    let mut axes = Vec::new();
+    let mut seen = BTreeSet::new();
+    let mut grid = Vec::new();
+    if let Some(t) = &f.grid {
+        flatten("", t, &mut grid);
+    }
+    for (k, v) in &grid {
+        let at = format!("{where_}, [grid] `{k}`");
+        keys.check(k, &at)?;
+        let values = list(v, &at)?;
+        axes.push(Axis {
+            keys: vec![k.clone()],
+            values: values
+                .iter()
+                .map(|v| vec![keys.coerce(k, v.clone())])
+                .collect(),
+        });
+    }
+    for (z, t) in f.zip.iter().flatten().enumerate() {
+        let mut entries = Vec::new();
+        flatten("", t, &mut entries);
+        let at = format!("{where_}, [[zip]] number {}", z + 1);
+        if entries.is_empty() {
+            return Err(SweepError::input(format!(
+                "{at} is empty: give two or more keys with lists of equal length"
+            )));
+        }
+        let mut lists = Vec::new();
+        for (k, v) in &entries {
+            let at_k = format!("{at}, `{k}`");
+            keys.check(k, &at_k)?;
+            lists.push(list(v, &at_k)?);
+        }
+        let n = lists[0].len();
+        if let Some((i, l)) = lists.iter().enumerate().find(|(_, l)| l.len() != n) {
+            return Err(SweepError::input(format!(
+                "{at}: `{}` has {} values but `{}` has {n}: zipped lists must be of equal length",
+                entries[i].0,
+                l.len(),
+                entries[0].0
+            )));
+        }
+        axes.push(Axis {
+            keys: entries.iter().map(|(k, _)| k.clone()).collect(),
+            values: (0..n)
+                .map(|i| {
+                    entries
+                        .iter()
+                        .zip(&lists)
+                        .map(|((k, _), l)| keys.coerce(k, l[i].clone()))
+                        .collect()
+                })
+                .collect(),
+        });
+    }
+    for a in &axes {
+        for k in &a.keys {
+            if !seen.insert(k.clone()) {
+                return Err(SweepError::input(format!(
+                    "{where_}: key `{k}` is swept twice (in [grid] and [[zip]], or in two [[zip]] tables): give it once"
+                )));
+            }
+        }
+    }
+
+    // The seeds.
+    let seeds: Vec<u64> = match &f.seeds {
+        None => vec![base.seed],
+        Some(toml::Value::Integer(n)) if (1..=100_000).contains(n) => (1..=*n as u64).collect(),
+        Some(toml::Value::Array(a)) if !a.is_empty() => {
+            let mut out = Vec::new();
+            for v in a {
+                match v {
+                    toml::Value::Integer(s) if *s >= 0 => out.push(*s as u64),
+                    other => {
+                        return Err(SweepError::input(format!(
+                            "{where_}: `seeds` holds {other}: every seed must be a whole number >= 0"
+                        )));
+                    }
+                }
+            }
+            let distinct: BTreeSet<u64> = out.iter().copied().collect();
+            if distinct.len() != out.len() {
+                return Err(SweepError::input(format!(
+                    "{where_}: `seeds` = {}: a seed is listed twice",
+                    f.seeds
+                        .as_ref()
+                        .map(ToString::to_string)
+                        .unwrap_or_default()
+                )));
+            }
+            out
+        }
+        Some(other) => {
+            return Err(SweepError::input(format!(
+                "{where_}: `seeds` = {other}: give a list of master seeds like [1, 2, 3], or a count from 1 to 100000"
+            )));
+        }
+    };
+
+    let mut count: usize = seeds.len();
+    for a in &axes {
+        count = count.saturating_mul(a.values.len());
+    }
+    if count > MAX_POINTS {
+        return Err(SweepError::input(format!(
+            "{where_}: the grid has {count} points: at most {MAX_POINTS} are allowed"
+        )));
+    }
+
+    let digits = count.saturating_sub(1).to_string().len().max(4);
+    let mut points = Vec::with_capacity(count);
+    let mut coords = vec![0usize; axes.len()];
+    for index in 0..count {
+        let mut rest = index / seeds.len();
+        for (c, a) in coords.iter_mut().zip(&axes).rev() {
+            *c = rest % a.values.len();
+            rest /= a.values.len();
+        }
+        let seed = seeds[index % seeds.len()];
+        let mut t = table.clone();
+        let mut slug = String::new();
+        for (a, &c) in axes.iter().zip(&coords) {
+            for (k, v) in a.keys.iter().zip(&a.values[c]) {
+                set_key(&mut t, k, v.clone())
+                    .map_err(|e| SweepError::input(format!("{where_}: `{k}`: {e}")))?;
+                let short = k.rsplit('.').next().unwrap_or(k);
+                let _ = write!(slug, "-{short}{}", value_text(v));
+            }
+        }
+        let _ = write!(slug, "-s{seed}");
+        let prefix = format!("p{index:0digits$}");
+        let id = format!(
+            "{prefix}{}",
+            sanitize(&slug, MAX_ID_CHARS.saturating_sub(prefix.len()))
+        );
+        // `sanitize` never starts with `.` or `_`, so put the dash back when it trimmed it.
+        let id = if id.len() > prefix.len() && !id[prefix.len()..].starts_with('-') {
+            format!("{prefix}-{}", &id[prefix.len()..])
+        } else {
+            id
+        };
+        t.insert("name".into(), toml::Value::String(id.clone()));
+        t.insert(
+            "seed".into(),
+            toml::Value::Integer(i64::try_from(seed).unwrap_or(i64::MAX)),
+        );
+        let p = Point {
+            index,
+            id,
+            coords: coords.clone(),
+            seed,
+            scenario: t,
+        };
+        p.resolve()
+            .map_err(|e| SweepError::input(format!("{where_}: {e}")))?;
+        points.push(p);
+    }
+
+    Ok(Sweep {
+        name,
+        axes,
+        seeds,
+        slurm: f.slurm.unwrap_or_default(),
+        points,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sweep(text: &str) -> Result<Sweep, String> {
+        parse(text, Path::new("t.toml")).map_err(|e| e.to_string())
+    }
+
+    #[test]
+    fn a_grid_expands_with_seeds_innermost() {
+        let s = sweep(
+            "seeds = [4, 5]\n[set]\nsteps = 50\n[grid]\n\"learner.eta\" = [0, 0.01]\nlearner.history = [0, 1, 2]\n",
+        )
+        .unwrap();
+        assert_eq!(s.points.len(), 12);
+        assert_eq!(s.name, "t");
+        let p = &s.points[7];
+        let sc = p.resolve().unwrap();
+        assert_eq!(sc.steps, 50);
+        assert_eq!(p.seed, 5);
+        assert_eq!(sc.seed, 5);
+        // Both axes' values reach the scenario (0 taken as 0.0 for the real-valued eta).
+        let (eta_axis, hist_axis) = if s.axes[0].keys[0] == "learner.eta" {
+            (0, 1)
+        } else {
+            (1, 0)
+        };
+        let eta = [0.0, 0.01][p.coords[eta_axis]];
+        assert_eq!(sc.learner.eta, eta);
+        assert_eq!(sc.learner.history, p.coords[hist_axis]);
+        assert!(p.id.starts_with("p0007-"), "{}", p.id);
+        assert!(p.id.ends_with("-s5"), "{}", p.id);
+        let ids: BTreeSet<&str> = s.points.iter().map(|p| p.id.as_str()).collect();
+        assert_eq!(ids.len(), 12);
+    }
+
+    #[test]
+    fn zipped_keys_move_together() {
+        let s = sweep("[[zip]]\nsteps = [40, 80]\nwindow = [10, 20]\n[grid]\nrobots = [3, 4]\n")
+            .unwrap();
+        assert_eq!(s.points.len(), 4);
+        for p in &s.points {
+            let sc = p.resolve().unwrap();
+            assert_eq!(sc.window * 4, sc.steps);
+        }
+        assert_eq!(s.seeds, vec![1]);
+    }
+
+    #[test]
+    fn bad_files_say_what_and_where() {
+        let e = sweep("[grid]\n\"learner.etaa\" = [1]\n").unwrap_err();
+        assert!(
+            e.contains("unknown key `learner.etaa`") && e.contains("learner.eta"),
+            "{e}"
+        );
+        let e = sweep("[grid]\nrobots = []\n").unwrap_err();
+        assert!(e.contains("empty list") && e.contains("robots"), "{e}");
+        let e = sweep("[grid]\nrobots = 3\n").unwrap_err();
+        assert!(e.contains("not a list"), "{e}");
+        let e = sweep("[[zip]]\nsteps = [40, 80]\nwindow = [10]\n").unwrap_err();
+        assert!(e.contains("equal length"), "{e}");
+        let e = sweep("[grid]\nseed = [1, 2]\n").unwrap_err();
+        assert!(e.contains("seeds = "), "{e}");
+        let e = sweep("seeds = [1, 1]\n").unwrap_err();
+        assert!(e.contains("twice"), "{e}");
+        let e = sweep("seeds = \"x\"\n").unwrap_err();
+        assert!(e.contains("seeds"), "{e}");
+        let e = sweep("grids = 1\n").unwrap_err();
+        assert!(e.contains("grids") && e.contains("t.toml"), "{e}");
+        let e = sweep("[grid]\n\"learner.eta\" = [0.5, 2.0]\n").unwrap_err();
+        assert!(e.contains("learner.eta") && e.contains("point 1"), "{e}");
+        let e = sweep("base = \"moon\"\n").unwrap_err();
+        assert!(e.contains("base") && e.contains("moon"), "{e}");
+        let e = sweep("[grid]\nrobots = [3]\n[[zip]]\nrobots = [4]\n").unwrap_err();
+        assert!(e.contains("twice"), "{e}");
+    }
+
+    #[test]
+    fn ids_cannot_leave_the_folder() {
+        let s =
+            sweep("[grid]\n\"controller.symbols\" = [\"../../etc/passwd\", \"/x y\"]\n").unwrap();
+        for p in &s.points {
+            assert!(
+                !p.id.contains('/') && !p.id.contains(' ') && !p.id.contains(".."),
+                "{}",
+                p.id
+            );
+        }
+        for bad in ["../../etc/passwd", "/abs", "..", "a/b\\c", "\n", ""] {
+            let id = sanitize(bad, 40);
+            assert!(!id.contains('/') && !id.contains('\\') && !id.starts_with('.'));
+            assert!(!id.is_empty() && id != "..");
+        }
+        assert_eq!(sanitize("eta0.001", 40), "eta0.001");
+        assert_eq!(sanitize("a b//c", 40), "a_b_c");
+    }
+}
