@@ -377,6 +377,11 @@ impl Scenario {
         }
         if let Some(v) = file.steps {
             s.steps = v;
+            // As `--steps` does: a file that shortens the run without naming a window gets
+            // one window of the whole run rather than an error about the base's window.
+            if file.window.is_none() {
+                s.window = s.window.min(v);
+            }
         }
         if let Some(v) = file.repeats {
             s.repeats = v;
@@ -595,6 +600,17 @@ mod tests {
         assert_eq!(s.robots, 4);
         assert_eq!(s.learner.behaviours, 2);
         assert_eq!(s.eta_q15(), 1638);
+        // A shorter run without a window gets the base's window cut to it; a window named
+        // beyond the run is still an error.
+        let s = Scenario::from_toml("steps = 200\n").unwrap();
+        assert_eq!((s.steps, s.window), (200, 200));
+        let s = Scenario::from_toml("steps = 2000\n").unwrap();
+        assert_eq!((s.steps, s.window), (2000, 500));
+        let e = format!(
+            "{:#}",
+            Scenario::from_toml("steps = 200\nwindow = 300\n").unwrap_err()
+        );
+        assert!(e.contains("window"), "{e}");
         let e = Scenario::from_toml("robts = 4\n").unwrap_err().to_string();
         assert!(e.contains("robts"), "{e}");
         let e = Scenario::from_toml("[learner]\netaa = 0.1\n")

@@ -163,6 +163,18 @@ impl Point {
     }
 }
 
+/// Cuts a point's `window` to its `steps` (a point that shortens the run without naming a
+/// window gets one window of the whole run, as a scenario file does).
+fn clamp_window(t: &mut toml::Table) {
+    if let (Some(toml::Value::Integer(steps)), Some(toml::Value::Integer(window))) =
+        (t.get("steps"), t.get("window"))
+        && window > steps
+    {
+        let steps = *steps;
+        t.insert("window".into(), toml::Value::Integer(steps));
+    }
+}
+
 /// A value as a label: strings bare, everything else as TOML writes it.
 #[must_use]
 pub fn value_text(v: &toml::Value) -> String {
@@ -376,6 +388,8 @@ pub fn parse(text: &str, file: &Path) -> Result<Sweep, SweepError> {
     if let Some(t) = &f.set {
         flatten("", t, &mut set);
     }
+    // As in a scenario file: `steps` set without `window` cuts the base's window to the run.
+    let window_given = set.iter().any(|(k, _)| k == "window");
     for (k, v) in set {
         keys.check(&k, &format!("{where_}, [set]"))?;
         let v = keys.coerce(&k, v);
@@ -513,6 +527,9 @@ pub fn parse(text: &str, file: &Path) -> Result<Sweep, SweepError> {
                 let short = k.rsplit('.').next().unwrap_or(k);
                 let _ = write!(slug, "-{short}{}", value_text(v));
             }
+        }
+        if !window_given && !seen.contains("window") {
+            clamp_window(&mut t);
         }
         let _ = write!(slug, "-s{seed}");
         let prefix = format!("p{index:0digits$}");
