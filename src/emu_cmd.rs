@@ -20,6 +20,8 @@ pub const EXIT_MAX_STATES: u8 = 124;
 pub const EXIT_CORE_ERROR: u8 = 125;
 /// Exit status when the program sleeps forever.
 pub const EXIT_SLEPT_FOREVER: u8 = 126;
+/// Exit status when a GDB client kills the program (128 + SIGKILL, as a shell reports it).
+pub const EXIT_KILLED: u8 = 137;
 
 pub fn run(image: &str, max_states: Option<u64>, trace: bool, stats: bool) -> Result<(), Failure> {
     let bytes = std::fs::read(image).map_err(|e| {
@@ -78,6 +80,10 @@ pub fn run(image: &str, max_states: Option<u64>, trace: bool, stats: bool) -> Re
                 "error: image `{image}`: SLEEP at H'{pc:06X} with interrupts enabled and nothing to wake the CPU"
             );
             Err(Failure::Program(EXIT_SLEPT_FOREVER))
+        }
+        Outcome::Killed => {
+            eprintln!("h8swarm emu: the GDB client killed the program");
+            Err(Failure::Program(EXIT_KILLED))
         }
     }
 }

@@ -62,6 +62,9 @@ pub struct I2cBus {
     sda_high: bool,
     now: u64,
     edges: EdgeCounts,
+    /// Every change of the line levels with its instant, while a log is kept
+    /// ([`I2cBus::set_line_log`]): for pin traces.
+    line_log: Option<Vec<(u64, LineLevels)>>,
 }
 
 impl I2cBus {
@@ -97,6 +100,7 @@ impl I2cBus {
             sda_high: true,
             now,
             edges: EdgeCounts::default(),
+            line_log: None,
         })
     }
 
@@ -253,6 +257,36 @@ impl I2cBus {
             .flatten())
     }
 
+    /// Starts (`true`) or stops (`false`) keeping a log of the line levels: every change of
+    /// SCL or SDA with the instant it happens (a master's pull, a chip's scheduled output
+    /// change, a power cut), for pin traces. Stopping discards what was not taken.
+    pub fn set_line_log(&mut self, on: bool) {
+        self.line_log = on.then(Vec::new);
+    }
+
+    /// The line changes logged since the last call, in time order: (instant, the levels from
+    /// then on). Empty when no log is kept.
+    pub fn take_line_log(&mut self) -> Vec<(u64, LineLevels)> {
+        self.line_log
+            .as_mut()
+            .map(std::mem::take)
+            .unwrap_or_default()
+    }
+
+    /// Appends the present levels to the line log, if one is kept.
+    #[inline]
+    fn log_lines(&mut self, now: u64) {
+        if let Some(log) = self.line_log.as_mut() {
+            log.push((
+                now,
+                LineLevels {
+                    scl: self.scl_high,
+                    sda: self.sda_high,
+                },
+            ));
+        }
+    }
+
     /// Recomputes the wired-AND levels and tells every device about each transition.
     fn settle(&mut self, now: u64) {
         let scl = !self.master_scl_low;
@@ -267,6 +301,7 @@ impl I2cBus {
             for d in &mut self.devices {
                 d.on_scl(now, scl, sda);
             }
+            self.log_lines(now);
         }
         let sda = !(self.master_sda_low || self.devices.iter().any(Eeprom24lc256::pulls_sda));
         if sda != self.sda_high {
@@ -280,6 +315,7 @@ impl I2cBus {
             for d in &mut self.devices {
                 d.on_sda(now, sda, scl);
             }
+            self.log_lines(now);
         }
     }
 
@@ -403,5 +439,48 @@ impl I2cBus {
             .iter()
             .map(Eeprom24lc256::timing_violation_count)
             .sum()
+    }
+}
+
+#[cfg(test)]
+mod line_log_tests {
+    use super::*;
+
+    #[test]
+    fn the_line_log_holds_every_change_with_its_instant() {
+        let mut bus = I2cBus::robot(7).unwrap();
+        // No log yet: nothing is kept.
+        bus.set_master(10, false, true).unwrap();
+        assert!(bus.take_line_log().is_empty());
+        bus.set_line_log(true);
+        bus.set_master(20, false, false).unwrap(); // SDA released: rises
+        bus.set_master(30, true, false).unwrap(); // SCL pulled: falls
+        bus.set_master(30, true, false).unwrap(); // no change, no entry
+        let log = bus.take_line_log();
+        assert_eq!(
+            log,
+            vec![
+                (
+                    20,
+                    LineLevels {
+                        scl: true,
+                        sda: true
+                    }
+                ),
+                (
+                    30,
+                    LineLevels {
+                        scl: false,
+                        sda: true
+                    }
+                ),
+            ]
+        );
+        // Taken: the next call starts afresh; stopping discards.
+        bus.set_master(40, false, false).unwrap();
+        assert_eq!(bus.take_line_log().len(), 1);
+        bus.set_master(50, true, false).unwrap();
+        bus.set_line_log(false);
+        assert!(bus.take_line_log().is_empty());
     }
 }

@@ -3,9 +3,12 @@
 //! it, and running the image on the core.
 
 use std::path::Path;
+use std::sync::Arc;
 
 use crate::board::symbols::{SymbolError, SymbolTable};
+use crate::chip::gdb::{DebugAction, Debugger};
 use crate::chip::mcu::{Board, LoadError, Mcu};
+use crate::chip::trace::{CodeNames, PhaseRecorder};
 use crate::core::cpu::{Cpu, CpuError, Event};
 use crate::core::srec::{self, SrecError, SrecImage};
 
@@ -486,13 +489,32 @@ pub enum StepError {
 /// is done when the CPU next executes SLEEP. Between steps the CPU sleeps through the ticks,
 /// each woken by its interrupt and put back to sleep by the firmware. States the CPU spends
 /// asleep are idle; all others are busy (the robot's CPU load).
-#[derive(Clone, Debug)]
+#[derive(Debug)]
 pub struct FirmwareController {
     cpu: Cpu,
     /// A/D runs started so far (the converter's count).
     adc_starts: u64,
     busy: u64,
     watchdog_states: u64,
+    /// The phase signal of a pin trace, while one is recorded ([`Self::record_phases`]).
+    phases: Option<PhaseRecorder>,
+    /// A GDB client's control of the firmware, while one is attached ([`Self::attach`]).
+    debugger: Option<Box<Debugger>>,
+}
+
+impl Clone for FirmwareController {
+    /// A copy of the CPU and the counters; a phase recording is copied, a debugger is not
+    /// (the copy runs on its own).
+    fn clone(&self) -> Self {
+        FirmwareController {
+            cpu: self.cpu.clone(),
+            adc_starts: self.adc_starts,
+            busy: self.busy,
+            watchdog_states: self.watchdog_states,
+            phases: None,
+            debugger: None,
+        }
+    }
 }
 
 impl FirmwareController {
@@ -512,7 +534,36 @@ impl FirmwareController {
             adc_starts: mcu.adc().starts(),
             busy: 0,
             watchdog_states: (WATCHDOG_S * f64::from(mcu.clock_hz())) as u64,
+            phases: None,
+            debugger: None,
         })
+    }
+
+    /// Starts recording the phase signal of a pin trace (which function runs, by `names`)
+    /// from `now` on; the MCU's pin trace is started apart ([`Mcu::start_trace`]).
+    pub fn record_phases(&mut self, names: Arc<dyn CodeNames + Send + Sync>, now: u64) {
+        let mut p = PhaseRecorder::new(names);
+        p.observe(now, self.cpu.pc());
+        self.phases = Some(p);
+    }
+
+    /// Stops recording phases and returns the changes recorded (empty if none were).
+    pub fn take_phases(&mut self) -> Vec<(u64, String)> {
+        self.phases.take().map(|mut p| p.take()).unwrap_or_default()
+    }
+
+    /// Puts the firmware under a GDB client's control: from here on it runs instruction by
+    /// instruction, stops at the client's breakpoints and watchpoints, and waits (and with it
+    /// whatever runs it, the swarm) while the client has it stopped.
+    pub fn attach(&mut self, debugger: Debugger) {
+        self.debugger = Some(Box::new(debugger));
+    }
+
+    /// Ends a GDB session: tells the client the program ended (`None` when none is attached).
+    pub fn detach(&mut self) {
+        if let Some(mut d) = self.debugger.take() {
+            d.finish(None, std::time::Duration::from_secs(1));
+        }
     }
 
     /// The CPU (registers, PC).
@@ -549,15 +600,79 @@ impl FirmwareController {
             }
         }
         let t0 = mcu.now();
-        let event = self
-            .cpu
-            .run_until(mcu, deadline, |cpu, m| cpu.sleeping() || stop(m))?;
+        let event = if self.debugger.is_some() {
+            self.run_debugged(mcu, deadline, &mut stop)?
+        } else if let Some(p) = self.phases.as_mut() {
+            // Which function runs, observed after every instruction (a stretch that loop
+            // fast-forwarding skips stays in one loop, so in one function).
+            let event = self.cpu.run_until(mcu, deadline, |cpu, m| {
+                p.observe(m.now(), cpu.pc());
+                cpu.sleeping() || stop(m)
+            })?;
+            if let Event::Interrupt(_) = event {
+                let at = mcu
+                    .trace_last_interrupt()
+                    .map_or(mcu.now(), |a| a.t.clamp(t0, mcu.now()));
+                p.observe(at, self.cpu.pc());
+            }
+            event
+        } else {
+            self.cpu
+                .run_until(mcu, deadline, |cpu, m| cpu.sleeping() || stop(m))?
+        };
         match event {
             Event::Halted => return Err(halted(&self.cpu)),
             Event::Asleep => {}
             Event::Executed | Event::Interrupt(_) => self.busy += mcu.now() - t0,
         }
         Ok(event)
+    }
+
+    /// [`Self::run`]'s loop under a debugger: step by step, asking it before each step.
+    fn run_debugged<B: Board>(
+        &mut self,
+        mcu: &mut Mcu<B>,
+        deadline: u64,
+        stop: &mut impl FnMut(&Mcu<B>) -> bool,
+    ) -> Result<Event, RunError> {
+        use crate::core::bus::Bus;
+        while mcu.now() < deadline {
+            let Some(d) = self.debugger.as_deref_mut() else {
+                break;
+            };
+            match d.before_step(&mut self.cpu, mcu) {
+                DebugAction::Run => {}
+                DebugAction::Detached | DebugAction::Kill => {
+                    // Without a client the firmware runs on as before.
+                    self.debugger = None;
+                    return Ok(Event::Executed);
+                }
+            }
+            let t0 = mcu.now();
+            let event = match d.step(&mut self.cpu, mcu, deadline) {
+                Ok(e) => e,
+                Err(e) => {
+                    d.report_error(&mut self.cpu, mcu);
+                    return Err(e.into());
+                }
+            };
+            if let Some(p) = self.phases.as_mut() {
+                match event {
+                    Event::Executed => p.observe(mcu.now(), self.cpu.pc()),
+                    Event::Interrupt(_) => {
+                        let at = mcu
+                            .trace_last_interrupt()
+                            .map_or(t0, |a| a.t.clamp(t0, mcu.now()));
+                        p.observe(at, self.cpu.pc());
+                    }
+                    _ => {}
+                }
+            }
+            if event != Event::Executed || self.cpu.sleeping() || stop(mcu) {
+                return Ok(event);
+            }
+        }
+        Ok(Event::Executed)
     }
 
     /// Runs until the firmware starts the A/D converter (its step begins); returns the clock

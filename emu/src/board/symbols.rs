@@ -145,3 +145,14 @@ impl SymbolTable {
             .is_ok()
     }
 }
+
+/// A program counter's phase is the C name of the function holding it (code in flash only: a
+/// PC in RAM has no name).
+impl crate::chip::trace::CodeNames for SymbolTable {
+    fn name_at(&self, pc: u32) -> Option<&str> {
+        if crate::core::memmap::Area::of(pc) != crate::core::memmap::Area::Rom {
+            return None;
+        }
+        self.function_at(pc).map(Symbol::c_name)
+    }
+}

@@ -125,6 +125,11 @@ impl Bus for Machine {
     }
 
     #[inline]
+    fn cpu_signal(&mut self, signal: crate::core::bus::CpuSignal) {
+        self.0.cpu_signal(signal);
+    }
+
+    #[inline]
     fn code_generation(&self) -> Option<u64> {
         self.0.code_generation()
     }

@@ -56,7 +56,8 @@ use crate::chip::periph::intc::Intc;
 use crate::chip::periph::itu::{self, Itu, PwmWave};
 use crate::chip::periph::ports::{PortPins, Ports};
 use crate::chip::periph::sci::Sci;
-use crate::core::bus::{Bus, fresh_code_generation};
+use crate::chip::trace::{Accepted, ChipView, PinTrace, Tracer};
+use crate::core::bus::{Bus, CpuSignal, fresh_code_generation};
 use crate::core::memmap::{
     ADDRESS_MASK, Area, IO_ACCESS_STATES, RAM_BYTES, RAM_START, ROM_BYTES, ROM_END,
 };
@@ -190,6 +191,8 @@ pub struct Mcu<B: Board> {
     irq_cached: Cell<Option<u8>>,
     /// The cached request is valid while `now` is below this.
     irq_valid_until: Cell<u64>,
+    /// The pin trace under way, if one is ([`Mcu::start_trace`]).
+    tracer: Option<Box<Tracer>>,
 }
 
 /// The on-chip module that owns an I/O address: the chip's map of its register blocks, each
@@ -352,6 +355,7 @@ impl<B: Board> Mcu<B> {
             board,
             irq_cached: Cell::new(None),
             irq_valid_until: Cell::new(0),
+            tracer: None,
         })
     }
 
@@ -575,6 +579,97 @@ impl<B: Board> Mcu<B> {
         self.ports.pb_pins(&mut self.itu, self.now)
     }
 
+    /// Starts a pin trace now ([`crate::chip::trace`]): from here on every change of the traced
+    /// signals is recorded at its instant, until [`Mcu::finish_trace`]. `cpu_sleeping` says
+    /// whether the CPU is in sleep mode now (the CPU reports later changes itself through
+    /// [`Bus::cpu_signal`]). A trace already under way is discarded.
+    pub fn start_trace(&mut self, cpu_sleeping: bool) {
+        let now = self.now;
+        let tracer = Tracer::start(
+            now,
+            &self.itu,
+            &self.adc,
+            ChipView {
+                ports: &self.ports,
+                i2c: &mut self.i2c,
+            },
+            cpu_sleeping,
+        );
+        self.tracer = Some(Box::new(tracer));
+    }
+
+    /// Whether a pin trace is under way.
+    #[must_use]
+    pub fn tracing(&self) -> bool {
+        self.tracer.is_some()
+    }
+
+    /// The last interrupt accepted during the trace under way, if any.
+    #[must_use]
+    pub fn trace_last_interrupt(&self) -> Option<Accepted> {
+        self.tracer.as_ref().and_then(|t| t.last_accepted())
+    }
+
+    /// Ends the pin trace now and returns it (`None` when none was under way).
+    pub fn finish_trace(&mut self) -> Option<PinTrace> {
+        let mut tracer = self.tracer.take()?;
+        let now = self.now;
+        tracer.catch_up(
+            now,
+            ChipView {
+                ports: &self.ports,
+                i2c: &mut self.i2c,
+            },
+        );
+        Some(tracer.finish(now, self.clock_hz, &mut self.i2c))
+    }
+
+    /// A CPU signal for the trace under way.
+    #[cold]
+    fn trace_cpu_signal(&mut self, signal: CpuSignal) {
+        self.trace_before_write();
+        let now = self.now;
+        if let Some(t) = self.tracer.as_mut() {
+            match signal {
+                CpuSignal::Sleep => t.set_sleeping(now, true, &self.ports),
+                CpuSignal::Wake => t.set_sleeping(now, false, &self.ports),
+                CpuSignal::Interrupt(v) => t.accepted(now, v),
+            }
+        }
+    }
+
+    /// Before a write at `now` that may change a traced level: records what happened up to it.
+    #[cold]
+    fn trace_before_write(&mut self) {
+        let now = self.now;
+        if let Some(t) = self.tracer.as_mut() {
+            t.catch_up(
+                now,
+                ChipView {
+                    ports: &self.ports,
+                    i2c: &mut self.i2c,
+                },
+            );
+        }
+    }
+
+    /// After a write at `now` to `module`: records its effect.
+    #[cold]
+    fn trace_after_write(&mut self, module: Module) {
+        let now = self.now;
+        if let Some(t) = self.tracer.as_mut() {
+            t.after_write(
+                now,
+                (module == Module::Itu).then_some(&self.itu),
+                (module == Module::Adc).then_some(&self.adc),
+                ChipView {
+                    ports: &self.ports,
+                    i2c: &mut self.i2c,
+                },
+            );
+        }
+    }
+
     /// Cuts the robot's power now: the EEPROMs lose power (a write cycle under way is
     /// corrupted as the `eeprom` crate models it), the RAM loses its contents and every
     /// peripheral returns to its reset state (ports released). The flash keeps its image. The
@@ -605,10 +700,17 @@ impl<B: Board> Mcu<B> {
     }
 
     fn reset_peripherals(&mut self) {
+        if self.tracer.is_some() {
+            self.trace_before_write();
+        }
         for m in Module::ALL {
             on_module!(self, m, |p, _outside| Peripheral::reset(p), ());
         }
         self.invalidate_irq();
+        if self.tracer.is_some() {
+            self.trace_after_write(Module::Itu);
+            self.trace_after_write(Module::Adc);
+        }
     }
 
     #[inline]
@@ -660,12 +762,18 @@ impl<B: Board> Mcu<B> {
         if module.affects_irq() {
             self.before_irq_write();
         }
+        if self.tracer.is_some() {
+            self.trace_before_write();
+        }
         on_module!(
             self,
             module,
             |p, outside| Peripheral::write::<B>(p, a, v, now, outside),
             ()
         );
+        if self.tracer.is_some() {
+            self.trace_after_write(module);
+        }
     }
 }
 
@@ -779,7 +887,13 @@ impl<B: Board> Bus for Mcu<B> {
                 if itu::is_word_register(a) {
                     self.now += u64::from(itu::ITU_WORD_ACCESS_STATES);
                     self.before_irq_write();
+                    if self.tracer.is_some() {
+                        self.trace_before_write();
+                    }
                     self.itu.write16(a, value, self.now);
+                    if self.tracer.is_some() {
+                        self.trace_after_write(Module::Itu);
+                    }
                 } else {
                     self.now += u64::from(IO_ACCESS_STATES);
                     self.io_write8(a, hi);
@@ -835,6 +949,14 @@ impl<B: Board> Bus for Mcu<B> {
                 Some(self.adc.next_event(self.now).unwrap_or(u64::MAX))
             }
             _ => None,
+        }
+    }
+
+    /// Tells a pin trace under way (SLEEP, and the accepted interrupts); otherwise nothing.
+    #[inline]
+    fn cpu_signal(&mut self, signal: CpuSignal) {
+        if self.tracer.is_some() {
+            self.trace_cpu_signal(signal);
         }
     }
 

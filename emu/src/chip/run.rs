@@ -12,8 +12,10 @@
 use std::fmt::Write as _;
 use std::io::Write;
 
+use crate::chip::gdb::DebugAction;
 use crate::chip::machine::{LoadError, Machine};
 use crate::chip::mcu::{Board, Mcu};
+use crate::chip::trace::{CodeNames, PhaseRecorder, phase_name};
 use crate::core::bus::Bus;
 use crate::core::cpu::disasm::format_instr;
 use crate::core::cpu::{Cpu, CpuError, Event};
@@ -49,6 +51,8 @@ pub enum Outcome {
         /// PC after the SLEEP instruction.
         pc: u32,
     },
+    /// A GDB client killed the program.
+    Killed,
 }
 
 /// Counters of a run.
@@ -86,6 +90,7 @@ impl RunReport {
             Outcome::MaxStates => ("max_states", None, None),
             Outcome::Error(e) => ("error", None, Some(e.to_string())),
             Outcome::SleptForever { .. } => ("slept_forever", None, None),
+            Outcome::Killed => ("killed", None, None),
         };
         let json = StatsJson {
             outcome,
@@ -183,9 +188,59 @@ pub fn run_mcu<B: Board>(
     machine: &mut Mcu<B>,
     options: &RunOptions,
     console: &mut dyn Write,
-    mut trace: Option<&mut dyn Write>,
+    trace: Option<&mut dyn Write>,
 ) -> std::io::Result<RunReport> {
+    run_mcu_probed(
+        cpu,
+        machine,
+        options,
+        console,
+        Probes {
+            trace,
+            ..Probes::default()
+        },
+    )
+}
+
+/// What a run records besides the console output.
+#[derive(Default)]
+pub struct Probes<'a> {
+    /// One line per step: address, disassembly (objdump's form), states, and the name of the
+    /// code it ran in when [`Probes::names`] are given.
+    pub trace: Option<&'a mut dyn Write>,
+    /// The names of the code (a firmware's functions) for the trace lines.
+    pub names: Option<&'a dyn CodeNames>,
+    /// The phase signal of a pin trace ([`PhaseRecorder`]): the code that runs, as it changes.
+    /// (The pin trace itself is the MCU's: [`Mcu::start_trace`] before the run,
+    /// [`Mcu::finish_trace`] after it.)
+    pub phases: Option<&'a mut PhaseRecorder>,
+    /// A GDB client's control of the run ([`crate::chip::gdb::Debugger`]): breakpoints,
+    /// watchpoints, single steps; the run waits while the client has the program stopped.
+    pub debugger: Option<&'a mut crate::chip::gdb::Debugger>,
+}
+
+/// [`run_mcu`] with every probe: an instruction trace naming the code, the phase signal of a
+/// pin trace, a debugger.
+///
+/// # Errors
+/// Only I/O errors of the writers.
+pub fn run_mcu_probed<B: Board>(
+    cpu: &mut Cpu,
+    machine: &mut Mcu<B>,
+    options: &RunOptions,
+    console: &mut dyn Write,
+    probes: Probes<'_>,
+) -> std::io::Result<RunReport> {
+    let Probes {
+        mut trace,
+        names,
+        mut phases,
+        mut debugger,
+    } = probes;
     let deadline = options.max_states.unwrap_or(u64::MAX);
+    if let Some(p) = phases.as_deref_mut() {
+        p.observe(machine.now(), cpu.pc());
+    }
     let start_instructions = cpu.instructions();
     let mut interrupts = 0u64;
     let mut line = String::new();
@@ -193,32 +248,64 @@ pub fn run_mcu<B: Board>(
         if machine.now() >= deadline {
             break Outcome::MaxStates;
         }
+        if let Some(d) = debugger.as_deref_mut() {
+            match d.before_step(cpu, machine) {
+                DebugAction::Run => {}
+                DebugAction::Detached => debugger = None,
+                DebugAction::Kill => break Outcome::Killed,
+            }
+        }
         let pc = cpu.pc();
         let t0 = machine.now();
-        let event = cpu.step(machine, deadline);
+        let event = match debugger.as_deref_mut() {
+            Some(d) => d.step(cpu, machine, deadline),
+            None => cpu.step(machine, deadline),
+        };
         if let Some(w) = trace.as_deref_mut() {
             line.clear();
             let states = machine.now() - t0;
             match &event {
                 Ok(Event::Executed | Event::Halted) => {
                     let text = format_instr(cpu.last_executed(), pc).replacen('\t', " ", 1);
-                    let _ = writeln!(line, "{pc:06x}: {text:<40} {states:>4} states");
+                    let _ = write!(line, "{pc:06x}: {text:<40} {states:>4} states");
                 }
                 Ok(Event::Interrupt(v)) => {
-                    let _ = writeln!(
+                    let _ = write!(
                         line,
                         "{pc:06x}: <interrupt vector {v} -> {:06x}> {states:>4} states",
                         cpu.pc()
                     );
                 }
                 Ok(Event::Asleep) => {
-                    let _ = writeln!(line, "{pc:06x}: <asleep> {states:>4} states");
+                    let _ = write!(line, "{pc:06x}: <asleep> {states:>4} states");
                 }
                 Err(e) => {
-                    let _ = writeln!(line, "{pc:06x}: <error: {e}>");
+                    let _ = write!(line, "{pc:06x}: <error: {e}>");
                 }
             }
+            if let Some(n) = names {
+                // The code the step ran in: the instruction's, or the handler's for an
+                // interrupt's entry (as the phase signal of a pin trace names it).
+                let at = match &event {
+                    Ok(Event::Interrupt(_)) => cpu.pc(),
+                    _ => pc,
+                };
+                let _ = write!(line, "  {}", phase_name(n, at));
+            }
+            line.push('\n');
             w.write_all(line.as_bytes())?;
+        }
+        if let Some(p) = phases.as_deref_mut() {
+            match &event {
+                Ok(Event::Executed) => p.observe(machine.now(), cpu.pc()),
+                Ok(Event::Interrupt(_)) => {
+                    let at = machine
+                        .trace_last_interrupt()
+                        .map_or(t0, |a| a.t.clamp(t0, machine.now()));
+                    p.observe(at, cpu.pc());
+                }
+                _ => {}
+            }
         }
         match event {
             Ok(Event::Executed) => {}
@@ -234,13 +321,25 @@ pub fn run_mcu<B: Board>(
                 }
                 break Outcome::MaxStates;
             }
-            Err(e) => break Outcome::Error(e),
+            Err(e) => {
+                if let Some(d) = debugger.as_deref_mut() {
+                    d.report_error(cpu, machine);
+                }
+                break Outcome::Error(e);
+            }
         }
         if machine.sci().has_output() {
             console.write_all(machine.sci().output())?;
             machine.sci_mut().clear_output();
         }
     };
+    if let Some(d) = debugger {
+        let status = match &outcome {
+            Outcome::Halted { exit_status } => Some(*exit_status),
+            _ => None,
+        };
+        d.finish(status, std::time::Duration::from_secs(2));
+    }
     let now = machine.now();
     machine.sci_mut().flush(now);
     console.write_all(machine.sci().output())?;

@@ -7,6 +7,20 @@
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
+/// What the CPU tells the chip about itself, at the instant it happens
+/// ([`Bus::cpu_signal`]): on the H8/3052F the CPU's sleep mode and its acceptance of an
+/// interrupt are seen by the rest of the chip (the clock pulse generator stops the CPU's
+/// clock; the interrupt controller is acknowledged). For observers such as pin traces.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CpuSignal {
+    /// SLEEP put the CPU into sleep mode (at the end of the instruction).
+    Sleep,
+    /// An interrupt request took the CPU out of sleep mode (before its acceptance).
+    Wake,
+    /// The interrupt with this vector was accepted: its exception handling begins now.
+    Interrupt(u8),
+}
+
 /// A bus on the H8/3052F's 24-bit address space with a clock in states.
 ///
 /// Conventions shared by every implementation:
@@ -35,6 +49,13 @@ pub trait Bus {
     /// SLEEP: advances the clock until an interrupt request is pending or the clock reaches
     /// `deadline`, whichever is first. Returns whether an interrupt is pending.
     fn sleep_until_irq(&mut self, deadline: u64) -> bool;
+
+    /// The CPU entered or left sleep mode, or accepted an interrupt, now (see
+    /// [`CpuSignal`]). Changes nothing; the default ignores it.
+    #[inline]
+    fn cpu_signal(&mut self, signal: CpuSignal) {
+        let _ = signal;
+    }
 
     /// A token for the flash contents, which lets the CPU decode ROM instructions once and
     /// charge their fetches without reading them ([`crate::core::cpu`]'s fast path).

@@ -285,6 +285,19 @@ impl Adc {
                 .is_some_and(|r| r.completed_by(now) > r.round_end_from(r.done))
     }
 
+    /// ADST and ADF as ADCSR shows them at `now`, without changing anything: ADST is 1 from
+    /// the start of a run until its conversion ends (single mode) or until software clears it
+    /// (scan mode); ADF is set at the end of each round. Valid for any `now` not before the
+    /// converter was last brought up to date (a copy taken after a register write answers for
+    /// every later instant until the next write: pin traces).
+    #[must_use]
+    pub fn status_at(&self, now: u64) -> (bool, bool) {
+        let adst = self
+            .run
+            .is_some_and(|r| r.scan || r.completed_by(now) <= r.done);
+        (adst, self.adf_at(now))
+    }
+
     /// The ADI request at `now` as a vector bit mask.
     #[inline]
     #[must_use]

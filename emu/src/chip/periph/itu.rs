@@ -722,6 +722,28 @@ impl Itu {
         (c.tioca, drives)
     }
 
+    /// What channel `n`'s TIOCA does at `now` without changing anything: (level, whether the
+    /// ITU drives the pin). Valid for any `now` not before the channel was last brought up to
+    /// date (a copy of the ITU taken after a register write answers for every later instant
+    /// until the next write: pin traces). Channels out of range: (false, false).
+    #[must_use]
+    pub fn output_at(&self, n: usize, now: u64) -> (bool, bool) {
+        let Some(c) = self.ch.get(n) else {
+            return (false, false);
+        };
+        let drives = c.pwm || matches!(c.tior & 0x07, 1..=3);
+        (c.advanced(now.max(c.synced_at)).tioca, drives)
+    }
+
+    /// Channel `n`'s interrupt requests at `now` (TSR flags that are set and enabled in TIER,
+    /// IMFA/IMFB/OVF bits), without changing anything; valid as [`Itu::output_at`].
+    #[must_use]
+    pub fn requests_of(&self, n: usize, now: u64) -> u8 {
+        self.ch
+            .get(n)
+            .map_or(0, |c| c.advanced(now.max(c.synced_at)).flags & c.tier)
+    }
+
     /// Whether channel `n` is counting (TSTR.STRn = 1 with an internal clock).
     #[must_use]
     pub fn running(&self, n: usize) -> bool {

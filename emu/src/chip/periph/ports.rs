@@ -177,6 +177,24 @@ impl Ports {
         }
     }
 
+    /// Port 4's registers (DDR as written, DR, PCR).
+    #[must_use]
+    pub const fn port4(&self) -> Port {
+        self.p4
+    }
+
+    /// Port A's registers (DDR as written, DR).
+    #[must_use]
+    pub const fn port_a(&self) -> Port {
+        self.pa
+    }
+
+    /// Port B's registers (DDR as written, DR).
+    #[must_use]
+    pub const fn port_b(&self) -> Port {
+        self.pb
+    }
+
     /// Pin levels of port A at `now`: ITU-driven TIOCA0–2 (PA2, PA4, PA6), else the output
     /// latch; input pins with nothing connected float and read 0 (port A has no pull-ups).
     pub fn pa_pins(&self, itu: &mut Itu, now: u64) -> u8 {

@@ -460,6 +460,7 @@ impl Cpu {
                     return Ok(Event::Halted);
                 }
                 self.state = RunState::Sleeping;
+                bus.cpu_signal(crate::core::bus::CpuSignal::Sleep);
             }
             Instr::Eepmov { word } => {
                 let count = if word {

@@ -144,6 +144,10 @@ impl<B: Bus> Bus for Recorder<'_, B> {
         self.bus.sleep_until_irq(deadline)
     }
     #[inline]
+    fn cpu_signal(&mut self, signal: crate::core::bus::CpuSignal) {
+        self.bus.cpu_signal(signal);
+    }
+    #[inline]
     fn code_generation(&self) -> Option<u64> {
         self.bus.code_generation()
     }

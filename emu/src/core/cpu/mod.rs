@@ -84,7 +84,7 @@ mod fast;
 mod ffwd;
 pub mod timing;
 
-use crate::core::bus::Bus;
+use crate::core::bus::{Bus, CpuSignal};
 use crate::core::memmap::Area;
 use decode::{DecodeError, Decoded, Instr, WordSource, decode};
 
@@ -683,6 +683,7 @@ impl Cpu {
                     }
                 }
                 self.state = RunState::Running;
+                bus.cpu_signal(CpuSignal::Wake);
             }
         }
         if let Some(v) = self.take_interrupt(bus) {
@@ -740,6 +741,7 @@ impl Cpu {
 
     /// Interrupt exception handling (H8/3052F hardware manual, section 5.4 and Table 5-5).
     fn interrupt<B: Bus>(&mut self, bus: &mut B, v: u8) {
+        bus.cpu_signal(CpuSignal::Interrupt(v));
         let external = v == VECTOR_NMI || (VECTOR_IRQ0..=VECTOR_IRQ5).contains(&v);
         bus.internal(if external {
             timing::N_PRIORITY_DECISION_EXTERNAL
