@@ -158,9 +158,56 @@ impl Point {
     /// A value out of range (naming the key).
     pub fn resolve(&self) -> Result<Scenario, SweepError> {
         let text = self.scenario_toml()?;
-        Scenario::from_toml(&text)
-            .map_err(|e| SweepError::input(format!("point {} ({}): {e:#}", self.index, self.id)))
+        Scenario::from_toml(&text).map_err(|e| {
+            SweepError::input(format!(
+                "point {} ({}): {}",
+                self.index,
+                self.id,
+                one_line(&format!("{e:#}"))
+            ))
+        })
     }
+}
+
+/// A TOML error in one line: where (line, column and the line's text) and what.
+#[must_use]
+pub fn toml_error(text: &str, e: &toml::de::Error) -> String {
+    let Some(span) = e.span() else {
+        return one_line(e.message());
+    };
+    let before = &text[..span.start.min(text.len())];
+    let line = before.matches('\n').count() + 1;
+    let column = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
+    let source: String = text
+        .lines()
+        .nth(line - 1)
+        .unwrap_or_default()
+        .trim()
+        .chars()
+        .take(60)
+        .collect();
+    format!(
+        "line {line}, column {column} (`{source}`): {}",
+        one_line(e.message())
+    )
+}
+
+/// A message of several lines (the TOML parser's, with its source excerpt) in one: the
+/// excerpt's lines dropped, the rest joined by `: `.
+#[must_use]
+pub fn one_line(text: &str) -> String {
+    text.lines()
+        .map(str::trim)
+        .filter(|l| {
+            !l.is_empty()
+                && !l.starts_with('|')
+                && !l.starts_with("TOML parse error")
+                && !l
+                    .split_once('|')
+                    .is_some_and(|(n, _)| n.trim().chars().all(|c| c.is_ascii_digit()))
+        })
+        .collect::<Vec<_>>()
+        .join(": ")
 }
 
 /// Cuts a point's `window` to its `steps` (a point that shortens the run without naming a
@@ -359,7 +406,7 @@ fn list<'a>(v: &'a toml::Value, where_: &str) -> Result<&'a Vec<toml::Value>, Sw
 pub fn parse(text: &str, file: &Path) -> Result<Sweep, SweepError> {
     let where_ = format!("sweep file `{}`", file.display());
     let f: SweepFile = toml::from_str(text)
-        .map_err(|e| SweepError::input(format!("{where_}: {}", e.to_string().trim_end())))?;
+        .map_err(|e| SweepError::input(format!("{where_}, {}", toml_error(text, &e))))?;
 
     let base_name = f.base.clone().unwrap_or_else(|| "arena".to_string());
     let base = if base_name == "arena" || base_name == "corridor" {

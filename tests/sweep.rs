@@ -1,0 +1,458 @@
+//! Drives `h8swarm sweep plan/run/merge` through the real binary (issue 15): the same table
+//! byte for byte however the points are split into tasks; reruns skip finished points and redo
+//! broken ones; failed and missing points are listed; bad input is a one-line error with exit
+//! status 2. The real-Slurm test is `scripts/slurm-test.sh`.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn h8swarm(args: &[&str], env: &[(&str, &str)]) -> Output {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_h8swarm"));
+    c.args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .env_remove("SLURM_ARRAY_TASK_ID")
+        .env_remove("SLURM_CPUS_PER_TASK");
+    for (k, v) in env {
+        c.env(k, v);
+    }
+    c.output().expect("the binary runs")
+}
+
+fn ok(args: &[&str]) -> String {
+    let o = h8swarm(args, &[]);
+    assert!(
+        o.status.success(),
+        "h8swarm {args:?}: {}\n{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+/// Exit status and standard error.
+fn fails(args: &[&str], env: &[(&str, &str)]) -> (i32, String) {
+    let o = h8swarm(args, env);
+    (
+        o.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+fn fresh(name: &str) -> PathBuf {
+    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("sweep-{name}"));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// A short sweep: 2 x 2 x 2 seeds of 30-step arena runs, one repeat.
+/// (One name: the table names its sweep, by default the file's stem.)
+const SWEEP: &str = r#"
+name = "split"
+seeds = [1, 2]
+[set]
+steps = 30
+window = 10
+repeats = 1
+[grid]
+"learner.eta" = [0.001, 0.01]
+[[zip]]
+"learner.history" = [0, 1]
+"learner.threshold" = [10, 20]
+[slurm]
+points_per_task = POINTS
+max_parallel = 3
+"#;
+
+/// Every file of every point folder (but run.txt, the console text with its wall time):
+/// scenario.toml, status.json, metrics.csv, summary.json, fit.json and the three figures.
+fn point_files(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut out = Vec::new();
+    let mut ids: Vec<_> = std::fs::read_dir(dir.join("points"))
+        .unwrap()
+        .flatten()
+        .map(|e| e.path())
+        .collect();
+    ids.sort();
+    for p in ids {
+        let mut files: Vec<_> = std::fs::read_dir(&p)
+            .unwrap()
+            .flatten()
+            .map(|e| e.path())
+            .collect();
+        files.sort();
+        for f in files {
+            if f.file_name().unwrap() == "run.txt" {
+                continue;
+            }
+            let name = format!(
+                "{}/{}",
+                p.file_name().unwrap().to_string_lossy(),
+                f.file_name().unwrap().to_string_lossy()
+            );
+            out.push((name, std::fs::read(&f).unwrap()));
+        }
+    }
+    out
+}
+
+#[test]
+fn the_table_is_the_same_however_the_points_are_split() {
+    let root = fresh("split");
+    let (a, b) = (root.join("a"), root.join("b"));
+    let file_a = root.join("one.toml");
+    let file_b = root.join("three.toml");
+    std::fs::write(&file_a, SWEEP.replace("POINTS", "1")).unwrap();
+    std::fs::write(&file_b, SWEEP.replace("POINTS", "3")).unwrap();
+    let text = ok(&["sweep", "plan", s(&file_a), "--out", s(&a)]);
+    assert!(
+        text.contains("8 points") && text.contains("8 tasks"),
+        "{text}"
+    );
+    ok(&["sweep", "plan", s(&file_b), "--out", s(&b)]);
+
+    // The script: a job array over the tasks, at most 3 at once, requests computed.
+    let script = std::fs::read_to_string(b.join("sweep.sbatch")).unwrap();
+    assert!(script.starts_with("#!/bin/bash\n"), "{script}");
+    assert!(script.contains("\n#SBATCH --array=0-2%3\n"), "{script}");
+    // 3 runs a point (learning and the two controls, one repeat).
+    assert!(script.contains("\n#SBATCH --cpus-per-task=3\n"), "{script}");
+    assert!(script.contains("\n#SBATCH --mem=128M\n"), "{script}");
+    assert!(script.contains("#SBATCH --requeue"), "{script}");
+    assert!(script.contains(&format!(
+        " sweep run '{}'",
+        b.canonicalize().unwrap().display()
+    )));
+    // The run list: one line per point, each with its full scenario.
+    let list = std::fs::read_to_string(a.join("points.jsonl")).unwrap();
+    assert_eq!(list.lines().count(), 8);
+    let line: serde_json::Value = serde_json::from_str(list.lines().nth(5).unwrap()).unwrap();
+    assert_eq!(line["index"], 5);
+    assert_eq!(line["seed"], 2);
+    assert_eq!(line["scenario"]["steps"], 30);
+    assert_eq!(line["scenario"]["world"]["substep_s"], 0.02);
+
+    // a: one task at a time, last task first; b: every task at once on two threads.
+    for t in (0..8).rev() {
+        ok(&[
+            "sweep",
+            "run",
+            s(&a),
+            "--task",
+            &t.to_string(),
+            "--threads",
+            "1",
+        ]);
+    }
+    ok(&["sweep", "run", s(&b), "--threads", "2"]);
+    let (fa, fb) = (point_files(&a), point_files(&b));
+    assert_eq!(
+        fa.len(),
+        8 * 8,
+        "{:?}",
+        fa.iter().map(|f| &f.0).collect::<Vec<_>>()
+    );
+    assert!(
+        fa == fb,
+        "a point's files depend on how the points were split"
+    );
+
+    let merged = ok(&["sweep", "merge", s(&a), "--require-complete"]);
+    assert!(
+        merged.contains("8 points, 8 ok, 0 failed, 0 missing"),
+        "{merged}"
+    );
+    ok(&["sweep", "merge", s(&b), "--require-complete"]);
+    for f in ["sweep.csv", "sweep.json"] {
+        let (x, y) = (
+            std::fs::read(a.join("merged").join(f)).unwrap(),
+            std::fs::read(b.join("merged").join(f)).unwrap(),
+        );
+        assert!(x == y, "merged/{f} differs");
+    }
+    let csv = std::fs::read_to_string(a.join("merged/sweep.csv")).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    assert_eq!(
+        &header[..7],
+        [
+            "index",
+            "id",
+            "status",
+            "learner.eta",
+            "learner.history",
+            "learner.threshold",
+            "seed"
+        ]
+    );
+    assert!(header.contains(&"learning.last.collisions_per_robot.mean"));
+    assert!(header.contains(&"random-walk.first.contact_fraction.hi"));
+    assert!(
+        header.contains(&"claim.collisions_per_robot_last_window_below_the_first_learning.effect")
+    );
+    assert_eq!(*header.last().unwrap(), "error");
+    assert_eq!(csv.lines().count(), 9);
+    // A row's zipped values move together and its effect is b - a.
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(a.join("merged/sweep.json")).unwrap())
+            .unwrap();
+    for row in json["rows"].as_array().unwrap() {
+        let h = row["learner.history"].as_i64().unwrap();
+        assert_eq!(row["learner.threshold"].as_i64().unwrap(), 10 + 10 * h);
+        let c = "claim.mean_d_in_the_last_window_learning_off_below_learning";
+        let (x, y, e) = (
+            row[format!("{c}.a")].as_f64().unwrap(),
+            row[format!("{c}.b")].as_f64().unwrap(),
+            row[format!("{c}.effect")].as_f64().unwrap(),
+        );
+        // (serde_json reads decimals to within an ulp, so b - a of the values read back may
+        // differ from the effect in the last digit.)
+        assert!(
+            (e - (y - x)).abs() <= 1e-12 * x.abs().max(y.abs()).max(1.0),
+            "{c}: effect {e}, b - a = {}",
+            y - x
+        );
+        assert_eq!(row[format!("{c}.holds")].as_bool().unwrap(), x < y);
+    }
+    // Two axes: one heat map a claim.
+    let plots = std::fs::read_dir(a.join("merged/plots")).unwrap().count();
+    assert_eq!(plots, json["claims"].as_array().unwrap().len());
+    assert!(plots >= 6);
+}
+
+#[test]
+fn reruns_skip_finished_points_and_redo_broken_ones() {
+    let root = fresh("rerun");
+    let dir = root.join("d");
+    let file = root.join("s.toml");
+    std::fs::write(
+        &file,
+        "seeds = 3\n[set]\nsteps = 20\nwindow = 10\nrepeats = 1\ncontrols.random_walk = false\n",
+    )
+    .unwrap();
+    ok(&["sweep", "plan", s(&file), "--out", s(&dir)]);
+    // No task asked: SLURM_ARRAY_TASK_ID picks task 1.
+    let o = h8swarm(&["sweep", "run", s(&dir)], &[("SLURM_ARRAY_TASK_ID", "1")]);
+    assert!(o.status.success());
+    let ids: Vec<String> = std::fs::read_to_string(dir.join("points.jsonl"))
+        .unwrap()
+        .lines()
+        .map(|l| {
+            serde_json::from_str::<serde_json::Value>(l).unwrap()["id"]
+                .as_str()
+                .unwrap()
+                .to_string()
+        })
+        .collect();
+    assert_eq!(ids, ["p0000-s1", "p0001-s2", "p0002-s3"]);
+    let pts = dir.join("points");
+    assert!(pts.join(&ids[1]).join("status.json").exists());
+    assert!(!pts.join(&ids[0]).exists());
+
+    let merged = ok(&["sweep", "merge", s(&dir)]);
+    assert!(
+        merged.contains("MISSING p0000-s1") && merged.contains("MISSING p0002-s3"),
+        "{merged}"
+    );
+    let (code, err) = fails(&["sweep", "merge", s(&dir), "--require-complete"], &[]);
+    assert_eq!(code, 1, "{err}");
+    let csv = std::fs::read_to_string(dir.join("merged/sweep.csv")).unwrap();
+    assert!(
+        csv.lines()
+            .nth(1)
+            .unwrap()
+            .starts_with("0,p0000-s1,missing,"),
+        "{csv}"
+    );
+
+    // Everything: task 1's point is skipped, the two others run.
+    let before = std::fs::read(pts.join(&ids[1]).join("metrics.csv")).unwrap();
+    let o = h8swarm(&["sweep", "run", s(&dir)], &[]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("p0001-s2 finished before: skipped"), "{err}");
+    assert!(String::from_utf8_lossy(&o.stdout).contains("2 run, 1 skipped"));
+
+    // A broken folder (no status), a changed scenario and a killed task's leftovers are redone.
+    std::fs::remove_file(pts.join(&ids[0]).join("status.json")).unwrap();
+    let sc = pts.join(&ids[2]).join("scenario.toml");
+    let changed = std::fs::read_to_string(&sc)
+        .unwrap()
+        .replace("steps = 20", "steps = 21");
+    std::fs::write(&sc, changed).unwrap();
+    let junk = pts.join(format!(".tmp-{}-deadhost-7", ids[1]));
+    std::fs::create_dir_all(&junk).unwrap();
+    std::fs::remove_file(pts.join(&ids[1]).join("status.json")).unwrap();
+    let merged = ok(&["sweep", "merge", s(&dir)]);
+    assert!(
+        merged.contains("BROKEN  p0000-s1") && merged.contains("BROKEN  p0002-s3"),
+        "{merged}"
+    );
+    assert!(
+        merged.contains("RUNNING points/.tmp-p0001-s2-deadhost-7"),
+        "{merged}"
+    );
+    let text = ok(&["sweep", "run", s(&dir)]);
+    assert!(text.contains("3 run, 0 skipped"), "{text}");
+    assert!(!junk.exists());
+    assert_eq!(
+        std::fs::read(pts.join(&ids[1]).join("metrics.csv")).unwrap(),
+        before
+    );
+    let merged = ok(&["sweep", "merge", s(&dir), "--require-complete"]);
+    assert!(merged.contains("3 points, 3 ok"), "{merged}");
+    // No axis: a table, no figure.
+    assert_eq!(
+        std::fs::read_dir(dir.join("merged/plots")).unwrap().count(),
+        0
+    );
+}
+
+#[test]
+fn failed_points_are_recorded_and_listed() {
+    let root = fresh("failed");
+    let dir = root.join("d");
+    let file = root.join("s.toml");
+    std::fs::write(
+        &file,
+        "[set]\nsteps = 20\nwindow = 10\nrepeats = 1\ncontrols.learning_off = false\ncontrols.random_walk = false\ncontroller.kind = \"firmware\"\n[grid]\n\"controller.image\" = [\"firmware/robot.mot\", \"no/such-image.mot\"]\n",
+    )
+    .unwrap();
+    ok(&["sweep", "plan", s(&file), "--out", s(&dir)]);
+    let o = h8swarm(&["sweep", "run", s(&dir)], &[]);
+    assert_eq!(o.status.code(), Some(1), "a failed point fails the task");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("p0001-") && err.contains("FAILED"), "{err}");
+    let status: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(
+            std::fs::read_dir(dir.join("points"))
+                .unwrap()
+                .flatten()
+                .find(|e| e.file_name().to_string_lossy().starts_with("p0001-"))
+                .unwrap()
+                .path()
+                .join("status.json"),
+        )
+        .unwrap(),
+    )
+    .unwrap();
+    assert_eq!(status["status"], "failed");
+    assert!(
+        status["error"]
+            .as_str()
+            .unwrap()
+            .contains("no/such-image.mot"),
+        "{status}"
+    );
+    let merged = ok(&["sweep", "merge", s(&dir)]);
+    assert!(
+        merged.contains("1 ok, 1 failed") && merged.contains("FAILED  p0001-"),
+        "{merged}"
+    );
+    let csv = std::fs::read_to_string(dir.join("merged/sweep.csv")).unwrap();
+    let row = csv.lines().nth(2).unwrap();
+    assert!(
+        row.starts_with("1,p0001-")
+            && row.contains(",failed,")
+            && row.contains("no/such-image.mot"),
+        "{row}"
+    );
+    // One axis: a line figure a claim.
+    assert!(std::fs::read_dir(dir.join("merged/plots")).unwrap().count() >= 2);
+}
+
+#[test]
+fn bad_input_is_one_line_and_status_2() {
+    let root = fresh("bad");
+    let w = |name: &str, text: &str| {
+        let p = root.join(name);
+        std::fs::write(&p, text).unwrap();
+        p
+    };
+    let out = root.join("out");
+    let cases: [(PathBuf, &str); 7] = [
+        (w("toml.toml", "[grid\n"), "toml.toml"),
+        (
+            w("key.toml", "[grid]\n\"learner.etta\" = [0.1]\n"),
+            "unknown key `learner.etta`",
+        ),
+        (w("empty.toml", "[grid]\nrobots = []\n"), "empty list"),
+        (w("range.toml", "[grid]\nrobots = [3, 0]\n"), "robots"),
+        (
+            w("zip.toml", "[[zip]]\nrobots = [3, 4]\nsteps = [10]\n"),
+            "equal length",
+        ),
+        (w("top.toml", "grid = 3\n"), "grid"),
+        (
+            w("slurm.toml", "[slurm]\npoints_per_task = 0\n"),
+            "points_per_task",
+        ),
+    ];
+    for (file, says) in &cases {
+        let (code, err) = fails(&["sweep", "plan", s(file), "--out", s(&out)], &[]);
+        assert_eq!(code, 2, "{}: {err}", file.display());
+        assert!(err.contains(says), "{}: {err}", file.display());
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+        assert!(!err.contains("panicked"), "{err}");
+    }
+    let (code, err) = fails(
+        &[
+            "sweep",
+            "plan",
+            s(&root.join("none.toml")),
+            "--out",
+            s(&out),
+        ],
+        &[],
+    );
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("none.toml"), "{err}");
+
+    let good = w(
+        "good.toml",
+        "[set]\nsteps = 10\nwindow = 5\n[grid]\nrobots = [3, 4]\n",
+    );
+    ok(&["sweep", "plan", s(&good), "--out", s(&out)]);
+    // Planning the same again is fine; another plan into the same folder is not.
+    ok(&["sweep", "plan", s(&good), "--out", s(&out)]);
+    let other = w(
+        "other.toml",
+        "[set]\nsteps = 10\nwindow = 5\n[grid]\nrobots = [3, 5]\n",
+    );
+    let (code, err) = fails(&["sweep", "plan", s(&other), "--out", s(&out)], &[]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("different sweep plan"), "{err}");
+
+    let (code, err) = fails(&["sweep", "run", s(&out), "--task", "2"], &[]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("task 2 is out of range") && err.contains("0 to 1"),
+        "{err}"
+    );
+    let (code, err) = fails(&["sweep", "run", s(&out)], &[("SLURM_ARRAY_TASK_ID", "x1")]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("SLURM_ARRAY_TASK_ID"), "{err}");
+    let (code, err) = fails(&["sweep", "run", s(&root), "--task", "0"], &[]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("not a sweep folder"), "{err}");
+    let (code, err) = fails(&["sweep", "merge", s(&root)], &[]);
+    assert_eq!(code, 2, "{err}");
+    // A tampered run list cannot point outside the folder.
+    let list = std::fs::read_to_string(out.join("points.jsonl")).unwrap();
+    let first_id = serde_json::from_str::<serde_json::Value>(list.lines().next().unwrap()).unwrap()
+        ["id"]
+        .as_str()
+        .unwrap()
+        .to_string();
+    std::fs::write(
+        out.join("points.jsonl"),
+        list.replacen(&first_id, "../../escape", 1),
+    )
+    .unwrap();
+    let (code, err) = fails(&["sweep", "run", s(&out), "--task", "0"], &[]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("points.jsonl line 1"), "{err}");
+    assert!(!root.join("escape").exists());
+}
