@@ -1,5 +1,5 @@
 //! Firmware robots and model robots side by side (issue 11 item 5): with identical sensor
-//! inputs the learner's state stays equal step for step, and the swarm's learning runs agree.
+//! inputs the learner's state (weights, x, O, D, the motors) stays equal step for step, and the swarm's learning runs agree.
 
 use h8swarm::robot::{Brain, Condition, Images, Robot};
 use h8swarm::scenario::Scenario;
@@ -17,15 +17,26 @@ fn scenario(corridor: bool) -> Scenario {
     s
 }
 
-/// The weights a firmware robot holds, read from its RAM through the firmware's symbols.
-fn firmware_weights(r: &Robot, n: usize) -> Vec<i16> {
+/// The learner's state a firmware robot holds (weights, the input vector x and the outputs O),
+/// read from its RAM through the firmware's symbols (each a pointer to a boot-sized array).
+fn firmware_learner(r: &Robot, n_in: usize, m: usize) -> (Vec<i16>, Vec<i8>, Vec<i16>) {
     let fw = emu::board::firmware::Firmware::robot().unwrap();
     let peek = |a: u32| r.mcu.peek(a);
-    let at = fw.symbols.addr("net_w").unwrap();
-    let w = (0..4).fold(0u32, |v, i| (v << 8) | u32::from(peek(at + i)));
-    (0..n as u32)
-        .map(|k| i16::from_be_bytes([peek(w + 2 * k), peek(w + 2 * k + 1)]))
-        .collect()
+    let array = |name: &str| {
+        let at = fw.symbols.addr(name).unwrap();
+        (0..4).fold(0u32, |v, i| (v << 8) | u32::from(peek(at + i)))
+    };
+    let words = |at: u32, n: usize| -> Vec<i16> {
+        (0..n as u32)
+            .map(|k| i16::from_be_bytes([peek(at + 2 * k), peek(at + 2 * k + 1)]))
+            .collect()
+    };
+    let x = array("net_x");
+    (
+        words(array("net_w"), n_in * m),
+        (0..n_in as u32).map(|k| peek(x + k) as i8).collect(),
+        words(array("net_o"), m),
+    )
 }
 
 fn side_by_side(corridor: bool, condition: Condition, steps: u32) -> (u64, i64) {
@@ -55,8 +66,18 @@ fn side_by_side(corridor: bool, condition: Condition, steps: u32) -> (u64, i64) 
         let Brain::Model(c) = &model.brain else {
             unreachable!()
         };
-        let wm: Vec<i16> = c.learner().weights().iter().map(|q| q.to_bits()).collect();
-        assert_eq!(firmware_weights(&fw, wm.len()), wm, "step {k}: weights");
+        let l = c.learner();
+        let model_state = (
+            l.weights().iter().map(|q| q.to_bits()).collect::<Vec<_>>(),
+            l.inputs().iter().map(|q| q.to_bits()).collect::<Vec<_>>(),
+            l.outputs().iter().map(|q| q.to_bits()).collect::<Vec<_>>(),
+        );
+        let (n_in, m) = (model_state.1.len(), model_state.2.len());
+        assert_eq!(
+            firmware_learner(&fw, n_in, m),
+            model_state,
+            "step {k}: weights, x and O"
+        );
         let (wf, wmod) = (fw.wheels(), model.wheels());
         assert_eq!(wf, wmod, "step {k}: the motors");
         updates += u64::from(a.saved);

@@ -512,6 +512,12 @@ impl DynLearner {
         &self.x
     }
 
+    /// The outputs O of the last forward pass (Q15), one per behaviour.
+    #[must_use]
+    pub fn outputs(&self) -> &[Q15] {
+        &self.o
+    }
+
     /// The learner's RAM items on the H8.
     #[must_use]
     pub const fn ram_items(&self) -> [RamItem; 7] {
