@@ -1,16 +1,30 @@
-//! `h8swarm emu IMAGE.mot [--max-states N] [--trace] [--stats]`: runs a program on the emulated
-//! H8/3052F (SPEC §7). SCI1 is the console (standard output); `--trace` writes one line per
-//! instruction (address, disassembly, states) and `--stats` a JSON summary, both on standard
-//! error.
+//! `h8swarm emu IMAGE.mot [--max-states N] [--trace] [--stats] [--vcd FILE] [--gdb ADDR]
+//! [--symbols FILE]`: runs a program on the emulated H8/3052F (SPEC §7). SCI1 is the console
+//! (standard output); `--trace` writes one line per instruction (address, disassembly, states,
+//! and the function it is in when the image has symbols) and `--stats` a JSON summary, both on
+//! standard error. `--vcd` writes a pin trace of the whole run (`emu::chip::vcd`); `--gdb`
+//! waits for a GDB client on a loopback address before the program's first instruction
+//! (`emu::chip::gdb`). Symbols (for the phase names): `--symbols`, else IMAGE.sym beside the
+//! image if present.
 //!
 //! Exit status: the program's (low byte of R0) when it halts with SLEEP under CCR.I = 1; 124
 //! when the state budget runs out; 125 when the core stops on an error (the message names the PC
 //! and the bytes); 126 when the program sleeps with interrupts enabled and nothing that could
-//! wake it; 2 when the image cannot be read or is not a valid S-record file.
+//! wake it; 137 when a GDB client kills it; 2 when the image, the symbol file or an option is
+//! bad (a VCD file that cannot be created, a GDB address that is not loopback).
 
 use std::io::{self, BufWriter, Write};
+use std::path::Path;
+use std::sync::Arc;
 
-use emu::chip::run::{Outcome, RunOptions, run_image};
+use emu::board::symbols::SymbolTable;
+use emu::chip::gdb::{GdbError, GdbListener};
+use emu::chip::machine::Machine;
+use emu::chip::run::{Outcome, Probes, RunOptions, run_mcu_probed};
+use emu::chip::trace::{CodeNames, PhaseRecorder};
+use emu::chip::vcd::{VcdInfo, write_vcd};
+use emu::core::cpu::Cpu;
+use emu::core::srec;
 
 use crate::Failure;
 
@@ -23,42 +37,146 @@ pub const EXIT_SLEPT_FOREVER: u8 = 126;
 /// Exit status when a GDB client kills the program (128 + SIGKILL, as a shell reports it).
 pub const EXIT_KILLED: u8 = 137;
 
-pub fn run(image: &str, max_states: Option<u64>, trace: bool, stats: bool) -> Result<(), Failure> {
+/// What `h8swarm emu` was asked to do.
+pub struct EmuOptions<'a> {
+    /// The image (.mot).
+    pub image: &'a str,
+    /// The state budget.
+    pub max_states: Option<u64>,
+    /// One line per instruction on standard error.
+    pub trace: bool,
+    /// The JSON summary on standard error at the end.
+    pub stats: bool,
+    /// Write a pin trace of the whole run here (VCD).
+    pub vcd: Option<&'a Path>,
+    /// Serve a GDB client on this loopback address before the program runs.
+    pub gdb: Option<&'a str>,
+    /// The image's symbol table (nm -n output); default IMAGE.sym beside the image if present.
+    pub symbols: Option<&'a Path>,
+}
+
+fn input(msg: String) -> Failure {
+    Failure::Input(anyhow::anyhow!(msg))
+}
+
+/// The symbol table for the phase names: `--symbols FILE`, else IMAGE.sym beside the image
+/// when it exists, else none.
+fn symbols(image: &str, given: Option<&Path>) -> Result<Option<SymbolTable>, Failure> {
+    let path = match given {
+        Some(p) => p.to_path_buf(),
+        None => {
+            let p = Path::new(image).with_extension("sym");
+            if !p.is_file() {
+                return Ok(None);
+            }
+            p
+        }
+    };
+    let text = std::fs::read_to_string(&path).map_err(|e| {
+        input(format!(
+            "cannot read symbol file `{}`: {e} (give the output of `h8300-hms-nm -n`, or leave --symbols out)",
+            path.display()
+        ))
+    })?;
+    SymbolTable::parse(&text)
+        .map(Some)
+        .map_err(|e| input(format!("symbol file `{}`: {e}", path.display())))
+}
+
+pub fn run(o: &EmuOptions<'_>) -> Result<(), Failure> {
+    let image = o.image;
     let bytes = std::fs::read(image).map_err(|e| {
-        Failure::Input(anyhow::anyhow!(
+        input(format!(
             "cannot read image `{image}`: {e} (give a Motorola S-record file, .mot)"
         ))
     })?;
-    let options = RunOptions { max_states };
+    let srec = srec::parse(&bytes).map_err(|e| {
+        Failure::Input(anyhow::Error::new(e).context(format!("image `{image}`: bad image")))
+    })?;
+    let mut machine = Machine::with_image(&srec).map_err(|e| {
+        Failure::Input(anyhow::Error::new(e).context(format!("image `{image}`: cannot load image")))
+    })?;
+    let names = symbols(image, o.symbols)?.map(Arc::new);
+    // Fail on a file that cannot be created before the program runs.
+    let mut vcd_file = match o.vcd {
+        Some(path) => Some(std::fs::File::create(path).map_err(|e| {
+            input(format!(
+                "--vcd: cannot create `{}`: {e} (give a writable file path)",
+                path.display()
+            ))
+        })?),
+        None => None,
+    };
+    let debugger = match o.gdb {
+        Some(addr) => {
+            let listener = GdbListener::bind(addr).map_err(gdb_failure)?;
+            let at = listener.local_addr();
+            eprintln!(
+                "h8swarm emu: GDB stub listening on {at}; waiting for a client (target remote {at})"
+            );
+            Some(listener.accept().map_err(gdb_failure)?)
+        }
+        None => None,
+    };
+    let mut debugger = debugger;
+    let mut cpu = Cpu::new();
+    cpu.reset(&mut machine);
+    let mcu = machine.mcu_mut();
+    let mut phases = None;
+    if vcd_file.is_some() {
+        mcu.start_trace(cpu.sleeping());
+        if let Some(n) = &names {
+            phases = Some(PhaseRecorder::new(n.clone()));
+        }
+    }
+    let options = RunOptions {
+        max_states: o.max_states,
+    };
     let stdout = io::stdout();
     let mut console = stdout.lock();
     let stderr = io::stderr();
     let mut trace_out = BufWriter::new(stderr.lock());
-    let report = run_image(
-        &bytes,
+    let report = run_mcu_probed(
+        &mut cpu,
+        mcu,
         &options,
         &mut console,
-        if trace { Some(&mut trace_out) } else { None },
+        Probes {
+            trace: if o.trace { Some(&mut trace_out) } else { None },
+            names: names.as_deref().map(|n| n as &dyn CodeNames),
+            phases: phases.as_mut(),
+            debugger: debugger.as_mut(),
+        },
     );
     let _ = trace_out.flush();
     drop(trace_out);
+    if let (Some(file), Some(trace)) = (vcd_file.as_mut(), mcu.finish_trace()) {
+        let changes = phases.as_mut().map(PhaseRecorder::take);
+        write_vcd(
+            file,
+            &trace,
+            changes.as_deref(),
+            &VcdInfo {
+                source: format!("{image} on h8swarm emu"),
+            },
+        )
+        .map_err(|e| {
+            Failure::Tool(anyhow::Error::new(e).context(format!(
+                "writing the VCD file `{}`",
+                o.vcd.map(|p| p.display().to_string()).unwrap_or_default()
+            )))
+        })?;
+    }
     let report = match report {
         Ok(r) => r,
-        Err(emu::chip::run::RunError::Io(e)) if e.kind() == io::ErrorKind::BrokenPipe => {
-            return Ok(());
-        }
-        Err(emu::chip::run::RunError::Io(e)) => {
+        Err(e) if e.kind() == io::ErrorKind::BrokenPipe => return Ok(()),
+        Err(e) => {
             return Err(Failure::Tool(
                 anyhow::Error::new(e).context("writing the console"),
             ));
         }
-        Err(e) => {
-            return Err(Failure::Input(
-                anyhow::Error::new(e).context(format!("image `{image}`")),
-            ));
-        }
     };
-    if stats {
+    if o.stats {
         eprintln!("{}", report.to_json());
     }
     match report.outcome {
@@ -86,4 +204,10 @@ pub fn run(image: &str, max_states: Option<u64>, trace: bool, stats: bool) -> Re
             Err(Failure::Program(EXIT_KILLED))
         }
     }
+}
+
+/// A GDB stub that cannot start (an address that is not loopback `HOST:PORT`, a port that
+/// cannot be bound): bad input, status 2.
+fn gdb_failure(e: GdbError) -> Failure {
+    Failure::Input(anyhow::Error::new(e).context("--gdb"))
 }

@@ -273,6 +273,11 @@ impl Swarm {
         }
     }
 
+    /// Robot `i` (its MCU, its controller), between steps; `None` past the last robot.
+    pub fn robot_mut(&mut self, i: usize) -> Option<&mut Robot> {
+        self.robots.get_mut(i)
+    }
+
     /// The world the robots are in (poses, bumpers, wheel speeds), as of the latest step.
     #[must_use]
     pub fn world(&self) -> &World {
@@ -493,13 +498,140 @@ pub fn run_one(
     keep_going: bool,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Result<RunOutput> {
+    run_one_probed(
+        s,
+        condition,
+        repeat,
+        record_track,
+        images,
+        keep_going,
+        progress,
+        RobotProbes::default(),
+    )
+}
+
+/// A pin trace of one firmware robot over a window of steps, written as a VCD file
+/// (`h8swarm run --vcd`).
+#[derive(Clone, Debug)]
+pub struct VcdProbe {
+    /// The robot.
+    pub robot: usize,
+    /// The first traced step: the trace starts where the robot's MCU is before it (asleep
+    /// after the previous step's work, or at reset for step 0).
+    pub from: u32,
+    /// Traced steps: the trace ends when the step after the last one begins sensing (so the
+    /// last step's behaviour shows to its end), or with the run.
+    pub steps: u32,
+    /// The VCD file.
+    pub path: std::path::PathBuf,
+}
+
+/// What to look at inside one robot of a run: its pins, its firmware under GDB.
+#[derive(Debug, Default)]
+pub struct RobotProbes {
+    /// A pin trace.
+    pub vcd: Option<VcdProbe>,
+    /// A GDB stub for a robot, waiting for its client: (robot, listener). The run waits for
+    /// the client before its first step and pauses while it has the robot stopped.
+    pub gdb: Option<(usize, emu::chip::gdb::GdbListener)>,
+}
+
+/// [`run_one`] with probes on one robot: a pin trace written as VCD, a GDB client's control.
+/// The run's results are the same as without them.
+///
+/// # Errors
+/// As [`run_one`]; a probed robot that is no firmware robot; a GDB client that cannot be
+/// accepted; a VCD file that cannot be written.
+#[allow(clippy::too_many_arguments)]
+pub fn run_one_probed(
+    s: &Scenario,
+    condition: Condition,
+    repeat: u32,
+    record_track: bool,
+    images: Option<&Images>,
+    keep_going: bool,
+    progress: &(dyn Fn(u64) + Sync),
+    probes: RobotProbes,
+) -> Result<RunOutput> {
     let mut swarm = Swarm::new(s, condition, repeat, record_track, images)?;
     swarm.set_keep_going(keep_going);
-    for _ in 0..s.steps {
+    let debugged = probes.gdb.as_ref().map(|(k, _)| *k);
+    if let Some((k, listener)) = probes.gdb {
+        let robot = swarm
+            .robot_mut(k)
+            .with_context(|| format!("--gdb-robot {k}: the run has {} robots", s.robots))?;
+        let debugger = listener
+            .accept()
+            .with_context(|| format!("--gdb: waiting for a client for robot {k}"))?;
+        robot
+            .attach_debugger(debugger)
+            .with_context(|| format!("--gdb-robot {k}"))?;
+    }
+    let mut tracing = false;
+    for step in 0..s.steps {
+        if let Some(v) = &probes.vcd {
+            let robot = swarm.robot_mut(v.robot).with_context(|| {
+                format!("--vcd-robot {}: the run has {} robots", v.robot, s.robots)
+            })?;
+            if step == v.from {
+                let names = images
+                    .map(|im| std::sync::Arc::new(im.for_robot(v.robot).symbols.clone()))
+                    .with_context(|| {
+                        format!("--vcd-robot {}: the robots run no firmware", v.robot)
+                    })?;
+                robot
+                    .start_pin_trace(names)
+                    .with_context(|| format!("--vcd-robot {}", v.robot))?;
+                tracing = true;
+            }
+            if tracing && step == v.from + v.steps {
+                robot.end_pin_trace_at_sensing();
+            }
+        }
         swarm.step()?;
+        if let Some(v) = &probes.vcd
+            && let Some(t) = swarm.robot_mut(v.robot).and_then(Robot::take_pin_trace)
+        {
+            write_robot_vcd(v, s, condition, repeat, &t)?;
+            tracing = false;
+        }
         progress(1);
     }
+    if let Some(v) = &probes.vcd
+        && tracing
+        && let Some(t) = swarm.robot_mut(v.robot).and_then(Robot::finish_pin_trace)
+    {
+        write_robot_vcd(v, s, condition, repeat, &t)?;
+    }
+    if let Some(robot) = debugged.and_then(|k| swarm.robot_mut(k)) {
+        robot.detach_debugger();
+    }
     swarm.finish()
+}
+
+/// Writes a robot's pin trace as the VCD file of `v`.
+fn write_robot_vcd(
+    v: &VcdProbe,
+    s: &Scenario,
+    condition: Condition,
+    repeat: u32,
+    t: &crate::robot::RobotTrace,
+) -> Result<()> {
+    let file = std::fs::File::create(&v.path)
+        .with_context(|| format!("--vcd: cannot create `{}`", v.path.display()))?;
+    let info = emu::chip::vcd::VcdInfo {
+        source: format!(
+            "robot {} of h8swarm run {} ({} run, repeat {repeat}, seed {}), steps {} to {}",
+            v.robot,
+            s.name,
+            condition.name(),
+            s.seed,
+            v.from,
+            (v.from + v.steps).min(s.steps) - 1
+        ),
+    };
+    emu::chip::vcd::write_vcd(file, &t.pins, Some(&t.phases), &info)
+        .with_context(|| format!("--vcd: cannot write `{}`", v.path.display()))
 }
 
 /// The step period in clock states.

@@ -4,7 +4,8 @@
 //! file, an option out of range, a usage error); 1 when the tool itself fails (an output that
 //! cannot be written). `h8swarm emu` exits with the program's own status when it halts, 124
 //! when `--max-states` runs out, 125 when the core stops on an error (undefined opcode, fetch
-//! outside ROM and RAM) and 126 when the program sleeps with nothing left to wake it.
+//! outside ROM and RAM), 126 when the program sleeps with nothing left to wake it and 137 when
+//! a GDB client kills it.
 #![forbid(unsafe_code)]
 
 mod emu_cmd;
@@ -56,6 +57,18 @@ struct EmuArgs {
     /// Print instructions, states and emulated time as JSON on standard error at the end.
     #[arg(long)]
     stats: bool,
+    /// Write a pin trace of the run (PWM, H-bridge, I2C lines, A/D, tick, sleep, the function
+    /// that runs) to FILE as VCD, for GTKWave or sigrok (written when the run ends).
+    #[arg(long, value_name = "FILE")]
+    vcd: Option<std::path::PathBuf>,
+    /// Wait for a GDB client on this loopback address (127.0.0.1:PORT; port 0 picks a free
+    /// one, printed on standard error) and run the program under its control.
+    #[arg(long, value_name = "ADDR")]
+    gdb: Option<String>,
+    /// The image's symbol table (`h8300-hms-nm -n` output) for function names in --trace and
+    /// --vcd (default: IMAGE.sym beside the image, if present).
+    #[arg(long, value_name = "FILE")]
+    symbols: Option<std::path::PathBuf>,
 }
 
 #[derive(Args, Debug)]
@@ -134,9 +147,15 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Some(Command::Learn(args)) => learn(&args),
         Some(Command::Cost(args)) => cost(&args),
-        Some(Command::Emu(args)) => {
-            emu_cmd::run(&args.image, args.max_states, args.trace, args.stats)
-        }
+        Some(Command::Emu(args)) => emu_cmd::run(&emu_cmd::EmuOptions {
+            image: &args.image,
+            max_states: args.max_states,
+            trace: args.trace,
+            stats: args.stats,
+            vcd: args.vcd.as_deref(),
+            gdb: args.gdb.as_deref(),
+            symbols: args.symbols.as_deref(),
+        }),
         Some(Command::Fit(args)) => fit(&args),
         Some(Command::Run(args)) => run(&args),
         Some(Command::Sweep(args)) => sweep(&args),

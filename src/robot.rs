@@ -6,13 +6,17 @@
 //! repeat, the robot and the purpose ([`crate::seeds::robot_stream`], the project's one
 //! derivation); adding a robot or a thread changes nobody else's numbers.
 
+use std::sync::Arc;
+
 use anyhow::{Context, Result};
 use emu::board::firmware::{
     ConfigBlock, ConfigStatus, FLAG_RANDOM_WALK, Firmware, FirmwareController,
 };
 use emu::board::model::{Controller, ControllerConfig};
 use emu::board::wiring::{Bridge, MotorDrive};
+use emu::chip::gdb::Debugger;
 use emu::chip::mcu::{Board, Mcu, McuConfig};
+use emu::chip::trace::{CodeNames, PinTrace};
 use emu::core::bus::Bus;
 use nn_q15::{Behaviour, InputLayout, Params};
 use rand::{RngExt, SeedableRng};
@@ -116,6 +120,19 @@ pub struct Robot {
     /// Where the firmware reports what it made of its configuration block (`cfg_status`),
     /// when it got one and has the symbol; checked once it has booted.
     cfg_status: Option<u32>,
+    /// A pin trace under way ends when the next step's sensing begins.
+    trace_ends_at_sensing: bool,
+    /// A pin trace that ended, not yet taken ([`Robot::take_pin_trace`]).
+    finished_trace: Option<RobotTrace>,
+}
+
+/// A robot's pin trace: the MCU's signals and the firmware's phases.
+#[derive(Clone, Debug)]
+pub struct RobotTrace {
+    /// The pins.
+    pub pins: PinTrace,
+    /// Which function ran, as it changed: (instant in states, name).
+    pub phases: Vec<(u64, String)>,
 }
 
 /// The images a swarm's firmware robots run, loaded once.
@@ -275,6 +292,8 @@ impl Robot {
             records: 0,
             busy_states: 0,
             cfg_status,
+            trace_ends_at_sensing: false,
+            finished_trace: None,
         };
         robot.records = robot.records_written();
         Ok(robot)
@@ -312,6 +331,14 @@ impl Robot {
             Brain::Firmware(c) => {
                 c.run_to_sensing(&mut self.mcu)?;
                 self.busy_states += c.take_busy();
+                if std::mem::take(&mut self.trace_ends_at_sensing)
+                    && let Some(pins) = self.mcu.finish_trace()
+                {
+                    self.finished_trace = Some(RobotTrace {
+                        pins,
+                        phases: c.take_phases(),
+                    });
+                }
                 // Booted: a configuration block the firmware rejected is an error.
                 if let Some(addr) = self.cfg_status.take()
                     && let ConfigStatus::Rejected { field, code } =
@@ -324,6 +351,69 @@ impl Robot {
             }
         }
         Ok(self.mcu.now())
+    }
+
+    /// Starts a pin trace of a firmware robot's MCU now, with the phase signal named by
+    /// `names` (the image's symbols): it runs until [`Robot::end_pin_trace_at_sensing`] ends
+    /// it at the start of a step, or [`Robot::finish_pin_trace`] now. Tracing changes nothing
+    /// the robot does.
+    ///
+    /// # Errors
+    /// A robot whose controller is the model (it has no firmware whose pins could be traced).
+    pub fn start_pin_trace(&mut self, names: Arc<dyn CodeNames + Send + Sync>) -> Result<()> {
+        let Brain::Firmware(c) = &mut self.brain else {
+            anyhow::bail!(
+                "its controller is the Rust model: only firmware robots have pins to trace"
+            );
+        };
+        self.mcu.start_trace(c.cpu().sleeping());
+        c.record_phases(names, self.mcu.now());
+        self.trace_ends_at_sensing = false;
+        Ok(())
+    }
+
+    /// Ends the pin trace under way when the next step's sensing begins (the write that starts
+    /// the A/D converter), so that the last traced step's behaviour shows to its end; take it
+    /// with [`Robot::take_pin_trace`] after that step.
+    pub fn end_pin_trace_at_sensing(&mut self) {
+        self.trace_ends_at_sensing = self.mcu.tracing();
+    }
+
+    /// The pin trace that ended at a step's sensing, if one did and was not taken yet.
+    pub fn take_pin_trace(&mut self) -> Option<RobotTrace> {
+        self.finished_trace.take()
+    }
+
+    /// Ends the pin trace under way now and returns it (`None` when none is).
+    pub fn finish_pin_trace(&mut self) -> Option<RobotTrace> {
+        self.trace_ends_at_sensing = false;
+        let pins = self.mcu.finish_trace()?;
+        let phases = match &mut self.brain {
+            Brain::Firmware(c) => c.take_phases(),
+            Brain::Model(_) => Vec::new(),
+        };
+        Some(RobotTrace { pins, phases })
+    }
+
+    /// Puts a firmware robot under a GDB client's control (see
+    /// [`FirmwareController::attach`]): the swarm waits while the client has it stopped.
+    ///
+    /// # Errors
+    /// A robot whose controller is the model.
+    pub fn attach_debugger(&mut self, debugger: Debugger) -> Result<()> {
+        let Brain::Firmware(c) = &mut self.brain else {
+            anyhow::bail!("its controller is the Rust model: only firmware robots can be debugged");
+        };
+        c.attach(debugger);
+        Ok(())
+    }
+
+    /// Ends a GDB session on this robot, if one is attached (the client is told the program
+    /// ended).
+    pub fn detach_debugger(&mut self) {
+        if let Brain::Firmware(c) = &mut self.brain {
+            c.detach();
+        }
     }
 
     /// Runs the step with the distances the world's rays found.

@@ -1,6 +1,9 @@
 //! `h8swarm run [corridor|arena|FILE.toml] [--robots N] [--steps S] [--repeats R] [--seed X]
-//! [--threads T] [--out DIR]`: the paper's experiment with its controls, in parallel, with the
-//! metrics, the summary, the figures and the fit verdict written to DIR.
+//! [--threads T] [--out DIR] [--vcd FILE [--vcd-robot K] [--vcd-from S] [--vcd-steps N]]
+//! [--gdb ADDR [--gdb-robot K]]`: the paper's experiment with its controls, in parallel, with
+//! the metrics, the summary, the figures and the fit verdict written to DIR; `--vcd` traces one
+//! firmware robot's pins over a window of steps, `--gdb` puts one under a GDB client's control
+//! (both in the learning run's first repeat; the results do not change).
 
 use std::fmt::Write as _;
 use std::io::IsTerminal;
@@ -13,7 +16,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::experiment::{RunOutput, build_world, run_one};
+use crate::experiment::{RunOutput, build_world, run_one_probed};
 use crate::plot::{
     ArenaFigure, LearningFigure, Panel, Series, arena_figure_panels, learning_figure,
 };
@@ -57,6 +60,88 @@ pub struct RunArgs {
     /// memory, no step for 10 s), mark that robot dead and go on instead of stopping.
     #[arg(long)]
     pub keep_going: bool,
+    /// Write a pin trace of one firmware robot of the learning run (repeat 0) to FILE as VCD
+    /// (PWM, H-bridge, I2C lines, A/D, tick, sleep, the function that runs).
+    #[arg(long, value_name = "FILE")]
+    pub vcd: Option<PathBuf>,
+    /// The robot --vcd traces (default 0).
+    #[arg(long, value_name = "K", requires = "vcd")]
+    pub vcd_robot: Option<usize>,
+    /// The first step --vcd traces (default 0: from reset).
+    #[arg(long, value_name = "S", requires = "vcd")]
+    pub vcd_from: Option<u32>,
+    /// How many steps --vcd traces (default 10, cut at the run's end).
+    #[arg(long, value_name = "N", requires = "vcd")]
+    pub vcd_steps: Option<u32>,
+    /// Wait for a GDB client on this loopback address (127.0.0.1:PORT; port 0 picks a free
+    /// one, printed on standard error) and run one firmware robot of the learning run
+    /// (repeat 0) under its control; the swarm pauses while the robot is stopped.
+    #[arg(long, value_name = "ADDR")]
+    pub gdb: Option<String>,
+    /// The robot --gdb controls (default 0).
+    #[arg(long, value_name = "K", requires = "gdb")]
+    pub gdb_robot: Option<usize>,
+}
+
+/// Steps `--vcd` traces unless `--vcd-steps` says otherwise.
+pub const DEFAULT_VCD_STEPS: u32 = 10;
+
+/// A robot index given with `option`, checked against the scenario: it exists and runs
+/// firmware.
+fn probed_robot(option: &str, k: usize, s: &Scenario) -> Result<usize> {
+    if k >= s.robots {
+        bail!(
+            "{option} {k}: the run has {} robots (valid: 0 to {})",
+            s.robots,
+            s.robots - 1
+        );
+    }
+    if s.controller.kind != crate::fit::ControllerKind::Firmware {
+        bail!(
+            "{option} {k}: robot {k} runs the Rust model, which has no firmware to look at (use --controller firmware, or --firmware IMAGE)"
+        );
+    }
+    Ok(k)
+}
+
+/// The probes `--vcd` and `--gdb` ask for, checked (a bad value fails before any run); the
+/// GDB stub is listening when this returns.
+fn probes(a: &RunArgs, s: &Scenario) -> Result<crate::experiment::RobotProbes> {
+    let mut p = crate::experiment::RobotProbes::default();
+    if let Some(path) = &a.vcd {
+        let robot = probed_robot("--vcd-robot", a.vcd_robot.unwrap_or(0), s)?;
+        let from = a.vcd_from.unwrap_or(0);
+        if from >= s.steps {
+            bail!(
+                "--vcd-from {from}: the run has {} steps (valid: 0 to {})",
+                s.steps,
+                s.steps - 1
+            );
+        }
+        let steps = a.vcd_steps.unwrap_or(DEFAULT_VCD_STEPS);
+        if steps == 0 {
+            bail!("--vcd-steps 0: trace at least 1 step");
+        }
+        // Fail now, not after the runs, if the file cannot be written.
+        std::fs::write(path, b"")
+            .with_context(|| format!("--vcd: cannot create `{}`", path.display()))?;
+        p.vcd = Some(crate::experiment::VcdProbe {
+            robot,
+            from,
+            steps: steps.min(s.steps - from),
+            path: path.clone(),
+        });
+    }
+    if let Some(addr) = &a.gdb {
+        let robot = probed_robot("--gdb-robot", a.gdb_robot.unwrap_or(0), s)?;
+        let listener = emu::chip::gdb::GdbListener::bind(addr).context("--gdb")?;
+        let at = listener.local_addr();
+        eprintln!(
+            "h8swarm run: GDB stub listening on {at} for robot {robot} of the learning run (repeat 0); waiting for a client (target remote {at})"
+        );
+        p.gdb = Some((robot, listener));
+    }
+    Ok(p)
 }
 
 #[derive(Serialize)]
@@ -110,6 +195,7 @@ pub fn run(a: &RunArgs) -> Result<String> {
         .with_context(|| format!("cannot write `{}`", metrics_path.display()))?;
     // Fail now if the robots do not fit the arena.
     build_world(&s, 0)?;
+    let probes = std::sync::Mutex::new(Some(probes(a, &s)?));
 
     let mut jobs: Vec<(Condition, u32)> = Vec::new();
     let mut kinds = vec![Condition::Learning];
@@ -155,9 +241,22 @@ pub fn run(a: &RunArgs) -> Result<String> {
         jobs.par_iter()
             .map(|&(c, r)| {
                 let track = c == Condition::Learning && r == 0;
-                run_one(&s, c, r, track, images.as_ref(), a.keep_going, &|k| {
-                    bar.inc(k)
-                })
+                // The probes go to the learning run's first repeat.
+                let probes = if track {
+                    probes.lock().ok().and_then(|mut p| p.take())
+                } else {
+                    None
+                };
+                run_one_probed(
+                    &s,
+                    c,
+                    r,
+                    track,
+                    images.as_ref(),
+                    a.keep_going,
+                    &|k| bar.inc(k),
+                    probes.unwrap_or_default(),
+                )
             })
             .collect::<Result<_>>()
     })?;
