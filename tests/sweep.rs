@@ -456,3 +456,25 @@ fn bad_input_is_one_line_and_status_2() {
     assert!(err.contains("points.jsonl line 1"), "{err}");
     assert!(!root.join("escape").exists());
 }
+
+#[test]
+fn the_readme_example_plans() {
+    let dir = fresh("example").join("d");
+    let text = ok(&[
+        "sweep",
+        "plan",
+        "scenarios/sweep-example.toml",
+        "--out",
+        s(&dir),
+    ]);
+    assert!(
+        text.contains("12 points") && text.contains("6 tasks"),
+        "{text}"
+    );
+    let script = std::fs::read_to_string(dir.join("sweep.sbatch")).unwrap();
+    assert!(script.contains("\n#SBATCH --array=0-5%6\n"), "{script}");
+    let first = std::fs::read_to_string(dir.join("points.jsonl")).unwrap();
+    let first: serde_json::Value = serde_json::from_str(first.lines().next().unwrap()).unwrap();
+    assert_eq!(first["id"], "p0000-eta0.001-history0-s1");
+    assert_eq!(first["scenario"]["steps"], 2000);
+}
