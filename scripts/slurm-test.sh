@@ -66,6 +66,8 @@ cleanup() {
 trap cleanup EXIT
 # A signal ends the script through the EXIT trap too (bash alone would not run it on TERM).
 trap 'fail "interrupted"' INT TERM HUP
+# A command that fails outside the checks (set -e) says which line.
+trap 'fail "line $LINENO: \`$BASH_COMMAND\` failed"' ERR
 
 # Two free loopback ports for slurmctld and slurmd.
 port_free() { ! (exec 3<>"/dev/tcp/127.0.0.1/$1") 2>/dev/null; }
