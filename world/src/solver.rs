@@ -17,7 +17,6 @@
 //! within the sub-step.
 
 use crate::contact::Manifold;
-use crate::world::BodyPose;
 
 /// A robot–robot or robot–wall contact and the solver's state for its points.
 #[derive(Debug, Clone, Copy, Default)]
@@ -26,6 +25,10 @@ pub(crate) struct Contact {
     pub a: u32,
     /// Second robot, or [`WALL`].
     pub b: u32,
+    /// First robot's index in its island (set before the solve).
+    pub la: u32,
+    /// Second robot's index in its island, or [`WALL`].
+    pub lb: u32,
     /// Unit normal from a to b.
     pub nx: f64,
     /// See `nx`.
@@ -73,6 +76,8 @@ impl Contact {
         let mut c = Contact {
             a,
             b,
+            la: 0,
+            lb: b,
             nx: m.nx,
             ny: m.ny,
             count: m.count as u8,
@@ -178,20 +183,31 @@ impl BodyConst {
     }
 }
 
-/// Returns the sweeps run. One sub-step's velocity solve over the robots `bodies` (each touching something) and the
-/// contacts (their `ln`, `lt` and `wheel_impulse` hold the warm-start guesses): `iterations` Gauss–Seidel sweeps, each over the bodies' wheels in the order given,
-/// then the contacts in the order given. `vel` holds world-frame velocities (vx, vy, ω),
-/// updated in place; `pose` the poses at the start of the sub-step; `wheel_speed` the wheel rim speeds
-/// (left, right) the motors give over the sub-step; `wheel_impulse` (per body, left along,
-/// left across, right along, right across) is the wheels' accumulated impulse (the warm-start guess in, the solution out).
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn solve_velocities(
-    bodies: &[u32],
+/// One robot of an island as the solver sees it: heading at the start of the sub-step, its
+/// world-frame velocity (vx, vy, ω; the momentum in, the solution out), its wheels' rim speeds
+/// over the sub-step (left, right) and their accumulated impulses (left along, left across,
+/// right along, right across; the warm-start guess in, the solution out).
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct IslandBody {
+    /// cos of the heading.
+    pub c: f64,
+    /// sin of the heading.
+    pub s: f64,
+    /// Velocity (vx, vy, ω).
+    pub vel: [f64; 3],
+    /// Wheel rim speeds, m/s.
+    pub wheel_speed: [f64; 2],
+    /// Wheel impulses, N·s.
+    pub wheel_imp: [f64; 4],
+}
+
+/// One sub-step's velocity solve of an island (robots connected by contacts; contacts refer
+/// to them by `la`, `lb`): the warm-start impulses are applied, then up to `iterations`
+/// Gauss–Seidel sweeps, each over the bodies' wheels in order, then the contacts in order,
+/// until a sweep changes no impulse by more than [`CONVERGED_N_S`]. Returns the sweeps run.
+pub(crate) fn solve_island(
+    bodies: &mut [IslandBody],
     contacts: &mut [Contact],
-    pose: &[BodyPose],
-    vel: &mut [[f64; 3]],
-    wheel_speed: &[[f64; 2]],
-    wheel_impulse: &mut [[f64; 4]],
     body: &BodyConst,
     h: f64,
     iterations: u32,
@@ -200,48 +216,40 @@ pub(crate) fn solve_velocities(
     let wheel_bound = body.wheel_force_n * h;
     // Warm start: the impulses the caller kept from the previous sub-step (the same contact,
     // the same wheels) are applied first, so that a steady push converges at once.
-    for &i in bodies {
-        let i = i as usize;
-        let (c, s) = (pose[i].c, pose[i].s);
-        let imp = wheel_impulse[i];
-        let v = &mut vel[i];
+    for b in bodies.iter_mut() {
+        let (c, s) = (b.c, b.s);
         for (w, y_w) in [(0usize, body.half_track), (1, -body.half_track)] {
-            let (dl, dt) = (imp[2 * w], imp[2 * w + 1]);
-            v[0] += (dl * c - dt * s) * body.inv_m;
-            v[1] += (dl * s + dt * c) * body.inv_m;
-            v[2] -= dl * y_w * body.inv_i;
+            let (dl, dt) = (b.wheel_imp[2 * w], b.wheel_imp[2 * w + 1]);
+            b.vel[0] += (dl * c - dt * s) * body.inv_m;
+            b.vel[1] += (dl * s + dt * c) * body.inv_m;
+            b.vel[2] -= dl * y_w * body.inv_i;
         }
     }
     for ct in contacts.iter() {
-        let a = ct.a as usize;
-        let wall = ct.b == WALL;
-        let b = if wall { a } else { ct.b as usize };
         let (nx, ny) = (ct.nx, ct.ny);
         for p in &ct.pts[..usize::from(ct.count)] {
             let px = p.ln * nx - p.lt * ny;
             let py = p.ln * ny + p.lt * nx;
-            apply(vel, a, b, wall, p, px, py, body);
+            apply(bodies, ct.la, ct.lb, p, px, py, body);
         }
     }
     let mut sweeps = 0;
     for _ in 0..iterations {
         sweeps += 1;
         // The largest impulse change of the sweep: below CONVERGED_N_S the sweep changed no
-        // velocity by more than a few nm/s and the rest would change nothing that shows.
+        // velocity by more than a few µm/s and the rest would change nothing that shows.
         let mut change: f64 = 0.0;
-        for &i in bodies {
-            let i = i as usize;
-            let (c, s) = (pose[i].c, pose[i].s);
-            let v = &mut vel[i];
-            let imp = &mut wheel_impulse[i];
+        for b in bodies.iter_mut() {
+            let (c, s) = (b.c, b.s);
             for (w, y_w) in [(0usize, body.half_track), (1, -body.half_track)] {
+                let v = b.vel;
                 // Wheel contact point at r = R·(0, y_w) = (−s·y_w, c·y_w).
                 let along = v[0] * c + v[1] * s - v[2] * y_w;
                 let across = -v[0] * s + v[1] * c;
-                let mut d_long = body.wheel_mass_long * (wheel_speed[i][w] - along);
-                let mut d_lat = -body.wheel_mass_lat * across;
+                let d_long = body.wheel_mass_long * (b.wheel_speed[w] - along);
+                let d_lat = -body.wheel_mass_lat * across;
                 // The wheel's friction disk: the accumulated impulse is clamped to it.
-                let (old_l, old_t) = (imp[2 * w], imp[2 * w + 1]);
+                let (old_l, old_t) = (b.wheel_imp[2 * w], b.wheel_imp[2 * w + 1]);
                 let (mut nl, mut nt) = (old_l + d_long, old_t + d_lat);
                 let mag2 = nl * nl + nt * nt;
                 if mag2 > wheel_bound * wheel_bound {
@@ -249,55 +257,45 @@ pub(crate) fn solve_velocities(
                     nl *= k;
                     nt *= k;
                 }
-                d_long = nl - old_l;
-                d_lat = nt - old_t;
+                let (d_long, d_lat) = (nl - old_l, nt - old_t);
                 change = change.max(d_long.abs()).max(d_lat.abs());
-                imp[2 * w] = nl;
-                imp[2 * w + 1] = nt;
-                // Impulse along e = (c, s) and f = (−s, c) at the wheel.
-                let px = d_long * c - d_lat * s;
-                let py = d_long * s + d_lat * c;
-                v[0] += px * body.inv_m;
-                v[1] += py * body.inv_m;
-                // r × e = −y_w; r × f = 0.
-                v[2] -= d_long * y_w * body.inv_i;
+                b.wheel_imp[2 * w] = nl;
+                b.wheel_imp[2 * w + 1] = nt;
+                // Impulse along e = (c, s) and f = (−s, c) at the wheel; r × e = −y_w, r × f = 0.
+                b.vel[0] += (d_long * c - d_lat * s) * body.inv_m;
+                b.vel[1] += (d_long * s + d_lat * c) * body.inv_m;
+                b.vel[2] -= d_long * y_w * body.inv_i;
             }
         }
         for ct in contacts.iter_mut() {
-            let a = ct.a as usize;
-            let wall = ct.b == WALL;
-            let b = if wall { a } else { ct.b as usize };
-            let mu = if wall { body.mu_wall } else { body.mu_robot };
+            let (la, lb) = (ct.la, ct.lb);
+            let mu = if lb == WALL {
+                body.mu_wall
+            } else {
+                body.mu_robot
+            };
             let (nx, ny) = (ct.nx, ct.ny);
             let (tx, ty) = (-ny, nx);
             for p in ct.pts[..usize::from(ct.count)].iter_mut() {
-                let va = vel[a];
-                let vb = if wall { [0.0; 3] } else { vel[b] };
-                // Relative velocity of b's point against a's.
-                let rvx = (vb[0] - vb[2] * p.rb[1]) - (va[0] - va[2] * p.ra[1]);
-                let rvy = (vb[1] + vb[2] * p.rb[0]) - (va[1] + va[2] * p.ra[0]);
+                let (rvx, rvy) = relative_velocity(bodies, la, lb, p);
                 let vn = rvx * nx + rvy * ny;
                 // Allowed approach: close the gap down to the skin (sep > 0), or open an overlap
                 // to it (sep < 0).
                 let target = -(p.sep - crate::world::CONTACT_SKIN_M) * inv_h;
-                let mut d = p.mass_n * (target - vn);
-                let new = (p.ln + d).max(0.0);
-                d = new - p.ln;
+                let new = (p.ln + p.mass_n * (target - vn)).max(0.0);
+                let d = new - p.ln;
                 p.ln = new;
                 change = change.max(d.abs());
-                apply(vel, a, b, wall, p, d * nx, d * ny, body);
+                apply(bodies, la, lb, p, d * nx, d * ny, body);
                 // Friction against the updated velocities.
-                let va = vel[a];
-                let vb = if wall { [0.0; 3] } else { vel[b] };
-                let rvx = (vb[0] - vb[2] * p.rb[1]) - (va[0] - va[2] * p.ra[1]);
-                let rvy = (vb[1] + vb[2] * p.rb[0]) - (va[1] + va[2] * p.ra[0]);
+                let (rvx, rvy) = relative_velocity(bodies, la, lb, p);
                 let vt = rvx * tx + rvy * ty;
                 let bound = mu * p.ln;
                 let new_t = (p.lt - p.mass_t * vt).clamp(-bound, bound);
                 let dt = new_t - p.lt;
                 p.lt = new_t;
                 change = change.max(dt.abs());
-                apply(vel, a, b, wall, p, dt * tx, dt * ty, body);
+                apply(bodies, la, lb, p, dt * tx, dt * ty, body);
             }
         }
         if change < CONVERGED_N_S {
@@ -307,29 +305,43 @@ pub(crate) fn solve_velocities(
     sweeps
 }
 
-/// An impulse change small enough to call a sweep converged: 1e-9 N·s, a velocity change of
-/// 2 nm/s on a 0.5 kg robot (40 pm over a 20 ms sub-step).
-const CONVERGED_N_S: f64 = 1e-9;
+/// Velocity of b's contact point relative to a's (a wall does not move).
+#[inline]
+fn relative_velocity(bodies: &[IslandBody], la: u32, lb: u32, p: &ContactRow) -> (f64, f64) {
+    let va = bodies[la as usize].vel;
+    let vb = if lb == WALL {
+        [0.0; 3]
+    } else {
+        bodies[lb as usize].vel
+    };
+    (
+        (vb[0] - vb[2] * p.rb[1]) - (va[0] - va[2] * p.ra[1]),
+        (vb[1] + vb[2] * p.rb[0]) - (va[1] + va[2] * p.ra[0]),
+    )
+}
+
+/// An impulse change small enough to call a sweep converged: 1e-6 N·s, a velocity change of
+/// 2 µm/s on a 0.5 kg robot (40 nm over a 20 ms sub-step; what it leaves of an overlap the
+/// position sweeps remove).
+const CONVERGED_N_S: f64 = 1e-6;
 
 /// Applies the impulse (px, py) to b at its lever arm and (−px, −py) to a.
 #[inline]
-#[allow(clippy::too_many_arguments)]
 fn apply(
-    vel: &mut [[f64; 3]],
-    a: usize,
-    b: usize,
-    wall: bool,
+    bodies: &mut [IslandBody],
+    la: u32,
+    lb: u32,
     p: &ContactRow,
     px: f64,
     py: f64,
     body: &BodyConst,
 ) {
-    let va = &mut vel[a];
+    let va = &mut bodies[la as usize].vel;
     va[0] -= px * body.inv_m;
     va[1] -= py * body.inv_m;
     va[2] -= (p.ra[0] * py - p.ra[1] * px) * body.inv_i;
-    if !wall {
-        let vb = &mut vel[b];
+    if lb != WALL {
+        let vb = &mut bodies[lb as usize].vel;
         vb[0] += px * body.inv_m;
         vb[1] += py * body.inv_m;
         vb[2] += (p.rb[0] * py - p.rb[1] * px) * body.inv_i;

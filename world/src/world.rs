@@ -14,11 +14,16 @@ use crate::geometry::{
 use crate::grid::Grid;
 use crate::motor::{Direction, LagCoefficients, MODE_BRAKE, MODE_COAST, MODE_DRIVE, WheelCommand};
 use crate::params::{MAX_ADVANCE_S, WorldParams};
-use crate::solver::{BodyConst, Contact, WALL, solve_velocities};
+use crate::solver::{BodyConst, Contact, IslandBody, WALL, solve_island};
 
 /// Overlaps are corrected to this gap (10 nm), so that corrected bodies do not touch even
 /// after rounding, and far below anything a sensor or a metric resolves.
 pub const CONTACT_SKIN_M: f64 = 1e-8;
+/// The gap a position correction opens (10 µm): more than the skin, so that a correction that
+/// pushes a body a little into a neighbour (a chain of contacts) still leaves the neighbour's
+/// pair clear, and a chain clears in a few sweeps instead of converging on the skin forever.
+/// Far below anything a sensor (3 mm per du) or a metric resolves.
+const CORRECTION_GAP_M: f64 = 1e-5;
 /// Smallest broad-phase margin (a Verlet skin): pairs of bodies whose bounding circles are
 /// closer than the margin, and bodies closer than it to a wall, are contact candidates; the
 /// grid and the candidate lists are kept until some robot has moved half the margin less the
@@ -110,11 +115,11 @@ type WarmStart = ((u32, u32, u8), u8, [[f64; 2]; 2]);
 /// In a binding contact this sub-step (or in contact with such a robot): solved, not moved
 /// freely.
 const ACTIVE: u8 = 1;
-/// The share of the previous sub-step's impulses a solve starts from. Less than 1 because a
-/// wheel pushing a body that is held (a braked robot against a wall) is statically
-/// indeterminate: a full warm start would keep a push that nothing sustains any more, while a
-/// half lets it decay in a few sub-steps, and a sustained push is rebuilt by a sweep or two.
-const WARM_START: f64 = 0.5;
+/// The share of the previous sub-step's impulses a solve starts from: all of them, so that a
+/// steady push converges in a sweep or two. (A wheel that is braked or coasting starts from
+/// nothing instead: a braked robot held against a wall is statically indeterminate, and a full
+/// warm start would keep a push that nothing sustains any more.)
+const WARM_START: f64 = 1.0;
 /// Listed in `World::active`.
 const LISTED: u8 = 2;
 /// In some contact (binding or not): checked for overlap after the move.
@@ -240,6 +245,15 @@ pub struct World {
     chunk_contacts: Vec<Vec<Contact>>,
     /// The robots solved this sub-step, in index order.
     active: Vec<u32>,
+    /// Union-find parents of the active robots (scratch, by robot).
+    uf: Vec<u32>,
+    /// Island number of a union-find root (scratch, by robot; `u32::MAX` when unset).
+    root_island: Vec<u32>,
+    /// Per active robot (in `active`'s order, which `build_islands` makes island by island),
+    /// what the solver needs.
+    island_bodies: Vec<IslandBody>,
+    /// Per island, its range in `active`/`island_bodies` and in `contacts`.
+    islands: Vec<(core::ops::Range<usize>, core::ops::Range<usize>)>,
     /// The solved contacts' impulses of the previous sub-step, sorted by contact identity
     /// (the warm start of the next solve).
     warm: Vec<WarmStart>,
@@ -435,6 +449,10 @@ impl World {
             chunk_contacts: Vec::new(),
             active: Vec::new(),
             warm: Vec::new(),
+            uf: vec![0; n],
+            root_island: vec![u32::MAX; n],
+            island_bodies: Vec::new(),
+            islands: Vec::new(),
             solved_at: vec![u64::MAX; n],
             checked: Vec::new(),
             overlaps: Candidates::default(),
@@ -752,7 +770,21 @@ impl World {
         }
         if !self.active.is_empty() {
             // Warm start from the previous sub-step's impulses of the same contacts and wheels.
+            let motion = &self.motion;
+            let driven = |i: u32| {
+                i != WALL
+                    && motion[i as usize]
+                        .mode
+                        .iter()
+                        .zip(motion[i as usize].target)
+                        .any(|(&m, t)| m == MODE_DRIVE && t != 0.0)
+            };
             for ct in self.contacts.iter_mut() {
+                // A contact between robots whose motors do not drive starts from nothing (a
+                // braked robot against a wall is statically indeterminate, see WARM_START).
+                if !driven(ct.a) && !driven(ct.b) {
+                    continue;
+                }
                 if let Ok(k) = self.warm.binary_search_by(|w| w.0.cmp(&ct.id()))
                     && self.warm[k].1 == ct.count
                 {
@@ -765,25 +797,32 @@ impl World {
             for &i in &self.active {
                 let i = i as usize;
                 if self.solved_at[i] == self.substeps.wrapping_sub(1) {
-                    for x in &mut self.wheel_imp[i] {
-                        *x *= WARM_START;
+                    for (w, x) in self.wheel_imp[i].iter_mut().enumerate() {
+                        let driven = self.motion[i].mode[w / 2] == MODE_DRIVE
+                            && self.motion[i].target[w / 2] != 0.0;
+                        *x *= if driven { WARM_START } else { 0.0 };
                     }
                 } else {
                     self.wheel_imp[i] = [0.0; 4];
                 }
                 self.solved_at[i] = self.substeps;
             }
-            self.stats.solver_sweeps += u64::from(solve_velocities(
-                &self.active,
-                &mut self.contacts,
-                &self.pose,
-                &mut self.vel,
-                &self.wmean,
-                &mut self.wheel_imp,
-                &self.body,
-                h,
-                self.params.solver_iterations,
-            ));
+            self.build_islands();
+            for k in 0..self.islands.len() {
+                let (bodies, contacts) = self.islands[k].clone();
+                self.stats.solver_sweeps += u64::from(solve_island(
+                    &mut self.island_bodies[bodies],
+                    &mut self.contacts[contacts],
+                    &self.body,
+                    h,
+                    self.params.solver_iterations,
+                ));
+            }
+            for (k, &i) in self.active.iter().enumerate() {
+                let b = &self.island_bodies[k];
+                self.vel[i as usize] = b.vel;
+                self.wheel_imp[i as usize] = b.wheel_imp;
+            }
             for k in 0..self.active.len() {
                 let i = self.active[k] as usize;
                 let p = &mut self.pose[i];
@@ -1014,6 +1053,102 @@ impl World {
         self.checked.sort_unstable();
     }
 
+    /// Splits the solved robots into islands (connected by robot–robot contacts), numbered in
+    /// order of their lowest robot: `active` is reordered island by island (index order within
+    /// each), `contacts` likewise (their order kept within each island), every contact gets
+    /// its robots' places in the island, and `island_bodies` the solver's view of each robot.
+    fn build_islands(&mut self) {
+        fn find(uf: &mut [u32], mut i: u32) -> u32 {
+            while uf[i as usize] != i {
+                let p = uf[uf[i as usize] as usize];
+                uf[i as usize] = p;
+                i = p;
+            }
+            i
+        }
+        for &i in &self.active {
+            self.uf[i as usize] = i;
+        }
+        for ct in &self.contacts {
+            if ct.b != WALL {
+                let (ra, rb) = (find(&mut self.uf, ct.a), find(&mut self.uf, ct.b));
+                if ra != rb {
+                    // The lower root wins, so the result does not depend on contact order.
+                    let (lo, hi) = (ra.min(rb), ra.max(rb));
+                    self.uf[hi as usize] = lo;
+                }
+            }
+        }
+        let mut count = 0u32;
+        let mut island = Vec::with_capacity(self.active.len());
+        for k in 0..self.active.len() {
+            let r = find(&mut self.uf, self.active[k]) as usize;
+            if self.root_island[r] == u32::MAX {
+                self.root_island[r] = count;
+                count += 1;
+            }
+            island.push(self.root_island[r]);
+        }
+        // Members island by island (stable: index order within each).
+        let mut order: Vec<usize> = (0..self.active.len()).collect();
+        order.sort_by_key(|&k| island[k]);
+        let members: Vec<u32> = order.iter().map(|&k| self.active[k]).collect();
+        let member_island: Vec<u32> = order.iter().map(|&k| island[k]).collect();
+        for &i in &self.active {
+            let r = find(&mut self.uf, i) as usize;
+            self.root_island[r] = u32::MAX;
+        }
+        self.active = members;
+        // Each robot's island and place in it, through the `uf` scratch (no longer needed).
+        self.islands.clear();
+        let mut start = 0;
+        for k in 0..self.active.len() {
+            if k + 1 == self.active.len() || member_island[k + 1] != member_island[k] {
+                for (local, &i) in self.active[start..=k].iter().enumerate() {
+                    self.uf[i as usize] = local as u32;
+                    self.root_island[i as usize] = member_island[k];
+                }
+                self.islands.push((start..k + 1, 0..0));
+                start = k + 1;
+            }
+        }
+        let root_island = &self.root_island;
+        self.contacts.sort_by_key(|ct| root_island[ct.a as usize]);
+        let mut c0 = 0;
+        for (isl, range) in self.islands.iter_mut().enumerate() {
+            let mut c1 = c0;
+            while c1 < self.contacts.len()
+                && root_island[self.contacts[c1].a as usize] == isl as u32
+            {
+                c1 += 1;
+            }
+            range.1 = c0..c1;
+            c0 = c1;
+        }
+        for ct in self.contacts.iter_mut() {
+            ct.la = self.uf[ct.a as usize];
+            ct.lb = if ct.b == WALL {
+                WALL
+            } else {
+                self.uf[ct.b as usize]
+            };
+        }
+        for &i in &self.active {
+            self.root_island[i as usize] = u32::MAX;
+        }
+        self.island_bodies.clear();
+        for &i in &self.active {
+            let i = i as usize;
+            self.island_bodies.push(IslandBody {
+                c: self.pose[i].c,
+                s: self.pose[i].s,
+                vel: self.vel[i],
+                wheel_speed: self.wmean[i],
+                wheel_imp: self.wheel_imp[i],
+            });
+        }
+    }
+
     /// Removes the overlaps the velocity solve left (a rotation is linearised in it; a cluster
     /// may not have converged): position sweeps over the overlapping pairs and walls, each
     /// pushing the bodies apart along the contact normal with rotation, weighted by mass and
@@ -1107,7 +1242,7 @@ impl World {
     /// deepest point is pushed out to the skin, then the manifold is taken again (a corner
     /// pushed out turns the body, which moves the other corner).
     fn correct_wall(&mut self, i: usize) {
-        let skin = CONTACT_SKIN_M;
+        let skin = CORRECTION_GAP_M;
         for _ in 0..4 {
             let mut deepest: Option<(Manifold, usize)> = None;
             box_walls(
@@ -1146,7 +1281,7 @@ impl World {
     /// pushed apart to the skin, shared by mass and inertia, then the manifold is taken again
     /// for the other point.
     fn correct_pair(&mut self, i: usize, j: usize) {
-        let skin = CONTACT_SKIN_M;
+        let skin = CORRECTION_GAP_M;
         for _ in 0..2 {
             let Some(m) = box_box(&self.obb(i), &self.obb(j), skin) else {
                 return;
