@@ -143,7 +143,10 @@ enum Failure {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => return usage(&e),
+    };
     let result = match cli.command {
         Some(Command::Learn(args)) => learn(&args),
         Some(Command::Cost(args)) => cost(&args),
@@ -172,6 +175,20 @@ fn main() -> ExitCode {
             eprintln!("error: {e:#}");
             ExitCode::from(1)
         }
+    }
+}
+
+/// What clap did not parse: help and version text (exit status 0, or 1 when it cannot be
+/// written), or a usage error (exit status 2).
+fn usage(e: &clap::Error) -> ExitCode {
+    let printed = e.print().and_then(|()| io::stdout().flush());
+    match printed {
+        Err(w) if w.kind() != io::ErrorKind::BrokenPipe => {
+            eprintln!("error: writing the output: {w}");
+            ExitCode::from(1)
+        }
+        _ if e.use_stderr() => ExitCode::from(2),
+        _ => ExitCode::SUCCESS,
     }
 }
 
@@ -220,7 +237,7 @@ fn learn(args: &LearnArgs) -> Result<(), Failure> {
         Err(replay::ReplayFailure::Core(e)) => Err(Failure::Tool(
             anyhow::Error::new(e).context(format!("replay `{}` on the core", args.replay)),
         )),
-        Err(replay::ReplayFailure::Io(e)) if e.kind() == io::ErrorKind::BrokenPipe => Ok(()),
+        Err(replay::ReplayFailure::Output(e)) => write_failure(e),
         Err(replay::ReplayFailure::Io(e)) => Err(Failure::Input(
             anyhow::Error::new(e).context(format!("reading replay `{}`", args.replay)),
         )),
@@ -270,8 +287,20 @@ fn sweep(args: &h8swarm::sweep::SweepArgs) -> Result<(), Failure> {
         .or_else(write_failure)
 }
 
+/// An error of `run`: a tool failure when some output could not be written
+/// ([`run_cmd::OutputError`] in its chain), else bad input.
+fn run_failure(e: anyhow::Error) -> Failure {
+    if e.downcast_ref::<run_cmd::OutputError>().is_some()
+        || e.chain().any(|c| c.is::<run_cmd::OutputError>())
+    {
+        Failure::Tool(e)
+    } else {
+        Failure::Input(e)
+    }
+}
+
 fn run(args: &run_cmd::RunArgs) -> Result<(), Failure> {
-    let text = run_cmd::run(args).map_err(Failure::Input)?;
+    let text = run_cmd::run(args).map_err(run_failure)?;
     io::stdout()
         .lock()
         .write_all(text.as_bytes())

@@ -20,7 +20,7 @@
 //! from its first instruction to its RTS). The two print the same lines for any input.
 
 use std::fmt;
-use std::io::{self, BufRead, Write};
+use std::io::{self, BufRead, Read, Write};
 
 use emu::board::firmware::Firmware;
 use emu::board::oncore::{LearnerOnCore, OnCoreError};
@@ -55,8 +55,10 @@ impl std::error::Error for ReplayError {}
 pub enum ReplayFailure {
     /// The input was malformed (exit status 2).
     Input(ReplayError),
-    /// Reading the input or writing the output failed.
+    /// Reading the input failed (exit status 2).
     Io(io::Error),
+    /// Writing the output failed (exit status 1; a closed pipe downstream ends the run).
+    Output(io::Error),
     /// The firmware's routines could not be run on the core (exit status 1).
     Core(OnCoreError),
 }
@@ -70,9 +72,11 @@ pub enum Engine {
     OnCore(Box<Firmware>),
 }
 
+/// Every `?` on an I/O error in a replay is a write; reads are mapped to
+/// [`ReplayFailure::Io`] where they happen.
 impl From<io::Error> for ReplayFailure {
     fn from(e: io::Error) -> Self {
-        ReplayFailure::Io(e)
+        ReplayFailure::Output(e)
     }
 }
 
@@ -139,7 +143,7 @@ const STEP_FIELDS: &str = "x, e";
 ///
 /// # Errors
 /// [`ReplayFailure::Input`] for the first malformed line (everything before it has been
-/// written), [`ReplayFailure::Io`] when reading or writing fails.
+/// written), [`ReplayFailure::Io`] when reading fails, [`ReplayFailure::Output`] when writing does.
 pub fn run(
     input: &mut dyn BufRead,
     out: &mut dyn Write,
@@ -152,10 +156,27 @@ pub fn run(
     let mut steps = 0usize;
     loop {
         buf.clear();
-        if input.read_until(b'\n', &mut buf)? == 0 {
+        // At most one byte more than a line may hold, so that a line without end (`/dev/zero`)
+        // is refused instead of filling the memory.
+        let limit = MAX_LINE_BYTES as u64 + 1;
+        if Read::take(&mut *input, limit)
+            .read_until(b'\n', &mut buf)
+            .map_err(ReplayFailure::Io)?
+            == 0
+        {
             break;
         }
         line_no += 1;
+        if buf.len() > MAX_LINE_BYTES {
+            return Err(ReplayFailure::Input(ReplayError {
+                line: line_no,
+                field: None,
+                message: format!(
+                    "longer than {MAX_LINE_BYTES} bytes without a line end: a header of 256 x 8 \
+                     weights needs about 16 KB; give one JSON object per line"
+                ),
+            }));
+        }
         let text = std::str::from_utf8(&buf).map_err(|e| {
             ReplayFailure::Input(ReplayError {
                 line: line_no,
@@ -322,6 +343,10 @@ fn field<'a>(
     })
 }
 
+/// The longest line read (1 MiB): far more than the largest valid line (a header of 256 × 8
+/// weights of at most 7 characters each is about 16 KB).
+pub const MAX_LINE_BYTES: usize = 1 << 20;
+
 /// An integer in `lo ..= hi`, described as `what` in errors.
 fn int_in(
     v: &Value,
@@ -345,7 +370,9 @@ fn int_in(
             )));
         }
     };
-    let i = n.as_i64().ok_or_else(|| {
+    // `-0` is a JSON integer, but serde_json reads it as the float -0.0.
+    let negative_zero = n.as_f64().is_some_and(|f| f == 0.0 && f.is_sign_negative());
+    let i = n.as_i64().or(negative_zero.then_some(0)).ok_or_else(|| {
         err(format!(
             "{n} is not an integer in range ({what}: valid is {lo} to {hi})"
         ))
@@ -504,6 +531,7 @@ mod tests {
         let r = run(&mut input.as_bytes(), &mut out, false, &Engine::Model).map_err(|e| match e {
             ReplayFailure::Input(e) => e.to_string(),
             ReplayFailure::Io(e) => format!("io: {e}"),
+            ReplayFailure::Output(e) => format!("output: {e}"),
             ReplayFailure::Core(e) => format!("core: {e}"),
         });
         (String::from_utf8(out).unwrap(), r)
@@ -587,5 +615,35 @@ mod tests {
         let (out, r) = replay(&input);
         assert_eq!(out.lines().count(), 1, "the good step was written");
         assert!(r.unwrap_err().starts_with("line 3: bad JSON"));
+    }
+
+    #[test]
+    fn minus_zero_is_the_integer_zero() {
+        let (a, ra) = replay(&format!("{HEADER}\n{{\"x\": [1, 2], \"e\": -0}}\n"));
+        let (b, rb) = replay(&format!("{HEADER}\n{{\"x\": [1, 2], \"e\": 0}}\n"));
+        ra.unwrap();
+        rb.unwrap();
+        assert_eq!(a, b);
+        // Other floats stay refused.
+        let (_, r) = replay(&format!("{HEADER}\n{{\"x\": [1, 2], \"e\": -1.0}}\n"));
+        assert!(r.unwrap_err().contains("not an integer"));
+    }
+
+    #[test]
+    fn a_line_without_end_is_refused_not_held() {
+        // An endless run of one byte (as `/dev/zero` gives): refused at the bound, after
+        // reading only the bound.
+        let mut endless = std::io::BufReader::new(std::io::repeat(b' '));
+        let mut out = Vec::new();
+        let e = run(&mut endless, &mut out, false, &Engine::Model).unwrap_err();
+        let ReplayFailure::Input(e) = e else {
+            panic!("not an input error: {e:?}")
+        };
+        assert_eq!(e.line, 1);
+        assert!(
+            e.message.contains("longer than 1048576 bytes"),
+            "{}",
+            e.message
+        );
     }
 }

@@ -124,7 +124,11 @@ fn probes(a: &RunArgs, s: &Scenario) -> Result<crate::experiment::RobotProbes> {
         }
         // Fail now, not after the runs, if the file cannot be written.
         std::fs::write(path, b"")
-            .with_context(|| format!("--vcd: cannot create `{}`", path.display()))?;
+            .map_err(anyhow::Error::new)
+            .context(OutputError(format!(
+                "--vcd: cannot create `{}`",
+                path.display()
+            )))?;
         p.vcd = Some(crate::experiment::VcdProbe {
             robot,
             from,
@@ -177,25 +181,231 @@ pub fn run(a: &RunArgs) -> Result<String> {
     }
     let s = s.with_overrides(a.robots, a.steps, a.repeats, a.seed)?;
     let images = crate::robot::Images::load(&s)?;
-    if a.threads == Some(0) {
-        bail!("--threads 0: give at least 1 (or leave it out for all cores)");
+    let max_threads = max_threads();
+    match a.threads {
+        Some(0) => bail!("--threads 0: give at least 1 (or leave it out for all cores)"),
+        Some(t) if t > max_threads => bail!(
+            "--threads {t}: at most {max_threads} on this machine ({THREADS_PER_CORE} per core; more only wait for each other)"
+        ),
+        _ => {}
     }
+    // The folder's name comes from what the user typed (a built-in's name or the file's
+    // stem), never from the scenario's `name`, which is data.
     let out = a.out.clone().unwrap_or_else(|| {
-        let mut name = s.name.clone();
+        let mut name = default_out_name(what);
         if let Some(n) = a.robots {
             let _ = write!(name, "-{n}robots");
         }
         Path::new("out").join(name)
     });
-    std::fs::create_dir_all(&out)
-        .with_context(|| format!("cannot create the output folder `{}`", out.display()))?;
-    let metrics_path = out.join("metrics.csv");
-    // Fail now, not after the runs, if the folder cannot be written.
-    std::fs::write(&metrics_path, b"")
-        .with_context(|| format!("cannot write `{}`", metrics_path.display()))?;
-    // Fail now if the robots do not fit the arena.
+    // Fail now if the robots do not fit the arena, or a probe's option is bad.
     build_world(&s, 0)?;
     let probes = std::sync::Mutex::new(Some(probes(a, &s)?));
+    // Every file is written into a staging folder beside `out` and moved into place only
+    // when the whole run succeeded; a failure before that leaves `out` as it was.
+    let stage = Stage::new(&out)?;
+    let result = run_into(
+        a,
+        &s,
+        images.as_ref(),
+        &probes,
+        &stage,
+        threads_or_all(a.threads),
+    );
+    match result {
+        Ok((mut text, names)) => {
+            stage.commit(&names)?;
+            let (files, plots): (Vec<&String>, Vec<&String>) = names
+                .iter()
+                .partition(|n| !n.ends_with(".png") && !n.ends_with(".svg"));
+            let list = |v: &[&String]| v.iter().map(|n| n.as_str()).collect::<Vec<_>>().join(", ");
+            let plots: Vec<String> = plots
+                .iter()
+                .map(|n| out.join(n).display().to_string())
+                .collect();
+            let _ = writeln!(
+                text,
+                "wrote {} ({}); plots: {}",
+                out.display(),
+                list(&files),
+                plots.join(", ")
+            );
+            Ok(text)
+        }
+        Err(e) => {
+            let kept = stage.abandon();
+            Err(e.context(format!("the run into `{}` failed; {kept}", out.display())))
+        }
+    }
+}
+
+/// Worker threads at most: [`THREADS_PER_CORE`] per core the machine has.
+#[must_use]
+pub fn max_threads() -> usize {
+    THREADS_PER_CORE * std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
+}
+
+/// `--threads` may be up to this many per core.
+pub const THREADS_PER_CORE: usize = 8;
+
+fn threads_or_all(t: Option<usize>) -> usize {
+    t.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get))
+}
+
+/// The default output folder's name for the scenario argument: a built-in's name, or the
+/// file's stem reduced to letters, digits, `-`, `_` and `.` (at most 64, never starting with
+/// `.`), `scenario` when nothing is left.
+#[must_use]
+pub fn default_out_name(what: &str) -> String {
+    let stem = Path::new(what)
+        .file_stem()
+        .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+    let clean: String = stem
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.') {
+                c
+            } else {
+                '_'
+            }
+        })
+        .take(64)
+        .collect();
+    let clean = clean.trim_start_matches('.').to_string();
+    if clean.is_empty() {
+        "scenario".to_string()
+    } else {
+        clean
+    }
+}
+
+/// An output that cannot be written (the tool failed: exit status 1), as the context of the
+/// error that says why.
+#[derive(Debug)]
+pub struct OutputError(pub String);
+
+impl std::fmt::Display for OutputError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for OutputError {}
+
+/// A staging folder beside the output folder: `<parent>/.<name>.partial-<pid>`.
+struct Stage {
+    out: PathBuf,
+    dir: PathBuf,
+}
+
+impl Stage {
+    fn new(out: &Path) -> Result<Stage> {
+        let name = out
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .filter(|n| n != "." && n != "..")
+            .ok_or_else(|| {
+                anyhow::Error::new(OutputError(format!(
+                    "--out `{}`: give a folder name (e.g. out/run1), not a root or `..`",
+                    out.display()
+                )))
+            })?;
+        if out.exists() && !out.is_dir() {
+            return Err(anyhow::Error::new(OutputError(format!(
+                "--out `{}` is a file: give a folder (new or holding earlier results)",
+                out.display()
+            ))));
+        }
+        let parent = match out.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        let dir = parent.join(format!(".{name}.partial-{}", std::process::id()));
+        std::fs::create_dir_all(&dir)
+            .map_err(anyhow::Error::new)
+            .context(OutputError(format!(
+                "cannot create the staging folder `{}` beside the output folder",
+                dir.display()
+            )))?;
+        Ok(Stage {
+            out: out.to_path_buf(),
+            dir,
+        })
+    }
+
+    fn path(&self, file: &str) -> PathBuf {
+        self.dir.join(file)
+    }
+
+    /// Moves the staged files into `out` (replacing earlier ones of the same names, removing
+    /// this tool's files the run did not write) and removes the staging folder.
+    fn commit(&self, names: &[String]) -> Result<()> {
+        let fail =
+            |what: String, e: std::io::Error| anyhow::Error::new(e).context(OutputError(what));
+        std::fs::create_dir_all(&self.out).map_err(|e| {
+            fail(
+                format!("cannot create the output folder `{}`", self.out.display()),
+                e,
+            )
+        })?;
+        for name in names {
+            let to = self.out.join(name);
+            std::fs::rename(self.dir.join(name), &to).map_err(|e| {
+                fail(
+                    format!("cannot move `{name}` into `{}`", self.out.display()),
+                    e,
+                )
+            })?;
+        }
+        for old in OUTPUT_FILES {
+            if !names.iter().any(|n| n == old) {
+                let stale = self.out.join(old);
+                if stale.is_file() {
+                    std::fs::remove_file(&stale).map_err(|e| {
+                        fail(
+                            format!("cannot remove the earlier `{}`", stale.display()),
+                            e,
+                        )
+                    })?;
+                }
+            }
+        }
+        let _ = std::fs::remove_dir_all(&self.dir);
+        Ok(())
+    }
+
+    /// Removes the staging folder after a failure; says what became of `out`.
+    fn abandon(&self) -> String {
+        let _ = std::fs::remove_dir_all(&self.dir);
+        if self.out.is_dir() {
+            "the earlier results there are untouched".to_string()
+        } else {
+            "nothing was written".to_string()
+        }
+    }
+}
+
+/// Every file `h8swarm run` writes into its output folder.
+pub const OUTPUT_FILES: [&str; 6] = [
+    "metrics.csv",
+    "summary.json",
+    "fit.json",
+    "learning.png",
+    "learning.svg",
+    "arena.png",
+];
+
+/// Runs the experiment, writing its files into `stage`; returns the text to print and the
+/// files written.
+fn run_into(
+    a: &RunArgs,
+    s: &Scenario,
+    images: Option<&crate::robot::Images>,
+    probes: &std::sync::Mutex<Option<crate::experiment::RobotProbes>>,
+    stage: &Stage,
+    threads: usize,
+) -> Result<(String, Vec<String>)> {
+    let metrics_path = stage.path("metrics.csv");
 
     let mut jobs: Vec<(Condition, u32)> = Vec::new();
     let mut kinds = vec![Condition::Learning];
@@ -210,9 +420,6 @@ pub fn run(a: &RunArgs) -> Result<String> {
             jobs.push((*c, r));
         }
     }
-    let threads = a.threads.unwrap_or_else(|| {
-        std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
-    });
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
@@ -248,11 +455,11 @@ pub fn run(a: &RunArgs) -> Result<String> {
                     None
                 };
                 run_one_probed(
-                    &s,
+                    s,
                     c,
                     r,
                     track,
-                    images.as_ref(),
+                    images,
                     a.keep_going,
                     &|k| bar.inc(k),
                     probes.unwrap_or_default(),
@@ -269,39 +476,60 @@ pub fn run(a: &RunArgs) -> Result<String> {
     let saves: u64 = runs.iter().map(|r| r.saves).sum();
     let summary = Summary {
         h8swarm_version: env!("CARGO_PKG_VERSION"),
-        scenario: &s,
+        scenario: s,
         window_steps: s.window,
         eeprom_records_written: saves,
         conditions: &stats,
         claims: &checked,
     };
-    let summary_path = out.join("summary.json");
+    let summary_path = stage.path("summary.json");
     std::fs::write(
         &summary_path,
         serde_json::to_string_pretty(&summary)? + "\n",
     )
-    .with_context(|| format!("cannot write `{}`", summary_path.display()))?;
+    .map_err(anyhow::Error::new)
+    .context(OutputError(format!(
+        "cannot write `{}`",
+        summary_path.display()
+    )))?;
 
     let fit = crate::fit::measure(&crate::fit::FitConfig {
-        controller: controller_config(&s, crate::fit::fit_weight_seed(s.seed))?,
+        controller: controller_config(s, crate::fit::fit_weight_seed(s.seed))?,
         steps: 400,
         seed: s.seed,
         kind: crate::fit::ControllerKind::Firmware,
         firmware: crate::fit::FirmwareUnderTest::robot()?,
         compare: true,
     })?;
-    let fit_path = out.join("fit.json");
+    let fit_path = stage.path("fit.json");
     std::fs::write(&fit_path, serde_json::to_string_pretty(&fit)? + "\n")
-        .with_context(|| format!("cannot write `{}`", fit_path.display()))?;
+        .map_err(anyhow::Error::new)
+        .context(OutputError(format!(
+            "cannot write `{}`",
+            fit_path.display()
+        )))?;
 
     let (png, svg, arena_png) = (
-        out.join("learning.png"),
-        out.join("learning.svg"),
-        out.join("arena.png"),
+        stage.path("learning.png"),
+        stage.path("learning.svg"),
+        stage.path("arena.png"),
     );
-    learning_figure(&learning(&s, &runs), &png, &svg)?;
+    let drawn = |e: crate::plot::PlotError| {
+        anyhow::Error::new(e).context(OutputError("cannot draw the figures".into()))
+    };
+    learning_figure(&learning(s, &runs), &png, &svg).map_err(drawn)?;
+    let mut names: Vec<String> = [
+        "metrics.csv",
+        "summary.json",
+        "fit.json",
+        "learning.png",
+        "learning.svg",
+    ]
+    .map(String::from)
+    .to_vec();
     if let Some(track) = runs.iter().find_map(|r| r.track.as_ref()) {
-        arena_figure_panels(&arena(&s, track), &arena_png)?;
+        arena_figure_panels(&arena(s, track), &arena_png).map_err(drawn)?;
+        names.push("arena.png".into());
     }
 
     let robot_steps = jobs.len() as f64 * f64::from(s.steps) * s.robots as f64;
@@ -402,19 +630,7 @@ pub fn run(a: &RunArgs) -> Result<String> {
     }
     let _ = writeln!(t);
     let _ = writeln!(t, "fit: {}", fit.verdict);
-    let _ = writeln!(
-        t,
-        "wrote {} (metrics.csv, summary.json, fit.json); plots: {}, {}{}",
-        out.display(),
-        png.display(),
-        svg.display(),
-        if arena_png.exists() {
-            format!(", {}", arena_png.display())
-        } else {
-            String::new()
-        }
-    );
-    Ok(t)
+    Ok((t, names))
 }
 
 fn fmt_est(e: &Estimate) -> String {
@@ -425,8 +641,11 @@ fn fmt_est(e: &Estimate) -> String {
 }
 
 fn write_metrics(path: &Path, runs: &[RunOutput]) -> Result<()> {
-    let mut w = csv::Writer::from_path(path)
-        .with_context(|| format!("cannot write `{}`", path.display()))?;
+    write_metrics_csv(path, runs).context(OutputError(format!("cannot write `{}`", path.display())))
+}
+
+fn write_metrics_csv(path: &Path, runs: &[RunOutput]) -> Result<()> {
+    let mut w = csv::Writer::from_path(path)?;
     w.write_record([
         "condition",
         "repeat",
@@ -455,8 +674,7 @@ fn write_metrics(path: &Path, runs: &[RunOutput]) -> Result<()> {
             ])?;
         }
     }
-    w.flush()
-        .with_context(|| format!("cannot write `{}`", path.display()))?;
+    w.flush()?;
     Ok(())
 }
 
@@ -584,4 +802,22 @@ fn arena(s: &Scenario, t: &crate::experiment::Track) -> Vec<ArenaFigure> {
         }
     };
     vec![first_of(0, k), first_of(n - k, n)]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn output_names_come_from_the_argument_not_the_data() {
+        assert_eq!(default_out_name("arena"), "arena");
+        assert_eq!(
+            default_out_name("scenarios/arena-surface.toml"),
+            "arena-surface"
+        );
+        assert_eq!(default_out_name("/etc/../x y$z.toml"), "x_y_z");
+        assert_eq!(default_out_name("..toml"), "scenario");
+        assert_eq!(default_out_name("dir/.hidden.toml"), "hidden");
+        assert_eq!(default_out_name(&"a".repeat(300)).len(), 64);
+    }
 }

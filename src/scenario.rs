@@ -179,7 +179,7 @@ macro_rules! patch {
         }
         impl $patch {
             fn apply(&self, spec: &mut $spec) {
-                $( if let Some(v) = &self.$field { spec.$field = v.clone(); } )*
+                $( if let Some(v) = &self.$field { spec.$field = v.clone().into(); } )*
             }
         }
     };
@@ -188,7 +188,33 @@ macro_rules! patch {
 patch!(LearnerPatch for LearnerSpec { behaviours: usize, eta: f64, threshold: i32, history: usize, bias: bool, save_every: u32 });
 patch!(TimingPatch for TimingSpec { step_period_s: f64, clock_hz: u32 });
 patch!(WorldPatch for WorldSpec { top_speed_m_per_s: f64, motor_time_constant_s: f64, motor_gain_spread: f64, wheel_track_m: f64, substep_s: f64, sensor_range_m: f64, sensor_setback_m: f64 });
-patch!(SensorPatch for SensorSpec { noise_sigma_v: f64, spike_probability: f64, spread: bool, channels: [u8; 4] });
+patch!(SensorPatch for SensorSpec { noise_sigma_v: f64, spike_probability: f64, spread: bool, channels: Channels });
+
+/// `sensors.channels` as a file gives it: exactly four whole numbers 0-255, checked when read
+/// (a fifth value or a string is an error naming the key, never dropped). Their range (AN0-AN7,
+/// one scan group) is checked with the rest of the scenario.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(transparent)]
+pub struct Channels(pub [u8; 4]);
+
+impl<'de> Deserialize<'de> for Channels {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        use serde::de::Error as _;
+        let v: Vec<u8> = Vec::deserialize(d)?;
+        let n = v.len();
+        <[u8; 4]>::try_from(v).map(Channels).map_err(|_| {
+            D::Error::custom(format!(
+                "{n} channels given: give exactly four analog inputs (left, front left, front right, right), e.g. [0, 1, 2, 3]"
+            ))
+        })
+    }
+}
+
+impl From<Channels> for [u8; 4] {
+    fn from(c: Channels) -> Self {
+        c.0
+    }
+}
 patch!(ControlPatch for ControlSpec { learning_off: bool, random_walk: bool });
 patch!(ControllerPatch for ControllerSpec { kind: crate::fit::ControllerKind, image: Option<String>, symbols: Option<String>, robots: Option<Vec<usize>> });
 
@@ -611,6 +637,24 @@ mod tests {
             Scenario::from_toml("steps = 200\nwindow = 300\n").unwrap_err()
         );
         assert!(e.contains("window"), "{e}");
+        // Channels: exactly four whole numbers, never silently cut.
+        for (text, expected) in [
+            (
+                "[sensors]\nchannels = [0, 1, 2, 3, 4]\n",
+                "5 channels given",
+            ),
+            ("[sensors]\nchannels = [0, 1, 2]\n", "3 channels given"),
+            (
+                "[sensors]\nchannels = [0, 1, 2, 3, \"junk\", {a = 1}]\n",
+                "channels",
+            ),
+            ("[sensors]\nchannels = [0, 1, 2, -3]\n", "channels"),
+        ] {
+            let e = format!("{:#}", Scenario::from_toml(text).unwrap_err());
+            assert!(e.contains(expected), "{text}: {e}");
+        }
+        let s = Scenario::from_toml("[sensors]\nchannels = [4, 5, 6, 7]\n").unwrap();
+        assert_eq!(s.sensors.channels, [4, 5, 6, 7]);
         let e = Scenario::from_toml("robts = 4\n").unwrap_err().to_string();
         assert!(e.contains("robts"), "{e}");
         let e = Scenario::from_toml("[learner]\netaa = 0.1\n")

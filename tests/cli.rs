@@ -397,10 +397,10 @@ fn run_reports_bad_scenarios_and_folders_clearly() {
             vec![
                 "run".into(),
                 "arena".into(),
-                "--out".into(),
-                bad_key.join("sub").display().to_string(),
+                "--threads".into(),
+                "100000".into(),
             ],
-            "cannot create the output folder",
+            "--threads 100000: at most",
         ),
     ];
     for (args, expected) in cases {
@@ -412,4 +412,127 @@ fn run_reports_bad_scenarios_and_folders_clearly() {
         assert!(!stderr.contains("panicked"));
     }
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// An output that cannot be written is the tool failing (status 1), named in one line, and
+/// nothing of the run is left behind.
+#[test]
+fn run_outputs_that_cannot_be_written_are_status_1() {
+    let dir = temp_dir("unwritable");
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let file = dir.join("a-file");
+    std::fs::write(&file, "mine\n").expect("write");
+    for (out, expected) in [
+        (file.clone(), "is a file: give a folder"),
+        (file.join("sub"), "cannot create the staging folder"),
+    ] {
+        let o = h8swarm(
+            &[
+                "run",
+                "--steps",
+                "20",
+                "--repeats",
+                "2",
+                "--out",
+                out.to_str().unwrap(),
+            ],
+            None,
+        );
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{out:?}: {stderr}");
+        assert!(
+            stderr.starts_with("error: ") && stderr.contains(expected),
+            "{stderr}"
+        );
+        assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    }
+    assert_eq!(std::fs::read_to_string(&file).unwrap(), "mine\n");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A run that fails after it started leaves the earlier results in its folder as they were,
+/// says so, and leaves no staging folder.
+#[test]
+fn a_failed_run_leaves_the_earlier_results_untouched() {
+    let dir = temp_dir("atomic");
+    let out = dir.join("results");
+    let out_s = out.to_str().unwrap();
+    let o = h8swarm(
+        &["run", "--steps", "30", "--repeats", "2", "--out", out_s],
+        None,
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let before: Vec<(String, Vec<u8>)> = h8swarm::run_cmd::OUTPUT_FILES
+        .iter()
+        .map(|f| (f.to_string(), std::fs::read(out.join(f)).expect("written")))
+        .collect();
+    // A program that is no robot firmware: it halts at once, so the run fails at its first
+    // step, after the staging folder was made.
+    let o = h8swarm(
+        &[
+            "run",
+            "--steps",
+            "30",
+            "--repeats",
+            "2",
+            "--seed",
+            "9",
+            "--firmware",
+            "emu/tests/programs/arith.mot",
+            "--out",
+            out_s,
+        ],
+        None,
+    );
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_ne!(o.status.code(), Some(0), "{stderr}");
+    assert!(
+        stderr.contains("the earlier results there are untouched"),
+        "{stderr}"
+    );
+    for (f, bytes) in &before {
+        assert_eq!(&std::fs::read(out.join(f)).unwrap(), bytes, "{f} changed");
+    }
+    let left: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(left, vec![std::ffi::OsString::from("results")]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Help, version and replay output that cannot be written: status 1, not 0 with nothing
+/// written; a replay line without end is refused (status 2) instead of filling the memory.
+#[test]
+fn writes_to_a_full_device_and_endless_lines_have_their_statuses() {
+    let full = || {
+        std::fs::OpenOptions::new()
+            .write(true)
+            .open("/dev/full")
+            .expect("/dev/full")
+    };
+    let bin = env!("CARGO_BIN_EXE_h8swarm");
+    let run = |args: &[&str], stdout: std::fs::File| {
+        Command::new(bin)
+            .args(args)
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .stdout(stdout)
+            .stderr(Stdio::piped())
+            .output()
+            .expect("runs")
+    };
+    for args in [
+        &["--help"][..],
+        &["--version"],
+        &["learn", "--replay", "examples/replay-arena.jsonl"],
+    ] {
+        let o = run(args, full());
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {stderr}");
+        assert!(stderr.contains("writing the output"), "{args:?}: {stderr}");
+    }
+    let o = h8swarm(&["learn", "--replay", "/dev/zero"], None);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("longer than 1048576 bytes"), "{stderr}");
 }
