@@ -191,7 +191,7 @@ fn run_under_gdb_stops_at_a_breakpoint_and_detaches_to_the_same_results() {
     let forward = fw.symbols.addr("learner_forward").unwrap();
     let steps = fw.symbols.addr("steps").unwrap();
     assert_eq!(gdb.ask(&format!("Z0,{forward:x},2")), "OK");
-    // Boot's forward pass, then each step's.
+    // The forward passes of steps 0, 1 and 2 (step 0 runs at the first tick after boot).
     for _ in 0..3 {
         let stop = gdb.ask("c");
         assert!(stop.contains("swbreak"), "{stop}");

@@ -1,6 +1,6 @@
 //! Pin traces: the levels of the chip's pins and status lines as they change, each change at
-//! the exact state it happens, for a logic-analyser view of a program (VCD files: the board
-//! layer's `emu::board::vcd`).
+//! the exact state it happens, for a logic-analyser view of a program (written as VCD files by
+//! [`crate::chip::vcd`]).
 //!
 //! # What is traced ([`Signal`])
 //! TIOCA1 and TIOCA2 (PA4, PA6: ITU1/ITU2 outputs, or the port latch when the ITU does not
