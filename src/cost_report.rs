@@ -51,7 +51,49 @@ pub struct Stats {
     pub max: u64,
 }
 
+/// Min, sum and max of a stream of values, kept as they come: a report over any number of
+/// steps in constant memory.
+#[derive(Clone, Copy, Debug)]
+struct Running {
+    min: u64,
+    max: u64,
+    sum: u128,
+    n: u64,
+}
+
+impl Running {
+    const EMPTY: Running = Running {
+        min: u64::MAX,
+        max: 0,
+        sum: 0,
+        n: 0,
+    };
+
+    fn add(&mut self, v: u64) {
+        self.min = self.min.min(v);
+        self.max = self.max.max(v);
+        self.sum += u128::from(v);
+        self.n += 1;
+    }
+
+    fn stats(&self) -> Stats {
+        if self.n == 0 {
+            return Stats {
+                min: 0,
+                mean: 0.0,
+                max: 0,
+            };
+        }
+        Stats {
+            min: self.min,
+            mean: self.sum as f64 / self.n as f64,
+            max: self.max,
+        }
+    }
+}
+
 impl Stats {
+    #[cfg(test)]
     fn of(values: &[u64]) -> Stats {
         let min = values.iter().copied().min().unwrap_or(0);
         let max = values.iter().copied().max().unwrap_or(0);
@@ -147,18 +189,19 @@ pub fn measure(cfg: &CostConfig) -> Result<CostReport> {
             )
         })?;
 
-    let mut per_phase: [Vec<u64>; Phase::COUNT] = Default::default();
-    let mut per_step = Vec::with_capacity(cfg.steps as usize);
+    // Streamed: `--steps` up to 2^32 - 1 in constant memory.
+    let mut per_phase = [Running::EMPTY; Phase::COUNT];
+    let mut per_step = Running::EMPTY;
     for _ in 0..cfg.steps {
         let p: [u8; 4] = rng.random();
         let mut meter = H8Meter::new();
         learner.step(&p, &mut meter);
         for phase in Phase::ALL {
-            per_phase[phase as usize].push(meter.states(phase));
+            per_phase[phase as usize].add(meter.states(phase));
         }
-        per_step.push(meter.total_states());
+        per_step.add(meter.total_states());
     }
-    let step_states = Stats::of(&per_step);
+    let step_states = per_step.stats();
     let step_max_us = step_states.max as f64 / PHI_HZ * 1e6;
     Ok(CostReport {
         n_in,
@@ -169,9 +212,9 @@ pub fn measure(cfg: &CostConfig) -> Result<CostReport> {
         threshold: cfg.threshold,
         steps: cfg.steps,
         seed: cfg.seed,
-        input_states: Stats::of(&per_phase[Phase::Input as usize]),
-        update_states: Stats::of(&per_phase[Phase::Update as usize]),
-        forward_states: Stats::of(&per_phase[Phase::Forward as usize]),
+        input_states: per_phase[Phase::Input as usize].stats(),
+        update_states: per_phase[Phase::Update as usize].stats(),
+        forward_states: per_phase[Phase::Forward as usize].stats(),
         step_states,
         step_max_us,
         cpu_share_max_percent: step_max_us / (cfg.step_period_s * 1e6) * 100.0,
@@ -249,4 +292,22 @@ pub fn render(r: &CostReport) -> String {
         f64::from(r.ram_bytes) / 8192.0 * 100.0
     );
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn streamed_statistics_equal_those_of_the_whole_list() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        for len in [0usize, 1, 2, 17, 1000] {
+            let values: Vec<u64> = (0..len).map(|_| rng.random_range(0..1u64 << 40)).collect();
+            let mut r = Running::EMPTY;
+            values.iter().for_each(|&v| r.add(v));
+            let (a, b) = (r.stats(), Stats::of(&values));
+            assert_eq!((a.min, a.max), (b.min, b.max), "{len}");
+            assert!((a.mean - b.mean).abs() <= b.mean * 1e-12, "{len}");
+        }
+    }
 }

@@ -237,13 +237,20 @@ fn parse_budget(text: &str) -> Result<f64> {
     Ok(v)
 }
 
+/// The most steps `fit` measures (1 million: under 100 MB of per-step states, about two
+/// minutes on the firmware).
+pub const MAX_FIT_STEPS: u32 = 1_000_000;
+
 /// Runs `h8swarm fit`; returns the text to print.
 ///
 /// # Errors
 /// Bad options or an impossible configuration, with what would be valid.
 pub fn run(a: &FitArgs) -> Result<String> {
-    if a.steps == 0 {
-        bail!("--steps must be at least 1");
+    if a.steps == 0 || a.steps > MAX_FIT_STEPS {
+        bail!(
+            "--steps {}: valid is 1 to {MAX_FIT_STEPS} (each measured step keeps its states per phase; the default 400 already holds many saves)",
+            a.steps
+        );
     }
     let budget = a.cpu_budget.as_deref().map(parse_budget).transpose()?;
     let settings: Vec<Setting> = match (a.setting, a.what_if()) {

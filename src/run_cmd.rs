@@ -60,6 +60,10 @@ pub struct RunArgs {
     /// memory, no step for 10 s), mark that robot dead and go on instead of stopping.
     #[arg(long)]
     pub keep_going: bool,
+    /// The most memory the run may need, e.g. `8G`, `512M` (default: the memory the machine
+    /// has available now). A run estimated to need more is refused before it starts.
+    #[arg(long, value_name = "BYTES", value_parser = parse_bytes)]
+    pub max_memory: Option<u64>,
     /// Write a pin trace of one firmware robot of the learning run (repeat 0) to FILE as VCD
     /// (PWM, H-bridge, I2C lines, A/D, tick, sleep, the function that runs).
     #[arg(long, value_name = "FILE")]
@@ -198,6 +202,7 @@ pub fn run(a: &RunArgs) -> Result<String> {
         }
         Path::new("out").join(name)
     });
+    check_memory(&s, threads_or_all(a.threads), a.max_memory)?;
     // Fail now if the robots do not fit the arena, or a probe's option is bad.
     build_world(&s, 0)?;
     let probes = std::sync::Mutex::new(Some(probes(a, &s)?));
@@ -237,6 +242,107 @@ pub fn run(a: &RunArgs) -> Result<String> {
             Err(e.context(format!("the run into `{}` failed; {kept}", out.display())))
         }
     }
+}
+
+/// Host memory one robot takes while its run is going (measured: the peak resident size of
+/// `h8swarm run --robots 1000` less that of 100 robots, per robot, with model robots 148 KB,
+/// with firmware robots 855 KB: the MCU's flash image, RAM and decode cache), with a margin.
+pub const MODEL_ROBOT_BYTES: u64 = 192 << 10;
+/// See [`MODEL_ROBOT_BYTES`].
+pub const FIRMWARE_ROBOT_BYTES: u64 = 1 << 20;
+/// Host memory per step of a finished run kept for the summary and the plots (a row of
+/// metrics), with a margin.
+pub const STEP_BYTES: u64 = 128;
+/// The tool itself (code, fonts, the fit, the plots), with a margin.
+pub const BASE_BYTES: u64 = 64 << 20;
+
+/// The memory a run of `s` on `threads` threads is estimated to need: the runs going at once
+/// (one per thread) with their robots, and every run's metrics.
+#[must_use]
+pub fn estimated_memory(s: &Scenario, threads: usize) -> u64 {
+    let conditions = 1 + u64::from(s.controls.learning_off) + u64::from(s.controls.random_walk);
+    let runs = conditions * u64::from(s.repeats);
+    let at_once = runs.min(threads as u64).max(1);
+    let per_robot = match s.controller.kind {
+        crate::fit::ControllerKind::Firmware => FIRMWARE_ROBOT_BYTES,
+        crate::fit::ControllerKind::Model => MODEL_ROBOT_BYTES,
+    };
+    BASE_BYTES
+        .saturating_add(
+            at_once
+                .saturating_mul(s.robots as u64)
+                .saturating_mul(per_robot),
+        )
+        .saturating_add(
+            runs.saturating_mul(u64::from(s.steps))
+                .saturating_mul(STEP_BYTES),
+        )
+}
+
+/// The memory the machine has available now (`MemAvailable` of /proc/meminfo), if known.
+fn available_memory() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb.saturating_mul(1024))
+}
+
+/// Refuses a run estimated to need more than `max` (default: the available memory).
+fn check_memory(s: &Scenario, threads: usize, max: Option<u64>) -> Result<()> {
+    let Some(limit) = max.or_else(available_memory) else {
+        return Ok(());
+    };
+    let need = estimated_memory(s, threads);
+    if need > limit {
+        let what = if max.is_some() {
+            "--max-memory"
+        } else {
+            "the memory available on this machine"
+        };
+        bail!(
+            "this run needs about {} of memory ({} robots x {} runs at once, {} steps x {} runs of metrics) but {what} is {}: use fewer robots, threads, steps or repeats, or raise --max-memory",
+            show_bytes(need),
+            s.robots,
+            (1 + u64::from(s.controls.learning_off) + u64::from(s.controls.random_walk))
+                .saturating_mul(u64::from(s.repeats))
+                .min(threads as u64)
+                .max(1),
+            s.steps,
+            (1 + u64::from(s.controls.learning_off) + u64::from(s.controls.random_walk))
+                .saturating_mul(u64::from(s.repeats)),
+            show_bytes(limit)
+        );
+    }
+    Ok(())
+}
+
+fn show_bytes(b: u64) -> String {
+    if b >= 1 << 30 {
+        format!("{:.1} GiB", b as f64 / f64::from(1u32 << 30))
+    } else {
+        format!("{:.0} MiB", b as f64 / f64::from(1u32 << 20))
+    }
+}
+
+/// `--max-memory`: a whole number of bytes, or with a suffix K, M, G or T (powers of 1024).
+///
+/// # Errors
+/// Anything else, saying what is valid.
+pub fn parse_bytes(text: &str) -> std::result::Result<u64, String> {
+    let t = text.trim();
+    let (digits, shift) = match t.chars().last().map(|c| c.to_ascii_uppercase()) {
+        Some('K') => (&t[..t.len() - 1], 10),
+        Some('M') => (&t[..t.len() - 1], 20),
+        Some('G') => (&t[..t.len() - 1], 30),
+        Some('T') => (&t[..t.len() - 1], 40),
+        _ => (t, 0),
+    };
+    let n: u64 = digits.parse().map_err(|_| {
+        format!("`{text}` is not a size: give bytes as a whole number, optionally with K, M, G or T (e.g. 8G)")
+    })?;
+    n.checked_mul(1u64 << shift)
+        .filter(|&b| b > 0)
+        .ok_or_else(|| format!("`{text}`: give a size from 1 byte to 16 EiB"))
 }
 
 /// Worker threads at most: [`THREADS_PER_CORE`] per core the machine has.
@@ -807,6 +913,27 @@ fn arena(s: &Scenario, t: &crate::experiment::Track) -> Vec<ArenaFigure> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn memory_sizes_parse_and_estimates_grow_with_the_run() {
+        assert_eq!(parse_bytes("512M"), Ok(512 << 20));
+        assert_eq!(parse_bytes("8g"), Ok(8 << 30));
+        assert_eq!(parse_bytes("1000"), Ok(1000));
+        for bad in ["", "0", "-1", "8 GB", "1.5G", "99999999999T"] {
+            assert!(parse_bytes(bad).is_err(), "{bad}");
+        }
+        let s = Scenario::arena();
+        let one = estimated_memory(&s, 1);
+        assert!(estimated_memory(&s, 2) > one);
+        let big = s
+            .clone()
+            .with_overrides(Some(100_000), None, None, None)
+            .unwrap();
+        // 100 000 model robots on one thread: over 15 GiB.
+        assert!(estimated_memory(&big, 1) > 15 << 30);
+        assert!(check_memory(&big, 1, Some(8 << 30)).is_err());
+        assert!(check_memory(&s, 1, Some(8 << 30)).is_ok());
+    }
 
     #[test]
     fn output_names_come_from_the_argument_not_the_data() {
