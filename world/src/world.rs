@@ -32,6 +32,8 @@ const CORRECTION_GAP_M: f64 = 1e-5;
 pub const BROAD_PHASE_MARGIN_M: f64 = 0.2;
 /// Robots per chunk in the parallel phases (fixed, so results never depend on thread count).
 const PAR_CHUNK: usize = 512;
+/// Solved robots from which [`World::advance_states_par`] solves islands in parallel.
+const PAR_ISLAND_ROBOTS: usize = 64;
 /// Most robots a world may hold (indices are stored as `u32`).
 pub const MAX_ROBOTS: usize = 50_000_000;
 
@@ -254,6 +256,16 @@ pub struct World {
     island_bodies: Vec<IslandBody>,
     /// Per island, its range in `active`/`island_bodies` and in `contacts`.
     islands: Vec<(core::ops::Range<usize>, core::ops::Range<usize>)>,
+    /// Island of each active robot (scratch, in `active`'s order before the sort).
+    isl_of: Vec<u32>,
+    /// First place of each island in `active` (scratch; one more entry than islands).
+    isl_start: Vec<usize>,
+    /// Next free place of each island (scratch).
+    isl_fill: Vec<usize>,
+    /// `active` being sorted into islands (scratch).
+    active_scratch: Vec<u32>,
+    /// `contacts` being sorted into islands (scratch).
+    contact_scratch: Vec<Contact>,
     /// The solved contacts' impulses of the previous sub-step, sorted by contact identity
     /// (the warm start of the next solve).
     warm: Vec<WarmStart>,
@@ -453,6 +465,11 @@ impl World {
             root_island: vec![u32::MAX; n],
             island_bodies: Vec::new(),
             islands: Vec::new(),
+            isl_of: Vec::new(),
+            isl_start: Vec::new(),
+            isl_fill: Vec::new(),
+            active_scratch: Vec::new(),
+            contact_scratch: Vec::new(),
             solved_at: vec![u64::MAX; n],
             checked: Vec::new(),
             overlaps: Candidates::default(),
@@ -678,7 +695,8 @@ impl World {
 
     /// As [`World::advance_states`], with the per-robot phases (motors, free robots' motion,
     /// broad-phase candidates, contact search) split over rayon's current thread pool in fixed
-    /// chunks merged in index order; the contact solve runs on one thread in a fixed order.
+    /// chunks merged in index order; the contact solve runs island by island, islands in
+    /// parallel (each island's solve is the same on any thread).
     /// Results are bit-identical to [`World::advance_states`] whatever the number of threads.
     pub fn advance_states_par(&mut self, dt_states: u64) {
         self.advance_states_impl(dt_states, true);
@@ -808,15 +826,35 @@ impl World {
                 self.solved_at[i] = self.substeps;
             }
             self.build_islands();
-            for k in 0..self.islands.len() {
-                let (bodies, contacts) = self.islands[k].clone();
-                self.stats.solver_sweeps += u64::from(solve_island(
-                    &mut self.island_bodies[bodies],
-                    &mut self.contacts[contacts],
-                    &self.body,
-                    h,
-                    self.params.solver_iterations,
-                ));
+            let (body, iterations) = (&self.body, self.params.solver_iterations);
+            if parallel && self.active.len() > PAR_ISLAND_ROBOTS && self.islands.len() > 1 {
+                // Islands share nothing: each is solved on whichever thread, with the same
+                // result as in order.
+                let mut jobs = Vec::with_capacity(self.islands.len());
+                let (mut bodies, mut contacts) =
+                    (&mut self.island_bodies[..], &mut self.contacts[..]);
+                for (b, c) in &self.islands {
+                    let (bi, rest) = core::mem::take(&mut bodies).split_at_mut(b.len());
+                    bodies = rest;
+                    let (ci, rest) = core::mem::take(&mut contacts).split_at_mut(c.len());
+                    contacts = rest;
+                    jobs.push((bi, ci));
+                }
+                self.stats.solver_sweeps += jobs
+                    .par_iter_mut()
+                    .with_min_len(16)
+                    .map(|(b, c)| u64::from(solve_island(b, c, body, h, iterations)))
+                    .sum::<u64>();
+            } else {
+                for (b, c) in &self.islands {
+                    self.stats.solver_sweeps += u64::from(solve_island(
+                        &mut self.island_bodies[b.clone()],
+                        &mut self.contacts[c.clone()],
+                        body,
+                        h,
+                        iterations,
+                    ));
+                }
             }
             for (k, &i) in self.active.iter().enumerate() {
                 let b = &self.island_bodies[k];
@@ -1079,60 +1117,79 @@ impl World {
                 }
             }
         }
+        // Island numbers in order of each island's lowest robot (`active` is in index order).
         let mut count = 0u32;
-        let mut island = Vec::with_capacity(self.active.len());
+        self.isl_of.clear();
         for k in 0..self.active.len() {
             let r = find(&mut self.uf, self.active[k]) as usize;
             if self.root_island[r] == u32::MAX {
                 self.root_island[r] = count;
                 count += 1;
             }
-            island.push(self.root_island[r]);
+            self.isl_of.push(self.root_island[r]);
         }
-        // Members island by island (stable: index order within each).
-        let mut order: Vec<usize> = (0..self.active.len()).collect();
-        order.sort_by_key(|&k| island[k]);
-        let members: Vec<u32> = order.iter().map(|&k| self.active[k]).collect();
-        let member_island: Vec<u32> = order.iter().map(|&k| island[k]).collect();
         for &i in &self.active {
             let r = find(&mut self.uf, i) as usize;
             self.root_island[r] = u32::MAX;
         }
-        self.active = members;
+        // Members island by island, index order within each (a stable counting sort).
+        let islands = count as usize;
+        self.isl_start.clear();
+        self.isl_start.resize(islands + 1, 0);
+        for &k in &self.isl_of {
+            self.isl_start[k as usize + 1] += 1;
+        }
+        for k in 0..islands {
+            self.isl_start[k + 1] += self.isl_start[k];
+        }
+        self.isl_fill.clear();
+        self.isl_fill.extend_from_slice(&self.isl_start[..islands]);
+        self.active_scratch.clear();
+        self.active_scratch.resize(self.active.len(), 0);
+        for (k, &i) in self.active.iter().enumerate() {
+            let isl = self.isl_of[k] as usize;
+            self.active_scratch[self.isl_fill[isl]] = i;
+            self.isl_fill[isl] += 1;
+        }
+        core::mem::swap(&mut self.active, &mut self.active_scratch);
         // Each robot's island and place in it, through the `uf` scratch (no longer needed).
         self.islands.clear();
-        let mut start = 0;
-        for k in 0..self.active.len() {
-            if k + 1 == self.active.len() || member_island[k + 1] != member_island[k] {
-                for (local, &i) in self.active[start..=k].iter().enumerate() {
-                    self.uf[i as usize] = local as u32;
-                    self.root_island[i as usize] = member_island[k];
-                }
-                self.islands.push((start..k + 1, 0..0));
-                start = k + 1;
+        for isl in 0..islands {
+            let range = self.isl_start[isl]..self.isl_start[isl + 1];
+            for (local, &i) in self.active[range.clone()].iter().enumerate() {
+                self.uf[i as usize] = local as u32;
+                self.root_island[i as usize] = isl as u32;
             }
+            self.islands.push((range, 0..0));
         }
-        let root_island = &self.root_island;
-        self.contacts.sort_by_key(|ct| root_island[ct.a as usize]);
-        let mut c0 = 0;
+        // Contacts island by island, their order kept within each (a stable counting sort).
+        self.isl_fill.clear();
+        self.isl_fill.resize(islands + 1, 0);
+        for ct in &self.contacts {
+            self.isl_fill[self.root_island[ct.a as usize] as usize + 1] += 1;
+        }
+        for k in 0..islands {
+            self.isl_fill[k + 1] += self.isl_fill[k];
+        }
         for (isl, range) in self.islands.iter_mut().enumerate() {
-            let mut c1 = c0;
-            while c1 < self.contacts.len()
-                && root_island[self.contacts[c1].a as usize] == isl as u32
-            {
-                c1 += 1;
-            }
-            range.1 = c0..c1;
-            c0 = c1;
+            range.1 = self.isl_fill[isl]..self.isl_fill[isl + 1];
         }
-        for ct in self.contacts.iter_mut() {
-            ct.la = self.uf[ct.a as usize];
-            ct.lb = if ct.b == WALL {
+        self.contact_scratch.clear();
+        self.contact_scratch
+            .resize(self.contacts.len(), Contact::default());
+        for ct in &self.contacts {
+            let isl = self.root_island[ct.a as usize] as usize;
+            let mut c = *ct;
+            c.la = self.uf[ct.a as usize];
+            c.lb = if ct.b == WALL {
                 WALL
             } else {
                 self.uf[ct.b as usize]
             };
+            self.contact_scratch[self.isl_fill[isl]] = c;
+            self.isl_fill[isl] += 1;
         }
+        core::mem::swap(&mut self.contacts, &mut self.contact_scratch);
         for &i in &self.active {
             self.root_island[i as usize] = u32::MAX;
         }
