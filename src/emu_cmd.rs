@@ -72,7 +72,10 @@ fn symbols(image: &str, given: Option<&Path>) -> Result<Option<SymbolTable>, Fai
             p
         }
     };
-    let text = std::fs::read_to_string(&path).map_err(|e| {
+    let max = emu::board::firmware::Firmware::MAX_FILE_BYTES;
+    let text = emu::board::firmware::read_bounded(&path, max)
+        .and_then(|b| String::from_utf8(b).map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e)))
+        .map_err(|e| {
         input(format!(
             "cannot read symbol file `{}`: {e} (give the output of `h8300-hms-nm -n`, or leave --symbols out)",
             path.display()
@@ -85,11 +88,13 @@ fn symbols(image: &str, given: Option<&Path>) -> Result<Option<SymbolTable>, Fai
 
 pub fn run(o: &EmuOptions<'_>) -> Result<(), Failure> {
     let image = o.image;
-    let bytes = std::fs::read(image).map_err(|e| {
-        input(format!(
-            "cannot read image `{image}`: {e} (give a Motorola S-record file, .mot)"
-        ))
-    })?;
+    let max = emu::board::firmware::Firmware::MAX_FILE_BYTES;
+    let bytes =
+        emu::board::firmware::read_bounded(std::path::Path::new(image), max).map_err(|e| {
+            input(format!(
+                "cannot read image `{image}`: {e} (give a Motorola S-record file, .mot)"
+            ))
+        })?;
     let srec = srec::parse(&bytes).map_err(|e| {
         Failure::Input(anyhow::Error::new(e).context(format!("image `{image}`: bad image")))
     })?;

@@ -181,6 +181,10 @@ fn main() -> ExitCode {
 /// What clap did not parse: help and version text (exit status 0, or 1 when it cannot be
 /// written), or a usage error (exit status 2).
 fn usage(e: &clap::Error) -> ExitCode {
+    if e.kind() == clap::error::ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand {
+        // clap prints the help alone: say first, in one line, what is wrong.
+        eprintln!("error: a subcommand or argument is missing: see the usage below");
+    }
     let printed = e.print().and_then(|()| io::stdout().flush());
     match printed {
         Err(w) if w.kind() != io::ErrorKind::BrokenPipe => {

@@ -218,6 +218,19 @@ impl From<Channels> for [u8; 4] {
 patch!(ControlPatch for ControlSpec { learning_off: bool, random_walk: bool });
 patch!(ControllerPatch for ControllerSpec { kind: crate::fit::ControllerKind, image: Option<String>, symbols: Option<String>, robots: Option<Vec<usize>> });
 
+/// The largest scenario or sweep file read (1 MiB; the documented example is 4 KB).
+pub const MAX_FILE_BYTES: u64 = 1 << 20;
+
+/// A text file a user named, at most `limit` bytes of UTF-8 (see
+/// [`emu::board::firmware::read_bounded`]).
+///
+/// # Errors
+/// The file cannot be read, is larger, or is not UTF-8.
+pub fn read_text(path: &Path, limit: u64) -> std::io::Result<String> {
+    let bytes = emu::board::firmware::read_bounded(path, limit)?;
+    String::from_utf8(bytes).map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e))
+}
+
 /// A resolved, checked scenario.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Scenario {
@@ -380,7 +393,7 @@ impl Scenario {
         if path.extension().and_then(|e| e.to_str()) != Some("toml") && !path.exists() {
             return Self::builtin(what);
         }
-        let text = std::fs::read_to_string(path)
+        let text = read_text(path, MAX_FILE_BYTES)
             .with_context(|| format!("cannot read scenario file `{what}`"))?;
         Self::from_toml(&text).with_context(|| format!("scenario file `{what}`"))
     }
@@ -390,7 +403,9 @@ impl Scenario {
     /// # Errors
     /// Bad TOML, an unknown key, or a value out of range.
     pub fn from_toml(text: &str) -> Result<Self> {
-        let file: ScenarioFile = toml::from_str(text).map_err(|e| anyhow::anyhow!("{e}"))?;
+        // One line: where (line, column, the line's text) and what.
+        let file: ScenarioFile = toml::from_str(text)
+            .map_err(|e| anyhow::anyhow!("{}", crate::sweep::spec::toml_error(text, &e)))?;
         let mut s = Self::builtin(file.base.as_deref().unwrap_or("arena")).context("key `base`")?;
         if let Some(v) = file.name {
             s.name = v;

@@ -533,6 +533,24 @@ fn writes_to_a_full_device_and_endless_lines_have_their_statuses() {
         assert_eq!(o.status.code(), Some(1), "{args:?}: {stderr}");
         assert!(stderr.contains("writing the output"), "{args:?}: {stderr}");
     }
+    // Files without end as scenario, sweep, image and symbols: refused at their bound.
+    for args in [
+        &["run", "/dev/zero"][..],
+        &["sweep", "plan", "/dev/zero", "--out", "/nonexistent/x"],
+        &["emu", "/dev/zero"],
+        &[
+            "emu",
+            "emu/tests/programs/arith.mot",
+            "--symbols",
+            "/dev/zero",
+        ],
+        &["run", "--firmware", "/dev/zero"],
+    ] {
+        let o = h8swarm(args, None);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(stderr.contains("larger than"), "{args:?}: {stderr}");
+    }
     let o = h8swarm(&["learn", "--replay", "/dev/zero"], None);
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{stderr}");

@@ -129,7 +129,8 @@ pub enum SweepCommand {
 pub fn command(args: &SweepArgs) -> Result<String, SweepError> {
     match &args.command {
         SweepCommand::Plan { sweep, out, bin } => {
-            let text = std::fs::read_to_string(sweep).map_err(|e| {
+            let max = crate::scenario::MAX_FILE_BYTES;
+            let text = crate::scenario::read_text(sweep, max).map_err(|e| {
                 SweepError::input(format!(
                     "cannot read sweep file `{}`: {e} (give a .toml sweep file)",
                     sweep.display()

@@ -307,13 +307,17 @@ impl Firmware {
         })
     }
 
+    /// The largest image or symbol file read (4 MiB: an S-record file of the whole 512 KB
+    /// flash is about 1.4 MB; a symbol table of a program that fills it far less).
+    pub const MAX_FILE_BYTES: u64 = 4 << 20;
+
     /// An image and its symbol file from disk.
     ///
     /// # Errors
     /// [`FirmwareError`] naming the file that could not be read or parsed.
     pub fn load(image: &Path, symbols: &Path) -> Result<Firmware, FirmwareError> {
         let read = |p: &Path| {
-            std::fs::read(p).map_err(|source| FirmwareError::Read {
+            read_bounded(p, Self::MAX_FILE_BYTES).map_err(|source| FirmwareError::Read {
                 path: p.display().to_string(),
                 source,
             })
@@ -341,10 +345,11 @@ impl Firmware {
     /// # Errors
     /// [`FirmwareError`] naming the file that could not be read or parsed.
     pub fn load_without_symbols(image: &Path) -> Result<Firmware, FirmwareError> {
-        let bytes = std::fs::read(image).map_err(|source| FirmwareError::Read {
-            path: image.display().to_string(),
-            source,
-        })?;
+        let bytes =
+            read_bounded(image, Self::MAX_FILE_BYTES).map_err(|source| FirmwareError::Read {
+                path: image.display().to_string(),
+                source,
+            })?;
         Ok(Firmware {
             image: srec::parse(&bytes).map_err(|source| FirmwareError::Srec {
                 path: image.display().to_string(),
@@ -723,4 +728,25 @@ impl FirmwareController {
         }
         Ok(())
     }
+}
+
+/// Reads a file a user named, refusing one larger than `limit` bytes (an error of kind
+/// `InvalidData` that says the bound) instead of holding whatever it gives: `/dev/zero` or a
+/// huge file as a scenario, image or symbol table.
+///
+/// # Errors
+/// The file cannot be opened or read, or is larger than `limit`.
+pub fn read_bounded(path: &Path, limit: u64) -> std::io::Result<Vec<u8>> {
+    use std::io::Read;
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)?
+        .take(limit + 1)
+        .read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > limit {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!("larger than {limit} bytes, the most this file may hold"),
+        ));
+    }
+    Ok(bytes)
 }
