@@ -111,7 +111,8 @@
 //!   `derive(seed, 0, Placement)`), so adding a robot changes no other robot's gains.
 //! - **Threads**: [`World::advance_states_par`] runs the per-robot phases (motors, free
 //!   motion, candidate search, contact search) on rayon's pool in fixed chunks merged in index
-//!   order; the contact solve runs on one thread in a fixed order. Results are bit-identical to
+//!   order; the contact solve runs island by island, islands in parallel (each island's solve
+//!   reads and writes only its own robots and contacts). Results are bit-identical to
 //!   [`World::advance_states`] whatever the thread count.
 //! - **Corridor metric**: [`World::corridor_gaps_m`] gives the free gaps between neighbouring
 //!   robots along the corridor (sorted by centre x; gap = shortest distance between the two
