@@ -14,6 +14,7 @@ cd "$(dirname "$0")/.."
 steps=${1:-1000000}
 fuzz_cases=${2:-100000}
 out=${OUT:-$(mktemp -d /tmp/h8swarm-soak.XXXXXX)}
+mkdir -p "$out"
 cargo build --release --quiet
 bin=${CARGO_TARGET_DIR:-target}/release/h8swarm
 fail() { echo "soak: FAILED: $*"; exit 1; }
