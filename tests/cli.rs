@@ -334,14 +334,7 @@ fn run_writes_identical_metrics_for_any_thread_count() {
             );
             let stdout = String::from_utf8_lossy(&out.stdout);
             assert!(stdout.contains("learning.png"), "{stdout}");
-            for f in [
-                "metrics.csv",
-                "summary.json",
-                "learning.png",
-                "learning.svg",
-                "arena.png",
-                "fit.json",
-            ] {
+            for f in h8swarm::run_cmd::OUTPUT_FILES {
                 assert!(dir.join(f).exists(), "{f} written");
             }
             files.push((

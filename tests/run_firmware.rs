@@ -64,14 +64,7 @@ fn firmware_robots_write_every_output_with_their_cpu_load_and_the_same_for_any_t
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    for f in [
-        "metrics.csv",
-        "summary.json",
-        "fit.json",
-        "learning.png",
-        "learning.svg",
-        "arena.png",
-    ] {
+    for f in h8swarm::run_cmd::OUTPUT_FILES {
         assert!(a.join(f).exists(), "{f}");
     }
     let m = metrics(&a);

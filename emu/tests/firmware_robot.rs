@@ -10,28 +10,11 @@ use emu::chip::mcu::{Board, Mcu, McuConfig, NullBoard};
 use emu::core::bus::Bus;
 use emu::core::cpu::Cpu;
 
+mod boards;
+use boards::Wandering;
+
 /// 10 ms ticks of φ/8 at 25 MHz, in states.
 const TICK_STATES: u64 = 31_250 * 8;
-
-/// A board whose four IR voltages wander (a different slow triangle per channel), so that the
-/// learner sees rewards and punishments.
-struct Wandering;
-
-impl Board for Wandering {
-    fn analog_volts(&mut self, channel: u8, now_states: u64) -> f64 {
-        let period = 40_000_000 + 7_000_000 * u64::from(channel);
-        let phase = (now_states % period) as f64 / period as f64;
-        let tri = if phase < 0.5 {
-            phase * 2.0
-        } else {
-            2.0 - phase * 2.0
-        };
-        0.4 + 2.2 * tri
-    }
-    fn port2_pins(&mut self, _now_states: u64) -> u8 {
-        0xFF
-    }
-}
 
 fn firmware() -> Firmware {
     Firmware::robot().expect("the committed firmware parses")

@@ -5,7 +5,7 @@
 use std::sync::Arc;
 
 use emu::board::firmware::{ConfigBlock, FLAG_RANDOM_WALK, Firmware, FirmwareController};
-use emu::chip::mcu::{Board, Mcu, McuConfig, NullBoard};
+use emu::chip::mcu::{Mcu, McuConfig, NullBoard};
 use emu::chip::periph::itu::PwmWave;
 use emu::chip::run::{Probes, RunOptions, run_mcu_probed};
 use emu::chip::trace::{PhaseRecorder, PinTrace, Signal};
@@ -13,29 +13,13 @@ use emu::chip::vcd::{VcdInfo, write_vcd};
 use emu::core::bus::Bus;
 use emu::core::cpu::Cpu;
 
+mod boards;
+use boards::Wandering;
+
 /// A 10 ms tick: 31 250 counts of φ/8.
 const TICK_STATES: u64 = 31_250 * 8;
 /// The firmware's PWM period: GRA = 1249, φ/8 (400 µs).
 const PWM_PERIOD_STATES: u64 = 1_250 * 8;
-
-/// IR voltages that wander, as in `firmware_robot.rs`.
-struct Wandering;
-
-impl Board for Wandering {
-    fn analog_volts(&mut self, channel: u8, now_states: u64) -> f64 {
-        let period = 40_000_000 + 7_000_000 * u64::from(channel);
-        let phase = (now_states % period) as f64 / period as f64;
-        let tri = if phase < 0.5 {
-            phase * 2.0
-        } else {
-            2.0 - phase * 2.0
-        };
-        0.4 + 2.2 * tri
-    }
-    fn port2_pins(&mut self, _now_states: u64) -> u8 {
-        0xFF
-    }
-}
 
 struct Window {
     trace: PinTrace,

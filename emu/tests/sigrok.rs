@@ -10,30 +10,14 @@ use std::process::Command;
 use std::sync::Arc;
 
 use emu::board::firmware::{ConfigBlock, FLAG_RANDOM_WALK, Firmware, FirmwareController};
-use emu::chip::mcu::{Board, Mcu, McuConfig};
+use emu::chip::mcu::{Mcu, McuConfig};
 use emu::chip::periph::itu::PwmWave;
 use emu::chip::trace::{PinTrace, Signal};
 use emu::chip::vcd::{VcdInfo, write_vcd};
 use emu::core::bus::Bus;
 
-/// IR voltages that wander, as in `pin_trace.rs`.
-struct Wandering;
-
-impl Board for Wandering {
-    fn analog_volts(&mut self, channel: u8, now_states: u64) -> f64 {
-        let period = 40_000_000 + 7_000_000 * u64::from(channel);
-        let phase = (now_states % period) as f64 / period as f64;
-        let tri = if phase < 0.5 {
-            phase * 2.0
-        } else {
-            2.0 - phase * 2.0
-        };
-        0.4 + 2.2 * tri
-    }
-    fn port2_pins(&mut self, _now_states: u64) -> u8 {
-        0xFF
-    }
-}
+mod boards;
+use boards::Wandering;
 
 /// What the emulator knows of one traced step.
 struct Step {
