@@ -294,9 +294,7 @@ fn sweep(args: &h8swarm::sweep::SweepArgs) -> Result<(), Failure> {
 /// An error of `run`: a tool failure when some output could not be written
 /// ([`run_cmd::OutputError`] in its chain), else bad input.
 fn run_failure(e: anyhow::Error) -> Failure {
-    if e.downcast_ref::<run_cmd::OutputError>().is_some()
-        || e.chain().any(|c| c.is::<run_cmd::OutputError>())
-    {
+    if run_cmd::is_output_error(&e) {
         Failure::Tool(e)
     } else {
         Failure::Input(e)

@@ -260,9 +260,7 @@ pub const BASE_BYTES: u64 = 64 << 20;
 /// (one per thread) with their robots, and every run's metrics.
 #[must_use]
 pub fn estimated_memory(s: &Scenario, threads: usize) -> u64 {
-    let conditions = 1 + u64::from(s.controls.learning_off) + u64::from(s.controls.random_walk);
-    let runs = conditions * u64::from(s.repeats);
-    let at_once = runs.min(threads as u64).max(1);
+    let (runs, at_once) = run_counts(s, threads);
     let per_robot = match s.controller.kind {
         crate::fit::ControllerKind::Firmware => FIRMWARE_ROBOT_BYTES,
         crate::fit::ControllerKind::Model => MODEL_ROBOT_BYTES,
@@ -277,6 +275,20 @@ pub fn estimated_memory(s: &Scenario, threads: usize) -> u64 {
             runs.saturating_mul(u64::from(s.steps))
                 .saturating_mul(STEP_BYTES),
         )
+}
+
+/// The runs of `s` (conditions × repeats) and how many of them go at once on `threads`.
+fn run_counts(s: &Scenario, threads: usize) -> (u64, u64) {
+    let conditions = 1 + u64::from(s.controls.learning_off) + u64::from(s.controls.random_walk);
+    let runs = conditions.saturating_mul(u64::from(s.repeats));
+    (runs, runs.min(threads as u64).max(1))
+}
+
+/// Whether `e` is an output that could not be written ([`OutputError`] anywhere in its chain
+/// of contexts): the tool failed (exit status 1), not the input.
+#[must_use]
+pub fn is_output_error(e: &anyhow::Error) -> bool {
+    e.downcast_ref::<OutputError>().is_some()
 }
 
 /// The memory the machine has available now (`MemAvailable` of /proc/meminfo), if known.
@@ -299,17 +311,12 @@ fn check_memory(s: &Scenario, threads: usize, max: Option<u64>) -> Result<()> {
         } else {
             "the memory available on this machine"
         };
+        let (runs, at_once) = run_counts(s, threads);
         bail!(
-            "this run needs about {} of memory ({} robots x {} runs at once, {} steps x {} runs of metrics) but {what} is {}: use fewer robots, threads, steps or repeats, or raise --max-memory",
+            "this run needs about {} of memory ({} robots x {at_once} runs at once, {} steps x {runs} runs of metrics) but {what} is {}: use fewer robots, threads, steps or repeats, or raise --max-memory",
             show_bytes(need),
             s.robots,
-            (1 + u64::from(s.controls.learning_off) + u64::from(s.controls.random_walk))
-                .saturating_mul(u64::from(s.repeats))
-                .min(threads as u64)
-                .max(1),
             s.steps,
-            (1 + u64::from(s.controls.learning_off) + u64::from(s.controls.random_walk))
-                .saturating_mul(u64::from(s.repeats)),
             show_bytes(limit)
         );
     }
@@ -933,6 +940,18 @@ mod tests {
         assert!(estimated_memory(&big, 1) > 15 << 30);
         assert!(check_memory(&big, 1, Some(8 << 30)).is_err());
         assert!(check_memory(&s, 1, Some(8 << 30)).is_ok());
+    }
+
+    #[test]
+    fn output_errors_are_found_under_any_context() {
+        let direct = anyhow::Error::new(OutputError("cannot write".into()));
+        assert!(is_output_error(&direct));
+        let wrapped = anyhow::Error::new(std::io::Error::other("disk full"))
+            .context(OutputError("cannot write `metrics.csv`".into()))
+            .context("the run into `out` failed; nothing was written");
+        assert!(is_output_error(&wrapped));
+        let input = anyhow::anyhow!("`steps` = 0 is out of range").context("scenario file");
+        assert!(!is_output_error(&input));
     }
 
     #[test]
