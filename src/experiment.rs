@@ -24,6 +24,13 @@
 //! stream is split per repeat, robot and purpose ([`crate::seeds`]); robots are processed
 //! in index order (in parallel for large swarms, with results gathered in index order), so the
 //! output is byte-identical for any thread count.
+//!
+//! Memory: a run keeps no per-step history. Each step's metrics, complete one step later (its
+//! behaviour's collisions are known when the next step begins), go as a row to the run's own
+//! CSV file, when it has one ([`Swarm::set_rows`]), and into sums per window
+//! ([`RunMetrics`]); the arena figure's paths are kept for the first and the last
+//! [`SNAPSHOT_STEPS`] steps only. A run of 10⁶ steps needs the memory of one of 10³ steps
+//! beside its window sums (one [`WindowSums`] per window).
 
 use anyhow::{Context, Result};
 use rayon::prelude::*;
@@ -74,8 +81,11 @@ pub struct StepMetrics {
 /// Robot paths and outlines for the arena figure.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Track {
-    /// Per tracked robot, its centre at every step (metres).
-    pub paths: Vec<Vec<(f64, f64)>>,
+    /// Per tracked robot, its centre at each of the first [`SNAPSHOT_STEPS`] steps (metres).
+    pub early: Vec<Vec<(f64, f64)>>,
+    /// Per tracked robot, its centre at each of the last [`SNAPSHOT_STEPS`] steps of the run
+    /// (metres; the same steps as `early` in a run of fewer than twice as many steps).
+    pub late: Vec<Vec<(f64, f64)>>,
     /// Outlines of the tracked robots at a few instants.
     pub outlines: Vec<Outline>,
     /// The arena's walls.
@@ -89,14 +99,159 @@ pub struct RunOutput {
     pub condition: Condition,
     /// The repeat index.
     pub repeat: u32,
-    /// Per-step metrics.
-    pub steps: Vec<StepMetrics>,
+    /// Per-window sums of the per-step metrics (the steps themselves went to the run's CSV
+    /// rows, when it had a file for them).
+    pub metrics: RunMetrics,
     /// Paths and outlines, when asked for.
     pub track: Option<Track>,
     /// EEPROM records written over the run (all robots).
     pub saves: u64,
     /// Robots that died (with `--keep-going`), with why.
     pub dead: Vec<(usize, String)>,
+}
+
+/// Sums of a run's per-step metrics over a span of steps: the summary's and the figure's
+/// window values are these divided by the steps (means) or as they are (totals). The sums run
+/// in step order, so they equal the sums of the same steps' metrics taken afterwards.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct WindowSums {
+    /// Steps summed.
+    pub steps: u32,
+    /// Sum of [`StepMetrics::mean_d`].
+    pub mean_d: f64,
+    /// Sum of [`StepMetrics::collisions_per_robot`].
+    pub collisions_per_robot: f64,
+    /// Sum of [`StepMetrics::contact_fraction`].
+    pub contact_fraction: f64,
+    /// Sum of [`StepMetrics::stuck_fraction`].
+    pub stuck_fraction: f64,
+    /// Sum of [`StepMetrics::moved_m`].
+    pub moved_m: f64,
+    /// Sum of [`StepMetrics::gap_cv`] over the steps that have one.
+    pub gap_cv: f64,
+    /// Steps that have a gap CV (all of them in the corridor, none in the square).
+    pub gap_cv_steps: u32,
+    /// Sum of [`StepMetrics::cpu_load_percent`].
+    pub cpu_load_percent: f64,
+}
+
+impl WindowSums {
+    /// Adds one step's metrics.
+    pub fn add(&mut self, m: &StepMetrics) {
+        self.steps += 1;
+        self.mean_d += m.mean_d;
+        self.collisions_per_robot += m.collisions_per_robot;
+        self.contact_fraction += m.contact_fraction;
+        self.stuck_fraction += m.stuck_fraction;
+        self.moved_m += m.moved_m;
+        if let Some(g) = m.gap_cv {
+            self.gap_cv += g;
+            self.gap_cv_steps += 1;
+        }
+        self.cpu_load_percent += m.cpu_load_percent;
+    }
+
+    /// Whether every step summed had a gap CV (and there was at least one step).
+    #[must_use]
+    pub fn all_have_gap_cv(&self) -> bool {
+        self.steps > 0 && self.gap_cv_steps == self.steps
+    }
+}
+
+/// What a run keeps of its per-step metrics: sums over windows.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RunMetrics {
+    /// The window length, steps.
+    pub window: u32,
+    /// The run's planned steps.
+    pub planned_steps: u32,
+    /// One sum per whole window of `window` steps from step 0 (steps past the last whole
+    /// window are in none); the learning figure's points.
+    pub windows: Vec<WindowSums>,
+    /// The summary's first window: steps `0..window`.
+    pub first: WindowSums,
+    /// The summary's last window: steps `planned_steps - window..planned_steps`.
+    pub last: WindowSums,
+    /// Every step of the run.
+    pub whole: WindowSums,
+}
+
+impl RunMetrics {
+    /// Empty sums for a run of `planned_steps` steps in windows of `window` (at least 1).
+    #[must_use]
+    pub fn new(planned_steps: u32, window: u32) -> Self {
+        Self {
+            window: window.max(1),
+            planned_steps,
+            ..Self::default()
+        }
+    }
+
+    /// Adds step `k`'s metrics (steps come in order, from 0).
+    pub fn add(&mut self, k: u32, m: &StepMetrics) {
+        let w = (k / self.window) as usize;
+        if k.is_multiple_of(self.window) && w == self.windows.len() {
+            self.windows.push(WindowSums::default());
+        }
+        if let Some(sums) = self.windows.get_mut(w) {
+            sums.add(m);
+        }
+        if k < self.window {
+            self.first.add(m);
+        }
+        if k < self.planned_steps && k >= self.planned_steps.saturating_sub(self.window) {
+            self.last.add(m);
+        }
+        self.whole.add(m);
+    }
+
+    /// The whole windows (a trailing partial window left out).
+    #[must_use]
+    pub fn whole_windows(&self) -> &[WindowSums] {
+        let whole = self
+            .windows
+            .iter()
+            .take_while(|w| w.steps == self.window)
+            .count();
+        &self.windows[..whole]
+    }
+}
+
+/// The columns of `metrics.csv`, one row per step of every run.
+pub const METRICS_HEADER: [&str; 10] = [
+    "condition",
+    "repeat",
+    "step",
+    "mean_d",
+    "collisions_per_robot",
+    "contact_fraction",
+    "stuck_fraction",
+    "moved_m",
+    "gap_cv",
+    "cpu_load_percent",
+];
+
+/// Step `k`'s row of `metrics.csv` (see [`METRICS_HEADER`]).
+#[must_use]
+pub fn metrics_row(condition: Condition, repeat: u32, k: u32, m: &StepMetrics) -> [String; 10] {
+    [
+        condition.name().to_string(),
+        repeat.to_string(),
+        k.to_string(),
+        format!("{}", m.mean_d),
+        format!("{}", m.collisions_per_robot),
+        format!("{}", m.contact_fraction),
+        format!("{}", m.stuck_fraction),
+        format!("{}", m.moved_m),
+        m.gap_cv.map(|v| format!("{v}")).unwrap_or_default(),
+        format!("{}", m.cpu_load_percent),
+    ]
+}
+
+/// A run's rows of `metrics.csv`, written as the steps complete.
+struct Rows {
+    path: std::path::PathBuf,
+    w: csv::Writer<std::io::BufWriter<std::fs::File>>,
 }
 
 /// The arena of a scenario (the square scaled to keep the paper's density for other than 3
@@ -170,7 +325,14 @@ pub struct Swarm {
     drove: Vec<bool>,
     /// The step period in clock states.
     period_states: u64,
-    steps: Vec<StepMetrics>,
+    /// Steps begun.
+    started: u32,
+    /// The latest step's metrics, complete once the world has run its behaviour.
+    pending: Option<StepMetrics>,
+    /// Window sums of the completed steps.
+    metrics: RunMetrics,
+    /// Where the completed steps' rows go, if anywhere.
+    rows: Option<Rows>,
     track: Option<Track>,
     tracked: usize,
     snapshots: [u32; 4],
@@ -210,8 +372,10 @@ impl Swarm {
         } else {
             0
         };
+        let k = SNAPSHOT_STEPS.min(s.steps as usize);
         let track = record_track.then(|| Track {
-            paths: vec![Vec::with_capacity(s.steps as usize); tracked],
+            early: vec![Vec::with_capacity(k); tracked],
+            late: vec![Vec::with_capacity(k); tracked],
             outlines: Vec::new(),
             walls: world
                 .arena()
@@ -230,7 +394,10 @@ impl Swarm {
             stuck: vec![StuckDetector::default(); n],
             drove: vec![false; n],
             period_states: period_states(s),
-            steps: Vec::with_capacity(s.steps as usize),
+            started: 0,
+            pending: None,
+            metrics: RunMetrics::new(s.steps, s.window),
+            rows: None,
             track,
             tracked,
             snapshots: {
@@ -244,6 +411,27 @@ impl Swarm {
             keep_going: false,
             dead: vec![None; n],
         })
+    }
+
+    /// Writes every step's row of `metrics.csv` (no header; [`metrics_row`]) to a new file at
+    /// `path` as the step completes.
+    ///
+    /// # Errors
+    /// The file cannot be created (an [`crate::run_cmd::OutputError`]).
+    pub fn set_rows(&mut self, path: &std::path::Path) -> Result<()> {
+        let file = std::fs::File::create(path)
+            .map_err(anyhow::Error::new)
+            .context(crate::run_cmd::OutputError(format!(
+                "cannot create `{}`",
+                path.display()
+            )))?;
+        self.rows = Some(Rows {
+            path: path.to_path_buf(),
+            w: csv::WriterBuilder::new()
+                .has_headers(false)
+                .from_writer(std::io::BufWriter::new(file)),
+        });
+        Ok(())
     }
 
     /// Whether a robot whose controller fails is marked dead and the run goes on (default:
@@ -297,7 +485,7 @@ impl Swarm {
     /// A world or controller failure (none is expected once the scenario checks out).
     pub fn step(&mut self) -> Result<()> {
         let n = self.robots.len();
-        let k = self.steps.len() as u32;
+        let k = self.started;
         let par = self.parallel;
         let dead = self.dead.clone();
         let sleep = |(i, r): (usize, &mut Robot)| -> Option<Result<u64>> {
@@ -325,10 +513,16 @@ impl Swarm {
         let t_step_s = t_step as f64 / f64::from(self.scenario.timing.clock_hz);
         self.close_step(t_step)?;
         if let Some(t) = self.track.as_mut() {
+            let (early, late) = (
+                (k as usize) < SNAPSHOT_STEPS,
+                k as usize + SNAPSHOT_STEPS >= self.scenario.steps as usize
+                    && k < self.scenario.steps,
+            );
             record(
                 &self.world,
                 t,
                 self.tracked,
+                (early, late),
                 self.snapshots.contains(&k),
                 t_step_s,
             )?;
@@ -408,7 +602,8 @@ impl Swarm {
             ArenaKind::Corridor => self.world.corridor_gap_cv()?,
             ArenaKind::Square => None,
         };
-        self.steps.push(StepMetrics {
+        self.started += 1;
+        self.pending = Some(StepMetrics {
             mean_d,
             collisions_per_robot: 0.0,
             contact_fraction: 0.0,
@@ -429,7 +624,7 @@ impl Swarm {
             advance_world(&mut self.world, t_states, &mut self.meters, self.parallel)?;
         let n = self.robots.len();
         let (moved, stuck) = self.moved()?;
-        if let Some(last) = self.steps.last_mut() {
+        if let Some(mut last) = self.pending.take() {
             last.collisions_per_robot = collided as f64 / n as f64;
             last.contact_fraction = if dt == 0 {
                 0.0
@@ -438,8 +633,26 @@ impl Swarm {
             };
             last.moved_m = moved;
             last.stuck_fraction = stuck as f64 / n as f64;
+            let k = self.started - 1;
+            self.metrics.add(k, &last);
+            if let Some(rows) = self.rows.as_mut() {
+                rows.w
+                    .write_record(metrics_row(self.condition, self.repeat, k, &last))
+                    .map_err(anyhow::Error::new)
+                    .context(crate::run_cmd::OutputError(format!(
+                        "cannot write `{}`",
+                        rows.path.display()
+                    )))?;
+            }
         }
         Ok(())
+    }
+
+    /// The window sums of the steps completed so far (a step completes when the next one
+    /// begins, or at [`Swarm::finish`]).
+    #[must_use]
+    pub fn metrics(&self) -> &RunMetrics {
+        &self.metrics
     }
 
     /// The mean distance the robots' centres moved since the previous call (0 on the first)
@@ -472,11 +685,20 @@ impl Swarm {
     pub fn finish(mut self) -> Result<RunOutput> {
         let end = self.world.elapsed_states() + self.period_states;
         self.close_step(end)?;
+        if let Some(mut rows) = self.rows.take() {
+            rows.w
+                .flush()
+                .map_err(anyhow::Error::new)
+                .context(crate::run_cmd::OutputError(format!(
+                    "cannot write `{}`",
+                    rows.path.display()
+                )))?;
+        }
         let dead = self.dead();
         Ok(RunOutput {
             condition: self.condition,
             repeat: self.repeat,
-            steps: self.steps,
+            metrics: self.metrics,
             track: self.track,
             saves: self.saves,
             dead,
@@ -526,9 +748,13 @@ pub struct VcdProbe {
     pub path: std::path::PathBuf,
 }
 
-/// What to look at inside one robot of a run: its pins, its firmware under GDB.
+/// What to look at inside one robot of a run (its pins, its firmware under GDB) and where its
+/// per-step rows go.
 #[derive(Debug, Default)]
 pub struct RobotProbes {
+    /// A file for the run's rows of `metrics.csv`, written as the steps complete
+    /// ([`Swarm::set_rows`]).
+    pub rows: Option<std::path::PathBuf>,
     /// A pin trace.
     pub vcd: Option<VcdProbe>,
     /// A GDB stub for a robot, waiting for its client: (robot, listener). The run waits for
@@ -555,6 +781,9 @@ pub fn run_one_probed(
 ) -> Result<RunOutput> {
     let mut swarm = Swarm::new(s, condition, repeat, record_track, images)?;
     swarm.set_keep_going(keep_going);
+    if let Some(path) = &probes.rows {
+        swarm.set_rows(path)?;
+    }
     let debugged = probes.gdb.as_ref().map(|(k, _)| *k);
     if let Some((k, listener)) = probes.gdb {
         let robot = swarm
@@ -678,10 +907,24 @@ fn advance_world(
     Ok((collisions, contact))
 }
 
-fn record(world: &World, t: &mut Track, tracked: usize, snapshot: bool, time_s: f64) -> Result<()> {
+/// Records the tracked robots' centres in the early and/or late paths, and their outlines at a
+/// snapshot instant.
+fn record(
+    world: &World,
+    t: &mut Track,
+    tracked: usize,
+    (early, late): (bool, bool),
+    snapshot: bool,
+    time_s: f64,
+) -> Result<()> {
     for i in 0..tracked {
         let p = world.pose(i)?;
-        t.paths[i].push((p.x_m, p.y_m));
+        if early {
+            t.early[i].push((p.x_m, p.y_m));
+        }
+        if late {
+            t.late[i].push((p.x_m, p.y_m));
+        }
         if snapshot {
             t.outlines.push(Outline {
                 robot: i,
@@ -751,5 +994,118 @@ mod tests {
         assert_eq!(plan.len(), 23);
         assert_eq!(plan.iter().sum::<u64>(), 11_250_000);
         assert!(plan.iter().all(|&l| l == 489_130 || l == 489_131));
+    }
+
+    /// Step metrics that differ every step (so a sum over the wrong steps shows).
+    fn metrics_of(k: u32, gap: bool) -> StepMetrics {
+        let x = f64::from(k);
+        StepMetrics {
+            mean_d: 700.0 + (x * 0.37).sin() * 50.0,
+            collisions_per_robot: f64::from(k % 7) / 3.0,
+            contact_fraction: (x * 0.11).cos().abs(),
+            stuck_fraction: f64::from(k % 5) / 5.0,
+            moved_m: 0.07 / (1.0 + x),
+            gap_cv: gap.then_some(0.1 + x * 1e-4),
+            cpu_load_percent: 0.3 + x * 1e-6,
+        }
+    }
+
+    /// The kept sums equal the sums of the same steps taken afterwards (as the summary and the
+    /// figure took them when every step was kept), for windows that do and do not divide the
+    /// run.
+    #[test]
+    fn window_sums_equal_the_sums_of_the_kept_steps() {
+        for (steps, win, gap) in [
+            (1000, 250, false),
+            (1234, 500, true),
+            (150, 150, true),
+            (7, 3, false),
+        ] {
+            let all: Vec<StepMetrics> = (0..steps).map(|k| metrics_of(k, gap)).collect();
+            let mut m = RunMetrics::new(steps, win);
+            for (k, s) in all.iter().enumerate() {
+                m.add(k as u32, s);
+            }
+            let sum = |r: std::ops::Range<u32>| {
+                let mut w = WindowSums::default();
+                for s in &all[r.start as usize..r.end as usize] {
+                    w.add(s);
+                }
+                w
+            };
+            // Spot-check one field the direct way too (not through WindowSums::add).
+            let d: f64 = all[(steps - win) as usize..].iter().map(|s| s.mean_d).sum();
+            assert_eq!(m.last.mean_d, d);
+            assert_eq!(m.first, sum(0..win));
+            assert_eq!(m.last, sum(steps - win..steps));
+            assert_eq!(m.whole, sum(0..steps));
+            assert_eq!(m.whole_windows().len() as u32, steps / win);
+            for (w, got) in m.whole_windows().iter().enumerate() {
+                let w = w as u32;
+                assert_eq!(*got, sum(w * win..(w + 1) * win));
+            }
+            assert_eq!(m.whole.all_have_gap_cv(), gap);
+        }
+    }
+
+    /// A run keeps sums per window, not its steps: the rows go to the file as the steps
+    /// complete, and the kept sums are the sums of those rows; the arena paths are kept for
+    /// the first and last snapshot steps only.
+    #[test]
+    fn a_run_streams_its_rows_and_keeps_window_sums() {
+        let mut s = Scenario::arena();
+        s.steps = 450;
+        s.window = 100;
+        let dir = std::env::temp_dir().join(format!("h8swarm-rows-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let rows = dir.join("rows.csv");
+        let mut swarm = Swarm::new(&s, Condition::Learning, 0, true, None).unwrap();
+        swarm.set_rows(&rows).unwrap();
+        for k in 0..s.steps {
+            swarm.step().unwrap();
+            // Step k completes when step k + 1 begins.
+            assert_eq!(swarm.metrics().whole.steps, k);
+        }
+        let out = swarm.finish().unwrap();
+        let text = std::fs::read_to_string(&rows).unwrap();
+        std::fs::remove_dir_all(&dir).unwrap();
+        let parsed: Vec<Vec<String>> = text
+            .lines()
+            .map(|l| l.split(',').map(String::from).collect())
+            .collect();
+        assert_eq!(parsed.len(), 450);
+        let mut again = RunMetrics::new(s.steps, s.window);
+        for (k, r) in parsed.iter().enumerate() {
+            assert_eq!(r[0], "learning");
+            assert_eq!(r[2], k.to_string());
+            let f = |i: usize| r[i].parse::<f64>().unwrap();
+            again.add(
+                k as u32,
+                &StepMetrics {
+                    mean_d: f(3),
+                    collisions_per_robot: f(4),
+                    contact_fraction: f(5),
+                    stuck_fraction: f(6),
+                    moved_m: f(7),
+                    gap_cv: (!r[8].is_empty()).then(|| f(8)),
+                    cpu_load_percent: f(9),
+                },
+            );
+        }
+        assert_eq!(out.metrics, again);
+        assert_eq!(
+            out.metrics.windows.len(),
+            5,
+            "four whole windows and a partial one"
+        );
+        assert_eq!(out.metrics.whole_windows().len(), 4);
+        assert!(
+            out.metrics.whole.collisions_per_robot > 0.0,
+            "something happened"
+        );
+        let t = out.track.unwrap();
+        assert!(t.early.iter().all(|p| p.len() == SNAPSHOT_STEPS));
+        assert!(t.late.iter().all(|p| p.len() == SNAPSHOT_STEPS));
+        assert_ne!(t.early, t.late);
     }
 }

@@ -250,9 +250,9 @@ pub fn run(a: &RunArgs) -> Result<String> {
 pub const MODEL_ROBOT_BYTES: u64 = 192 << 10;
 /// See [`MODEL_ROBOT_BYTES`].
 pub const FIRMWARE_ROBOT_BYTES: u64 = 1 << 20;
-/// Host memory per step of a finished run kept for the summary and the plots (a row of
-/// metrics), with a margin.
-pub const STEP_BYTES: u64 = 128;
+/// Host memory per window of a run kept for the summary and the plots (the window's sums;
+/// the steps themselves are written as they complete and not kept), with a margin.
+pub const WINDOW_BYTES: u64 = 128;
 /// The tool itself (code, fonts, the fit, the plots), with a margin.
 pub const BASE_BYTES: u64 = 64 << 20;
 
@@ -272,8 +272,8 @@ pub fn estimated_memory(s: &Scenario, threads: usize) -> u64 {
                 .saturating_mul(per_robot),
         )
         .saturating_add(
-            runs.saturating_mul(u64::from(s.steps))
-                .saturating_mul(STEP_BYTES),
+            runs.saturating_mul(u64::from(s.steps / s.window.max(1)) + 1)
+                .saturating_mul(WINDOW_BYTES),
         )
 }
 
@@ -557,6 +557,9 @@ fn run_into(
         ProgressBar::hidden()
     };
     let started = Instant::now();
+    // Each run writes its rows as its steps complete into a file of its own in the staging
+    // folder; they are joined in run order into metrics.csv at the end.
+    let rows_path = |c: Condition, r: u32| stage.path(&format!(".rows-{}-{r}.csv", c.name()));
     let runs: Vec<RunOutput> = pool.install(|| {
         jobs.par_iter()
             .map(|&(c, r)| {
@@ -575,7 +578,10 @@ fn run_into(
                     images,
                     a.keep_going,
                     &|k| bar.inc(k),
-                    probes.unwrap_or_default(),
+                    crate::experiment::RobotProbes {
+                        rows: Some(rows_path(c, r)),
+                        ..probes.unwrap_or_default()
+                    },
                 )
             })
             .collect::<Result<_>>()
@@ -583,7 +589,8 @@ fn run_into(
     bar.finish_and_clear();
     let wall_s = started.elapsed().as_secs_f64();
 
-    write_metrics(&metrics_path, &runs)?;
+    let parts: Vec<PathBuf> = jobs.iter().map(|&(c, r)| rows_path(c, r)).collect();
+    write_metrics(&metrics_path, &parts)?;
     let stats = conditions(&runs, s.steps, s.window);
     let checked = claims(&stats);
     let saves: u64 = runs.iter().map(|r| r.saves).sum();
@@ -753,41 +760,25 @@ fn fmt_est(e: &Estimate) -> String {
     }
 }
 
-fn write_metrics(path: &Path, runs: &[RunOutput]) -> Result<()> {
-    write_metrics_csv(path, runs).context(OutputError(format!("cannot write `{}`", path.display())))
+/// Joins the runs' row files (in run order) under the header into `path`, removing them.
+fn write_metrics(path: &Path, parts: &[PathBuf]) -> Result<()> {
+    write_metrics_csv(path, parts)
+        .context(OutputError(format!("cannot write `{}`", path.display())))
 }
 
-fn write_metrics_csv(path: &Path, runs: &[RunOutput]) -> Result<()> {
+fn write_metrics_csv(path: &Path, parts: &[PathBuf]) -> Result<()> {
     let mut w = csv::Writer::from_path(path)?;
-    w.write_record([
-        "condition",
-        "repeat",
-        "step",
-        "mean_d",
-        "collisions_per_robot",
-        "contact_fraction",
-        "stuck_fraction",
-        "moved_m",
-        "gap_cv",
-        "cpu_load_percent",
-    ])?;
-    for r in runs {
-        for (k, m) in r.steps.iter().enumerate() {
-            w.write_record([
-                r.condition.name().to_string(),
-                r.repeat.to_string(),
-                k.to_string(),
-                format!("{}", m.mean_d),
-                format!("{}", m.collisions_per_robot),
-                format!("{}", m.contact_fraction),
-                format!("{}", m.stuck_fraction),
-                format!("{}", m.moved_m),
-                m.gap_cv.map(|v| format!("{v}")).unwrap_or_default(),
-                format!("{}", m.cpu_load_percent),
-            ])?;
-        }
+    w.write_record(crate::experiment::METRICS_HEADER)?;
+    let mut out = w
+        .into_inner()
+        .map_err(|e| anyhow::anyhow!("{}", e.error()))?;
+    for part in parts {
+        let mut f = std::fs::File::open(part)
+            .with_context(|| format!("reading the run's rows `{}`", part.display()))?;
+        std::io::copy(&mut f, &mut out)?;
+        std::fs::remove_file(part)?;
     }
-    w.flush()?;
+    std::io::Write::flush(&mut out)?;
     Ok(())
 }
 
@@ -796,14 +787,18 @@ fn write_metrics_csv(path: &Path, runs: &[RunOutput]) -> Result<()> {
 /// the gap CV (elsewhere the stuck robot-steps, percent): mean over repeats with its 95 % band
 /// (or the mean alone with fewer than two repeats).
 fn learning(s: &Scenario, runs: &[RunOutput]) -> LearningFigure {
-    use crate::experiment::StepMetrics;
+    use crate::experiment::WindowSums;
     let win = s.window.max(1) as usize;
-    let windows = s.steps as usize / win;
+    let windows = runs
+        .iter()
+        .map(|r| r.metrics.whole_windows().len())
+        .min()
+        .unwrap_or(0);
     let of =
         |c: Condition| -> Vec<&RunOutput> { runs.iter().filter(|r| r.condition == c).collect() };
     // One series per condition of a per-step metric, summed or averaged over each window.
     let panel =
-        |f: &dyn Fn(&StepMetrics) -> f64, sum: bool, scale: f64, floor0: bool| -> Vec<Series> {
+        |f: &dyn Fn(&WindowSums) -> f64, sum: bool, scale: f64, floor0: bool| -> Vec<Series> {
             let mut out = Vec::new();
             for c in Condition::ALL {
                 let of_c = of(c);
@@ -812,11 +807,10 @@ fn learning(s: &Scenario, runs: &[RunOutput]) -> LearningFigure {
                 }
                 let (mut xs, mut m, mut lo, mut hi) = (vec![], vec![], vec![], vec![]);
                 for w in 0..windows {
-                    let range = w * win..(w + 1) * win;
                     let vals: Vec<f64> = of_c
                         .iter()
                         .map(|r| {
-                            let t: f64 = r.steps[range.clone()].iter().map(f).sum();
+                            let t = f(&r.metrics.windows[w]);
                             scale * if sum { t } else { t / win as f64 }
                         })
                         .collect();
@@ -847,14 +841,12 @@ fn learning(s: &Scenario, runs: &[RunOutput]) -> LearningFigure {
         y_label: "% of the window".to_string(),
         series: panel(&|m| m.contact_fraction, false, 100.0, true),
     }];
-    let corridor = runs
-        .iter()
-        .all(|r| r.steps.iter().all(|m| m.gap_cv.is_some()));
+    let corridor = runs.iter().all(|r| r.metrics.whole.all_have_gap_cv());
     more.push(if corridor {
         Panel {
             caption: "Gap CV between neighbours (evenly spaced: low)".to_string(),
             y_label: "coefficient of variation".to_string(),
-            series: panel(&|m| m.gap_cv.unwrap_or(0.0), false, 1.0, true),
+            series: panel(&|m| m.gap_cv, false, 1.0, true),
         }
     } else {
         Panel {
@@ -882,11 +874,7 @@ fn arena(s: &Scenario, t: &crate::experiment::Track) -> Vec<ArenaFigure> {
     let k = crate::experiment::SNAPSHOT_STEPS.min(s.steps as usize);
     let n = s.steps as usize;
     let first_of = |from: usize, to: usize| -> ArenaFigure {
-        let paths = t
-            .paths
-            .iter()
-            .map(|p| p[from.min(p.len())..to.min(p.len())].to_vec())
-            .collect();
+        let paths = if from == 0 { &t.early } else { &t.late }.clone();
         let t0 = from as f64 * s.timing.step_period_s;
         let t1 = to as f64 * s.timing.step_period_s;
         let outlines = t
@@ -903,8 +891,8 @@ fn arena(s: &Scenario, t: &crate::experiment::Track) -> Vec<ArenaFigure> {
                 t0,
                 t1,
                 s.robots,
-                if t.paths.len() < s.robots {
-                    format!(", paths of the first {}", t.paths.len())
+                if t.early.len() < s.robots {
+                    format!(", paths of the first {}", t.early.len())
                 } else {
                     String::new()
                 }

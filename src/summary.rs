@@ -3,7 +3,7 @@
 use serde::Serialize;
 use statrs::distribution::{ContinuousCDF, StudentsT};
 
-use crate::experiment::RunOutput;
+use crate::experiment::{RunOutput, WindowSums};
 use crate::robot::Condition;
 
 /// The two-sided 95 % quantile of Student's t with `dof` degrees of freedom (its 97.5 %
@@ -146,34 +146,34 @@ impl Claim {
     }
 }
 
-/// Window statistics of the runs of one condition over steps `from..to`.
+/// Window statistics over runs of one condition, from each run's sums over the same window of
+/// steps `from..to`.
 #[must_use]
-pub fn window(runs: &[&RunOutput], from: u32, to: u32) -> WindowStats {
-    let per_run = |f: &dyn Fn(&crate::experiment::StepMetrics) -> f64, mean: bool| -> Vec<f64> {
-        runs.iter()
-            .map(|r| {
-                let s = &r.steps[from as usize..to as usize];
-                let total: f64 = s.iter().map(f).sum();
-                if mean { total / s.len() as f64 } else { total }
+pub fn window(sums: &[&WindowSums], from: u32, to: u32) -> WindowStats {
+    let per_run = |f: &dyn Fn(&WindowSums) -> f64, mean: bool| -> Vec<f64> {
+        sums.iter()
+            .map(|w| {
+                let total = f(w);
+                if mean {
+                    total / f64::from(w.steps)
+                } else {
+                    total
+                }
             })
             .collect()
     };
-    let gap = runs
+    let gap = sums
         .iter()
-        .all(|r| {
-            r.steps[from as usize..to as usize]
-                .iter()
-                .all(|m| m.gap_cv.is_some())
-        })
-        .then(|| Estimate::of(&per_run(&|m| m.gap_cv.unwrap_or(0.0), true)));
+        .all(|w| w.all_have_gap_cv())
+        .then(|| Estimate::of(&per_run(&|w| w.gap_cv, true)));
     WindowStats {
         from_step: from,
         to_step: to,
-        mean_d: Estimate::of(&per_run(&|m| m.mean_d, true)),
-        collisions_per_robot: Estimate::of(&per_run(&|m| m.collisions_per_robot, false)),
-        moved_m: Estimate::of(&per_run(&|m| m.moved_m, true)),
-        contact_fraction: Estimate::of(&per_run(&|m| m.contact_fraction, true)),
-        stuck_fraction: Estimate::of(&per_run(&|m| m.stuck_fraction, true)),
+        mean_d: Estimate::of(&per_run(&|w| w.mean_d, true)),
+        collisions_per_robot: Estimate::of(&per_run(&|w| w.collisions_per_robot, false)),
+        moved_m: Estimate::of(&per_run(&|w| w.moved_m, true)),
+        contact_fraction: Estimate::of(&per_run(&|w| w.contact_fraction, true)),
+        stuck_fraction: Estimate::of(&per_run(&|w| w.stuck_fraction, true)),
         gap_cv: gap,
     }
 }
@@ -187,10 +187,12 @@ pub fn conditions(runs: &[RunOutput], steps: u32, win: u32) -> Vec<ConditionStat
         if of_c.is_empty() {
             continue;
         }
+        let first: Vec<&WindowSums> = of_c.iter().map(|r| &r.metrics.first).collect();
+        let last: Vec<&WindowSums> = of_c.iter().map(|r| &r.metrics.last).collect();
         out.push(ConditionStats {
             condition: c,
-            first: window(&of_c, 0, win),
-            last: window(&of_c, steps - win, steps),
+            first: window(&first, 0, win),
+            last: window(&last, steps - win, steps),
         });
     }
     out
