@@ -5,7 +5,7 @@
 #
 #   scripts/paper-runs.sh [OUT] [THREADS]   (default OUT: out/paper, THREADS: 2)
 #
-# About 25 minutes on this 2-core machine (shared with other jobs) with model robots.
+# About 10 minutes on this 2-core machine (shared with other jobs) with model robots.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${1:-out/paper}

@@ -56,7 +56,9 @@
 //!   (SPEC §1) and the inertia of a uniform box; each of its two drive wheels grips the floor
 //!   and makes the body's velocity at the wheel equal the wheel's rim speed along it and zero
 //!   across it, with a force of at most `μ_floor · m·g/2` (default μ 0.6, about 1.5 N per
-//!   wheel); past that it slips. The 203:1 gear motors could push harder at stall, so a
+//!   wheel); past that it slips, and a slipping wheel's friction points against the slip of its
+//!   contact patch (isotropic Coulomb: a wheel spinning against a blocked body holds it only
+//!   weakly sideways). The 203:1 gear motors could push harder at stall, so a
 //!   blocked robot pushes with its traction and its wheels slip ([`World::wheel_speeds`] still
 //!   shows the motors' speed). A robot touching nothing follows its wheels exactly.
 //! - **Contacts** (robot–wall, robot–robot; [`SolverStats`] counts what they did): at the start
@@ -74,8 +76,10 @@
 //!   impulses (braked or coasting ones start from nothing: a braked robot held against a wall
 //!   is statically indeterminate, and a kept push would outlive what sustained it). So bodies push each other (two equal tractions
 //!   balance), slide along walls and each other when friction allows, and turn under an
-//!   off-centre contact (a robot driving into a wall at an angle turns square to it and stays,
-//!   wheels slipping, as a differential-drive robot does). Poses follow the exact motion of the
+//!   off-centre contact (a robot driving into a wall less than atan(width/length) + atan(μ_wall)
+//!   = 54.7° off its normal turns square to it and stays, wheels slipping, as a differential-drive
+//!   robot does; at a flatter angle it turns along the wall and slides; the README derives it and
+//!   `tests/wall_angle.rs` checks it against a plain-Coulomb reference). Poses follow the exact motion of the
 //!   solved velocities. What the linearised solve leaves of an overlap (a turning corner) is
 //!   removed by position sweeps that push along the contact normal with rotation, weighted by
 //!   mass and inertia, to a 10 µm gap (so that a chain of contacts clears in a few sweeps); if `position_iterations` sweeps do not clear a cluster, its robots stop

@@ -1,0 +1,187 @@
+//! What a stuck robot senses, evaluates and chooses (issue 12): runs the learning and
+//! learning-off conditions of a scenario with model robots and, for every robot-step of the last
+//! window, records whether the robot is stuck (the metric's rule: its motors drove and it moved
+//! < 1 mm over the last 100 steps), its four proximities p (du), E = D(t) − D(t−1) (the
+//! evaluation the learner applies at this step), the winning behaviour, the winner's margin over
+//! the runner-up in the outputs O, and which bumper is pressed. Prints the means over stuck and
+//! over moving robot-steps, and how stuck spells end.
+//!
+//!     cargo run --release --example stuck_probe [arena|corridor|FILE.toml] [REPEATS] [SEED]
+
+use h8swarm::collisions::StuckDetector;
+use h8swarm::experiment::Swarm;
+use h8swarm::robot::{Brain, Condition};
+use h8swarm::scenario::Scenario;
+
+#[derive(Default)]
+struct Tally {
+    n: u64,
+    win: [u64; 4],
+    p: [f64; 4],
+    e_abs_over_t: u64,
+    reward: u64,
+    punish: u64,
+    margin: f64,
+    bumper: [u64; 4],
+    any_bumper: u64,
+}
+
+impl Tally {
+    fn add(&mut self, s: &Sample, threshold: i32) {
+        self.n += 1;
+        self.win[s.win] += 1;
+        for k in 0..4 {
+            self.p[k] += f64::from(s.p[k]);
+            self.bumper[k] += u64::from(s.bumpers[k]);
+        }
+        self.any_bumper += u64::from(s.bumpers.iter().any(|&b| b));
+        let e = i32::from(s.e);
+        self.e_abs_over_t += u64::from(e.abs() > threshold);
+        self.reward += u64::from(e > threshold);
+        self.punish += u64::from(e < -threshold);
+        self.margin += f64::from(s.margin);
+    }
+
+    fn print(&self, what: &str) {
+        let n = self.n.max(1) as f64;
+        let pc = |x: u64| 100.0 * x as f64 / n;
+        println!(
+            "| {what} | {} | {:.0} / {:.0} / {:.0} / {:.0} % | {:.0} / {:.0} / {:.0} / {:.0} | {:.0} % ({:.0} % reward, {:.0} % punish) | {:.0} | {:.0} % (front {:.0}, rear {:.0}, left {:.0}, right {:.0} %) |",
+            self.n,
+            pc(self.win[0]),
+            pc(self.win[1]),
+            pc(self.win[2]),
+            pc(self.win[3]),
+            self.p[0] / n,
+            self.p[1] / n,
+            self.p[2] / n,
+            self.p[3] / n,
+            pc(self.e_abs_over_t),
+            pc(self.reward),
+            pc(self.punish),
+            self.margin / n,
+            pc(self.any_bumper),
+            pc(self.bumper[0]),
+            pc(self.bumper[1]),
+            pc(self.bumper[2]),
+            pc(self.bumper[3]),
+        );
+    }
+}
+
+struct Sample {
+    win: usize,
+    p: [i16; 4],
+    e: i16,
+    margin: i32,
+    bumpers: [bool; 4],
+}
+
+fn main() -> anyhow::Result<()> {
+    let mut args = std::env::args().skip(1);
+    let mut s = Scenario::load(&args.next().unwrap_or_else(|| "arena".into()))?;
+    let repeats: u32 = args.next().map_or(Ok(5), |a| a.parse())?;
+    if let Some(seed) = args.next() {
+        s.seed = seed.parse()?;
+    }
+    let threshold = s.learner.threshold;
+    let last_from = s.steps.saturating_sub(s.window);
+    println!(
+        "{}: {} robots, {} steps, last window from step {last_from}, {repeats} repeats, seed {}, T = {threshold} du",
+        s.name, s.robots, s.steps, s.seed
+    );
+    println!(
+        "| condition, robot-steps | n | winner fwd / back / left / right | p front / rear / left / right (du) | abs(E) > T | margin O_win − O_2nd (Q15) | bumper pressed |"
+    );
+    println!("|---|---:|---|---|---|---:|---|");
+    for condition in [Condition::Learning, Condition::LearningOff] {
+        let (mut stuck, mut moving) = (Tally::default(), Tally::default());
+        // Stuck spells in the last window: ended by which behaviour, or lasting to the end.
+        let (mut spells_ended, mut spells_to_end, mut ended_by) = (0u64, 0u64, [0u64; 4]);
+        for repeat in 0..repeats {
+            let mut sw = Swarm::new(&s, condition, repeat, false, None)?;
+            let n = s.robots;
+            let mut det = vec![StuckDetector::default(); n];
+            let mut was_stuck = vec![false; n];
+            let mut xy: Vec<(f64, f64)> = (0..n)
+                .map(|i| {
+                    let p = sw.world().pose(i).unwrap();
+                    (p.x_m, p.y_m)
+                })
+                .collect();
+            let mut d_prev = vec![None::<i16>; n];
+            let mut prev_win = vec![0usize; n];
+            for step in 0..s.steps {
+                sw.step()?;
+                for i in 0..n {
+                    let pose = sw.world().pose(i)?;
+                    let moved = (pose.x_m - xy[i].0).hypot(pose.y_m - xy[i].1);
+                    xy[i] = (pose.x_m, pose.y_m);
+                    let speeds = sw.world().wheel_speeds(i)?;
+                    let is_stuck = det[i].record(moved, speeds.iter().any(|&v| v != 0.0));
+                    let bumpers = sw.world().bumpers(i)?;
+                    let Some(robot) = sw.robot_mut(i) else {
+                        continue;
+                    };
+                    let Brain::Model(c) = &robot.brain else {
+                        anyhow::bail!("the probe reads model robots only");
+                    };
+                    let l = c.learner();
+                    let x = l.inputs();
+                    let p: [i16; 4] = std::array::from_fn(|k| i16::from(x[k].to_bits()) + 128);
+                    let d: i16 = p.iter().sum();
+                    let e = d_prev[i].map_or(0, |dp| d - dp);
+                    d_prev[i] = Some(d);
+                    let o: Vec<i32> = l.outputs().iter().map(|v| i32::from(v.to_bits())).collect();
+                    let mut win = 0;
+                    for (j, &v) in o.iter().enumerate() {
+                        if v > o[win] {
+                            win = j;
+                        }
+                    }
+                    let second = o
+                        .iter()
+                        .enumerate()
+                        .filter(|&(j, _)| j != win)
+                        .map(|(_, &v)| v)
+                        .max()
+                        .unwrap_or(o[win]);
+                    if step >= last_from {
+                        let sample = Sample {
+                            win,
+                            p,
+                            e,
+                            margin: o[win] - second,
+                            bumpers,
+                        };
+                        if is_stuck {
+                            stuck.add(&sample, threshold);
+                        } else {
+                            moving.add(&sample, threshold);
+                        }
+                        if was_stuck[i] && !is_stuck {
+                            // The move that ended it ran the behaviour chosen a step ago.
+                            spells_ended += 1;
+                            ended_by[prev_win[i]] += 1;
+                        }
+                    }
+                    was_stuck[i] = is_stuck;
+                    prev_win[i] = win;
+                }
+            }
+            spells_to_end += was_stuck.iter().filter(|&&b| b).count() as u64;
+        }
+        stuck.print(&format!("{}, stuck", condition.name()));
+        moving.print(&format!("{}, moving", condition.name()));
+        println!(
+            "|  {}: stuck spells ended in the last window {spells_ended} (the behaviour then: fwd {}, back {}, left {}, right {}); robots stuck at the end {spells_to_end} of {} |",
+            condition.name(),
+            ended_by[0],
+            ended_by[1],
+            ended_by[2],
+            ended_by[3],
+            repeats as usize * s.robots
+        );
+    }
+    Ok(())
+}
