@@ -4,7 +4,8 @@
 //! < 1 mm over the last 100 steps), its four proximities p (du), E = D(t) − D(t−1) (the
 //! evaluation the learner applies at this step), the winning behaviour, the winner's margin over
 //! the runner-up in the outputs O, and which bumper is pressed. Prints the means over stuck and
-//! over moving robot-steps, and how stuck spells end.
+//! over moving robot-steps, and how stuck spells end and how long they last over the whole run
+//! (a spell counted from the step the rule first flags it, i.e. 100 steps after it began).
 //!
 //!     cargo run --release --example stuck_probe [arena|corridor|FILE.toml] [REPEATS] [SEED]
 
@@ -98,6 +99,9 @@ fn main() -> anyhow::Result<()> {
         let (mut stuck, mut moving) = (Tally::default(), Tally::default());
         // Stuck spells in the last window: ended by which behaviour, or lasting to the end.
         let (mut spells_ended, mut spells_to_end, mut ended_by) = (0u64, 0u64, [0u64; 4]);
+        // Every stuck spell of the whole run: its length in steps (counted from the step the
+        // detector first flags it) and whether it ended before the run did.
+        let mut spells: Vec<(u32, bool)> = Vec::new();
         for repeat in 0..repeats {
             let mut sw = Swarm::new(&s, condition, repeat, false, None)?;
             let n = s.robots;
@@ -111,6 +115,7 @@ fn main() -> anyhow::Result<()> {
                 .collect();
             let mut d_prev = vec![None::<i16>; n];
             let mut prev_win = vec![0usize; n];
+            let mut since = vec![0u32; n];
             for step in 0..s.steps {
                 sw.step()?;
                 for i in 0..n {
@@ -165,11 +170,22 @@ fn main() -> anyhow::Result<()> {
                             ended_by[prev_win[i]] += 1;
                         }
                     }
+                    if is_stuck && !was_stuck[i] {
+                        since[i] = step;
+                    }
+                    if was_stuck[i] && !is_stuck {
+                        spells.push((step - since[i], true));
+                    }
                     was_stuck[i] = is_stuck;
                     prev_win[i] = win;
                 }
             }
             spells_to_end += was_stuck.iter().filter(|&&b| b).count() as u64;
+            for i in 0..n {
+                if was_stuck[i] {
+                    spells.push((s.steps - since[i], false));
+                }
+            }
         }
         stuck.print(&format!("{}, stuck", condition.name()));
         moving.print(&format!("{}, moving", condition.name()));
@@ -181,6 +197,24 @@ fn main() -> anyhow::Result<()> {
             ended_by[2],
             ended_by[3],
             repeats as usize * s.robots
+        );
+        let mut ended: Vec<u32> = spells.iter().filter(|x| x.1).map(|x| x.0).collect();
+        ended.sort_unstable();
+        let total: u64 = spells.iter().map(|x| u64::from(x.0)).sum();
+        let long: u64 = spells
+            .iter()
+            .filter(|x| x.0 >= 1000)
+            .map(|x| u64::from(x.0))
+            .sum();
+        println!(
+            "|  {}: whole run: {} stuck spells, {} ended (median length {} steps, 90th percentile {}), {} lasted to the end; spells of 1 000 steps or more hold {:.0} % of the stuck robot-steps |",
+            condition.name(),
+            spells.len(),
+            ended.len(),
+            ended.get(ended.len() / 2).copied().unwrap_or(0),
+            ended.get(ended.len() * 9 / 10).copied().unwrap_or(0),
+            spells.len() - ended.len(),
+            100.0 * long as f64 / total.max(1) as f64
         );
     }
     Ok(())
