@@ -1147,3 +1147,212 @@ fn the_benchmark_window_of_crcmacdiv_has_no_io() {
         .collect();
     assert!(io.is_empty(), "{:?}", &io[..io.len().min(5)]);
 }
+
+// ----- idle cycles (Cpu::run_idle) -----------------------------------------------------------
+
+/// The tick counter of the idle-loop programs (a RAM longword above the stack).
+const TICKS: u32 = 0xFF_FF0C;
+
+/// An idle-loop program: ITU0 ticking every `gra + 1` counts of φ/8, a main loop of random
+/// straight code and a wait for `wait` ticks (`mov.l @TICKS,er5; add.l #wait,er5; 1: sleep;
+/// mov.l @TICKS,er6; cmp.l er5,er6; blt 1b`), and a handler that clears the flag, adds
+/// `stride` to the counter (`add.l`, or `inc.l #1` when `stride` is 0) and runs `body`.
+#[derive(Clone, Debug)]
+struct IdleProgram {
+    gra: u16,
+    wait: u32,
+    stride: u32,
+    ticks: u32,
+    main: Vec<[u8; 10]>,
+    body: Vec<[u8; 10]>,
+}
+
+fn install_idle(p: &IdleProgram) -> (Cpu, Mcu<NullBoard>) {
+    let mut m = Mcu::new(McuConfig::default(), NullBoard).expect("default MCU");
+    for v in 1..61u32 {
+        m.poke(v * 4, &HANDLER.to_be_bytes());
+    }
+    m.poke(0, &START.to_be_bytes());
+    m.poke(TICKS, &p.ticks.to_be_bytes());
+    let [t0, t1, t2, t3] = TICKS.to_be_bytes();
+    let mut a = Asm::new(START);
+    a.mov_l(7, STACK_TOP);
+    a.piece(&Piece::StartTimer(p.gra), 1);
+    let top = a.here();
+    a.straight(&p.main);
+    a.emit(&[0x01, 0x00, 0x6b, 0x25, t0, t1, t2, t3], "mov.l"); // @TICKS,er5
+    let [w0, w1, w2, w3] = p.wait.to_be_bytes();
+    a.emit(&[0x7a, 0x15, w0, w1, w2, w3], "add.l"); // #wait,er5
+    let wait = a.here();
+    a.emit(&[0x01, 0x80], "sleep");
+    a.emit(&[0x01, 0x00, 0x6b, 0x26, t0, t1, t2, t3], "mov.l"); // @TICKS,er6
+    a.emit(&[0x1f, 0xd6], "cmp.l"); // er5,er6
+    a.branch(13, wait); // blt
+    a.branch(0, top);
+    m.poke(START, &a.code);
+    let mut h = Asm::new(HANDLER);
+    h.emit(&[0x7f, 0x67, 0x72, 0x00], "bclr"); // TSR0.IMFA
+    h.emit(&[0x01, 0x00, 0x6b, 0x26, t0, t1, t2, t3], "mov.l"); // @TICKS,er6
+    if p.stride == 0 {
+        h.emit(&[0x0b, 0x76], "inc"); // inc.l #1,er6
+    } else {
+        let [s0, s1, s2, s3] = p.stride.to_be_bytes();
+        h.emit(&[0x7a, 0x16, s0, s1, s2, s3], "add.l");
+    }
+    h.emit(&[0x01, 0x00, 0x6b, 0xa6, t0, t1, t2, t3], "mov.l"); // er6,@TICKS
+    h.straight(&p.body);
+    h.emit(&[0x56, 0x70], "rte");
+    m.poke(HANDLER, &h.code);
+    let mut cpu = Cpu::new();
+    cpu.reset(&mut m);
+    (cpu, m)
+}
+
+/// What `FirmwareController` does per call: idle cycles first when asleep, then sleep to the
+/// next interrupt and run to the next SLEEP, interrupt or the deadline.
+fn drive(cpu: &mut Cpu, m: &mut Mcu<NullBoard>, deadline: u64) -> Result<Event, CpuError> {
+    if cpu.sleeping() {
+        let r = cpu.run_idle(m, deadline, &mut |_, _| false)?;
+        if let Some(e) = r.end {
+            return Ok(e);
+        }
+    }
+    if cpu.sleeping() {
+        m.sleep_until_irq(deadline);
+        if m.now() >= deadline {
+            return Ok(Event::Asleep);
+        }
+    }
+    cpu.run_until(m, deadline, |c, _| c.sleeping())
+}
+
+/// Runs `p` with idle cycles advanced and with everything stepped (fast-forwarding off), to
+/// the same deadlines `chunk` states apart until `until`; compares the state and the RAM at
+/// every deadline. Returns the idle cycles advanced.
+fn idle_vs_steps(p: &IdleProgram, chunk: u64, until: u64) -> Result<u64, String> {
+    let (mut ca, mut ma) = install_idle(p);
+    let (mut cb, mut mb) = install_idle(p);
+    cb.set_fast_forward(false);
+    let mut deadline = 0;
+    let mut errors: [Option<CpuError>; 2] = [None, None];
+    while deadline < until {
+        deadline += chunk;
+        for (k, (c, m)) in [(&mut ca, &mut ma), (&mut cb, &mut mb)]
+            .into_iter()
+            .enumerate()
+        {
+            while m.now() < deadline && !c.halted() && errors[k].is_none() {
+                if let Err(e) = drive(c, m, deadline) {
+                    errors[k] = Some(e);
+                }
+            }
+        }
+        if errors[0] != errors[1] {
+            return Err(format!("at {deadline}: {errors:?}"));
+        }
+        let (sa, sb) = (snapshot(&ca, ma.now()), snapshot(&cb, mb.now()));
+        if sa != sb {
+            return Err(format!("at {deadline}: {sa:?} vs {sb:?}"));
+        }
+        if let Some(x) = ram_differs(&ma, &mb) {
+            return Err(format!("at {deadline}: RAM differs at H'{x:06X}"));
+        }
+        if errors[0].is_some() {
+            break;
+        }
+    }
+    assert_eq!(cb.idle_cycles_skipped(), 0);
+    Ok(ca.idle_cycles_skipped())
+}
+
+fn idle_program() -> impl Strategy<Value = IdleProgram> {
+    (
+        20u16..400,
+        1u32..300,
+        prop_oneof![3 => Just(0u32), 1 => Just(1), 1 => Just(0xFFFF_FFFF), 1 => any::<u32>()],
+        prop_oneof![2 => 0u32..1_000, 1 => any::<u32>()],
+        raw_insns(6),
+        prop_oneof![1 => Just(Vec::new()), 1 => raw_insns(3)],
+    )
+        .prop_map(|(gra, wait, stride, ticks, main, body)| IdleProgram {
+            gra,
+            wait,
+            stride,
+            ticks,
+            main,
+            body,
+        })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    #[test]
+    fn idle_cycles_advance_to_the_state_stepping_reaches(p in idle_program(), chunk in 50_000u64..700_000) {
+        let r = idle_vs_steps(&p, chunk, 3_000_000);
+        prop_assert!(r.is_ok(), "{}", r.unwrap_err());
+    }
+}
+
+#[test]
+fn idle_cycles_are_advanced_and_only_when_proven() {
+    let plain = IdleProgram {
+        gra: 99,
+        wait: 200,
+        stride: 0,
+        ticks: 0,
+        main: Vec::new(),
+        body: Vec::new(),
+    };
+    // A counter by 1, by 3 and downwards; the wait's end and the counter's sign change
+    // (ticks from H'7FFFFF00) are crossed by stepping.
+    for (stride, ticks) in [(0, 0), (3, 5), (0xFFFF_FFFF, 1000), (0, 0x7FFF_FF00)] {
+        let p = IdleProgram {
+            stride,
+            ticks,
+            ..plain.clone()
+        };
+        for chunk in [99_991, 1_000_003] {
+            let n = idle_vs_steps(&p, chunk, 4_000_000).unwrap_or_else(|e| panic!("{e}"));
+            assert!(
+                n > 1_000,
+                "stride {stride:#x}, chunk {chunk}: {n} idle cycles advanced"
+            );
+        }
+    }
+    // A handler that shifts the counter (not affine): stepped, and alike.
+    let shifting = IdleProgram {
+        body: vec![[0x10, 0x36, 0, 0, 0, 0, 0, 0, 0, 0]], // shll.l er6
+        ..plain.clone()
+    };
+    let n = idle_vs_steps(&shifting, 333_333, 2_000_000).unwrap_or_else(|e| panic!("{e}"));
+    assert!(
+        n > 0,
+        "shll.l of a copy in ER6 changes nothing the proof needs: {n}"
+    );
+    let toggling = IdleProgram {
+        body: vec![[0x7f, TOGGLE as u8, 0x71, 0x00, 0, 0, 0, 0, 0, 0]], // bnot #0,@TOGGLE
+        ..plain
+    };
+    let n = idle_vs_steps(&toggling, 333_333, 2_000_000).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(n, 0, "a byte that alternates: no cycle repeats");
+}
+
+/// The random idle programs' advancing, printed (`-- --nocapture`): some cycles must be
+/// advanced, or the property test above passes vacuously.
+#[test]
+fn random_idle_programs_have_cycles_to_advance() {
+    let mut runner = proptest::test_runner::TestRunner::deterministic();
+    let (mut advanced, mut with) = (0, 0);
+    for _ in 0..32 {
+        let p = idle_program()
+            .new_tree(&mut runner)
+            .expect("a program")
+            .current();
+        let n = idle_vs_steps(&p, 250_000, 2_000_000).unwrap_or_else(|e| panic!("{e}"));
+        advanced += n;
+        with += usize::from(n > 0);
+    }
+    println!("32 random idle programs: {advanced} idle cycles advanced, in {with} programs");
+    assert!(with > 4, "{with}");
+}

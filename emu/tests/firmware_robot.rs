@@ -378,6 +378,9 @@ fn the_sensors_are_read_from_the_configured_channels() {
     }
 }
 
+/// Registers, CCR, PC, instructions, clock and RAM at a step's end.
+type StepEnd = ([u32; 8], u8, u32, u64, u64, Vec<u8>);
+
 /// What a firmware robot's run leaves, for comparing two runs.
 #[derive(Debug, PartialEq)]
 struct Trace {
@@ -388,11 +391,13 @@ struct Trace {
     ccr: u8,
     instructions: u64,
     ram: Vec<u8>,
+    /// Registers, CCR, PC, instructions, clock and RAM at the end of every step.
+    states: Vec<StepEnd>,
     write_counts: Vec<Vec<u32>>,
     violations: Vec<u64>,
 }
 
-fn controller_trace(fast_forward: bool, steps: usize) -> (Trace, u64) {
+fn controller_trace(fast_forward: bool, steps: usize) -> (Trace, u64, u64) {
     use emu::board::firmware::FirmwareController;
     use emu::core::memmap::{RAM_BYTES, RAM_START};
     let fw = firmware();
@@ -403,11 +408,22 @@ fn controller_trace(fast_forward: bool, steps: usize) -> (Trace, u64) {
     };
     let mut c = FirmwareController::start(&fw, &mut mcu, Some(&block)).unwrap();
     c.set_fast_forward(fast_forward);
-    let (mut sensing, mut busy) = (Vec::new(), Vec::new());
+    let (mut sensing, mut busy, mut states) = (Vec::new(), Vec::new(), Vec::new());
     for _ in 0..steps {
         sensing.push(c.run_to_sensing(&mut mcu).unwrap());
         c.run_to_sleep(&mut mcu).unwrap();
         busy.push(c.take_busy());
+        // The whole state at every step's end: registers, flags, count, clock, RAM.
+        let cpu = c.cpu();
+        let ram: Vec<u8> = (0..RAM_BYTES).map(|i| mcu.peek(RAM_START + i)).collect();
+        states.push((
+            cpu.regs(),
+            cpu.ccr(),
+            cpu.pc(),
+            cpu.instructions(),
+            mcu.now(),
+            ram,
+        ));
     }
     let cpu = c.cpu();
     let trace = Trace {
@@ -418,6 +434,7 @@ fn controller_trace(fast_forward: bool, steps: usize) -> (Trace, u64) {
         ccr: cpu.ccr(),
         instructions: cpu.instructions(),
         ram: (0..RAM_BYTES).map(|i| mcu.peek(RAM_START + i)).collect(),
+        states,
         write_counts: mcu
             .i2c()
             .devices()
@@ -431,24 +448,33 @@ fn controller_trace(fast_forward: bool, steps: usize) -> (Trace, u64) {
             .map(|d| d.timing_violation_count())
             .collect(),
     };
-    (trace, cpu.skipped_instructions())
+    (trace, cpu.skipped_instructions(), cpu.idle_cycles_skipped())
 }
 
 #[test]
 fn the_robot_runs_alike_with_loop_fast_forwarding_on_and_off() {
-    // 120 steps with a save every 3: delay loops (the I2C bit timing, ACK polling's pauses)
-    // and the ADF poll are skipped on one side, executed on the other.
-    let (on, skipped) = controller_trace(true, 120);
-    let (off, none) = controller_trace(false, 120);
-    assert_eq!(none, 0);
+    // 120 steps with a save every 3: delay loops (the I2C bit timing, ACK polling's pauses),
+    // the ADF poll and the idle cycles between steps (tick interrupt, handler, back to sleep)
+    // are skipped on one side, executed on the other; the whole state is compared at every
+    // step's end.
+    let (on, skipped, idle) = controller_trace(true, 120);
+    let (off, none, no_idle) = controller_trace(false, 120);
+    assert_eq!((none, no_idle), (0, 0));
     assert!(
         skipped > on.instructions / 4,
         "{skipped} of {} instructions skipped",
         on.instructions
     );
+    // 45 ticks a step: most of them advanced in closed form (two are run to prove the rest,
+    // and the one that ends the wait is run).
+    assert!(idle > 120 * 30, "{idle} idle cycles advanced");
     assert!(
         on.write_counts.iter().flatten().any(|&n| n > 0),
         "records were saved"
     );
+    assert_eq!(on.states.len(), off.states.len());
+    for (k, (a, b)) in on.states.iter().zip(&off.states).enumerate() {
+        assert!(a == b, "step {k}: the states differ");
+    }
     assert_eq!(on, off);
 }

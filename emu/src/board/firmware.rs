@@ -598,6 +598,16 @@ impl FirmwareController {
         mut stop: impl FnMut(&Mcu<B>) -> bool,
     ) -> Result<Event, RunError> {
         use crate::core::bus::Bus;
+        if self.cpu.sleeping() && self.debugger.is_none() && self.phases.is_none() {
+            // Idle cycles (tick, handler, back to sleep) proven to repeat are advanced at once.
+            let idle = self.cpu.run_idle(mcu, deadline, &mut |_, m| stop(m))?;
+            self.busy += idle.busy;
+            match idle.end {
+                Some(Event::Halted) => return Err(halted(&self.cpu)),
+                Some(event) => return Ok(event),
+                None => {}
+            }
+        }
         if self.cpu.sleeping() {
             mcu.sleep_until_irq(deadline);
             if mcu.now() >= deadline {

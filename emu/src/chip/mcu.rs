@@ -952,6 +952,51 @@ impl<B: Board> Bus for Mcu<B> {
         }
     }
 
+    /// The ITU's state relative to now ([`Itu::idle_signature`]), when every other module is
+    /// quiet: the A/D converter, SCI1 and the EEPROMs have nothing under way (no event to
+    /// come), so that without accesses their state stays as it is and they request nothing
+    /// new. `None` while a pin trace is recorded (it must see every cycle) or a module is busy.
+    fn idle_signature(&mut self) -> Option<Vec<u64>> {
+        let now = self.now;
+        if self.tracer.is_some()
+            || self.adc.next_event(now).is_some()
+            || Peripheral::next_event(&self.sci, now).is_some()
+            || Peripheral::next_event(&self.ports, now).is_some()
+            || Peripheral::next_event(&self.intc, now).is_some()
+            || self.i2c.next_event_states().is_some_and(|t| t > now)
+        {
+            return None;
+        }
+        let mut out = Vec::with_capacity(80);
+        self.itu.idle_signature(now, &mut out);
+        Some(out)
+    }
+
+    /// The ITU's registers: the only ones [`Bus::idle_signature`] covers.
+    fn idle_io(&self, addr: u32) -> bool {
+        Module::of(addr & ADDRESS_MASK) == Module::Itu
+    }
+
+    /// The clock and the ITU move `states` ahead; the other modules, quiet, catch up lazily;
+    /// `ram` is stored as by [`Mcu::poke`]. Refused (nothing done) while a pin trace is
+    /// recorded or when an address of `ram` is not in RAM.
+    fn idle_shift(&mut self, states: u64, ram: &[(u32, u32)]) -> bool {
+        if self.tracer.is_some()
+            || ram
+                .iter()
+                .any(|&(a, _)| (0..4).any(|i| Area::of((a + i) & ADDRESS_MASK) != Area::Ram))
+        {
+            return false;
+        }
+        for &(a, v) in ram {
+            self.poke(a, &v.to_be_bytes());
+        }
+        self.now += states;
+        self.itu.shift(states);
+        self.invalidate_irq();
+        true
+    }
+
     /// Tells a pin trace under way (SLEEP, and the accepted interrupts); otherwise nothing.
     #[inline]
     fn cpu_signal(&mut self, signal: CpuSignal) {

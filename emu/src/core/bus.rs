@@ -91,6 +91,32 @@ pub trait Bus {
         let _ = addr;
         None
     }
+
+    /// For the core's idle-cycle fast-forwarding ([`crate::core::cpu::Cpu::run_idle`]): a
+    /// description of the devices' state now, relative to now. The promise: if two
+    /// descriptions taken `P` states apart are equal, and in between the program's only device
+    /// accesses are to addresses [`Bus::idle_io`] accepts, then the devices repeat with period
+    /// `P` as long as the program repeats the same accesses at the same offsets (same reads,
+    /// same interrupt requests at the same instants). `None` (the default): no promise.
+    fn idle_signature(&mut self) -> Option<Vec<u64>> {
+        None
+    }
+
+    /// Whether accesses to the device register at `addr` are covered by
+    /// [`Bus::idle_signature`]'s promise. The default: none is.
+    fn idle_io(&self, addr: u32) -> bool {
+        let _ = addr;
+        false
+    }
+
+    /// Moves the clock `states` ahead (a whole number of the periods [`Bus::idle_signature`]
+    /// found) with the devices where repeating their period would bring them, and stores the
+    /// longwords `ram` (address, value) without bus cycles: the state a program repeating its
+    /// idle cycle reaches. Returns whether it did; the default does nothing and says no.
+    fn idle_shift(&mut self, states: u64, ram: &[(u32, u32)]) -> bool {
+        let _ = (states, ram);
+        false
+    }
 }
 
 /// The source of [`Bus::code_generation`] tokens: one process-wide counter, so a token is

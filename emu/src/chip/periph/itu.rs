@@ -676,6 +676,49 @@ impl Itu {
         }
     }
 
+    /// Appends the ITU's state at `now` (every channel brought to it) relative to `now`: the
+    /// registers, flags, counters and outputs, and the prescaler phase (`now` modulo 8, the
+    /// largest internal prescaler). Two equal signatures `P` states apart mean the ITU's
+    /// future is the same function of time from either instant, shifted by `P`.
+    pub fn idle_signature(&mut self, now: u64, out: &mut Vec<u64>) {
+        self.sync(now);
+        out.extend([
+            now & 7,
+            u64::from(self.tstr),
+            u64::from(self.tsnc),
+            u64::from(self.tmdr),
+            u64::from(self.tfcr),
+            u64::from(self.toer),
+            u64::from(self.tocr),
+        ]);
+        for c in &self.ch {
+            out.extend([
+                u64::from(c.tcr),
+                u64::from(c.tior),
+                u64::from(c.tier),
+                u64::from(c.flags),
+                u64::from(c.seen),
+                u64::from(c.tcnt),
+                u64::from(c.gra),
+                u64::from(c.grb),
+                u64::from(c.bra),
+                u64::from(c.brb),
+                u64::from(c.tioca),
+                u64::from(c.running),
+                u64::from(c.pwm),
+            ]);
+        }
+    }
+
+    /// Moves every channel `states` later in time without changing its state: right when the
+    /// ITU's evolution repeats with a period that divides `states` (see
+    /// [`Itu::idle_signature`]).
+    pub fn shift(&mut self, states: u64) {
+        for c in &mut self.ch {
+            c.synced_at += states;
+        }
+    }
+
     /// Interrupt requests at `now` as a vector bit mask (bit v = vector v).
     #[must_use]
     pub fn requests(&self, now: u64) -> u64 {

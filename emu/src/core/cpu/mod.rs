@@ -82,7 +82,10 @@ pub mod disasm;
 mod exec;
 mod fast;
 mod ffwd;
+mod idle;
 pub mod timing;
+
+pub use idle::{IdleRun, MAX_CYCLE};
 
 use crate::core::bus::{Bus, CpuSignal};
 use crate::core::memmap::Area;
@@ -211,6 +214,10 @@ pub struct Cpu {
     loops: Vec<ffwd::Loop>,
     /// Instructions fast-forwarded so far.
     skipped: u64,
+    /// Idle cycles advanced in closed form so far ([`Cpu::run_idle`]).
+    idle_skipped: u64,
+    /// Sleep PCs whose idle cycles failed the proof, with the failures.
+    idle_fails: Vec<(u32, u8)>,
     instructions: u64,
     /// Where the instruction executed last is kept (for traces and the profiler): its index
     /// in `cache` (the fast path), or [`LAST_IN_COPY`] for `last_copy`.
@@ -262,6 +269,8 @@ impl Cpu {
             fast_forward: true,
             loops: Vec::new(),
             skipped: 0,
+            idle_skipped: 0,
+            idle_fails: Vec::new(),
             instructions: 0,
             last_index: LAST_IN_COPY,
             last_copy: EMPTY_SLOT,
@@ -373,6 +382,7 @@ impl Cpu {
         self.cache.clear();
         self.fast.clear();
         self.loops.clear();
+        self.idle_fails.clear();
     }
 
     /// Empties the caches if the bus's flash token changed since they were filled.
