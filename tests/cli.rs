@@ -197,6 +197,8 @@ fn missing_file_and_bad_options_are_errors_not_panics() {
         &["cost", "--history", "9"],
         &["cost", "--eta", "-1"],
         &["cost", "--steps", "0"],
+        &["cost", "--steps", "4294967295"],
+        &["cost", "--steps", "10000001"],
         &["fit", "--steps", "4294967295"],
         &["fit", "--steps", "1000001"],
         &["learn"],
