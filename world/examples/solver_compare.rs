@@ -19,6 +19,8 @@ use std::time::Instant;
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64;
 use rapier2d::prelude::*;
+
+mod rapier_wheels;
 use world::geometry::{Obb, obb_overlap};
 use world::{Arena, Behaviour, World, WorldParams};
 
@@ -153,8 +155,7 @@ fn rapier(n: usize, plan: &[Vec<Behaviour>]) -> Outcome {
         gains.push(start.motor_gains(i).unwrap());
     }
     let inertia = MASS * (0.23 * 0.23 + 0.18 * 0.18) / 12.0;
-    let m_long = 1.0 / (1.0 / MASS + HALF_TRACK * HALF_TRACK / inertia);
-    let wheel_max = MU_FLOOR * MASS * 9.80665 * 0.5;
+    let wheels = rapier_wheels::Wheels::new(MASS, inertia, HALF_TRACK, MU_FLOOR);
     let decay = (-h / TAU).exp();
     let mean_factor = TAU / h * (1.0 - decay);
     let mut speed = vec![[0.0f64; 2]; n];
@@ -188,29 +189,7 @@ fn rapier(n: usize, plan: &[Vec<Behaviour>]) -> Outcome {
                     mean[w] = target + diff * mean_factor;
                     speed[i][w] = target + diff * decay;
                 }
-                let b = &mut pw.bodies[hd];
-                b.reset_forces(false);
-                let ang = f64::from(b.rotation().angle());
-                let (s, c) = ang.sin_cos();
-                let v = b.linvel();
-                let (vx, vy, om) = (f64::from(v.x), f64::from(v.y), f64::from(b.angvel()));
-                let tr = b.translation();
-                for (w, y_w) in [(0usize, HALF_TRACK), (1, -HALF_TRACK)] {
-                    let (rx, ry) = (-s * y_w, c * y_w);
-                    let (px, py) = (vx - om * ry, vy + om * rx);
-                    let along = px * c + py * s;
-                    let across = -px * s + py * c;
-                    let mut fl = m_long * (mean[w] - along) / h;
-                    let mut ft = MASS * 0.5 * (-across) / h;
-                    let mag = fl.hypot(ft);
-                    if mag > wheel_max {
-                        fl *= wheel_max / mag;
-                        ft *= wheel_max / mag;
-                    }
-                    let f = Vector::new((fl * c - ft * s) as Real, (fl * s + ft * c) as Real);
-                    let at = Vector::new(tr.x + rx as Real, tr.y + ry as Real);
-                    b.add_force_at_point(f, at, false);
-                }
+                wheels.apply(&mut pw.bodies[hd], mean, h);
             }
             pw.step();
         }

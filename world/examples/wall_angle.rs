@@ -22,6 +22,7 @@
 
 #[path = "../tests/coulomb_reference/mod.rs"]
 mod coulomb_reference;
+mod rapier_wheels;
 
 use rapier2d::prelude::*;
 use world::{Arena, Pose, World, WorldParams};
@@ -115,8 +116,7 @@ fn rapier(theta: f64, duty: [f64; 2]) -> Track {
         .restitution(0.0)
         .build();
     pw.colliders.insert_with_parent(col, hd, &mut pw.bodies);
-    let m_long = 1.0 / (1.0 / MASS + HALF_TRACK * HALF_TRACK / inertia());
-    let wheel_max = MU_FLOOR * MASS * world::params::GRAVITY_M_PER_S2 * 0.5;
+    let wheels = rapier_wheels::Wheels::new(MASS, inertia(), HALF_TRACK, MU_FLOOR);
     let decay = (-H / TAU).exp();
     let mean_factor = TAU / H * (1.0 - decay);
     let mut speed = [0.0f64; 2];
@@ -130,28 +130,7 @@ fn rapier(theta: f64, duty: [f64; 2]) -> Track {
             mean[wh] = target + diff * mean_factor;
             speed[wh] = target + diff * decay;
         }
-        let b = &mut pw.bodies[hd];
-        b.reset_forces(false);
-        let (s, c) = f64::from(b.rotation().angle()).sin_cos();
-        let v = b.linvel();
-        let (vx, vy, om) = (f64::from(v.x), f64::from(v.y), f64::from(b.angvel()));
-        let tr = b.translation();
-        for (wh, y_w) in [(0usize, HALF_TRACK), (1, -HALF_TRACK)] {
-            let (rx, ry) = (-s * y_w, c * y_w);
-            let (px, py) = (vx - om * ry, vy + om * rx);
-            let along = px * c + py * s;
-            let across = -px * s + py * c;
-            let mut fl = m_long * (mean[wh] - along) / H;
-            let mut ft = MASS * 0.5 * (-across) / H;
-            let mag = fl.hypot(ft);
-            if mag > wheel_max {
-                fl *= wheel_max / mag;
-                ft *= wheel_max / mag;
-            }
-            let f = Vector::new((fl * c - ft * s) as Real, (fl * s + ft * c) as Real);
-            let at = Vector::new(tr.x + rx as Real, tr.y + ry as Real);
-            b.add_force_at_point(f, at, false);
-        }
+        wheels.apply(&mut pw.bodies[hd], mean, H);
         pw.step();
         let b = &pw.bodies[hd];
         let tr = b.translation();
