@@ -165,11 +165,10 @@ pub struct RunMetrics {
     pub window: u32,
     /// The run's planned steps.
     pub planned_steps: u32,
-    /// One sum per whole window of `window` steps from step 0 (steps past the last whole
-    /// window are in none); the learning figure's points.
+    /// One sum per window of `window` steps from step 0 (the last one partial when `window`
+    /// does not divide the run); the learning figure's points are the whole ones, the summary's
+    /// first window is the first.
     pub windows: Vec<WindowSums>,
-    /// The summary's first window: steps `0..window`.
-    pub first: WindowSums,
     /// The summary's last window: steps `planned_steps - window..planned_steps`.
     pub last: WindowSums,
     /// Every step of the run.
@@ -196,13 +195,27 @@ impl RunMetrics {
         if let Some(sums) = self.windows.get_mut(w) {
             sums.add(m);
         }
-        if k < self.window {
-            self.first.add(m);
-        }
         if k < self.planned_steps && k >= self.planned_steps.saturating_sub(self.window) {
             self.last.add(m);
         }
         self.whole.add(m);
+    }
+
+    /// The summary's first window, steps `0..window` (empty before the first step).
+    #[must_use]
+    pub fn first(&self) -> &WindowSums {
+        const NONE: WindowSums = WindowSums {
+            steps: 0,
+            mean_d: 0.0,
+            collisions_per_robot: 0.0,
+            contact_fraction: 0.0,
+            stuck_fraction: 0.0,
+            moved_m: 0.0,
+            gap_cv: 0.0,
+            gap_cv_steps: 0,
+            cpu_load_percent: 0.0,
+        };
+        self.windows.first().unwrap_or(&NONE)
     }
 
     /// The whole windows (a trailing partial window left out).
@@ -706,32 +719,6 @@ impl Swarm {
     }
 }
 
-/// Runs one condition of one repeat. `progress` is called with the number of steps done since
-/// its last call.
-///
-/// # Errors
-/// A world or controller failure (none is expected once the scenario checks out).
-pub fn run_one(
-    s: &Scenario,
-    condition: Condition,
-    repeat: u32,
-    record_track: bool,
-    images: Option<&Images>,
-    keep_going: bool,
-    progress: &(dyn Fn(u64) + Sync),
-) -> Result<RunOutput> {
-    run_one_probed(
-        s,
-        condition,
-        repeat,
-        record_track,
-        images,
-        keep_going,
-        progress,
-        RobotProbes::default(),
-    )
-}
-
 /// A pin trace of one firmware robot over a window of steps, written as a VCD file
 /// (`h8swarm run --vcd`).
 #[derive(Clone, Debug)]
@@ -748,13 +735,9 @@ pub struct VcdProbe {
     pub path: std::path::PathBuf,
 }
 
-/// What to look at inside one robot of a run (its pins, its firmware under GDB) and where its
-/// per-step rows go.
+/// What to look at inside one robot of a run: its pins, its firmware under GDB.
 #[derive(Debug, Default)]
 pub struct RobotProbes {
-    /// A file for the run's rows of `metrics.csv`, written as the steps complete
-    /// ([`Swarm::set_rows`]).
-    pub rows: Option<std::path::PathBuf>,
     /// A pin trace.
     pub vcd: Option<VcdProbe>,
     /// A GDB stub for a robot, waiting for its client: (robot, listener). The run waits for
@@ -762,28 +745,42 @@ pub struct RobotProbes {
     pub gdb: Option<(usize, emu::chip::gdb::GdbListener)>,
 }
 
-/// [`run_one`] with probes on one robot: a pin trace written as VCD, a GDB client's control.
-/// The run's results are the same as without them.
+/// How one run goes besides its scenario, condition and repeat: what it records and what looks
+/// inside it. The run's results do not depend on any of it but `keep_going`.
+#[derive(Debug, Default)]
+pub struct RunOptions {
+    /// Record the tracked robots' paths and outlines for the arena figure.
+    pub record_track: bool,
+    /// Go on when a robot's controller fails (see [`Swarm::set_keep_going`]).
+    pub keep_going: bool,
+    /// A file for the run's rows of `metrics.csv`, written as the steps complete
+    /// ([`Swarm::set_rows`]).
+    pub rows: Option<std::path::PathBuf>,
+    /// Probes on one robot: a pin trace written as VCD, a GDB client's control.
+    pub probes: RobotProbes,
+}
+
+/// Runs one condition of one repeat. `progress` is called with the number of steps done since
+/// its last call.
 ///
 /// # Errors
-/// As [`run_one`]; a probed robot that is no firmware robot; a GDB client that cannot be
-/// accepted; a VCD file that cannot be written.
-#[allow(clippy::too_many_arguments)]
-pub fn run_one_probed(
+/// A world or controller failure (none is expected once the scenario checks out); a row file
+/// that cannot be written; a probed robot that is no firmware robot; a GDB client that cannot
+/// be accepted; a VCD file that cannot be written.
+pub fn run_one(
     s: &Scenario,
     condition: Condition,
     repeat: u32,
-    record_track: bool,
     images: Option<&Images>,
-    keep_going: bool,
     progress: &(dyn Fn(u64) + Sync),
-    probes: RobotProbes,
+    opts: RunOptions,
 ) -> Result<RunOutput> {
-    let mut swarm = Swarm::new(s, condition, repeat, record_track, images)?;
-    swarm.set_keep_going(keep_going);
-    if let Some(path) = &probes.rows {
+    let mut swarm = Swarm::new(s, condition, repeat, opts.record_track, images)?;
+    swarm.set_keep_going(opts.keep_going);
+    if let Some(path) = &opts.rows {
         swarm.set_rows(path)?;
     }
+    let probes = opts.probes;
     let debugged = probes.gdb.as_ref().map(|(k, _)| *k);
     if let Some((k, listener)) = probes.gdb {
         let robot = swarm
@@ -1036,7 +1033,7 @@ mod tests {
             // Spot-check one field the direct way too (not through WindowSums::add).
             let d: f64 = all[(steps - win) as usize..].iter().map(|s| s.mean_d).sum();
             assert_eq!(m.last.mean_d, d);
-            assert_eq!(m.first, sum(0..win));
+            assert_eq!(*m.first(), sum(0..win));
             assert_eq!(m.last, sum(steps - win..steps));
             assert_eq!(m.whole, sum(0..steps));
             assert_eq!(m.whole_windows().len() as u32, steps / win);

@@ -16,7 +16,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::experiment::{RunOutput, build_world, run_one_probed};
+use crate::experiment::{RunOptions, RunOutput, build_world, run_one};
 use crate::plot::{
     ArenaFigure, LearningFigure, Panel, Series, arena_figure_panels, learning_figure,
 };
@@ -570,17 +570,17 @@ fn run_into(
                 } else {
                     None
                 };
-                run_one_probed(
+                run_one(
                     s,
                     c,
                     r,
-                    track,
                     images,
-                    a.keep_going,
                     &|k| bar.inc(k),
-                    crate::experiment::RobotProbes {
+                    RunOptions {
+                        record_track: track,
+                        keep_going: a.keep_going,
                         rows: Some(rows_path(c, r)),
-                        ..probes.unwrap_or_default()
+                        probes: probes.unwrap_or_default(),
                     },
                 )
             })

@@ -187,7 +187,7 @@ pub fn conditions(runs: &[RunOutput], steps: u32, win: u32) -> Vec<ConditionStat
         if of_c.is_empty() {
             continue;
         }
-        let first: Vec<&WindowSums> = of_c.iter().map(|r| &r.metrics.first).collect();
+        let first: Vec<&WindowSums> = of_c.iter().map(|r| r.metrics.first()).collect();
         let last: Vec<&WindowSums> = of_c.iter().map(|r| &r.metrics.last).collect();
         out.push(ConditionStats {
             condition: c,

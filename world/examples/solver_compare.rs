@@ -20,7 +20,7 @@ use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64;
 use rapier2d::prelude::*;
 
-mod rapier_wheels;
+mod rapier_scene;
 use world::geometry::{Obb, obb_overlap};
 use world::{Arena, Behaviour, World, WorldParams};
 
@@ -118,23 +118,7 @@ fn rapier(n: usize, plan: &[Vec<Behaviour>]) -> Outcome {
     .unwrap();
     let side = start.arena().width_m();
     let h = STEP_STATES as f64 / CLOCK_HZ / f64::from(SUBSTEPS);
-    let mut pw = PhysicsWorld::new();
-    pw.gravity = Vector::ZERO;
-    pw.integration_parameters.dt = h as Real;
-    let t = 0.5;
-    for (x, y, hx, hy) in [
-        (side / 2.0, -t, side / 2.0 + t, t),
-        (side / 2.0, side + t, side / 2.0 + t, t),
-        (-t, side / 2.0, t, side / 2.0 + t),
-        (side + t, side / 2.0, t, side / 2.0 + t),
-    ] {
-        pw.colliders.insert(
-            ColliderBuilder::cuboid(hx as Real, hy as Real)
-                .translation(Vector::new(x as Real, y as Real))
-                .friction(MU_CONTACT as Real)
-                .build(),
-        );
-    }
+    let mut pw = rapier_scene::walled_world(side, side, MU_CONTACT, h);
     let mut handles = Vec::with_capacity(n);
     let mut gains = Vec::with_capacity(n);
     for i in 0..n {
@@ -155,7 +139,7 @@ fn rapier(n: usize, plan: &[Vec<Behaviour>]) -> Outcome {
         gains.push(start.motor_gains(i).unwrap());
     }
     let inertia = MASS * (0.23 * 0.23 + 0.18 * 0.18) / 12.0;
-    let wheels = rapier_wheels::Wheels::new(MASS, inertia, HALF_TRACK, MU_FLOOR);
+    let wheels = rapier_scene::Wheels::new(MASS, inertia, HALF_TRACK, MU_FLOOR);
     let decay = (-h / TAU).exp();
     let mean_factor = TAU / h * (1.0 - decay);
     let mut speed = vec![[0.0f64; 2]; n];

@@ -22,7 +22,7 @@
 
 #[path = "../tests/coulomb_reference/mod.rs"]
 mod coulomb_reference;
-mod rapier_wheels;
+mod rapier_scene;
 
 use rapier2d::prelude::*;
 use world::{Arena, Pose, World, WorldParams};
@@ -84,24 +84,7 @@ fn own(theta: f64, duty: [f64; 2]) -> Track {
 }
 
 fn rapier(theta: f64, duty: [f64; 2]) -> Track {
-    let mut pw = PhysicsWorld::new();
-    pw.gravity = Vector::ZERO;
-    pw.integration_parameters.dt = H as Real;
-    let t = 0.5;
-    let (w, hgt) = (WALL_X, ARENA_H);
-    for (x, y, hx, hy) in [
-        (w / 2.0, -t, w / 2.0 + t, t),
-        (w / 2.0, hgt + t, w / 2.0 + t, t),
-        (-t, hgt / 2.0, t, hgt / 2.0 + t),
-        (w + t, hgt / 2.0, t, hgt / 2.0 + t),
-    ] {
-        pw.colliders.insert(
-            ColliderBuilder::cuboid(hx as Real, hy as Real)
-                .translation(Vector::new(x as Real, y as Real))
-                .friction(MU_WALL as Real)
-                .build(),
-        );
-    }
+    let mut pw = rapier_scene::walled_world(WALL_X, ARENA_H, MU_WALL, H);
     let (x0, y0) = start(theta);
     let hd = pw.bodies.insert(
         RigidBodyBuilder::dynamic()
@@ -116,7 +99,7 @@ fn rapier(theta: f64, duty: [f64; 2]) -> Track {
         .restitution(0.0)
         .build();
     pw.colliders.insert_with_parent(col, hd, &mut pw.bodies);
-    let wheels = rapier_wheels::Wheels::new(MASS, inertia(), HALF_TRACK, MU_FLOOR);
+    let wheels = rapier_scene::Wheels::new(MASS, inertia(), HALF_TRACK, MU_FLOOR);
     let decay = (-H / TAU).exp();
     let mean_factor = TAU / H * (1.0 - decay);
     let mut speed = [0.0f64; 2];

@@ -1,10 +1,35 @@
-//! A differential-drive robot's wheels in rapier2d, for the examples that put rapier2d beside the
-//! world's own solver (`solver_compare`, `wall_angle`): rapier has no wheels, so each wheel is a
+//! The scene of the examples that put rapier2d beside the world's own solver (`solver_compare`,
+//! `wall_angle`): a walled rectangle, and a differential-drive robot's wheels. Rapier has no
+//! wheels, so each wheel is a
 //! force at its contact patch, explicit per step, that drives the patch's speed along the heading
 //! towards the motor's mean speed over the step and resists its sideways slip, limited together
 //! to the patch's Coulomb friction (μ_floor · m · g / 2).
 
 use rapier2d::prelude::*;
+
+/// A world without gravity (the floor is the plane of the scene), stepped by `dt` s, with four
+/// walls 0.5 m thick around the rectangle from (0, 0) to (`width`, `height`) m, of friction
+/// `friction` against the bodies.
+pub fn walled_world(width: f64, height: f64, friction: f64, dt: f64) -> PhysicsWorld {
+    let mut pw = PhysicsWorld::new();
+    pw.gravity = Vector::ZERO;
+    pw.integration_parameters.dt = dt as Real;
+    let t = 0.5;
+    for (x, y, hx, hy) in [
+        (width / 2.0, -t, width / 2.0 + t, t),
+        (width / 2.0, height + t, width / 2.0 + t, t),
+        (-t, height / 2.0, t, height / 2.0 + t),
+        (width + t, height / 2.0, t, height / 2.0 + t),
+    ] {
+        pw.colliders.insert(
+            ColliderBuilder::cuboid(hx as Real, hy as Real)
+                .translation(Vector::new(x as Real, y as Real))
+                .friction(friction as Real)
+                .build(),
+        );
+    }
+    pw
+}
 
 /// The wheel model of one robot body.
 pub struct Wheels {
