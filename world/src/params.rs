@@ -66,6 +66,12 @@ pub const MU_WALL: f64 = 0.3;
 /// choice; a robot driving into an obstacle pushes with its whole traction, about 2.9 N, a
 /// body merely resting against one with none).
 pub const BUMPER_FORCE_N: f64 = 0.1;
+/// Default force below which a pressed bumper's switch releases: 0.02 N. A snap-action
+/// micro-switch releases at a much lower force than it operates (hysteresis): Omron's D2F-01FL
+/// (hinge lever, low operating force) operates at 0.25 N max and releases at 0.02 N min, the
+/// D2F-01 at 0.74 N / 0.05 N (Omron D2F datasheet, "Operating Characteristics"). We keep the
+/// data sheet's release force with our lower operating force.
+pub const BUMPER_RELEASE_FORCE_N: f64 = 0.02;
 /// Default clock that counts the world's time: φ = 25 MHz, one state = 40 ns (SPEC §4.1): the
 /// world advances in whole MCU states, the clock the robots' MCUs count.
 pub const CLOCK_HZ: u64 = 25_000_000;
@@ -159,6 +165,8 @@ pub struct WorldParams {
     pub mu_wall: f64,
     /// Force a contact must carry to hold a bumper pressed, N.
     pub bumper_force_n: f64,
+    /// Force below which a pressed bumper releases, N (at most `bumper_force_n`).
+    pub bumper_release_force_n: f64,
     /// Gauss–Seidel sweeps of the velocity solver per sub-step.
     pub solver_iterations: u32,
     /// Position-correction sweeps per sub-step.
@@ -189,6 +197,7 @@ impl Default for WorldParams {
             mu_robot: MU_ROBOT,
             mu_wall: MU_WALL,
             bumper_force_n: BUMPER_FORCE_N,
+            bumper_release_force_n: BUMPER_RELEASE_FORCE_N,
             solver_iterations: SOLVER_ITERATIONS,
             position_iterations: POSITION_ITERATIONS,
             clock_hz: CLOCK_HZ,
@@ -387,6 +396,13 @@ impl WorldParams {
             0.0,
             100.0,
             "a force in 0..=100 N",
+        )?;
+        check_range(
+            "bumper_release_force_n",
+            self.bumper_release_force_n,
+            0.0,
+            self.bumper_force_n,
+            "a force in 0..=bumper_force_n",
         )?;
         if self.clock_hz < 1_000 || self.clock_hz > 1_000_000_000 {
             return Err(WorldError::Parameter {

@@ -236,6 +236,14 @@ pub struct World {
     /// Accumulated wheel impulses of the latest solve (left along, left across, right …).
     wheel_imp: Vec<[f64; 4]>,
     bumpers: Vec<u8>,
+    /// Normal impulse each bumper face took in the current sub-step, from the solver's
+    /// contacts and the position corrections (front, rear, left, right), N·s.
+    face_impulse: Vec<[f64; 4]>,
+    /// The robots with some face impulse in the current sub-step.
+    pushed: Vec<u32>,
+    /// The bumpers as the previous sub-step left them (a pressed switch releases at a lower
+    /// force than it operates).
+    held: Vec<u8>,
     grid: Grid,
     cand: Candidates,
     /// Broad-phase margin in use, metres.
@@ -453,6 +461,9 @@ impl World {
             wheel_imp: vec![[0.0; 4]; n],
             pose: poses,
             bumpers: vec![0; n],
+            face_impulse: vec![[0.0; 4]; n],
+            pushed: Vec::new(),
+            held: vec![0; n],
             grid,
             cand: Candidates::default(),
             margin_m,
@@ -767,6 +778,7 @@ impl World {
                 &self.pose,
             );
         }
+        core::mem::swap(&mut self.bumpers, &mut self.held);
         self.bumpers.fill(0);
         // 2. Contacts at the start of the sub-step, gaps up to the speculative distance.
         let spec = self.speculative_m(h);
@@ -887,18 +899,37 @@ impl World {
         self.warm.sort_unstable_by_key(|w| w.0);
         if !self.checked.is_empty() {
             // 4. What the linearised solve left of an overlap is corrected.
-            self.clear_overlaps();
-            // 5. A bumper is pressed by a contact that carried force.
-            let threshold = self.params.bumper_force_n * h;
+            self.clear_overlaps(h);
+            // 5. A bumper is pressed when the contacts on its face carried force: the solver's
+            // impulses and the corrections' pushes (as impulses) summed over the sub-step.
             for k in 0..self.contacts.len() {
                 let ct = self.contacts[k];
-                if ct.normal_impulse() > threshold {
-                    self.press(ct.a as usize, ct.nx, ct.ny);
-                    if ct.b != WALL {
-                        self.press(ct.b as usize, -ct.nx, -ct.ny);
-                    }
+                let j = ct.normal_impulse();
+                self.push_face(ct.a as usize, ct.nx, ct.ny, j);
+                if ct.b != WALL {
+                    self.push_face(ct.b as usize, -ct.nx, -ct.ny, j);
                 }
             }
+            // A switch operates at `bumper_force_n` and, once pressed, releases only below
+            // `bumper_release_force_n` (a snap-action switch's hysteresis).
+            let operate = self.params.bumper_force_n * h;
+            let release = self.params.bumper_release_force_n * h;
+            for &i in &self.pushed {
+                let i = i as usize;
+                let held = self.held[i];
+                for (side, j) in self.face_impulse[i].iter_mut().enumerate() {
+                    let threshold = if held & (1 << side) != 0 {
+                        release
+                    } else {
+                        operate
+                    };
+                    if *j > threshold {
+                        self.bumpers[i] |= 1 << side;
+                    }
+                    *j = 0.0;
+                }
+            }
+            self.pushed.clear();
             self.stats.active_robot_substeps += self.active.len() as u64;
             self.stats.contacts += self.contacts.len() as u64;
             for &i in &self.checked {
@@ -1214,7 +1245,7 @@ impl World {
     /// early: its robots move only the largest fraction (1/2, 1/4, …, 0) of this sub-step's
     /// motion at which nothing overlaps (a time of impact: no body jumps anywhere, it is only
     /// kept from going on), and so do robots whose motion ends in those robots.
-    fn clear_overlaps(&mut self) {
+    fn clear_overlaps(&mut self, h: f64) {
         self.epoch += 1;
         let mut since = self.epoch;
         for k in 0..self.checked.len() {
@@ -1236,10 +1267,10 @@ impl World {
             since = self.epoch;
             let list = core::mem::take(&mut self.overlaps);
             for &i in &list.walls {
-                self.correct_wall(i as usize);
+                self.correct_wall(i as usize, h);
             }
             for &[i, j] in &list.pairs {
-                self.correct_pair(i as usize, j as usize);
+                self.correct_pair(i as usize, j as usize, h);
             }
             self.overlaps = list;
         }
@@ -1297,8 +1328,9 @@ impl World {
 
     /// One position correction of robot `i` against the walls: per wall in contact, the
     /// deepest point is pushed out to the skin, then the manifold is taken again (a corner
-    /// pushed out turns the body, which moves the other corner).
-    fn correct_wall(&mut self, i: usize) {
+    /// pushed out turns the body, which moves the other corner). A push of `λ` (kg·m) in a
+    /// sub-step of `h` seconds is the impulse λ / h on the bumper face it acts on.
+    fn correct_wall(&mut self, i: usize, h: f64) {
         let skin = CORRECTION_GAP_M;
         for _ in 0..4 {
             let mut deepest: Option<(Manifold, usize)> = None;
@@ -1323,21 +1355,22 @@ impl World {
             if c >= 0.0 {
                 return;
             }
-            self.press(i, m.nx, m.ny);
             let b = self.pose[i];
             let r = [p.x - b.x, p.y - b.y];
             let rn = r[0] * m.ny - r[1] * m.nx;
             let kn = self.body.inv_m + self.body.inv_i * rn * rn;
             // The wall does not give way: the body takes the whole push, into the arena.
             let lambda = -c / kn;
+            self.push_face(i, m.nx, m.ny, lambda / h);
             self.nudge(i, -lambda * m.nx, -lambda * m.ny, r);
         }
     }
 
     /// One position correction of the pair (i, j): the deepest point of their manifold is
     /// pushed apart to the skin, shared by mass and inertia, then the manifold is taken again
-    /// for the other point.
-    fn correct_pair(&mut self, i: usize, j: usize) {
+    /// for the other point. The push is an impulse on both robots' faces, as in
+    /// [`World::correct_wall`].
+    fn correct_pair(&mut self, i: usize, j: usize, h: f64) {
         let skin = CORRECTION_GAP_M;
         for _ in 0..2 {
             let Some(m) = box_box(&self.obb(i), &self.obb(j), skin) else {
@@ -1353,8 +1386,6 @@ impl World {
             if c >= 0.0 {
                 return;
             }
-            self.press(i, m.nx, m.ny);
-            self.press(j, -m.nx, -m.ny);
             let (a, b) = (self.pose[i], self.pose[j]);
             let ra = [p.x - a.x, p.y - a.y];
             let rb = [p.x - b.x, p.y - b.y];
@@ -1362,6 +1393,8 @@ impl World {
             let rnb = rb[0] * m.ny - rb[1] * m.nx;
             let kn = 2.0 * self.body.inv_m + self.body.inv_i * (rna * rna + rnb * rnb);
             let lambda = -c / kn;
+            self.push_face(i, m.nx, m.ny, lambda / h);
+            self.push_face(j, -m.nx, -m.ny, lambda / h);
             self.nudge(i, -lambda * m.nx, -lambda * m.ny, ra);
             self.nudge(j, lambda * m.nx, lambda * m.ny, rb);
         }
@@ -1435,12 +1468,20 @@ impl World {
         self.stats.stopped_robot_substeps += group.len() as u64;
     }
 
-    /// Presses the bumper of robot `i` that faces the world direction (fx, fy).
+    /// Adds a normal impulse (N·s, > 0 to count) to the bumper face of robot `i` that faces
+    /// the world direction (fx, fy).
     #[inline]
-    fn press(&mut self, i: usize, fx: f64, fy: f64) {
+    fn push_face(&mut self, i: usize, fx: f64, fy: f64, impulse: f64) {
+        if impulse <= 0.0 {
+            return;
+        }
         let b = self.pose[i];
         let side = side_of(fx * b.c + fy * b.s, -fx * b.s + fy * b.c);
-        self.bumpers[i] |= 1 << side;
+        let f = &mut self.face_impulse[i];
+        if f.iter().all(|&x| x == 0.0) {
+            self.pushed.push(i as u32);
+        }
+        f[side] += impulse;
     }
 
     fn wall_penetration(&self, i: usize) -> bool {
