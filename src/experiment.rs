@@ -541,23 +541,26 @@ impl Swarm {
             )?;
         }
         let world = &self.world;
-        let sense = |i: usize| -> Result<[Option<f64>; 4]> {
+        // What each robot's board shows its MCU for the step: the sensors' true distances and
+        // the bumper switches as the latest sub-step left them (port 2's pins).
+        let sense = |i: usize| -> Result<([Option<f64>; 4], [bool; 4])> {
             let mut d = [None; 4];
             for (k, dk) in d.iter_mut().enumerate() {
                 *dk = world.sense(i, k)?;
             }
-            Ok(d)
+            Ok((d, world.bumpers(i)?))
         };
-        let distances: Vec<[Option<f64>; 4]> = if par {
+        let distances: Vec<([Option<f64>; 4], [bool; 4])> = if par {
             (0..n).into_par_iter().map(sense).collect::<Result<_>>()?
         } else {
             (0..n).map(sense).collect::<Result<_>>()?
         };
         let dead = self.dead.clone();
-        let step = |(i, (r, d)): (usize, (&mut Robot, &[Option<f64>; 4]))| {
-            dead[i]
-                .is_none()
-                .then(|| r.step(*d).map(|rep| (rep, r.take_busy_states())))
+        let step = |(i, (r, (d, b))): (usize, (&mut Robot, &([Option<f64>; 4], [bool; 4])))| {
+            dead[i].is_none().then(|| {
+                r.set_bumpers(*b);
+                r.step(*d).map(|rep| (rep, r.take_busy_states()))
+            })
         };
         let results: Vec<_> = if par {
             self.robots
@@ -1048,6 +1051,35 @@ mod tests {
     /// A run keeps sums per window, not its steps: the rows go to the file as the steps
     /// complete, and the kept sums are the sums of those rows; the arena paths are kept for
     /// the first and last snapshot steps only.
+    /// Port 2 shows each robot's MCU the bumpers the world pressed (a user image may read
+    /// them; before, the pins read released whatever the world did).
+    #[test]
+    fn the_board_shows_the_world_s_bumpers_on_port_2() {
+        use emu::chip::mcu::Board;
+        let mut s = Scenario::arena();
+        s.robots = 10;
+        s.steps = 300;
+        let mut swarm = Swarm::new(&s, Condition::Learning, 0, false, None).unwrap();
+        let mut pressed = 0;
+        for _ in 0..s.steps {
+            swarm.step().unwrap();
+            for i in 0..s.robots {
+                let b = swarm.world().bumpers(i).unwrap();
+                pressed += usize::from(b.iter().any(|&x| x));
+                let board = swarm.robot_mut(i).unwrap().mcu.board_mut();
+                assert_eq!(board.bumpers, b);
+                let [front, rear, left, right] = b;
+                let want =
+                    sensors::port2_pins(sensors::BumperSet::from_flags(front, rear, left, right));
+                assert_eq!(board.port2_pins(0), want);
+            }
+        }
+        assert!(
+            pressed > 50,
+            "only {pressed} pressed robot-steps: the test saw too few"
+        );
+    }
+
     #[test]
     fn a_run_streams_its_rows_and_keeps_window_sums() {
         let mut s = Scenario::arena();

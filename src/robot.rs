@@ -34,7 +34,8 @@ pub struct RobotBoard {
     sensors: [IrSensor; 4],
     /// The true distance each sensor's ray finds (mm), as of the step being run.
     pub distance_mm: [Option<f64>; 4],
-    /// The bumpers, as of the latest world sub-step.
+    /// The bumpers (front, rear, left, right; `true` = pressed) as the world's latest sub-step
+    /// before the step's sensing left them; port 2 shows them active low.
     pub bumpers: [bool; 4],
     /// The A/D input each sensor is wired to (the scenario's `sensors.channels`).
     channels: [u8; 4],
@@ -414,6 +415,12 @@ impl Robot {
         if let Brain::Firmware(c) = &mut self.brain {
             c.detach();
         }
+    }
+
+    /// Sets the bumper switches the board shows on port 2 (front, rear, left, right; `true` =
+    /// pressed), as they stand for the coming step.
+    pub fn set_bumpers(&mut self, bumpers: [bool; 4]) {
+        self.mcu.board_mut().bumpers = bumpers;
     }
 
     /// Runs the step with the distances the world's rays found.
