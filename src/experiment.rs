@@ -543,20 +543,20 @@ impl Swarm {
         let world = &self.world;
         // What each robot's board shows its MCU for the step: the sensors' true distances and
         // the bumper switches as the latest sub-step left them (port 2's pins).
-        let sense = |i: usize| -> Result<([Option<f64>; 4], [bool; 4])> {
+        let sense = |i: usize| -> Result<Senses> {
             let mut d = [None; 4];
             for (k, dk) in d.iter_mut().enumerate() {
                 *dk = world.sense(i, k)?;
             }
             Ok((d, world.bumpers(i)?))
         };
-        let distances: Vec<([Option<f64>; 4], [bool; 4])> = if par {
+        let distances: Vec<Senses> = if par {
             (0..n).into_par_iter().map(sense).collect::<Result<_>>()?
         } else {
             (0..n).map(sense).collect::<Result<_>>()?
         };
         let dead = self.dead.clone();
-        let step = |(i, (r, (d, b))): (usize, (&mut Robot, &([Option<f64>; 4], [bool; 4])))| {
+        let step = |(i, (r, (d, b))): (usize, (&mut Robot, &Senses))| {
             dead[i].is_none().then(|| {
                 r.set_bumpers(*b);
                 r.step(*d).map(|rep| (rep, r.take_busy_states()))
@@ -862,6 +862,10 @@ fn write_robot_vcd(
     emu::chip::vcd::write_vcd(file, &t.pins, Some(&t.phases), &info)
         .with_context(|| format!("--vcd: cannot write `{}`", v.path.display()))
 }
+
+/// What a robot's board shows its MCU for a step: each sensor's true distance (mm, `None`
+/// beyond range) and the bumper switches (front, rear, left, right).
+type Senses = ([Option<f64>; 4], [bool; 4]);
 
 /// The step period in clock states.
 #[must_use]
