@@ -550,7 +550,7 @@ impl Swarm {
             }
             Ok((d, world.bumpers(i)?))
         };
-        let distances: Vec<Senses> = if par {
+        let senses: Vec<Senses> = if par {
             (0..n).into_par_iter().map(sense).collect::<Result<_>>()?
         } else {
             (0..n).map(sense).collect::<Result<_>>()?
@@ -565,14 +565,14 @@ impl Swarm {
         let results: Vec<_> = if par {
             self.robots
                 .par_iter_mut()
-                .zip(distances.par_iter())
+                .zip(senses.par_iter())
                 .enumerate()
                 .map(step)
                 .collect()
         } else {
             self.robots
                 .iter_mut()
-                .zip(&distances)
+                .zip(&senses)
                 .enumerate()
                 .map(step)
                 .collect()
@@ -1052,9 +1052,6 @@ mod tests {
         }
     }
 
-    /// A run keeps sums per window, not its steps: the rows go to the file as the steps
-    /// complete, and the kept sums are the sums of those rows; the arena paths are kept for
-    /// the first and last snapshot steps only.
     /// Port 2 shows each robot's MCU the bumpers the world pressed (a user image may read
     /// them; before, the pins read released whatever the world did).
     #[test]
@@ -1084,6 +1081,9 @@ mod tests {
         );
     }
 
+    /// A run keeps sums per window, not its steps: the rows go to the file as the steps
+    /// complete, and the kept sums are the sums of those rows; the arena paths are kept for
+    /// the first and last snapshot steps only.
     #[test]
     fn a_run_streams_its_rows_and_keeps_window_sums() {
         let mut s = Scenario::arena();

@@ -62,7 +62,7 @@ pub const MU_FLOOR: f64 = 0.6;
 pub const MU_ROBOT: f64 = 0.3;
 /// Default body–wall friction coefficient: 0.3 (our choice: plastic on a painted board).
 pub const MU_WALL: f64 = 0.3;
-/// Default force a contact must carry to hold a micro-switch bumper pressed: 0.1 N (our
+/// Default force a bumper face's contacts must carry to press its micro-switch: 0.1 N (our
 /// choice; a robot driving into an obstacle pushes with its whole traction, about 2.9 N, a
 /// body merely resting against one with none).
 pub const BUMPER_FORCE_N: f64 = 0.1;
@@ -163,7 +163,8 @@ pub struct WorldParams {
     pub mu_robot: f64,
     /// Body–wall friction coefficient.
     pub mu_wall: f64,
-    /// Force a contact must carry to hold a bumper pressed, N.
+    /// Force a bumper face's contacts must carry between them in a sub-step to press its
+    /// switch (the operating force), N.
     pub bumper_force_n: f64,
     /// Force below which a pressed bumper releases, N (at most `bumper_force_n`).
     pub bumper_release_force_n: f64,
