@@ -36,7 +36,7 @@ use anyhow::{Context, Result};
 use rayon::prelude::*;
 use world::{Arena, SensorMount, SubstepPlan, World, WorldParams};
 
-use crate::collisions::{ContactMeter, StuckDetector};
+use crate::collisions::{ContactMeter, RobotTally, StuckDetector};
 
 use crate::plot::Outline;
 use crate::robot::{Condition, Images, Robot};
@@ -58,18 +58,21 @@ pub struct StepMetrics {
     pub mean_d: f64,
     /// Collisions per robot during this step's behaviour.
     pub collisions_per_robot: f64,
-    /// Mean over robots of the fraction of this step's behaviour spent with a bumper pressed
-    /// (time in contact, weighted by sub-step length).
-    pub contact_fraction: f64,
-    /// Fraction of the robots stuck at the end of this step's behaviour: moved less than 1 mm
-    /// over the last 100 steps while their motors drove (see [`crate::collisions`]).
-    pub stuck_fraction: f64,
+    /// Mean over robots of the share of this step's behaviour spent with a bumper pressed
+    /// (time in contact, weighted by sub-step length), percent.
+    pub contact_percent: f64,
+    /// Share of the robots stuck at the end of this step's behaviour, percent: moved less than
+    /// 1 mm over the last 100 steps while their motors drove (see [`crate::collisions`]).
+    pub stuck_percent: f64,
+    /// Share of the robots that moved at least [`crate::collisions::MOVING_MIN_MM`] during
+    /// this step's behaviour, percent.
+    pub moving_percent: f64,
     /// Mean over robots of how far the body's centre moved during this step's behaviour
-    /// (straight-line distance between the two step instants), metres: 0 for a robot held
-    /// against a wall or another body, about 0.07 m for a free one driving straight in the
+    /// (straight-line distance between the two step instants), millimetres: 0 for a robot held
+    /// against a wall or another body, about 67 mm for a free one driving straight in the
     /// arena. Not in the paper; it tells a robot that avoids obstacles from one that is stuck
     /// (both make no new collisions).
-    pub moved_m: f64,
+    pub moved_mm: f64,
     /// Corridor only: coefficient of variation of the gaps between neighbours at the step.
     pub gap_cv: Option<f64>,
     /// Mean over robots of their MCU's CPU load over this step's period (percent): busy
@@ -90,6 +93,19 @@ pub struct Track {
     pub outlines: Vec<Outline>,
     /// The arena's walls.
     pub walls: Vec<[(f64, f64); 2]>,
+    /// Corridor only: per tracked robot, (step, position along the corridor in metres) every
+    /// [`spacetime_stride`] steps and at the last step, for the space-time figure.
+    pub spacetime: Vec<Vec<(f64, f64)>>,
+}
+
+/// The space-time figure's most samples per robot.
+pub const SPACETIME_SAMPLES: u32 = 2000;
+
+/// Steps between two samples of the space-time figure in a run of `steps` steps (every step
+/// up to [`SPACETIME_SAMPLES`] steps).
+#[must_use]
+pub fn spacetime_stride(steps: u32) -> u32 {
+    steps.div_ceil(SPACETIME_SAMPLES).max(1)
 }
 
 /// What one run produced.
@@ -108,6 +124,8 @@ pub struct RunOutput {
     pub saves: u64,
     /// Robots that died (with `--keep-going`), with why.
     pub dead: Vec<(usize, String)>,
+    /// Each robot's record over the run (distance, collisions, stuck spells), by index.
+    pub robots: Vec<RobotTally>,
 }
 
 /// Sums of a run's per-step metrics over a span of steps: the summary's and the figure's
@@ -121,12 +139,14 @@ pub struct WindowSums {
     pub mean_d: f64,
     /// Sum of [`StepMetrics::collisions_per_robot`].
     pub collisions_per_robot: f64,
-    /// Sum of [`StepMetrics::contact_fraction`].
-    pub contact_fraction: f64,
-    /// Sum of [`StepMetrics::stuck_fraction`].
-    pub stuck_fraction: f64,
-    /// Sum of [`StepMetrics::moved_m`].
-    pub moved_m: f64,
+    /// Sum of [`StepMetrics::contact_percent`].
+    pub contact_percent: f64,
+    /// Sum of [`StepMetrics::stuck_percent`].
+    pub stuck_percent: f64,
+    /// Sum of [`StepMetrics::moving_percent`].
+    pub moving_percent: f64,
+    /// Sum of [`StepMetrics::moved_mm`].
+    pub moved_mm: f64,
     /// Sum of [`StepMetrics::gap_cv`] over the steps that have one.
     pub gap_cv: f64,
     /// Steps that have a gap CV (all of them in the corridor, none in the square).
@@ -141,9 +161,10 @@ impl WindowSums {
         self.steps += 1;
         self.mean_d += m.mean_d;
         self.collisions_per_robot += m.collisions_per_robot;
-        self.contact_fraction += m.contact_fraction;
-        self.stuck_fraction += m.stuck_fraction;
-        self.moved_m += m.moved_m;
+        self.contact_percent += m.contact_percent;
+        self.stuck_percent += m.stuck_percent;
+        self.moving_percent += m.moving_percent;
+        self.moved_mm += m.moved_mm;
         if let Some(g) = m.gap_cv {
             self.gap_cv += g;
             self.gap_cv_steps += 1;
@@ -208,9 +229,10 @@ impl RunMetrics {
             steps: 0,
             mean_d: 0.0,
             collisions_per_robot: 0.0,
-            contact_fraction: 0.0,
-            stuck_fraction: 0.0,
-            moved_m: 0.0,
+            contact_percent: 0.0,
+            stuck_percent: 0.0,
+            moving_percent: 0.0,
+            moved_mm: 0.0,
             gap_cv: 0.0,
             gap_cv_steps: 0,
             cpu_load_percent: 0.0,
@@ -231,31 +253,33 @@ impl RunMetrics {
 }
 
 /// The columns of `metrics.csv`, one row per step of every run.
-pub const METRICS_HEADER: [&str; 10] = [
+pub const METRICS_HEADER: [&str; 11] = [
     "condition",
     "repeat",
     "step",
     "mean_d",
     "collisions_per_robot",
-    "contact_fraction",
-    "stuck_fraction",
-    "moved_m",
+    "contact_percent",
+    "stuck_percent",
+    "moving_percent",
+    "moved_mm",
     "gap_cv",
     "cpu_load_percent",
 ];
 
 /// Step `k`'s row of `metrics.csv` (see [`METRICS_HEADER`]).
 #[must_use]
-pub fn metrics_row(condition: Condition, repeat: u32, k: u32, m: &StepMetrics) -> [String; 10] {
+pub fn metrics_row(condition: Condition, repeat: u32, k: u32, m: &StepMetrics) -> [String; 11] {
     [
         condition.name().to_string(),
         repeat.to_string(),
         k.to_string(),
         format!("{}", m.mean_d),
         format!("{}", m.collisions_per_robot),
-        format!("{}", m.contact_fraction),
-        format!("{}", m.stuck_fraction),
-        format!("{}", m.moved_m),
+        format!("{}", m.contact_percent),
+        format!("{}", m.stuck_percent),
+        format!("{}", m.moving_percent),
+        format!("{}", m.moved_mm),
         m.gap_cv.map(|v| format!("{v}")).unwrap_or_default(),
         format!("{}", m.cpu_load_percent),
     ]
@@ -274,7 +298,11 @@ struct Rows {
 /// An arena the world refuses.
 pub fn arena_of(s: &Scenario) -> Result<Arena> {
     Ok(match s.arena {
-        ArenaKind::Corridor => Arena::paper_corridor(),
+        ArenaKind::Corridor => Arena::corridor_with_clearance(
+            world::params::BODY_WIDTH_M,
+            s.world.corridor_clearance_m,
+        )
+        .context("arena")?,
         ArenaKind::Square if s.robots == world::arena::PAPER_ROBOTS => Arena::square(),
         ArenaKind::Square => Arena::scaled_square(s.robots).context("arena")?,
     })
@@ -291,6 +319,7 @@ pub fn world_params(s: &Scenario) -> WorldParams {
         max_substep_s: s.world.substep_s,
         clock_hz: u64::from(s.timing.clock_hz),
         sensor_max_range_m: s.world.sensor_range_m,
+        mu_wall: s.world.mu_wall,
         sensor_mounts: SensorMount::default_mounts(
             world::params::BODY_LENGTH_M,
             world::params::BODY_WIDTH_M,
@@ -334,6 +363,10 @@ pub struct Swarm {
     robots: Vec<Robot>,
     meters: Vec<ContactMeter>,
     stuck: Vec<StuckDetector>,
+    /// Each robot's record over the run.
+    tallies: Vec<RobotTally>,
+    /// Collisions counted for each robot since its last tally.
+    collided: Vec<u64>,
     /// Whether each robot's motors drove through the step being run.
     drove: Vec<bool>,
     /// The step period in clock states.
@@ -396,6 +429,7 @@ impl Swarm {
                 .iter()
                 .map(|w| [(w.a.0, w.a.1), (w.b.0, w.b.1)])
                 .collect(),
+            spacetime: vec![Vec::new(); tracked],
         });
         Ok(Self {
             scenario: s.clone(),
@@ -405,6 +439,8 @@ impl Swarm {
             robots,
             meters: vec![ContactMeter::new(nominal_substep_states(s)); n],
             stuck: vec![StuckDetector::default(); n],
+            tallies: vec![RobotTally::new(s.window); n],
+            collided: vec![0; n],
             drove: vec![false; n],
             period_states: period_states(s),
             started: 0,
@@ -539,6 +575,14 @@ impl Swarm {
                 self.snapshots.contains(&k),
                 t_step_s,
             )?;
+            let steps = self.scenario.steps;
+            if self.scenario.arena == ArenaKind::Corridor
+                && (k % spacetime_stride(steps) == 0 || k + 1 == steps)
+            {
+                for (i, path) in t.spacetime.iter_mut().enumerate() {
+                    path.push((f64::from(k), self.world.pose(i)?.x_m));
+                }
+            }
         }
         let world = &self.world;
         // What each robot's board shows its MCU for the step: the sensors' true distances and
@@ -622,9 +666,10 @@ impl Swarm {
         self.pending = Some(StepMetrics {
             mean_d,
             collisions_per_robot: 0.0,
-            contact_fraction: 0.0,
-            stuck_fraction: 0.0,
-            moved_m: 0.0,
+            contact_percent: 0.0,
+            stuck_percent: 0.0,
+            moving_percent: 0.0,
+            moved_mm: 0.0,
             gap_cv,
             cpu_load_percent: sum_load / live_f,
         });
@@ -636,20 +681,36 @@ impl Swarm {
     /// robots.
     fn close_step(&mut self, t_states: u64) -> Result<()> {
         let dt = t_states.saturating_sub(self.world.elapsed_states());
-        let (collided, contact_states) =
-            advance_world(&mut self.world, t_states, &mut self.meters, self.parallel)?;
+        let (collided, contact_states) = advance_world(
+            &mut self.world,
+            t_states,
+            &mut self.meters,
+            &mut self.collided,
+            self.parallel,
+        )?;
         let n = self.robots.len();
-        let (moved, stuck) = self.moved()?;
+        let moved = self.moved()?;
         if let Some(mut last) = self.pending.take() {
+            let k = self.started - 1;
+            let in_last = k >= self.scenario.steps.saturating_sub(self.scenario.window);
+            let (mut sum_m, mut stuck, mut moving) = (0.0, 0usize, 0usize);
+            for (i, &(d, is_stuck)) in moved.iter().enumerate() {
+                let c = std::mem::take(&mut self.collided[i]);
+                self.tallies[i].record(k, d, c, is_stuck, in_last);
+                sum_m += d;
+                stuck += usize::from(is_stuck);
+                moving += usize::from(d * 1000.0 >= crate::collisions::MOVING_MIN_MM);
+            }
+            let share = |count: usize| 100.0 * count as f64 / n as f64;
             last.collisions_per_robot = collided as f64 / n as f64;
-            last.contact_fraction = if dt == 0 {
+            last.contact_percent = if dt == 0 {
                 0.0
             } else {
-                contact_states as f64 / (dt as f64 * n as f64)
+                100.0 * contact_states as f64 / (dt as f64 * n as f64)
             };
-            last.moved_m = moved;
-            last.stuck_fraction = stuck as f64 / n as f64;
-            let k = self.started - 1;
+            last.moved_mm = 1000.0 * sum_m / n as f64;
+            last.stuck_percent = share(stuck);
+            last.moving_percent = share(moving);
             self.metrics.add(k, &last);
             if let Some(rows) = self.rows.as_mut() {
                 rows.w
@@ -671,26 +732,25 @@ impl Swarm {
         &self.metrics
     }
 
-    /// The mean distance the robots' centres moved since the previous call (0 on the first)
-    /// and how many robots are stuck, remembering where they are now.
-    fn moved(&mut self) -> Result<(f64, usize)> {
+    /// How far each robot's centre moved since the previous call (metres, 0 on the first)
+    /// and whether it is stuck now, remembering where the robots are.
+    fn moved(&mut self) -> Result<Vec<(f64, bool)>> {
         let n = self.robots.len();
-        let mut sum = 0.0;
-        let mut stuck = 0;
         let first = self.last_xy.is_empty();
         self.last_xy.resize(n, (0.0, 0.0));
+        let mut out = Vec::with_capacity(n);
         for (i, xy) in self.last_xy.iter_mut().enumerate() {
             let p = self.world.pose(i)?;
-            if !first {
+            if first {
+                out.push((0.0, false));
+            } else {
                 let d = (p.x_m - xy.0).hypot(p.y_m - xy.1);
-                sum += d;
-                if self.stuck[i].record(d, self.drove[i] && self.dead[i].is_none()) {
-                    stuck += 1;
-                }
+                let stuck = self.stuck[i].record(d, self.drove[i] && self.dead[i].is_none());
+                out.push((d, stuck));
             }
             *xy = (p.x_m, p.y_m);
         }
-        Ok((sum / n as f64, stuck))
+        Ok(out)
     }
 
     /// Lets the last behaviour run its full period (its collisions counted) and returns the
@@ -711,6 +771,9 @@ impl Swarm {
                 )))?;
         }
         let dead = self.dead();
+        for t in &mut self.tallies {
+            t.finish();
+        }
         Ok(RunOutput {
             condition: self.condition,
             repeat: self.repeat,
@@ -718,6 +781,7 @@ impl Swarm {
             track: self.track,
             saves: self.saves,
             dead,
+            robots: self.tallies,
         })
     }
 }
@@ -885,11 +949,13 @@ pub fn nominal_substep_states(s: &Scenario) -> u64 {
 }
 
 /// Advances the world to `target_states` in its sub-steps, feeding every robot's bumpers
-/// after each to its meter; returns the collisions counted and the robot-states in contact.
+/// after each to its meter; adds each robot's collisions to `per_robot` and returns the
+/// collisions counted and the robot-states in contact.
 fn advance_world(
     world: &mut World,
     target_states: u64,
     meters: &mut [ContactMeter],
+    per_robot: &mut [u64],
     par: bool,
 ) -> Result<(u64, u64)> {
     let (mut collisions, mut contact) = (0u64, 0u64);
@@ -904,6 +970,7 @@ fn advance_world(
             let pressed = world.bumpers(i)?.iter().any(|&b| b);
             m.sample(pressed, len);
             let (c, t) = m.take();
+            per_robot[i] += c;
             collisions += c;
             contact += t;
         }
@@ -971,6 +1038,7 @@ mod tests {
         let nominal = nominal_substep_states(&s);
         assert_eq!(nominal, 500_000, "0.6 s in 30 sub-steps of 20 ms");
         let mut meters = vec![ContactMeter::new(nominal)];
+        let mut per_robot = vec![0];
         let mut collisions = Vec::new();
         let mut t = 0u64;
         for _ in 0..500 {
@@ -978,12 +1046,14 @@ mod tests {
             for len in w.substep_plan(t - w.elapsed_states()) {
                 assert_eq!(len, nominal, "no sliver of a sub-step");
             }
-            let (c, contact) = advance_world(&mut w, t, &mut meters, false).unwrap();
+            let (c, contact) =
+                advance_world(&mut w, t, &mut meters, &mut per_robot, false).unwrap();
             collisions.push((c, contact));
         }
         assert_eq!(w.elapsed_states(), 500 * period, "no drift");
         let total: u64 = collisions.iter().map(|c| c.0).sum();
         assert_eq!(total, 1, "one push, one collision");
+        assert_eq!(per_robot, [1], "counted for the robot");
         // From the step it arrives (2.5 m → 2.885 m at 0.15 m/s: about 4 steps) it is in
         // contact the whole step.
         assert!(collisions[10..].iter().all(|&(_, c)| c == period));
@@ -1006,9 +1076,10 @@ mod tests {
         StepMetrics {
             mean_d: 700.0 + (x * 0.37).sin() * 50.0,
             collisions_per_robot: f64::from(k % 7) / 3.0,
-            contact_fraction: (x * 0.11).cos().abs(),
-            stuck_fraction: f64::from(k % 5) / 5.0,
-            moved_m: 0.07 / (1.0 + x),
+            contact_percent: 100.0 * (x * 0.11).cos().abs(),
+            stuck_percent: f64::from(k % 5) * 20.0,
+            moving_percent: f64::from(k % 3) * 50.0,
+            moved_mm: 70.0 / (1.0 + x),
             gap_cv: gap.then_some(0.1 + x * 1e-4),
             cpu_load_percent: 0.3 + x * 1e-6,
         }
@@ -1117,11 +1188,12 @@ mod tests {
                 &StepMetrics {
                     mean_d: f(3),
                     collisions_per_robot: f(4),
-                    contact_fraction: f(5),
-                    stuck_fraction: f(6),
-                    moved_m: f(7),
-                    gap_cv: (!r[8].is_empty()).then(|| f(8)),
-                    cpu_load_percent: f(9),
+                    contact_percent: f(5),
+                    stuck_percent: f(6),
+                    moving_percent: f(7),
+                    moved_mm: f(8),
+                    gap_cv: (!r[9].is_empty()).then(|| f(9)),
+                    cpu_load_percent: f(10),
                 },
             );
         }

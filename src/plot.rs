@@ -122,9 +122,17 @@ pub struct LearningFigure {
     pub d: Vec<Series>,
     /// Series of the right panel: collisions per robot per window.
     pub collisions: Vec<Series>,
-    /// Further panels (at most two, e.g. contact time and the corridor's gap CV), drawn in a
-    /// second row under the first two; none keeps the paper's two-panel figure.
+    /// Further panels (at most four, e.g. collisions per metre, contact time and the
+    /// corridor's gap CV), drawn two to a row under the first two; none keeps the paper's
+    /// two-panel figure.
     pub more: Vec<Panel>,
+    /// The share of stuck robot-steps per condition (percent, labels as in the panels), drawn
+    /// dotted on a right-hand axis of 0–100 % in the collisions panel and in every further
+    /// panel that asks for it, so a falling collision curve is read beside the robots that
+    /// stopped; none draws no overlay.
+    pub stuck: Vec<Series>,
+    /// Mark every point (a run with few windows, whose lines are no trend).
+    pub markers: bool,
 }
 
 /// A further panel of the learning figure.
@@ -136,6 +144,8 @@ pub struct Panel {
     pub y_label: String,
     /// Its series (checked like the first two panels').
     pub series: Vec<Series>,
+    /// Draw [`LearningFigure::stuck`] on a right-hand axis.
+    pub stuck_overlay: bool,
 }
 
 /// The paper's Fig. 8: the arena from above with every robot's trajectory and its outline at a
@@ -150,6 +160,23 @@ pub struct ArenaFigure {
     pub paths: Vec<Vec<(f64, f64)>>,
     /// Robot outlines at chosen instants.
     pub outlines: Vec<Outline>,
+}
+
+/// The corridor seen over time: each robot's position along the corridor against the learning
+/// step, its body drawn as a band (its centre ± half its length), so the gaps between
+/// neighbours are the white space between the bands and an even spacing shows as parallel
+/// bands.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SpaceTimeFigure {
+    /// Title.
+    pub title: String,
+    /// The corridor's length, metres (the y axis runs from 0 to it).
+    pub length_m: f64,
+    /// A robot's length along the corridor, metres (the band's width).
+    pub body_m: f64,
+    /// One path per robot: (learning step, position along the corridor in metres), steps
+    /// increasing.
+    pub paths: Vec<Vec<(f64, f64)>>,
 }
 
 /// A robot's outline at one instant.
@@ -324,16 +351,17 @@ const CURVE_WIDTH_PX: u32 = 3;
 pub fn learning_figure(fig: &LearningFigure, png: &Path, svg: &Path) -> Result<(), PlotError> {
     validate_panel("D", &fig.d)?;
     validate_panel("collisions", &fig.collisions)?;
-    for p in fig.more.iter().take(2) {
+    for p in fig.more.iter().take(MAX_MORE_PANELS) {
         validate_panel("further", &p.series)?;
+    }
+    if !fig.stuck.is_empty() {
+        validate_panel("stuck", &fig.stuck)?;
     }
     check_png_name(png)?;
     register_font()?;
     let styles = CurveStyles::new(fig);
     let (w, mut h) = LEARNING_SIZE_PX;
-    if !fig.more.is_empty() {
-        h += LEARNING_SIZE_PX.1 - LEARNING_TITLE_PX - 60;
-    }
+    h += more_rows(fig) * (LEARNING_SIZE_PX.1 - LEARNING_TITLE_PX - 60);
     let rows = legend_rows(&styles, w as i32 - 60).map_err(|e| draw_error(png, e))?;
     let extra_rows = rows.len().saturating_sub(1) as u32;
     let size = (w, h + extra_rows * LEGEND_ROW_PX);
@@ -353,6 +381,14 @@ pub fn learning_figure(fig: &LearningFigure, png: &Path, svg: &Path) -> Result<(
         root.present().map_err(|e| draw_error(svg, e))?;
     }
     std::fs::write(svg, text.as_bytes()).map_err(|e| write_error(svg, e))
+}
+
+/// Most further panels of the learning figure (two rows of two).
+const MAX_MORE_PANELS: usize = 4;
+
+/// Rows of further panels under the first two.
+fn more_rows(fig: &LearningFigure) -> u32 {
+    fig.more.len().min(MAX_MORE_PANELS).div_ceil(2) as u32
 }
 
 /// Checks one panel's series: present, non-empty, equal lengths, finite, x strictly increasing.
@@ -417,7 +453,11 @@ struct CurveStyles {
 impl CurveStyles {
     fn new(fig: &LearningFigure) -> Self {
         let mut entries: Vec<(String, RGBColor, bool)> = Vec::new();
-        let more = fig.more.iter().take(2).flat_map(|p| p.series.iter());
+        let more = fig
+            .more
+            .iter()
+            .take(MAX_MORE_PANELS)
+            .flat_map(|p| p.series.iter());
         for s in fig.d.iter().chain(&fig.collisions).chain(more) {
             if !entries.iter().any(|(l, _, _)| *l == s.label) {
                 let colour = CURVE_PALETTE[entries.len() % CURVE_PALETTE.len()];
@@ -489,43 +529,34 @@ fn draw_learning<DB: DrawingBackend>(
         ((w / 2) as i32, (LEARNING_TITLE_PX / 2) as i32 + 4),
     )?;
 
-    let (top, bottom) = if fig.more.is_empty() {
-        (panels, None)
-    } else {
-        let (_, ph) = panels.dim_in_pixel();
-        let (t, b) = panels.split_vertically(ph / 2);
-        (t, Some(b))
-    };
-    if let Some(bottom) = bottom {
-        let (bl, br) = bottom.split_horizontally(w / 2);
-        for (area, p) in [bl, br].iter().zip(fig.more.iter().take(2)) {
-            draw_panel(
-                area,
-                &p.caption,
-                &fig.x_label,
-                &p.y_label,
-                &p.series,
-                styles,
-            )?;
-        }
+    let rows_of_panels = 1 + more_rows(fig);
+    let areas = panels.split_evenly((rows_of_panels as usize, 2));
+    let stuck = (!fig.stuck.is_empty()).then_some(fig.stuck.as_slice());
+    let first = [
+        Panel {
+            caption: "Mean summed sensor distance D".into(),
+            y_label: "mean summed distance D (du)".into(),
+            series: fig.d.clone(),
+            stuck_overlay: false,
+        },
+        Panel {
+            caption: "Collisions".into(),
+            y_label: "collisions per robot per window".into(),
+            series: fig.collisions.clone(),
+            stuck_overlay: true,
+        },
+    ];
+    let all = first.iter().chain(fig.more.iter().take(MAX_MORE_PANELS));
+    for (area, p) in areas.iter().zip(all) {
+        draw_panel(
+            area,
+            p,
+            &fig.x_label,
+            stuck.filter(|_| p.stuck_overlay),
+            fig.markers,
+            styles,
+        )?;
     }
-    let (left, right) = top.split_horizontally(w / 2);
-    draw_panel(
-        &left,
-        "Mean summed sensor distance D",
-        &fig.x_label,
-        "mean summed distance D (du)",
-        &fig.d,
-        styles,
-    )?;
-    draw_panel(
-        &right,
-        "Collisions",
-        &fig.x_label,
-        "collisions per robot per window",
-        &fig.collisions,
-        styles,
-    )?;
     draw_curve_legend(&legend_area, styles, rows, &legend_font)
 }
 
@@ -606,23 +637,34 @@ fn tick_label(value: f64, span: f64) -> String {
 
 fn draw_panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
-    caption: &str,
+    panel: &Panel,
     x_label: &str,
-    y_label: &str,
-    series: &[Series],
+    stuck: Option<&[Series]>,
+    markers: bool,
     styles: &CurveStyles,
 ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
-    let (x0, x1) = x_range(series);
+    let series = &panel.series;
+    let (x0, x1) = match stuck {
+        Some(st) => {
+            let (a, b) = x_range(series);
+            let (c, d) = x_range(st);
+            (a.min(c), b.max(d))
+        }
+        None => x_range(series),
+    };
     let (y0, y1) = value_range(series);
     let mut chart = ChartBuilder::on(area)
         .margin_left(14)
-        .margin_right(34)
+        .margin_right(if stuck.is_some() { 8 } else { 34 })
         .margin_top(6)
         .margin_bottom(4)
-        .caption(caption, (FONT_FAMILY, 22).into_font().color(&INK))
+        .caption(&panel.caption, (FONT_FAMILY, 22).into_font().color(&INK))
         .x_label_area_size(62)
         .y_label_area_size(92)
-        .build_cartesian_2d(x0..x1, y0..y1)?;
+        .right_y_label_area_size(if stuck.is_some() { 80 } else { 0 })
+        .build_cartesian_2d(x0..x1, y0..y1)?
+        .set_secondary_coord(x0..x1, 0.0..100.0);
+    let y_label = panel.y_label.as_str();
     let x_fmt = |v: &f64| tick_label(*v, x1 - x0);
     let y_fmt = |v: &f64| tick_label(*v, y1 - y0);
     chart
@@ -639,6 +681,33 @@ fn draw_panel<DB: DrawingBackend>(
         .x_label_formatter(&x_fmt)
         .y_label_formatter(&y_fmt)
         .draw()?;
+    if let Some(st) = stuck {
+        chart
+            .configure_secondary_axes()
+            .y_desc("stuck robot-steps (%), dotted")
+            .label_style((FONT_FAMILY, 16).into_font().color(&INK))
+            .axis_desc_style((FONT_FAMILY, 19).into_font().color(&INK))
+            .axis_style(INK.mix(0.7))
+            .y_labels(6)
+            .draw()?;
+        for s in st {
+            let colour = styles.colour(&s.label);
+            let points: Vec<(f64, f64)> = s.x.iter().copied().zip(s.mean.iter().copied()).collect();
+            chart.draw_secondary_series(DashedLineSeries::new(
+                points.clone(),
+                3,
+                6,
+                colour.mix(0.8).stroke_width(2),
+            ))?;
+            if markers || points.len() == 1 {
+                chart.draw_secondary_series(
+                    points
+                        .into_iter()
+                        .map(|p| Circle::new(p, 4, colour.mix(0.8).stroke_width(2))),
+                )?;
+            }
+        }
+    }
 
     // Bands first, then dashed lines, then solid lines, so the learning runs lie on top.
     for s in series {
@@ -661,16 +730,17 @@ fn draw_panel<DB: DrawingBackend>(
         for s in series.iter().filter(|s| s.dashed == dashed) {
             let colour = styles.colour(&s.label);
             let points: Vec<(f64, f64)> = s.x.iter().copied().zip(s.mean.iter().copied()).collect();
-            if points.len() == 1 {
-                chart.draw_series(std::iter::once(Circle::new(points[0], 5, colour.filled())))?;
-            } else if dashed {
+            if markers || points.len() == 1 {
+                chart.draw_series(points.iter().map(|&p| Circle::new(p, 6, colour.filled())))?;
+            }
+            if points.len() > 1 && dashed {
                 chart.draw_series(DashedLineSeries::new(
                     points,
                     12,
                     8,
                     colour.stroke_width(CURVE_WIDTH_PX),
                 ))?;
-            } else {
+            } else if points.len() > 1 {
                 chart.draw_series(LineSeries::new(points, colour.stroke_width(CURVE_WIDTH_PX)))?;
             }
         }
@@ -746,18 +816,32 @@ const ARENA_LISTED_TIMES: usize = 12;
 /// The image's size follows the arena's shape (equal aspect ratio); a 1.8 m square arena gives
 /// about 1 300 × 1 050 pixels. Nothing is written unless the figure is valid.
 pub fn arena_figure(fig: &ArenaFigure, png: &Path) -> Result<(), PlotError> {
-    let headings = validate_arena(fig)?;
     check_png_name(png)?;
+    let (size, rgb) = render_arena(fig).map_err(|e| match e {
+        PlotError::Draw { reason, .. } => draw_error(png, reason),
+        other => other,
+    })?;
+    write_png(png, size, &rgb)
+}
+
+/// The arena figure's pixels: its size and its RGB bytes, row by row (what [`arena_figure`]
+/// writes).
+///
+/// # Errors
+/// Invalid data, or a drawing that fails.
+pub fn render_arena(fig: &ArenaFigure) -> Result<((u32, u32), Vec<u8>), PlotError> {
+    let headings = validate_arena(fig)?;
     register_font()?;
     let layout = ArenaLayout::new(fig, &headings);
     let size = layout.size_px;
     let mut rgb = vec![0u8; (size.0 as usize) * (size.1 as usize) * 3];
     {
+        let here = Path::new("arena figure");
         let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
-        draw_arena(&root, fig, &layout).map_err(|e| draw_error(png, e))?;
-        root.present().map_err(|e| draw_error(png, e))?;
+        draw_arena(&root, fig, &layout).map_err(|e| draw_error(here, e))?;
+        root.present().map_err(|e| draw_error(here, e))?;
     }
-    write_png(png, size, &rgb)
+    Ok((size, rgb))
 }
 
 /// Draws several arena figures side by side into one `png` (e.g. the paths of early and of
@@ -794,6 +878,109 @@ pub fn arena_figure_panels(figs: &[ArenaFigure], png: &Path) -> Result<(), PlotE
         x0 += w;
     }
     write_png(png, (width, height), &out)
+}
+
+/// Size of the space-time figure, pixels.
+pub const SPACETIME_SIZE_PX: (u32, u32) = (1500, 760);
+
+/// Draws the corridor's space-time figure into `png` (which must end in `.png`).
+pub fn spacetime_figure(fig: &SpaceTimeFigure, png: &Path) -> Result<(), PlotError> {
+    let bad = |item: String, value: f64| PlotError::ArenaBadValue { item, value };
+    for (name, v) in [("length_m", fig.length_m), ("body_m", fig.body_m)] {
+        if !v.is_finite() || v <= 0.0 || v > MAX_ABS_COORD_M {
+            return Err(bad(format!("space-time figure, {name}"), v));
+        }
+    }
+    for (r, path) in fig.paths.iter().enumerate() {
+        for (i, &(t, x)) in path.iter().enumerate() {
+            if let Some(v) = [t, x]
+                .into_iter()
+                .find(|v| !v.is_finite() || v.abs() > MAX_ABS_VALUE)
+            {
+                return Err(bad(format!("path of robot {r}, point {i}"), v));
+            }
+        }
+    }
+    if fig.paths.iter().all(Vec::is_empty) {
+        return Err(PlotError::NothingToDraw);
+    }
+    check_png_name(png)?;
+    register_font()?;
+    let size = SPACETIME_SIZE_PX;
+    let mut rgb = vec![0u8; (size.0 as usize) * (size.1 as usize) * 3];
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
+        draw_spacetime(&root, fig).map_err(|e| draw_error(png, e))?;
+        root.present().map_err(|e| draw_error(png, e))?;
+    }
+    write_png(png, size, &rgb)
+}
+
+fn draw_spacetime<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    fig: &SpaceTimeFigure,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    root.fill(&WHITE)?;
+    let (t0, t1) = fig
+        .paths
+        .iter()
+        .flatten()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &(t, _)| {
+            (a.min(t), b.max(t))
+        });
+    let (t0, t1) = if t1 > t0 {
+        (t0, t1)
+    } else {
+        (t0 - 0.5, t0 + 0.5)
+    };
+    let mut chart = ChartBuilder::on(root)
+        .margin(20)
+        .caption(&fig.title, (FONT_FAMILY, 24).into_font().color(&INK))
+        .x_label_area_size(60)
+        .y_label_area_size(90)
+        .build_cartesian_2d(t0..t1, 0.0..fig.length_m)?;
+    let x_fmt = |v: &f64| tick_label(*v, t1 - t0);
+    let y_fmt = |v: &f64| tick_label(*v, fig.length_m);
+    chart
+        .configure_mesh()
+        .x_desc("learning step")
+        .y_desc("position along the corridor (m)")
+        .label_style((FONT_FAMILY, 16).into_font().color(&INK))
+        .axis_desc_style((FONT_FAMILY, 19).into_font().color(&INK))
+        .axis_style(INK.mix(0.7))
+        .bold_line_style(INK.mix(0.10))
+        .max_light_lines(0)
+        .x_label_formatter(&x_fmt)
+        .y_label_formatter(&y_fmt)
+        .draw()?;
+    let half = 0.5 * fig.body_m;
+    for (r, path) in fig.paths.iter().enumerate() {
+        if path.is_empty() {
+            continue;
+        }
+        let c = ROBOT_PALETTE[r % ROBOT_PALETTE.len()];
+        let band: Vec<(f64, f64)> = path
+            .iter()
+            .map(|&(t, x)| (t, (x + half).min(fig.length_m)))
+            .chain(path.iter().rev().map(|&(t, x)| (t, (x - half).max(0.0))))
+            .collect();
+        chart.draw_series(std::iter::once(Polygon::new(band, c.mix(0.25).filled())))?;
+        chart
+            .draw_series(
+                path.windows(2)
+                    .map(|w| PathElement::new(vec![w[0], w[1]], c.stroke_width(2))),
+            )?
+            .label(format!("robot {r}"))
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], c.stroke_width(3)));
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .label_font((FONT_FAMILY, 16).into_font().color(&INK))
+        .background_style(WHITE.mix(0.85))
+        .border_style(INK.mix(0.4))
+        .draw()?;
+    Ok(())
 }
 
 /// Checks the arena figure; returns each outline's heading normalised to unit length.
@@ -1094,10 +1281,16 @@ fn draw_arena<DB: DrawingBackend>(
     let robots = fig.paths.len();
     let colour = |r: usize| ROBOT_PALETTE[r % ROBOT_PALETTE.len()];
     let (path_px, path_alpha) = layout.path_style;
+    // Each step of a path is a segment of its own: plotters joins a wide polyline's segments
+    // with mitres, and where a robot reverses (backward after forward) the two segments meet
+    // at almost 180° and the mitre becomes a long thin spike far past the path.
     for (r, path) in fig.paths.iter().enumerate() {
         let thin = thin_path(path, 0.75 * m_per_px);
         let style = colour(r).mix(path_alpha).stroke_width(path_px);
-        chart.draw_series(std::iter::once(PathElement::new(thin, style)))?;
+        chart.draw_series(
+            thin.windows(2)
+                .map(|w| PathElement::new(vec![w[0], w[1]], style)),
+        )?;
     }
     for (r, path) in fig.paths.iter().enumerate() {
         if let Some(&start) = path.first() {

@@ -18,11 +18,12 @@ use serde::Serialize;
 
 use crate::experiment::{RunOptions, RunOutput, build_world, run_one};
 use crate::plot::{
-    ArenaFigure, LearningFigure, Panel, Series, arena_figure_panels, learning_figure,
+    ArenaFigure, LearningFigure, Panel, Series, SpaceTimeFigure, arena_figure_panels,
+    learning_figure, spacetime_figure,
 };
 use crate::robot::{Condition, controller_config};
 use crate::scenario::Scenario;
-use crate::summary::{Claim, ConditionStats, Estimate, claims, conditions};
+use crate::summary::{Analysis, Claim, ConditionStats, Estimate, Pairing, Quantity, analyse};
 
 /// Options of `h8swarm run`.
 #[derive(Args, Debug, Default, Clone)]
@@ -157,8 +158,11 @@ struct Summary<'a> {
     h8swarm_version: &'static str,
     scenario: &'a Scenario,
     window_steps: u32,
+    units: Units,
     eeprom_records_written: u64,
+    warnings: &'a [String],
     conditions: &'a [ConditionStats],
+    pairings: &'a [Pairing],
     claims: &'a [Claim],
 }
 
@@ -499,13 +503,15 @@ impl Stage {
 }
 
 /// Every file `h8swarm run` writes into its output folder.
-pub const OUTPUT_FILES: [&str; 6] = [
+pub const OUTPUT_FILES: [&str; 8] = [
     "metrics.csv",
+    "robots.csv",
     "summary.json",
     "fit.json",
     "learning.png",
     "learning.svg",
     "arena.png",
+    "spacetime.png",
 ];
 
 /// Runs the experiment, writing its files into `stage`; returns the text to print and the
@@ -591,16 +597,27 @@ fn run_into(
 
     let parts: Vec<PathBuf> = jobs.iter().map(|&(c, r)| rows_path(c, r)).collect();
     write_metrics(&metrics_path, &parts)?;
-    let stats = conditions(&runs, s.steps, s.window);
-    let checked = claims(&stats);
+    let robots_path = stage.path("robots.csv");
+    write_robots(&robots_path, &runs)?;
+    let analysis = analyse(
+        &runs,
+        s.robots,
+        s.steps,
+        s.window,
+        crate::seeds::bootstrap_seed(s.seed),
+    );
+    let warnings = warnings(s);
     let saves: u64 = runs.iter().map(|r| r.saves).sum();
     let summary = Summary {
         h8swarm_version: env!("CARGO_PKG_VERSION"),
         scenario: s,
         window_steps: s.window,
+        units: UNITS,
         eeprom_records_written: saves,
-        conditions: &stats,
-        claims: &checked,
+        warnings: &warnings,
+        conditions: &analysis.conditions,
+        pairings: &analysis.pairings,
+        claims: &analysis.claims,
     };
     let summary_path = stage.path("summary.json");
     std::fs::write(
@@ -629,17 +646,14 @@ fn run_into(
             fit_path.display()
         )))?;
 
-    let (png, svg, arena_png) = (
-        stage.path("learning.png"),
-        stage.path("learning.svg"),
-        stage.path("arena.png"),
-    );
+    let (png, svg) = (stage.path("learning.png"), stage.path("learning.svg"));
     let drawn = |e: crate::plot::PlotError| {
         anyhow::Error::new(e).context(OutputError("cannot draw the figures".into()))
     };
     learning_figure(&learning(s, &runs), &png, &svg).map_err(drawn)?;
     let mut names: Vec<String> = [
         "metrics.csv",
+        "robots.csv",
         "summary.json",
         "fit.json",
         "learning.png",
@@ -648,8 +662,13 @@ fn run_into(
     .map(String::from)
     .to_vec();
     if let Some(track) = runs.iter().find_map(|r| r.track.as_ref()) {
-        arena_figure_panels(&arena(s, track), &arena_png).map_err(drawn)?;
-        names.push("arena.png".into());
+        if s.arena == crate::scenario::ArenaKind::Corridor {
+            spacetime_figure(&spacetime(s, track), &stage.path("spacetime.png")).map_err(drawn)?;
+            names.push("spacetime.png".into());
+        } else {
+            arena_figure_panels(&arena(s, track), &stage.path("arena.png")).map_err(drawn)?;
+            names.push("arena.png".into());
+        }
     }
 
     let robot_steps = jobs.len() as f64 * f64::from(s.steps) * s.robots as f64;
@@ -657,12 +676,12 @@ fn run_into(
     let mut t = String::new();
     let _ = writeln!(
         t,
-        "h8swarm run {}: {} robots, {} steps of {} s, {} repeats x {} conditions, seed {}",
+        "h8swarm run {}: {} robots, {} steps of {} s, {} x {} conditions, seed {}",
         s.name,
         s.robots,
         s.steps,
         s.timing.step_period_s,
-        s.repeats,
+        plural(s.repeats, "repeat"),
         kinds.len(),
         s.seed
     );
@@ -673,71 +692,11 @@ fn run_into(
         robot_steps / wall_s,
         simulated_s / wall_s
     );
-    let _ = writeln!(t);
-    let _ = writeln!(
-        t,
-        "{:<14} {:>22} {:>22} {:>22} {:>22}",
-        "condition", "D first window", "D last window", "coll./robot first", "coll./robot last"
-    );
-    for c in &stats {
-        let _ = writeln!(
-            t,
-            "{:<14} {:>22} {:>22} {:>22} {:>22}",
-            c.condition.name(),
-            fmt_est(&c.first.mean_d),
-            fmt_est(&c.last.mean_d),
-            fmt_est(&c.first.collisions_per_robot),
-            fmt_est(&c.last.collisions_per_robot)
-        );
-        let mm = |e: &Estimate| Estimate {
-            mean: e.mean * 1e3,
-            lo: e.lo.map(|v| v * 1e3),
-            hi: e.hi.map(|v| v * 1e3),
-            n: e.n,
-        };
-        let _ = writeln!(
-            t,
-            "{:<14} moved per step {} -> {} mm",
-            "",
-            fmt_est(&mm(&c.first.moved_m)),
-            fmt_est(&mm(&c.last.moved_m))
-        );
-        let pct = |e: &Estimate| Estimate {
-            mean: e.mean * 100.0,
-            lo: e.lo.map(|v| v * 100.0),
-            hi: e.hi.map(|v| v * 100.0),
-            n: e.n,
-        };
-        let _ = writeln!(
-            t,
-            "{:<14} contact time {} -> {} %; stuck robot-steps {} -> {} %",
-            "",
-            fmt_est(&pct(&c.first.contact_fraction)),
-            fmt_est(&pct(&c.last.contact_fraction)),
-            fmt_est(&pct(&c.first.stuck_fraction)),
-            fmt_est(&pct(&c.last.stuck_fraction))
-        );
-        if let (Some(f), Some(l)) = (&c.first.gap_cv, &c.last.gap_cv) {
-            let _ = writeln!(t, "{:<14} gap CV {} -> {}", "", fmt_est(f), fmt_est(l));
-        }
+    for w in &warnings {
+        let _ = writeln!(t, "WARNING {w}");
     }
-    let _ = writeln!(
-        t,
-        "(windows of {} steps; mean over repeats [95 % interval])",
-        s.window
-    );
     let _ = writeln!(t);
-    for c in &checked {
-        let _ = writeln!(
-            t,
-            "{} {} ({:.3} vs {:.3}: {})",
-            if c.holds { "HOLDS " } else { "FAILS " },
-            c.claim,
-            c.values[0],
-            c.values[1],
-            c.verdict
-        );
-    }
+    report(&mut t, s, &analysis);
     for r in &runs {
         for (i, why) in &r.dead {
             let _ = writeln!(
@@ -753,11 +712,252 @@ fn run_into(
     Ok((t, names))
 }
 
+/// `n` and the noun, plural when `n` is not 1.
+fn plural(n: u32, noun: &str) -> String {
+    if n == 1 {
+        format!("1 {noun}")
+    } else {
+        format!("{n} {noun}s")
+    }
+}
+
+/// What the run's shape makes unreliable, said on screen and in summary.json.
+fn warnings(s: &Scenario) -> Vec<String> {
+    let mut w = Vec::new();
+    let windows = s.steps / s.window.max(1);
+    if windows < 3 {
+        w.push(format!(
+            "the run has {windows} whole windows of {} steps: the curves' points are marked and are no trend (use more steps or a smaller window)",
+            s.window
+        ));
+    }
+    if s.repeats < 2 {
+        w.push("one repeat: no intervals and no paired test (use --repeats 5 or more)".into());
+    } else if s.repeats < 5 {
+        w.push(format!(
+            "{} repeats: a one-sided sign test needs at least 5 repeats all going one way to reach p < 0.05, so no claim can hold",
+            s.repeats
+        ));
+    }
+    w
+}
+
+/// The unit of every quantity the outputs hold (the same on screen, in the CSV files, in
+/// summary.json and in the figures).
+#[derive(Serialize)]
+struct Units {
+    mean_d: &'static str,
+    collisions_per_robot: &'static str,
+    collisions_per_m: &'static str,
+    collisions_per_moving_step: &'static str,
+    contact_percent: &'static str,
+    stuck_percent: &'static str,
+    moving_percent: &'static str,
+    moved_mm: &'static str,
+    gap_cv: &'static str,
+    distance_m: &'static str,
+}
+
+const UNITS: Units = Units {
+    mean_d: "du (1 du = 80/255 cm), mean over robots and steps",
+    collisions_per_robot: "collisions per robot over the window",
+    collisions_per_m: "collisions per metre the robots' centres moved (none below 1 m moved)",
+    collisions_per_moving_step: "collisions per robot-step in which the robot moved at least 5 mm",
+    contact_percent: "% of robot time with a bumper pressed",
+    stuck_percent: "% of robot-steps stuck (moved < 1 mm over the last 100 steps while driving)",
+    moving_percent: "% of robot-steps in which the robot moved at least 5 mm",
+    moved_mm: "mm a robot's centre moved per step",
+    gap_cv: "coefficient of variation of the gaps between neighbours",
+    distance_m: "metres a robot's centre moved over the run",
+};
+
+/// The printed tables: per condition the first and last window, the robots, the pairings and
+/// the claims.
+fn report(t: &mut String, s: &Scenario, a: &Analysis) {
+    let _ = writeln!(
+        t,
+        "{:<14} {:>26} {:>26} {:>26}",
+        "condition", "D (du)", "collisions per robot", "collisions per metre"
+    );
+    let arrow = |f: &Estimate, l: &Estimate| format!("{} -> {}", fmt_mean(f), fmt_mean(l));
+    for c in &a.conditions {
+        let (f, l) = (&c.first, &c.last);
+        let _ = writeln!(
+            t,
+            "{:<14} {:>26} {:>26} {:>26}",
+            c.condition.name(),
+            arrow(&f.mean_d, &l.mean_d),
+            arrow(&f.collisions_per_robot, &l.collisions_per_robot),
+            arrow(&f.collisions_per_m, &l.collisions_per_m),
+        );
+        let _ = writeln!(
+            t,
+            "{:<14} last window: D {}, collisions per metre {}",
+            "",
+            fmt_est(&l.mean_d),
+            fmt_est(&l.collisions_per_m)
+        );
+        let _ = writeln!(
+            t,
+            "{:<14} stuck {} -> {} %; moving {} -> {} %; contact {} -> {} %; moved {} -> {} mm per step",
+            "",
+            fmt_mean(&f.stuck_percent),
+            fmt_est(&l.stuck_percent),
+            fmt_mean(&f.moving_percent),
+            fmt_mean(&l.moving_percent),
+            fmt_mean(&f.contact_percent),
+            fmt_est(&l.contact_percent),
+            fmt_mean(&f.moved_mm),
+            fmt_mean(&l.moved_mm),
+        );
+        if let (Some(fg), Some(lg)) = (&f.gap_cv, &l.gap_cv) {
+            let _ = writeln!(t, "{:<14} gap CV {} -> {}", "", fmt_mean(fg), fmt_est(lg));
+        }
+        let r = &c.robots;
+        let onset = r
+            .first_lasting_stuck_step_median
+            .map_or_else(String::new, |m| format!(", median onset step {m:.0}"));
+        let _ = writeln!(
+            t,
+            "{:<14} robots ending the run stuck {} of {} ({} %); a lasting stuck spell: {} of {}{onset}",
+            "",
+            r.ending_stuck,
+            r.robots,
+            fmt_est(&r.ending_stuck_percent),
+            r.with_lasting_spell,
+            r.robots,
+        );
+    }
+    let _ = writeln!(
+        t,
+        "(windows of {} steps; first -> last window, mean over repeats; [95 % interval: expanded percentile bootstrap over repeats])",
+        s.window
+    );
+    for p in &a.pairings {
+        let _ = writeln!(
+            t,
+            "robot by robot against {}: learning frees {} and traps {} of {} robots, leaves {} alone ({} stuck under both, {} under neither); McNemar exact p = {}",
+            p.other.name(),
+            p.frees,
+            p.traps,
+            p.robots,
+            p.both_stuck + p.neither,
+            p.both_stuck,
+            p.neither,
+            crate::summary::fmt_p(p.p)
+        );
+    }
+    let _ = writeln!(t);
+    let _ = writeln!(
+        t,
+        "The paper's claims (learning, paired by repeat, one-sided sign test at p < 0.05):"
+    );
+    let line = |t: &mut String, c: &Claim| {
+        let _ = writeln!(
+            t,
+            "{:<9} {} ({} vs {} {}: {})",
+            c.outcome.word(),
+            c.claim,
+            fmt_value(c.values[0]),
+            fmt_value(c.values[1]),
+            c.unit,
+            c.verdict
+        );
+    };
+    for c in a.claims.iter().filter(|c| c.paper) {
+        line(t, c);
+    }
+    let _ = writeln!(
+        t,
+        "Against the controls the paper lacks, and for reference:"
+    );
+    for c in a.claims.iter().filter(|c| !c.paper) {
+        line(t, c);
+    }
+    let paper: Vec<&Claim> = a.claims.iter().filter(|c| c.paper).collect();
+    let held = paper
+        .iter()
+        .filter(|c| c.outcome == crate::summary::Outcome::Holds)
+        .count();
+    let _ = writeln!(
+        t,
+        "{held} of the paper's {} text claims hold together here{}",
+        paper.len(),
+        if held == paper.len() {
+            ""
+        } else {
+            " (see docs/claims.md for where they do)"
+        }
+    );
+}
+
+fn fmt_value(v: f64) -> String {
+    if v.is_nan() {
+        "none".to_string()
+    } else {
+        format!("{v:.2}")
+    }
+}
+
+fn fmt_mean(e: &Estimate) -> String {
+    if e.mean.is_nan() {
+        "none".to_string()
+    } else {
+        format!("{:.2}", e.mean)
+    }
+}
+
 fn fmt_est(e: &Estimate) -> String {
     match (e.lo, e.hi) {
+        _ if e.mean.is_nan() => "none".to_string(),
         (Some(lo), Some(hi)) => format!("{:.2} [{:.2}, {:.2}]", e.mean, lo, hi),
         _ => format!("{:.2}", e.mean),
     }
+}
+
+/// The columns of `robots.csv`, one row per robot of every run.
+pub const ROBOTS_HEADER: [&str; 11] = [
+    "condition",
+    "repeat",
+    "robot",
+    "distance_m",
+    "collisions",
+    "moving_steps",
+    "stuck_steps",
+    "ends_stuck",
+    "first_lasting_stuck_step",
+    "last_window_distance_m",
+    "last_window_collisions",
+];
+
+/// Writes every robot's record of every run (in run order, robots in index order).
+fn write_robots(path: &Path, runs: &[RunOutput]) -> Result<()> {
+    let write = || -> Result<()> {
+        let mut w = csv::Writer::from_path(path)?;
+        w.write_record(ROBOTS_HEADER)?;
+        for r in runs {
+            for (i, t) in r.robots.iter().enumerate() {
+                w.write_record([
+                    r.condition.name().to_string(),
+                    r.repeat.to_string(),
+                    i.to_string(),
+                    format!("{}", t.distance_m),
+                    t.collisions.to_string(),
+                    t.moving_steps.to_string(),
+                    t.stuck_steps.to_string(),
+                    u8::from(t.ends_stuck).to_string(),
+                    t.first_lasting_stuck_step
+                        .map(|k| k.to_string())
+                        .unwrap_or_default(),
+                    format!("{}", t.last_window_distance_m),
+                    t.last_window_collisions.to_string(),
+                ])?;
+            }
+        }
+        w.flush()?;
+        Ok(())
+    };
+    write().context(OutputError(format!("cannot write `{}`", path.display())))
 }
 
 /// Joins the runs' row files (in run order) under the header into `path`, removing them.
@@ -782,88 +982,130 @@ fn write_metrics_csv(path: &Path, parts: &[PathBuf]) -> Result<()> {
     Ok(())
 }
 
-/// The learning figure: per condition, mean D per window and collisions per robot per window
-/// (the paper's two panels), then contact time (percent of the window) and, in the corridor,
-/// the gap CV (elsewhere the stuck robot-steps, percent): mean over repeats with its 95 % band
-/// (or the mean alone with fewer than two repeats).
+/// The learning figure: per condition, mean D and collisions per robot per window (the
+/// paper's two panels), then collisions per metre moved, contact time and, in the corridor,
+/// the gap CV and the robots moving; the stuck robot-steps drawn dotted beside every
+/// collision curve. Each curve is the mean over repeats with its 95 % band (the mean alone
+/// with one repeat); a window in which no repeat has a value (collisions per metre of robots
+/// that did not move) has no point.
 fn learning(s: &Scenario, runs: &[RunOutput]) -> LearningFigure {
-    use crate::experiment::WindowSums;
-    let win = s.window.max(1) as usize;
+    let win = s.window.max(1);
     let windows = runs
         .iter()
         .map(|r| r.metrics.whole_windows().len())
         .min()
         .unwrap_or(0);
-    let of =
-        |c: Condition| -> Vec<&RunOutput> { runs.iter().filter(|r| r.condition == c).collect() };
-    // One series per condition of a per-step metric, summed or averaged over each window.
-    let panel =
-        |f: &dyn Fn(&WindowSums) -> f64, sum: bool, scale: f64, floor0: bool| -> Vec<Series> {
-            let mut out = Vec::new();
-            for c in Condition::ALL {
-                let of_c = of(c);
-                if of_c.is_empty() {
+    let seed = crate::seeds::bootstrap_seed(s.seed);
+    let panel = |q: Quantity| -> Vec<Series> {
+        let mut out = Vec::new();
+        for c in Condition::ALL {
+            let mut of_c: Vec<&RunOutput> = runs.iter().filter(|r| r.condition == c).collect();
+            if of_c.is_empty() {
+                continue;
+            }
+            of_c.sort_by_key(|r| r.repeat);
+            let (mut xs, mut m, mut lo, mut hi) = (vec![], vec![], vec![], vec![]);
+            for w in 0..windows {
+                let vals: Vec<Option<f64>> = of_c
+                    .iter()
+                    .map(|r| q.of(&r.metrics.windows[w], s.robots))
+                    .collect();
+                let e = Estimate::of_defined(&vals, seed);
+                if e.n == 0 {
                     continue;
                 }
-                let (mut xs, mut m, mut lo, mut hi) = (vec![], vec![], vec![], vec![]);
-                for w in 0..windows {
-                    let vals: Vec<f64> = of_c
-                        .iter()
-                        .map(|r| {
-                            let t = f(&r.metrics.windows[w]);
-                            scale * if sum { t } else { t / win as f64 }
-                        })
-                        .collect();
-                    let e = Estimate::of(&vals);
-                    xs.push((w * win + win / 2) as f64);
-                    m.push(e.mean);
-                    let l = e.lo.unwrap_or(e.mean);
-                    lo.push(if floor0 { l.max(0.0) } else { l });
-                    hi.push(e.hi.unwrap_or(e.mean));
-                }
-                out.push(Series {
-                    label: match c {
-                        Condition::Learning => "learning".to_string(),
-                        Condition::LearningOff => "learning off (η = 0)".to_string(),
-                        Condition::RandomWalk => "random walk".to_string(),
-                    },
-                    dashed: c != Condition::Learning,
-                    x: xs,
-                    mean: m,
-                    lo,
-                    hi,
-                });
+                xs.push(f64::from(w as u32 * win + win / 2));
+                m.push(e.mean);
+                lo.push(e.lo.unwrap_or(e.mean));
+                hi.push(e.hi.unwrap_or(e.mean));
             }
-            out
-        };
-    let mut more = vec![Panel {
+            if xs.is_empty() {
+                continue;
+            }
+            out.push(Series {
+                label: match c {
+                    Condition::Learning => "learning".to_string(),
+                    Condition::LearningOff => "learning off (η = 0)".to_string(),
+                    Condition::RandomWalk => "random walk".to_string(),
+                },
+                dashed: c != Condition::Learning,
+                x: xs,
+                mean: m,
+                lo,
+                hi,
+            });
+        }
+        out
+    };
+    let mut more = Vec::new();
+    let per_m = panel(Quantity::CollisionsPerM);
+    if !per_m.is_empty() {
+        more.push(Panel {
+            caption: "Collisions per metre moved (robots that stop add nothing)".to_string(),
+            y_label: "collisions per metre".to_string(),
+            series: per_m,
+            stuck_overlay: true,
+        });
+    }
+    more.push(Panel {
         caption: "Contact time (a bumper pressed)".to_string(),
-        y_label: "% of the window".to_string(),
-        series: panel(&|m| m.contact_fraction, false, 100.0, true),
-    }];
-    let corridor = runs.iter().all(|r| r.metrics.whole.all_have_gap_cv());
-    more.push(if corridor {
-        Panel {
+        y_label: "% of robot time".to_string(),
+        series: panel(Quantity::ContactPercent),
+        stuck_overlay: false,
+    });
+    if runs.iter().all(|r| r.metrics.whole.all_have_gap_cv()) {
+        more.push(Panel {
             caption: "Gap CV between neighbours (evenly spaced: low)".to_string(),
             y_label: "coefficient of variation".to_string(),
-            series: panel(&|m| m.gap_cv, false, 1.0, true),
-        }
-    } else {
-        Panel {
-            caption: "Stuck robots (< 1 mm in 100 steps, driving)".to_string(),
+            series: panel(Quantity::GapCv),
+            stuck_overlay: false,
+        });
+        more.push(Panel {
+            caption: "Robots moving (at least 5 mm in a step)".to_string(),
             y_label: "% of robot-steps".to_string(),
-            series: panel(&|m| m.stuck_fraction, false, 100.0, true),
-        }
-    });
+            series: panel(Quantity::MovingPercent),
+            stuck_overlay: false,
+        });
+    }
     LearningFigure {
         title: format!(
-            "h8swarm {}: {} robots, {} repeats, windows of {} steps ({} s per step)",
-            s.name, s.robots, s.repeats, s.window, s.timing.step_period_s
+            "h8swarm {}: {} robots, {}, windows of {} steps ({} s per step){}",
+            s.name,
+            s.robots,
+            plural(s.repeats, "repeat"),
+            s.window,
+            s.timing.step_period_s,
+            if windows < 3 {
+                format!(": only {windows} windows, no trend")
+            } else {
+                String::new()
+            }
         ),
         x_label: "learning step".to_string(),
-        d: panel(&|m| m.mean_d, false, 1.0, false),
-        collisions: panel(&|m| m.collisions_per_robot, true, 1.0, true),
+        d: panel(Quantity::MeanD),
+        collisions: panel(Quantity::CollisionsPerRobot),
         more,
+        stuck: panel(Quantity::StuckPercent),
+        markers: windows < 3,
+    }
+}
+
+/// The corridor's space-time figure: each tracked robot's position along the corridor over
+/// the run (learning, repeat 0).
+fn spacetime(s: &Scenario, t: &crate::experiment::Track) -> SpaceTimeFigure {
+    let length_m = t
+        .walls
+        .iter()
+        .flat_map(|w| [w[0].0, w[1].0])
+        .fold(0.0, f64::max);
+    SpaceTimeFigure {
+        title: format!(
+            "{}: the robots along the corridor (learning, repeat 0, seed {}); bands = bodies, white = gaps",
+            s.name, s.seed
+        ),
+        length_m,
+        body_m: world::params::BODY_LENGTH_M,
+        paths: t.spacetime.clone(),
     }
 }
 

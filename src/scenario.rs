@@ -76,6 +76,14 @@ pub struct WorldSpec {
     /// by 8 cm an obstacle touching the body reads as near as the curve allows (the peak,
     /// about 3.2 V), where on the surface it would read as 28–42 cm.
     pub sensor_setback_m: f64,
+    /// Friction coefficient between a robot's body and a wall (0–2; default 0.3). The paper
+    /// gives none; it decides whether a robot driving into a wall squares up against it or
+    /// slides along (see `docs/claims.md`).
+    pub mu_wall: f64,
+    /// The corridor's width beyond the robot's, metres (0.001–1; default 0.04 as the paper's
+    /// figure suggests: robots in one line that cannot pass each other). The square arena
+    /// ignores it.
+    pub corridor_clearance_m: f64,
 }
 
 /// The IR sensors (defaults: SPEC §3.1 and the `sensors` crate).
@@ -187,7 +195,7 @@ macro_rules! patch {
 
 patch!(LearnerPatch for LearnerSpec { behaviours: usize, eta: f64, threshold: i32, history: usize, bias: bool, save_every: u32 });
 patch!(TimingPatch for TimingSpec { step_period_s: f64, clock_hz: u32 });
-patch!(WorldPatch for WorldSpec { top_speed_m_per_s: f64, motor_time_constant_s: f64, motor_gain_spread: f64, wheel_track_m: f64, substep_s: f64, sensor_range_m: f64, sensor_setback_m: f64 });
+patch!(WorldPatch for WorldSpec { top_speed_m_per_s: f64, motor_time_constant_s: f64, motor_gain_spread: f64, wheel_track_m: f64, substep_s: f64, sensor_range_m: f64, sensor_setback_m: f64, mu_wall: f64, corridor_clearance_m: f64 });
 patch!(SensorPatch for SensorSpec { noise_sigma_v: f64, spike_probability: f64, spread: bool, channels: Channels });
 
 /// `sensors.channels` as a file gives it: exactly four whole numbers 0-255, checked when read
@@ -289,6 +297,8 @@ impl Default for WorldSpec {
             // 8 cm and falls again nearer), so that an obstacle touching the body reads as near
             // as the curve allows instead of folding back to a far reading.
             sensor_setback_m: sensors::curve::FAR_BRANCH_MIN_MM / 1000.0,
+            mu_wall: world::params::MU_WALL,
+            corridor_clearance_m: world::arena::CORRIDOR_EXTRA_WIDTH_M,
         }
     }
 }
@@ -542,6 +552,13 @@ impl Scenario {
             self.world.sensor_setback_m,
             0.0,
             MAX_SENSOR_SETBACK_M,
+        )?;
+        finite("world.mu_wall", self.world.mu_wall, 0.0, 2.0)?;
+        finite(
+            "world.corridor_clearance_m",
+            self.world.corridor_clearance_m,
+            0.001,
+            1.0,
         )?;
         finite(
             "sensors.noise_sigma_v",

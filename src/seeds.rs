@@ -17,6 +17,13 @@ pub const fn world_seed(master: u64, repeat: u32) -> u64 {
     derive(repeat_seed(master, repeat), 0, Purpose::World)
 }
 
+/// The seed of the summary's bootstrap resamples (the same resamples for every estimate of a
+/// run, so two quantities' intervals come from the same draws).
+#[must_use]
+pub const fn bootstrap_seed(master: u64) -> u64 {
+    derive(master, 0, Purpose::Bootstrap)
+}
+
 /// The seed of robot `robot` of repeat `repeat`.
 #[must_use]
 pub const fn robot_seed(master: u64, repeat: u32, robot: u32) -> u64 {

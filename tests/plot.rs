@@ -54,6 +54,8 @@ fn learning() -> LearningFigure {
             series("random walk", true, 100, 0.08, |x| 0.95 - 0.03 * wiggle(x)),
         ],
         more: Vec::new(),
+        stuck: Vec::new(),
+        markers: false,
     }
 }
 
@@ -652,6 +654,8 @@ mod sweeps {
                     .map(|_| random_series(&mut rng))
                     .collect(),
                 more: Vec::new(),
+                stuck: Vec::new(),
+                markers: rng.random(),
             };
             let result = learning_figure(&fig, &dir.join("fig.png"), &dir.join("fig.svg"));
             assert!(result.is_ok(), "case {case}: {result:?}");
@@ -681,26 +685,45 @@ mod sweeps {
 }
 
 #[test]
-fn four_panels_and_side_by_side_arenas_are_drawn() {
+fn six_panels_with_the_stuck_overlay_and_side_by_side_arenas_are_drawn() {
     let dir = out_dir("four_panels");
     let mut fig = learning();
+    let panel = |caption: &str, series: &[Series], stuck_overlay| h8swarm::plot::Panel {
+        caption: caption.into(),
+        y_label: "y".into(),
+        series: series.to_vec(),
+        stuck_overlay,
+    };
     fig.more = vec![
-        h8swarm::plot::Panel {
-            caption: "Contact time".into(),
-            y_label: "% of the window".into(),
-            series: fig.d.clone(),
-        },
-        h8swarm::plot::Panel {
-            caption: "Gap CV".into(),
-            y_label: "CV".into(),
-            series: fig.collisions.clone(),
-        },
+        panel("Collisions per metre", &fig.collisions, true),
+        panel("Contact time", &fig.d, false),
     ];
+    fig.stuck = fig
+        .collisions
+        .iter()
+        .map(|s| Series {
+            mean: s.mean.iter().map(|m| 50.0 * m).collect(),
+            lo: s.lo.iter().map(|m| 50.0 * m).collect(),
+            hi: s.hi.iter().map(|m| 50.0 * m).collect(),
+            ..s.clone()
+        })
+        .collect();
     let (png, svg) = (dir.join("fig.png"), dir.join("fig.svg"));
     learning_figure(&fig, &png, &svg).expect("draw");
-    let (w, h) = png_size(&std::fs::read(&png).unwrap());
+    let (w, h2) = png_size(&std::fs::read(&png).unwrap());
     assert_eq!(w, LEARNING_SIZE_PX.0);
-    assert!(h > LEARNING_SIZE_PX.1 + 400, "a second row: {h}");
+    assert!(h2 > LEARNING_SIZE_PX.1 + 400, "a second row: {h2}");
+    fig.more.push(panel("Gap CV", &fig.d, false));
+    fig.more.push(panel("Moving", &fig.d, false));
+    fig.markers = true;
+    learning_figure(&fig, &png, &svg).expect("draw");
+    let (_, h3) = png_size(&std::fs::read(&png).unwrap());
+    assert!(h3 > h2 + 400, "a third row: {h3} after {h2}");
+    let svg_text = std::fs::read_to_string(&svg).unwrap();
+    assert!(
+        svg_text.contains("stuck robot-steps"),
+        "the right-hand axis"
+    );
     let panels = dir.join("arena.png");
     h8swarm::plot::arena_figure_panels(&[arena(3, 1.8, 200), arena(3, 1.8, 200)], &panels)
         .expect("draw panels");
@@ -709,4 +732,107 @@ fn four_panels_and_side_by_side_arenas_are_drawn() {
     arena_figure(&arena(3, 1.8, 200), &single).expect("draw one");
     let (sw, _) = png_size(&std::fs::read(&single).unwrap());
     assert_eq!(pw, 2 * sw);
+}
+
+/// A robot that reverses (forward, then backward along almost the same line) near the left
+/// wall: every pixel its path colours lies inside the walls. Drawn as one wide polyline,
+/// plotters' mitre joins made spikes reaching past the wall.
+#[test]
+fn arena_paths_stay_inside_the_walls() {
+    let side = 1.8;
+    let walls = vec![
+        [(0.0, 0.0), (side, 0.0)],
+        [(side, 0.0), (side, side)],
+        [(side, side), (0.0, side)],
+        [(0.0, side), (0.0, 0.0)],
+    ];
+    let path: Vec<(f64, f64)> = (0..40)
+        .map(|i| (0.15 + 0.25 * f64::from(i % 2), 0.9 + 0.002 * f64::from(i)))
+        .collect();
+    let fig = |path: Vec<(f64, f64)>| ArenaFigure {
+        title: "reversals".into(),
+        walls: walls.clone(),
+        paths: vec![path],
+        outlines: Vec::new(),
+    };
+    let (size, with) = plot::render_arena(&fig(path)).expect("draw");
+    let (size2, without) = plot::render_arena(&fig(Vec::new())).expect("draw");
+    assert_eq!(size, size2, "the same layout with and without the path");
+    let (w, h) = (size.0 as usize, size.1 as usize);
+    let px = |img: &[u8], x: usize, y: usize| {
+        let i = (y * w + x) * 3;
+        (img[i], img[i + 1], img[i + 2])
+    };
+    // The walls: columns and rows with many pixels of the wall colour.
+    let wall = |x: usize, y: usize| px(&without, x, y) == (40, 40, 40);
+    let cols: Vec<usize> = (0..w)
+        .filter(|&x| (0..h).filter(|&y| wall(x, y)).count() > 100)
+        .collect();
+    let rows: Vec<usize> = (0..h)
+        .filter(|&y| (0..w).filter(|&x| wall(x, y)).count() > 100)
+        .collect();
+    let (x0, x1) = (cols[0], *cols.last().unwrap());
+    let (y0, y1) = (rows[0], *rows.last().unwrap());
+    assert!(
+        x1 > x0 + 500 && y1 > y0 + 500,
+        "walls found: {x0}..{x1} x {y0}..{y1}"
+    );
+    let mut drawn = 0;
+    for y in 0..h {
+        for x in 0..w {
+            if px(&with, x, y) != px(&without, x, y) {
+                drawn += 1;
+                assert!(
+                    (x0..=x1).contains(&x) && (y0..=y1).contains(&y),
+                    "path pixel ({x}, {y}) outside the walls {x0}..{x1} x {y0}..{y1}"
+                );
+            }
+        }
+    }
+    assert!(drawn > 1000, "the path was drawn: {drawn} pixels");
+}
+
+/// The corridor's space-time figure draws, and refuses bad data.
+#[test]
+fn the_space_time_figure_is_drawn() {
+    let dir = out_dir("spacetime");
+    let paths: Vec<Vec<(f64, f64)>> = (0..3)
+        .map(|r| {
+            (0..500)
+                .map(|k| {
+                    let k = f64::from(k);
+                    (
+                        k,
+                        0.5 + f64::from(r) * 0.9 + 0.2 * (k / 40.0 + f64::from(r)).sin(),
+                    )
+                })
+                .collect()
+        })
+        .collect();
+    let fig = plot::SpaceTimeFigure {
+        title: "corridor".into(),
+        length_m: 3.0,
+        body_m: 0.23,
+        paths,
+    };
+    let png = dir.join("st.png");
+    plot::spacetime_figure(&fig, &png).expect("draw");
+    assert_eq!(
+        png_size(&std::fs::read(&png).unwrap()),
+        plot::SPACETIME_SIZE_PX
+    );
+    let mut bad = fig.clone();
+    bad.paths[1][7].1 = f64::NAN;
+    assert!(matches!(
+        plot::spacetime_figure(&bad, &png),
+        Err(PlotError::ArenaBadValue { .. })
+    ));
+    let empty = plot::SpaceTimeFigure {
+        paths: vec![Vec::new()],
+        ..fig
+    };
+    assert!(matches!(
+        plot::spacetime_figure(&empty, &png),
+        Err(PlotError::NothingToDraw)
+    ));
 }

@@ -69,7 +69,7 @@ fn firmware_robots_write_every_output_with_their_cpu_load_and_the_same_for_any_t
     }
     let m = metrics(&a);
     assert!(m.starts_with(
-        "condition,repeat,step,mean_d,collisions_per_robot,contact_fraction,stuck_fraction,moved_m,gap_cv,cpu_load_percent"
+        "condition,repeat,step,mean_d,collisions_per_robot,contact_percent,stuck_percent,moving_percent,moved_mm,gap_cv,cpu_load_percent"
     ));
     // Every step's CPU load: the ticks and the step at least (about 0.1 %), a save about 5 %.
     let loads: Vec<f64> = m

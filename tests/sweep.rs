@@ -189,7 +189,7 @@ fn the_table_is_the_same_however_the_points_are_split() {
         ]
     );
     assert!(header.contains(&"learning.last.collisions_per_robot.mean"));
-    assert!(header.contains(&"random-walk.first.contact_fraction.hi"));
+    assert!(header.contains(&"random-walk.first.contact_percent.hi"));
     assert!(
         header.contains(&"claim.collisions_per_robot_last_window_below_the_first_learning.effect")
     );

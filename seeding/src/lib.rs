@@ -13,6 +13,7 @@
 //!
 //! ```text
 //! master seed (h8swarm run --seed, h8swarm fit --seed)
+//! ├─ bootstrap           derive(master, 0, Bootstrap)      (the summary's intervals)
 //! └─ repeat r            derive(master, r, Repeat)
 //!    ├─ world            derive(repeat, 0, World)          → world::World::new
 //!    │  ├─ placement     derive(world, 0, Placement)
@@ -79,6 +80,8 @@ pub enum Purpose {
     FitDistances = 8,
     /// The sensor codes and weights of the learner's cost summary (index 0).
     CostInputs = 9,
+    /// The resamples of the summary's bootstrap intervals (index 0), under the master seed.
+    Bootstrap = 10,
     /// Placement of the robots in the arena (index 0), under the world's seed.
     Placement = 16,
     /// The motor gain spread of one robot (index: the robot), under the world's seed.

@@ -43,6 +43,15 @@ pub struct Arena {
 impl Arena {
     /// The paper's corridor (environment 1): 3.0 m along x, `body_width_m + 0.04` m across.
     pub fn corridor(body_width_m: f64) -> Result<Arena, WorldError> {
+        Self::corridor_with_clearance(body_width_m, CORRIDOR_EXTRA_WIDTH_M)
+    }
+
+    /// A corridor 3.0 m along x and `body_width_m + clearance_m` across (the paper gives no
+    /// width; `clearance_m` in 0.001..=1 m).
+    pub fn corridor_with_clearance(
+        body_width_m: f64,
+        clearance_m: f64,
+    ) -> Result<Arena, WorldError> {
         if body_width_m.is_nan() || !(0.01..=10.0).contains(&body_width_m) {
             return Err(WorldError::Parameter {
                 name: "body_width_m",
@@ -50,10 +59,17 @@ impl Arena {
                 valid: "a width in 0.01..=10 m",
             });
         }
+        if clearance_m.is_nan() || !(0.001..=1.0).contains(&clearance_m) {
+            return Err(WorldError::Parameter {
+                name: "clearance_m",
+                value: clearance_m,
+                valid: "a clearance in 0.001..=1 m",
+            });
+        }
         Ok(Arena {
             kind: ArenaKind::Corridor,
             width_m: CORRIDOR_LENGTH_M,
-            height_m: body_width_m + CORRIDOR_EXTRA_WIDTH_M,
+            height_m: body_width_m + clearance_m,
         })
     }
 
