@@ -577,7 +577,7 @@ impl Swarm {
             )?;
             let steps = self.scenario.steps;
             if self.scenario.arena == ArenaKind::Corridor
-                && (k % spacetime_stride(steps) == 0 || k + 1 == steps)
+                && (k.is_multiple_of(spacetime_stride(steps)) || k + 1 == steps)
             {
                 for (i, path) in t.spacetime.iter_mut().enumerate() {
                     path.push((f64::from(k), self.world.pose(i)?.x_m));

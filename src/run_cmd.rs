@@ -502,7 +502,8 @@ impl Stage {
     }
 }
 
-/// Every file `h8swarm run` writes into its output folder.
+/// Every file `h8swarm run` writes into its output folder (`arena.png` for the square arena,
+/// `spacetime.png` for the corridor; the others always).
 pub const OUTPUT_FILES: [&str; 8] = [
     "metrics.csv",
     "robots.csv",

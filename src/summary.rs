@@ -233,15 +233,15 @@ impl Paired {
     }
 }
 
-/// How a claim came out.
+/// How a claim came out, from the repeat-by-repeat comparison.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Outcome {
-    /// The sign test says so (p below [`SIGNIFICANCE`]).
+    /// The sign test says so (one-sided p below [`SIGNIFICANCE`]).
     Holds,
-    /// The means go the claimed way, the repeats not clearly so.
+    /// More repeats go the claimed way than the other, but not enough to say so.
     Unsure,
-    /// The means are equal or go the other way.
+    /// As many repeats go each way, or more go the other way.
     Fails,
     /// No repeat has a value on both sides.
     Undecided,
@@ -274,10 +274,9 @@ pub struct Claim {
     pub unit: String,
     /// How it came out.
     pub outcome: Outcome,
-    /// Whether the means go the claimed way (strictly).
-    pub holds: bool,
-    /// Whether the sign test says so at [`SIGNIFICANCE`].
-    pub significant: bool,
+    /// Whether the means go the claimed way (strictly): a description; the outcome follows
+    /// the repeats.
+    pub means_agree: bool,
     /// Whether the two 95 % intervals are apart (do not overlap), whichever way.
     pub apart: bool,
     /// In words, with the repeats and the p-value.
@@ -302,69 +301,72 @@ impl Claim {
         seed: u64,
     ) -> Claim {
         let (ea, eb) = (Estimate::of_defined(a, seed), Estimate::of_defined(b, seed));
-        let repeats = Paired::of(a, b);
-        let n = repeats.defined();
-        let holds = ea.mean < eb.mean;
-        let significant = repeats.p < SIGNIFICANCE;
-        let (outcome, mut verdict) = if n == 0 || ea.n == 0 || eb.n == 0 {
+        let r = Paired::of(a, b);
+        let n = r.defined();
+        let (outcome, mut verdict) = if n == 0 {
             (
                 Outcome::Undecided,
                 "undecided: no repeat has a value on both sides".to_string(),
             )
-        } else if holds && significant {
+        } else if r.p < SIGNIFICANCE {
             (
                 Outcome::Holds,
                 format!(
                     "holds: {} of {n} repeats, sign test p = {}",
-                    repeats.for_,
-                    fmt_p(repeats.p)
+                    r.for_,
+                    fmt_p(r.p)
                 ),
             )
-        } else if holds {
-            (
-                Outcome::Unsure,
-                format!(
-                    "unsure: the means go this way, {} of {n} repeats (sign test p = {})",
-                    repeats.for_,
-                    fmt_p(repeats.p)
-                ),
-            )
-        } else if ea.mean == eb.mean {
-            (Outcome::Fails, "fails: the two are equal".to_string())
-        } else if repeats.p_opposite < SIGNIFICANCE {
+        } else if r.p_opposite < SIGNIFICANCE {
             (
                 Outcome::Fails,
                 format!(
-                    "fails: the opposite, {} of {n} repeats (sign test p = {})",
-                    repeats.against,
-                    fmt_p(repeats.p_opposite)
+                    "fails: the opposite, {} of {n} repeats, sign test p = {}",
+                    r.against,
+                    fmt_p(r.p_opposite)
+                ),
+            )
+        } else if r.for_ > r.against {
+            (
+                Outcome::Unsure,
+                format!(
+                    "unsure: {} of {n} repeats go this way, {} the other (sign test p = {})",
+                    r.for_,
+                    r.against,
+                    fmt_p(r.p)
+                ),
+            )
+        } else if r.for_ == r.against {
+            (
+                Outcome::Fails,
+                format!(
+                    "fails: as many repeats go each way ({} and {}, {} tied)",
+                    r.for_, r.against, r.tied
                 ),
             )
         } else {
             (
                 Outcome::Fails,
                 format!(
-                    "fails: the opposite in the means, {} of {n} repeats (sign test p = {})",
-                    repeats.against,
-                    fmt_p(repeats.p_opposite)
+                    "fails: {} of {n} repeats go the other way, {} this way (sign test p = {})",
+                    r.against,
+                    r.for_,
+                    fmt_p(r.p_opposite)
                 ),
             )
         };
-        if repeats.undefined > 0 {
-            let s = if repeats.undefined == 1 { "" } else { "s" };
-            verdict.push_str(&format!(
-                "; {} repeat{s} without a value",
-                repeats.undefined
-            ));
+        if r.undefined > 0 {
+            let s = if r.undefined == 1 { "" } else { "s" };
+            verdict.push_str(&format!("; {} repeat{s} without a value", r.undefined));
         }
+        let repeats = r;
         Claim {
             claim: claim.to_string(),
             paper,
             quantity: quantity.name().to_string(),
             unit: quantity.unit().to_string(),
             outcome,
-            holds,
-            significant: outcome == Outcome::Holds,
+            means_agree: ea.mean < eb.mean,
             apart: ea.apart_from(&eb),
             verdict,
             values: [ea.mean, eb.mean],
@@ -911,11 +913,27 @@ mod tests {
         let mixed: Vec<Option<f64>> = [5.0, 5.1, 4.9, 5.2, 0.5].map(Some).to_vec();
         let c = Claim::paired("x", true, q, &lo, &mixed, 1);
         assert_eq!(c.outcome, Outcome::Unsure, "{}", c.verdict);
+        assert!(c.means_agree);
+        // The means agree, the repeats mostly do not: the repeats decide.
+        let skew: Vec<Option<f64>> = [0.9, 1.0, 0.8, 0.9, 90.0].map(Some).to_vec();
+        let c = Claim::paired("x", true, q, &lo, &skew, 1);
+        assert!(c.means_agree);
+        assert_eq!(c.outcome, Outcome::Fails, "{}", c.verdict);
+        assert!(
+            c.verdict
+                .starts_with("fails: 4 of 5 repeats go the other way"),
+            "{}",
+            c.verdict
+        );
         // Equal values: fails, and never "the opposite".
         let c = Claim::paired("x", true, q, &constant(600.67, 5), &constant(600.67, 5), 1);
         assert_eq!(c.outcome, Outcome::Fails);
-        assert_eq!(c.verdict, "fails: the two are equal");
+        assert_eq!(
+            c.verdict,
+            "fails: as many repeats go each way (0 and 0, 5 tied)"
+        );
         assert!(!c.verdict.contains("opposite"));
+        assert!(!c.means_agree);
         let c = Claim::paired("x", true, q, &[None, None], &constant(1.0, 2), 1);
         assert_eq!(c.outcome, Outcome::Undecided);
     }

@@ -152,7 +152,7 @@ fn the_table_is_the_same_however_the_points_are_split() {
     let (fa, fb) = (point_files(&a), point_files(&b));
     assert_eq!(
         fa.len(),
-        8 * 8,
+        8 * 9,
         "{:?}",
         fa.iter().map(|f| &f.0).collect::<Vec<_>>()
     );
@@ -191,7 +191,7 @@ fn the_table_is_the_same_however_the_points_are_split() {
     assert!(header.contains(&"learning.last.collisions_per_robot.mean"));
     assert!(header.contains(&"random-walk.first.contact_percent.hi"));
     assert!(
-        header.contains(&"claim.collisions_per_robot_last_window_below_the_first_learning.effect")
+        header.contains(&"claim.d_rises_mean_d_in_the_last_window_above_the_first_learning.effect")
     );
     assert_eq!(*header.last().unwrap(), "error");
     assert_eq!(csv.lines().count(), 9);
@@ -202,7 +202,7 @@ fn the_table_is_the_same_however_the_points_are_split() {
     for row in json["rows"].as_array().unwrap() {
         let h = row["learner.history"].as_i64().unwrap();
         assert_eq!(row["learner.threshold"].as_i64().unwrap(), 10 + 10 * h);
-        let c = "claim.mean_d_in_the_last_window_learning_off_below_learning";
+        let c = "claim.mean_d_in_the_last_window_learning_above_learning_off";
         let (x, y, e) = (
             row[format!("{c}.a")].as_f64().unwrap(),
             row[format!("{c}.b")].as_f64().unwrap(),
@@ -215,12 +215,20 @@ fn the_table_is_the_same_however_the_points_are_split() {
             "{c}: effect {e}, b - a = {}",
             y - x
         );
-        assert_eq!(row[format!("{c}.holds")].as_bool().unwrap(), x < y);
+        assert_eq!(row[format!("{c}.means_agree")].as_bool().unwrap(), x < y);
+        // The repeat counts add up to the point's repeats (1 here).
+        let n = |part: &str| row[format!("{c}.{part}")].as_u64().unwrap();
+        assert_eq!(n("for") + n("against") + n("tied") + n("undefined"), 1);
+        let outcome = row[format!("{c}.outcome")].as_str().unwrap();
+        assert!(["holds", "unsure", "fails", "undecided"].contains(&outcome));
     }
-    // Two axes: one heat map a claim.
+    // A map a claim, and the region of the paper's text claims.
     let plots = std::fs::read_dir(a.join("merged/plots")).unwrap().count();
-    assert_eq!(plots, json["claims"].as_array().unwrap().len());
-    assert!(plots >= 6);
+    let claims = json["claims"].as_array().unwrap();
+    assert!(claims.iter().any(|c| c["paper"] == true));
+    assert_eq!(plots, claims.len() + 1);
+    assert!(a.join("merged/plots/region.png").exists());
+    assert!(json["region"].is_array());
 }
 
 #[test]

@@ -1,16 +1,18 @@
-//! The sweep's figures: each claim's effect against the swept keys, drawn with `plotters`.
+//! The sweep's figures, drawn with `plotters`: a **claim map** for every claim and a **region**
+//! figure for the paper's text claims together.
 //!
-//! A claim says "a below b"; its **effect** at a point is b − a, positive where the claim
-//! holds (the table's `claim.….effect`). Seeds, and the axes a figure does not show, are
-//! averaged over.
-//! * One axis: the effect at each value, every point as a grey dot and the mean as a line, a
-//!   line at 0 (`plots/CLAIM.png`).
-//! * Two axes: a heat map (`plots/CLAIM.png`), the first axis down, the second across; each
-//!   cell coloured by its mean effect (blue where the claim holds, vermillion where it fails,
-//!   stronger with the size of the effect against the figure's largest) and labelled with the
-//!   mean and how many of its points the claim holds in (`holds 2/3`); a cell with no finished
-//!   point is grey and says so.
-//! * Three axes or more: a heat map for every pair of axes (`plots/CLAIM--A--B.png`).
+//! A claim says "a below b", checked in every point repeat by repeat ([`crate::summary`]). A
+//! map's cell is one combination of the swept values; it pools the points that differ only in
+//! their master seed: their repeats' counts for and against the claim are added and judged by
+//! the same one-sided exact sign test at the same level, so a cell of 5 seeds × 10 repeats is
+//! judged on 50 paired repeats. The cell is coloured by that pooled outcome ([`CellOutcome`])
+//! and labelled with it, the repeats for it out of those with a value, and the mean over its
+//! points of the effect b − a.
+//!
+//! Layout: the first swept axis runs down a panel, the second across; every combination of the
+//! further axes gets a panel of its own, in a grid (one axis alone: one row of cells). The
+//! region figure has the same layout; a cell shows which of the paper's text claims hold
+//! there, and the cells where all of them hold are drawn strong.
 //!
 //! Like the run's own figures, the bytes are a pure function of the table (the embedded DejaVu
 //! Sans font; no clock).
@@ -22,7 +24,8 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::SweepError;
-use super::spec::{Axis, sanitize};
+use super::spec::Axis;
+use crate::summary::{SIGNIFICANCE, sign_test_p};
 
 /// The font family the run's figures register (DejaVu Sans, embedded).
 const FONT: &str = "sans-serif";
@@ -30,39 +33,180 @@ const FONT: &str = "sans-serif";
 const INK: RGBColor = RGBColor(34, 34, 34);
 /// Where a claim holds (Okabe–Ito blue).
 const HOLDS: RGBColor = RGBColor(0, 114, 178);
-/// Where a claim fails (Okabe–Ito vermillion).
-const FAILS: RGBColor = RGBColor(213, 94, 0);
+/// Where more repeats go the claimed way, not enough to say so.
+const UNSURE: RGBColor = RGBColor(158, 202, 230);
+/// Where as many or more repeats go the other way.
+const FAILS: RGBColor = RGBColor(245, 196, 160);
+/// Where the opposite holds (Okabe–Ito vermillion).
+const OPPOSITE: RGBColor = RGBColor(213, 94, 0);
 /// A cell without data.
 const NO_DATA: RGBColor = RGBColor(215, 215, 215);
 
-/// One claim's values over the points, in point order.
+/// One point's result for one claim.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PointClaim {
+    /// Repeats for the claim.
+    pub for_: u32,
+    /// Repeats against it.
+    pub against: u32,
+    /// Repeats with a value on both sides.
+    pub defined: u32,
+    /// b − a of the point's means, when both have one.
+    pub effect: Option<f64>,
+}
+
+/// One claim's results over the points, in point order.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ClaimSeries {
     /// The claim's column name (`claim.SLUG.…`), also its figure's file name.
     pub slug: String,
     /// The claim's text (the figure's title).
     pub text: String,
-    /// Per point: its effect (b − a) and whether the claim holds, or nothing when the point
-    /// did not finish.
-    pub per_point: Vec<Option<(f64, bool)>>,
+    /// Whether it is one of the paper's own text claims.
+    pub paper: bool,
+    /// Per point, its result, or nothing when the point did not finish.
+    pub per_point: Vec<Option<PointClaim>>,
 }
 
-/// The points of one cell of a figure.
-#[derive(Clone, Debug, Default)]
-struct Cell {
-    /// Effects of its finished points.
-    effects: Vec<f64>,
-    /// How many of them the claim holds in.
-    holds: usize,
-    /// Points planned in the cell.
-    planned: usize,
+/// A cell's pooled outcome.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CellOutcome {
+    /// The pooled sign test says so.
+    Holds,
+    /// More repeats for than against, not enough to say so.
+    Unsure,
+    /// As many or more against.
+    Fails,
+    /// The pooled sign test says the opposite.
+    Opposite,
+    /// No finished point, or no repeat with a value on both sides.
+    NoData,
+}
+
+impl CellOutcome {
+    fn colour(self) -> RGBColor {
+        match self {
+            CellOutcome::Holds => HOLDS,
+            CellOutcome::Unsure => UNSURE,
+            CellOutcome::Fails => FAILS,
+            CellOutcome::Opposite => OPPOSITE,
+            CellOutcome::NoData => NO_DATA,
+        }
+    }
+
+    fn word(self) -> &'static str {
+        match self {
+            CellOutcome::Holds => "holds",
+            CellOutcome::Unsure => "unsure",
+            CellOutcome::Fails => "fails",
+            CellOutcome::Opposite => "opposite",
+            CellOutcome::NoData => "no data",
+        }
+    }
+}
+
+/// The points of one cell of a map.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Cell {
+    /// Repeats for the claim, over the cell's points.
+    pub for_: u32,
+    /// Repeats against it.
+    pub against: u32,
+    /// Repeats with a value on both sides.
+    pub defined: u32,
+    /// Effects of its points that have one.
+    pub effects: Vec<f64>,
+    /// Points finished.
+    pub finished: usize,
+    /// Points planned.
+    pub planned: usize,
 }
 
 impl Cell {
-    fn mean(&self) -> Option<f64> {
+    /// The pooled outcome.
+    #[must_use]
+    pub fn outcome(&self) -> CellOutcome {
+        let n = self.for_ + self.against;
+        if self.defined == 0 {
+            CellOutcome::NoData
+        } else if sign_test_p(self.for_, n) < SIGNIFICANCE {
+            CellOutcome::Holds
+        } else if sign_test_p(self.against, n) < SIGNIFICANCE {
+            CellOutcome::Opposite
+        } else if self.for_ > self.against {
+            CellOutcome::Unsure
+        } else {
+            CellOutcome::Fails
+        }
+    }
+
+    fn mean_effect(&self) -> Option<f64> {
         (!self.effects.is_empty())
             .then(|| self.effects.iter().sum::<f64>() / self.effects.len() as f64)
     }
+}
+
+/// The cells of a claim: one per combination of the axes' values, in the order of
+/// [`cell_index`].
+#[must_use]
+pub fn cells(axes: &[Axis], coords: &[Vec<usize>], s: &ClaimSeries) -> Vec<Cell> {
+    let n: usize = axes.iter().map(|a| a.values.len()).product();
+    let mut out = vec![Cell::default(); n.max(1)];
+    for (c, v) in coords.iter().zip(&s.per_point) {
+        let cell = &mut out[cell_index(axes, c)];
+        cell.planned += 1;
+        if let Some(p) = v {
+            cell.finished += 1;
+            cell.for_ += p.for_;
+            cell.against += p.against;
+            cell.defined += p.defined;
+            if let Some(e) = p.effect {
+                cell.effects.push(e);
+            }
+        }
+    }
+    out
+}
+
+/// The cell of a point's coordinates: the first axis varies slowest.
+#[must_use]
+pub fn cell_index(axes: &[Axis], coords: &[usize]) -> usize {
+    axes.iter()
+        .zip(coords)
+        .fold(0, |i, (a, &c)| i * a.values.len() + c)
+}
+
+/// The values of cell `index`: (axis name, value label) per axis.
+#[must_use]
+pub fn cell_values(axes: &[Axis], mut index: usize) -> Vec<(String, String)> {
+    let mut out = Vec::with_capacity(axes.len());
+    for a in axes.iter().rev() {
+        let n = a.values.len().max(1);
+        out.push((a.name(), a.label(index % n)));
+        index /= n;
+    }
+    out.reverse();
+    out
+}
+
+/// The region: the cells where every one of `paper` holds (pooled over seeds), and how many
+/// cells have data for all of them. Empty without claims.
+#[must_use]
+pub fn region(axes: &[Axis], coords: &[Vec<usize>], paper: &[&ClaimSeries]) -> (Vec<usize>, usize) {
+    if paper.is_empty() {
+        return (Vec::new(), 0);
+    }
+    let per_claim: Vec<Vec<Cell>> = paper.iter().map(|s| cells(axes, coords, s)).collect();
+    let n = per_claim[0].len();
+    let all =
+        |i: usize, o: &dyn Fn(CellOutcome) -> bool| per_claim.iter().all(|c| o(c[i].outcome()));
+    let inside = (0..n)
+        .filter(|&i| all(i, &|o| o == CellOutcome::Holds))
+        .collect();
+    let with_data = (0..n)
+        .filter(|&i| all(i, &|o| o != CellOutcome::NoData))
+        .count();
+    (inside, with_data)
 }
 
 fn tool(path: &Path, e: impl std::fmt::Display) -> SweepError {
@@ -96,7 +240,8 @@ fn wrap(text: &str, width: usize) -> Vec<String> {
     lines
 }
 
-/// Draws every claim's figures into `dir`; returns the files written.
+/// Draws every claim's map, and the region of the paper's text claims when there are any,
+/// into `dir`; returns the files written.
 ///
 /// # Errors
 /// A figure that cannot be drawn or written (tool).
@@ -108,341 +253,327 @@ pub fn claim_figures(
 ) -> Result<Vec<PathBuf>, SweepError> {
     crate::plot::register_font().map_err(|e| tool(dir, e))?;
     let mut written = Vec::new();
+    if axes.is_empty() {
+        return Ok(written);
+    }
+    let grid = Grid::new(axes);
     for s in series {
         if s.per_point.iter().all(Option::is_none) {
             continue;
         }
-        match axes.len() {
-            0 => {}
-            1 => {
-                let path = dir.join(format!("{}.png", s.slug));
-                line_figure(&axes[0], coords, s, &path)?;
-                written.push(path);
-            }
-            2 => {
-                let path = dir.join(format!("{}.png", s.slug));
-                heat_map(axes, (0, 1), coords, s, &path)?;
-                written.push(path);
-            }
-            n => {
-                for i in 0..n {
-                    for j in i + 1..n {
-                        let path = dir.join(format!(
-                            "{}--{}--{}.png",
-                            s.slug,
-                            sanitize(&axes[i].name(), 40),
-                            sanitize(&axes[j].name(), 40)
-                        ));
-                        heat_map(axes, (i, j), coords, s, &path)?;
-                        written.push(path);
-                    }
+        let path = dir.join(format!("{}.png", s.slug));
+        let cells = cells(axes, coords, s);
+        let labels: Vec<[String; 3]> = cells
+            .iter()
+            .map(|c| {
+                let o = c.outcome();
+                if o == CellOutcome::NoData {
+                    return [
+                        "no data".into(),
+                        format!("{}/{} points", c.finished, c.planned),
+                        String::new(),
+                    ];
                 }
-            }
+                [
+                    o.word().to_string(),
+                    format!("{}/{}", c.for_, c.defined),
+                    c.mean_effect().map_or_else(String::new, fmt_effect),
+                ]
+            })
+            .collect();
+        let fills: Vec<(RGBColor, bool)> = cells
+            .iter()
+            .map(|c| {
+                let o = c.outcome();
+                (
+                    o.colour(),
+                    matches!(o, CellOutcome::Holds | CellOutcome::Opposite),
+                )
+            })
+            .collect();
+        let note = "each cell pools its seeds: outcome of the one-sided sign test on all their repeats (holds, unsure, fails, opposite), repeats for the claim / repeats with a value, mean effect b - a over its points";
+        let key: Vec<(RGBColor, &str)> = [
+            CellOutcome::Holds,
+            CellOutcome::Unsure,
+            CellOutcome::Fails,
+            CellOutcome::Opposite,
+            CellOutcome::NoData,
+        ]
+        .iter()
+        .map(|o| (o.colour(), o.word()))
+        .collect();
+        draw_map(&path, &grid, &s.text, &labels, &fills, &key, note)?;
+        written.push(path);
+    }
+    let paper: Vec<&ClaimSeries> = series.iter().filter(|s| s.paper).collect();
+    if !paper.is_empty()
+        && paper
+            .iter()
+            .any(|s| s.per_point.iter().any(Option::is_some))
+    {
+        let path = dir.join("region.png");
+        let per_claim: Vec<Vec<Cell>> = paper.iter().map(|s| cells(axes, coords, s)).collect();
+        let k = paper.len();
+        let n = per_claim[0].len();
+        let mut labels = Vec::with_capacity(n);
+        let mut fills = Vec::with_capacity(n);
+        let outcomes = |i: usize| per_claim.iter().map(move |c| c[i].outcome());
+        for i in 0..n {
+            let holding: Vec<usize> = outcomes(i)
+                .enumerate()
+                .filter(|(_, o)| *o == CellOutcome::Holds)
+                .map(|(j, _)| j)
+                .collect();
+            let data = outcomes(i).any(|o| o != CellOutcome::NoData);
+            let all = holding.len() == k;
+            let names: Vec<String> = holding.iter().map(|j| (j + 1).to_string()).collect();
+            labels.push([
+                if all {
+                    "ALL HOLD".to_string()
+                } else if data {
+                    format!("{} of {k}", holding.len())
+                } else {
+                    "no data".to_string()
+                },
+                if names.is_empty() {
+                    "-".into()
+                } else {
+                    names.join(" ")
+                },
+                String::new(),
+            ]);
+            let shade = |t: f64| {
+                let mix =
+                    |w: u8, b: u8| (f64::from(w) * (1.0 - t) + f64::from(b) * t).round() as u8;
+                RGBColor(mix(255, UNSURE.0), mix(255, UNSURE.1), mix(255, UNSURE.2))
+            };
+            fills.push(if all {
+                (HOLDS, true)
+            } else if !data {
+                (NO_DATA, false)
+            } else {
+                (shade(holding.len() as f64 / k as f64), false)
+            });
         }
+        let mut title =
+            "Where the paper's text claims hold together (pooled over seeds):".to_string();
+        for (j, s) in paper.iter().enumerate() {
+            let short = s.text.split(':').next().unwrap_or(&s.text);
+            title.push_str(&format!(" {} {short};", j + 1));
+        }
+        title.pop();
+        let key = vec![
+            (HOLDS, "all hold"),
+            (UNSURE, "some hold"),
+            (RGBColor(255, 255, 255), "none holds"),
+            (NO_DATA, "no data"),
+        ];
+        let note = "each cell: how many of the claims hold there (pooled sign test at p < 0.05) and which (their numbers)";
+        draw_map(&path, &grid, &title, &labels, &fills, &key, note)?;
+        written.push(path);
     }
     Ok(written)
 }
 
-/// Renders `draw` into an RGB buffer of `size`, then writes it as PNG.
-fn render(
+/// The layout of a map: cells in panels, panels in a grid.
+struct Grid {
+    /// (axis, label) down a panel.
+    rows: (String, Vec<String>),
+    /// (axis, label) across a panel.
+    cols: (String, Vec<String>),
+    /// One title per panel, in the order of the cells (the further axes' combinations).
+    panels: Vec<String>,
+    /// Panels per row of the grid.
+    per_row: usize,
+}
+
+impl Grid {
+    fn new(axes: &[Axis]) -> Self {
+        let labels = |a: &Axis| (0..a.values.len()).map(|i| a.label(i)).collect::<Vec<_>>();
+        let (rows, cols) = match axes.len() {
+            1 => (
+                (String::new(), vec![String::new()]),
+                (axes[0].name(), labels(&axes[0])),
+            ),
+            _ => (
+                (axes[0].name(), labels(&axes[0])),
+                (axes[1].name(), labels(&axes[1])),
+            ),
+        };
+        let further = if axes.len() > 2 { &axes[2..] } else { &[][..] };
+        let mut panels = vec![String::new()];
+        for a in further {
+            let mut next = Vec::new();
+            for p in &panels {
+                for i in 0..a.values.len() {
+                    let sep = if p.is_empty() { "" } else { ", " };
+                    next.push(format!("{p}{sep}{} = {}", a.name(), a.label(i)));
+                }
+            }
+            panels = next;
+        }
+        let per_row = further.last().map_or(1, |a| a.values.len()).clamp(1, 4);
+        Self {
+            rows,
+            cols,
+            panels,
+            per_row,
+        }
+    }
+}
+
+/// Cell size, pixels.
+const CELL_W: i32 = 104;
+const CELL_H: i32 = 62;
+/// Room for the row labels left of a panel and the panel's title above it.
+const PANEL_LEFT: i32 = 96;
+const PANEL_TOP: i32 = 34;
+/// Space between panels.
+const PANEL_GAP: i32 = 26;
+
+#[allow(clippy::too_many_arguments)]
+fn draw_map(
     path: &Path,
-    size: (u32, u32),
-    draw: impl FnOnce(&DrawingArea<BitMapBackend<'_>, Shift>) -> Result<(), String>,
+    g: &Grid,
+    title: &str,
+    labels: &[[String; 3]],
+    fills: &[(RGBColor, bool)],
+    key: &[(RGBColor, &str)],
+    note: &str,
 ) -> Result<(), SweepError> {
-    let mut rgb = vec![0u8; size.0 as usize * size.1 as usize * 3];
+    let (nr, nc) = (g.rows.1.len() as i32, g.cols.1.len() as i32);
+    let panel_w = PANEL_LEFT + nc * CELL_W;
+    let panel_h = PANEL_TOP + nr * CELL_H + 30;
+    let per_row = g.per_row as i32;
+    let grid_rows = (g.panels.len() as i32 + per_row - 1) / per_row;
+    let width = (40 + per_row * (panel_w + PANEL_GAP)).max(1000);
+    let title_lines = wrap(title, (width as usize / 11).max(40));
+    let top = 20 + 26 * title_lines.len() as i32 + 60;
+    let height = top + grid_rows * (panel_h + PANEL_GAP) + 70;
+    let size = (width as u32, height as u32);
+    let mut rgb = vec![0u8; width as usize * height as usize * 3];
     {
         let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| tool(path, e))?;
-        draw(&root).map_err(|e| tool(path, e))?;
+        draw_map_on(&root, g, &title_lines, labels, fills, key, note, top)
+            .map_err(|e| tool(path, e))?;
         root.present().map_err(|e| tool(path, e))?;
     }
     crate::plot::write_png(path, size, &rgb).map_err(|e| tool(path, e))
 }
 
-fn title_lines(
+#[allow(clippy::too_many_arguments)]
+fn draw_map_on(
     root: &DrawingArea<BitMapBackend<'_>, Shift>,
-    text: &str,
-    width_px: u32,
-) -> Result<i32, String> {
-    let font = (FONT, 20).into_font().color(&INK);
-    let mut y = 16;
-    for l in wrap(text, (width_px as usize / 11).max(30)) {
-        root.draw_text(&l, &font, (20, y))
-            .map_err(|e| e.to_string())?;
-        y += 26;
+    g: &Grid,
+    title_lines: &[String],
+    labels: &[[String; 3]],
+    fills: &[(RGBColor, bool)],
+    key: &[(RGBColor, &str)],
+    note: &str,
+    top: i32,
+) -> Result<(), String> {
+    let e = |e: DrawingAreaErrorKind<_>| e.to_string();
+    root.fill(&WHITE).map_err(e)?;
+    let title_font = (FONT, 20).into_font().color(&INK);
+    for (i, l) in title_lines.iter().enumerate() {
+        root.draw_text(l, &title_font, (20, 16 + 26 * i as i32))
+            .map_err(e)?;
     }
-    Ok(y)
-}
-
-fn line_figure(
-    axis: &Axis,
-    coords: &[Vec<usize>],
-    s: &ClaimSeries,
-    path: &Path,
-) -> Result<(), SweepError> {
-    let n = axis.values.len();
-    let mut cells = vec![Cell::default(); n];
-    for (c, v) in coords.iter().zip(&s.per_point) {
-        let cell = &mut cells[c[0]];
-        cell.planned += 1;
-        if let Some((e, h)) = v {
-            cell.effects.push(*e);
-            cell.holds += usize::from(*h);
-        }
-    }
-    let all: Vec<f64> = cells
-        .iter()
-        .flat_map(|c| c.effects.iter().copied())
-        .collect();
-    let lo = all.iter().copied().fold(0.0f64, f64::min);
-    let hi = all.iter().copied().fold(0.0f64, f64::max);
-    let pad = ((hi - lo) * 0.08).max(1e-9);
-    let (lo, hi) = (lo - pad, hi + pad);
-    let labels: Vec<String> = (0..n).map(|i| axis.label(i)).collect();
-    let size = (1000, 700);
-    render(path, size, |root| {
-        let top = title_lines(root, &s.text, size.0)?;
-        let (_, body) = root.split_vertically(top + 4);
-        let mut chart = ChartBuilder::on(&body)
-            .margin(20)
-            .x_label_area_size(60)
-            .y_label_area_size(90)
-            .build_cartesian_2d((0..n as i32).into_segmented(), lo..hi)
-            .map_err(|e| e.to_string())?;
-        let label_of = |v: &SegmentValue<i32>| match v {
-            SegmentValue::CenterOf(i) => labels.get(*i as usize).cloned().unwrap_or_default(),
-            _ => String::new(),
-        };
-        chart
-            .configure_mesh()
-            .disable_x_mesh()
-            .x_labels(n)
-            .x_label_formatter(&label_of)
-            .x_desc(axis.name())
-            .y_desc("effect b - a (> 0: the claim holds)")
-            .label_style((FONT, 16).into_font().color(&INK))
-            .axis_desc_style((FONT, 18).into_font().color(&INK))
-            .draw()
-            .map_err(|e| e.to_string())?;
-        // The zero line across the plotting area.
-        let (x0, _) = chart.backend_coord(&(SegmentValue::CenterOf(0), 0.0));
-        let (x1, y0) = chart.backend_coord(&(SegmentValue::CenterOf(n as i32 - 1), 0.0));
-        body.draw(&PathElement::new(
-            vec![(x0 - 40, y0), (x1 + 40, y0)],
-            RGBColor(120, 120, 120).stroke_width(1),
+    let small = (FONT, 14).into_font().color(&INK);
+    let left_text = small.pos(Pos::new(HPos::Left, VPos::Center));
+    // The key, and which axis runs where.
+    let mut kx = 20;
+    let ky = top - 44;
+    for (c, word) in key {
+        root.draw(&Rectangle::new(
+            [(kx, ky - 9), (kx + 22, ky + 9)],
+            c.filled(),
         ))
-        .map_err(|e| e.to_string())?;
-        let dots = cells.iter().enumerate().flat_map(|(i, c)| {
-            c.effects.iter().map(move |&e| {
-                Circle::new(
-                    (SegmentValue::CenterOf(i as i32), e),
-                    4,
-                    RGBColor(150, 150, 150).filled(),
-                )
-            })
-        });
-        chart.draw_series(dots).map_err(|e| e.to_string())?;
-        let means: Vec<(SegmentValue<i32>, f64)> = cells
-            .iter()
-            .enumerate()
-            .filter_map(|(i, c)| c.mean().map(|m| (SegmentValue::CenterOf(i as i32), m)))
-            .collect();
-        chart
-            .draw_series(LineSeries::new(means.clone(), HOLDS.stroke_width(3)))
-            .map_err(|e| e.to_string())?;
-        chart
-            .draw_series(
-                means
-                    .iter()
-                    .map(|p| Circle::new(p.clone(), 6, HOLDS.filled())),
-            )
-            .map_err(|e| e.to_string())?;
-        // How often it holds, above each value.
-        let font = (FONT, 15)
-            .into_font()
-            .color(&INK)
-            .pos(Pos::new(HPos::Center, VPos::Bottom));
-        for (i, c) in cells.iter().enumerate() {
-            let (x, _) = chart.backend_coord(&(SegmentValue::CenterOf(i as i32), 0.0));
-            let (_, y) = chart.backend_coord(&(SegmentValue::CenterOf(i as i32), hi));
-            let text = if c.effects.is_empty() {
-                "no data".to_string()
-            } else if c.effects.len() < c.planned {
-                format!("holds {}/{} of {}", c.holds, c.effects.len(), c.planned)
-            } else {
-                format!("holds {}/{}", c.holds, c.effects.len())
-            };
-            body.draw_text(&text, &font, (x, y + 18))
-                .map_err(|e| e.to_string())?;
-        }
-        Ok(())
-    })
-}
-
-fn heat_map(
-    axes: &[Axis],
-    (ay, ax): (usize, usize),
-    coords: &[Vec<usize>],
-    s: &ClaimSeries,
-    path: &Path,
-) -> Result<(), SweepError> {
-    let (ny, nx) = (axes[ay].values.len(), axes[ax].values.len());
-    let mut cells = vec![Cell::default(); nx * ny];
-    for (c, v) in coords.iter().zip(&s.per_point) {
-        let cell = &mut cells[c[ay] * nx + c[ax]];
-        cell.planned += 1;
-        if let Some((e, h)) = v {
-            cell.effects.push(*e);
-            cell.holds += usize::from(*h);
-        }
+        .map_err(e)?;
+        root.draw(&Rectangle::new(
+            [(kx, ky - 9), (kx + 22, ky + 9)],
+            INK.mix(0.4),
+        ))
+        .map_err(e)?;
+        root.draw_text(word, &left_text, (kx + 28, ky)).map_err(e)?;
+        kx += 40 + 9 * word.len() as i32;
     }
-    let max_abs = cells
-        .iter()
-        .filter_map(Cell::mean)
-        .map(f64::abs)
-        .fold(0.0f64, f64::max);
-    let cell_w = (760 / nx as u32).clamp(48, 170);
-    let cell_h = (520 / ny as u32).clamp(34, 110);
-    let (left, right, top_pad, bottom) = (230u32, 170u32, 30u32, 90u32);
-    let width = (left + nx as u32 * cell_w + right).max(900);
-    let title_h = 16 + 26 * wrap(&s.text, (width as usize / 11).max(30)).len() as u32;
-    let top = title_h + top_pad;
-    let size = (width, top + ny as u32 * cell_h + bottom);
-    let x_labels: Vec<String> = (0..nx).map(|i| axes[ax].label(i)).collect();
-    let y_labels: Vec<String> = (0..ny).map(|i| axes[ay].label(i)).collect();
-    render(path, size, |root| {
-        title_lines(root, &s.text, size.0)?;
-        let e = |e: DrawingAreaErrorKind<_>| e.to_string();
-        for j in 0..ny {
-            for i in 0..nx {
-                let c = &cells[j * nx + i];
-                let x0 = (left + i as u32 * cell_w) as i32;
-                let y0 = (top + j as u32 * cell_h) as i32;
-                let (fill, strong) = match c.mean() {
-                    None => (NO_DATA, false),
-                    Some(m) => {
-                        let t = if max_abs > 0.0 {
-                            (m / max_abs).clamp(-1.0, 1.0)
-                        } else {
-                            0.0
-                        };
-                        let base = if t >= 0.0 { HOLDS } else { FAILS };
-                        let a = t.abs();
-                        let mix = |w: u8, b: u8| {
-                            (f64::from(w) * (1.0 - a) + f64::from(b) * a).round() as u8
-                        };
-                        (
-                            RGBColor(mix(255, base.0), mix(255, base.1), mix(255, base.2)),
-                            a > 0.55,
-                        )
-                    }
-                };
-                root.draw(&Rectangle::new(
-                    [(x0, y0), (x0 + cell_w as i32, y0 + cell_h as i32)],
-                    fill.filled(),
-                ))
+    let axes_text = if g.rows.0.is_empty() {
+        format!("across: {}", g.cols.0)
+    } else {
+        format!("down: {}; across: {}", g.rows.0, g.cols.0)
+    };
+    root.draw_text(&axes_text, &left_text, (kx + 30, ky))
+        .map_err(e)?;
+
+    let (nr, nc) = (g.rows.1.len(), g.cols.1.len());
+    let panel_w = PANEL_LEFT + nc as i32 * CELL_W;
+    let panel_h = PANEL_TOP + nr as i32 * CELL_H + 30;
+    let centred = |ink: &RGBColor, px: i32| {
+        (FONT, px)
+            .into_font()
+            .color(ink)
+            .pos(Pos::new(HPos::Center, VPos::Center))
+    };
+    for (p, name) in g.panels.iter().enumerate() {
+        let px = 20 + (p % g.per_row) as i32 * (panel_w + PANEL_GAP);
+        let py = top + (p / g.per_row) as i32 * (panel_h + PANEL_GAP);
+        if !name.is_empty() {
+            root.draw_text(name, &(FONT, 15).into_font().color(&INK), (px, py + 4))
                 .map_err(e)?;
-                root.draw(&Rectangle::new(
-                    [(x0, y0), (x0 + cell_w as i32, y0 + cell_h as i32)],
-                    WHITE.stroke_width(2),
-                ))
-                .map_err(e)?;
-                let ink = if strong { WHITE } else { INK };
-                let centred = (FONT, 15)
-                    .into_font()
-                    .color(&ink)
-                    .pos(Pos::new(HPos::Center, VPos::Center));
-                let (cx, cy) = (x0 + cell_w as i32 / 2, y0 + cell_h as i32 / 2);
-                let (first, second) = match c.mean() {
-                    None => ("no data".to_string(), String::new()),
-                    Some(m) => (
-                        fmt_effect(m),
-                        if c.effects.len() < c.planned {
-                            format!("{}/{} of {}", c.holds, c.effects.len(), c.planned)
-                        } else {
-                            format!("holds {}/{}", c.holds, c.effects.len())
-                        },
-                    ),
+        }
+        let x0 = px + PANEL_LEFT;
+        let y0 = py + PANEL_TOP;
+        for (r, label) in g.rows.1.iter().enumerate() {
+            let y = y0 + r as i32 * CELL_H + CELL_H / 2;
+            root.draw_text(
+                label,
+                &small.pos(Pos::new(HPos::Right, VPos::Center)),
+                (x0 - 8, y),
+            )
+            .map_err(e)?;
+        }
+        for (c, label) in g.cols.1.iter().enumerate() {
+            let x = x0 + c as i32 * CELL_W + CELL_W / 2;
+            root.draw_text(
+                label,
+                &small.pos(Pos::new(HPos::Center, VPos::Top)),
+                (x, y0 + nr as i32 * CELL_H + 6),
+            )
+            .map_err(e)?;
+        }
+        for r in 0..nr {
+            for c in 0..nc {
+                // The further axes vary fastest in a cell's index.
+                let i = (r * nc + c) * g.panels.len() + p;
+                let (Some((fill, strong)), Some(text)) = (fills.get(i), labels.get(i)) else {
+                    continue;
                 };
-                if cell_h >= 44 && !second.is_empty() {
-                    root.draw_text(&first, &centred, (cx, cy - 10)).map_err(e)?;
-                    root.draw_text(&second, &centred, (cx, cy + 10))
+                let cx0 = x0 + c as i32 * CELL_W;
+                let cy0 = y0 + r as i32 * CELL_H;
+                let rect = [(cx0, cy0), (cx0 + CELL_W, cy0 + CELL_H)];
+                root.draw(&Rectangle::new(rect, fill.filled())).map_err(e)?;
+                root.draw(&Rectangle::new(rect, INK.mix(0.25))).map_err(e)?;
+                let ink = if *strong { WHITE } else { INK };
+                let (mx, my) = (cx0 + CELL_W / 2, cy0 + CELL_H / 2);
+                let lines: Vec<&String> = text.iter().filter(|t| !t.is_empty()).collect();
+                let step = 17;
+                let y_first = my - step * (lines.len() as i32 - 1) / 2;
+                for (k, t) in lines.iter().enumerate() {
+                    let size = if k == 0 { 15 } else { 13 };
+                    root.draw_text(t, &centred(&ink, size), (mx, y_first + step * k as i32))
                         .map_err(e)?;
-                } else {
-                    root.draw_text(&first, &centred, (cx, cy)).map_err(e)?;
                 }
             }
         }
-        let label = (FONT, 16).into_font().color(&INK);
-        let right_of = label.pos(Pos::new(HPos::Right, VPos::Center));
-        for (j, l) in y_labels.iter().enumerate() {
-            let y = (top + j as u32 * cell_h + cell_h / 2) as i32;
-            root.draw_text(l, &right_of, (left as i32 - 10, y))
-                .map_err(e)?;
-        }
-        let below = label.pos(Pos::new(HPos::Center, VPos::Top));
-        for (i, l) in x_labels.iter().enumerate() {
-            let x = (left + i as u32 * cell_w + cell_w / 2) as i32;
-            root.draw_text(l, &below, (x, (top + ny as u32 * cell_h + 8) as i32))
-                .map_err(e)?;
-        }
-        let desc = (FONT, 18).into_font().color(&INK);
-        root.draw_text(
-            &format!("{} (across)", axes[ax].name()),
-            &desc.pos(Pos::new(HPos::Center, VPos::Top)),
-            (
-                (left + nx as u32 * cell_w / 2) as i32,
-                (top + ny as u32 * cell_h + 40) as i32,
-            ),
-        )
-        .map_err(e)?;
-        root.draw_text(
-            &format!("{} (down)", axes[ay].name()),
-            &desc.pos(Pos::new(HPos::Right, VPos::Bottom)),
-            (left as i32 - 10, top as i32 - 6),
-        )
-        .map_err(e)?;
-        // The colour key.
-        let kx = (left + nx as u32 * cell_w + 40) as i32;
-        let kh = (ny as u32 * cell_h).max(120) as i32;
-        let steps = 40;
-        for k in 0..steps {
-            let t = 1.0 - 2.0 * (f64::from(k) + 0.5) / f64::from(steps);
-            let base = if t >= 0.0 { HOLDS } else { FAILS };
-            let a = t.abs();
-            let mix = |w: u8, b: u8| (f64::from(w) * (1.0 - a) + f64::from(b) * a).round() as u8;
-            let y0 = top as i32 + kh * k / steps;
-            let y1 = top as i32 + kh * (k + 1) / steps;
-            root.draw(&Rectangle::new(
-                [(kx, y0), (kx + 24, y1)],
-                RGBColor(mix(255, base.0), mix(255, base.1), mix(255, base.2)).filled(),
-            ))
-            .map_err(e)?;
-        }
-        let small = (FONT, 14).into_font().color(&INK);
-        let key_text = small.pos(Pos::new(HPos::Left, VPos::Center));
-        root.draw_text(&fmt_effect(max_abs), &key_text, (kx + 30, top as i32 + 6))
-            .map_err(e)?;
-        root.draw_text("holds", &key_text, (kx + 30, top as i32 + 24))
-            .map_err(e)?;
-        root.draw_text("0", &key_text, (kx + 30, top as i32 + kh / 2))
-            .map_err(e)?;
-        root.draw_text("fails", &key_text, (kx + 30, top as i32 + kh - 24))
-            .map_err(e)?;
-        root.draw_text(
-            &fmt_effect(-max_abs),
-            &key_text,
-            (kx + 30, top as i32 + kh - 6),
-        )
-        .map_err(e)?;
-        root.draw_text(
-            "each cell: the mean over its points of the effect b - a (> 0 where the claim holds) and how many it holds in",
-            &small.pos(Pos::new(HPos::Left, VPos::Top)),
-            (20, (size.1 - 28) as i32),
-        )
-        .map_err(e)?;
-        Ok(())
-    })
+    }
+    let (w, h) = root.dim_in_pixel();
+    let lines = wrap(note, (w as usize / 8).max(40));
+    for (i, l) in lines.iter().enumerate() {
+        let y = h as i32 - 14 - 18 * (lines.len() - i) as i32;
+        root.draw_text(l, &small, (20, y)).map_err(e)?;
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -452,14 +583,71 @@ mod tests {
     #[test]
     fn effects_keep_three_digits_and_a_sign() {
         assert_eq!(fmt_effect(0.012345), "+0.0123");
-        assert_eq!(fmt_effect(-12.345), "-12.3");
-        assert_eq!(fmt_effect(1234.5), "+1234");
+        assert_eq!(fmt_effect(-123.45), "-123");
         assert_eq!(fmt_effect(0.0), "0");
     }
 
     #[test]
     fn titles_wrap_at_spaces() {
         assert_eq!(wrap("aa bb cc", 5), vec!["aa bb", "cc"]);
-        assert_eq!(wrap("", 5), vec![""]);
+    }
+
+    fn axis(n: usize) -> Axis {
+        Axis {
+            keys: vec!["k".into()],
+            values: (0..n)
+                .map(|i| vec![toml::Value::Integer(i as i64)])
+                .collect(),
+        }
+    }
+
+    #[test]
+    fn cells_pool_their_seeds_and_judge_all_their_repeats() {
+        let axes = [axis(2), axis(3)];
+        // Two seeds per cell; cell (1, 2) gets 4 + 5 of 10 + 10 repeats for: 9 of 20 does not
+        // hold; cell (0, 0) gets 9 + 8 of 10 + 10: 17 of 20 holds (p = 0.0013).
+        let coords = vec![vec![0, 0], vec![0, 0], vec![1, 2], vec![1, 2], vec![0, 1]];
+        let pc = |f: u32, e: f64| {
+            Some(PointClaim {
+                for_: f,
+                against: 10 - f,
+                defined: 10,
+                effect: Some(e),
+            })
+        };
+        let s = ClaimSeries {
+            slug: "x".into(),
+            text: "x".into(),
+            paper: true,
+            per_point: vec![pc(9, 1.0), pc(8, 3.0), pc(4, -1.0), pc(5, 0.0), None],
+        };
+        let c = cells(&axes, &coords, &s);
+        assert_eq!(c.len(), 6);
+        let a = &c[cell_index(&axes, &[0, 0])];
+        assert_eq!((a.for_, a.against, a.defined, a.finished), (17, 3, 20, 2));
+        assert_eq!(a.outcome(), CellOutcome::Holds);
+        assert_eq!(a.mean_effect(), Some(2.0));
+        let b = &c[cell_index(&axes, &[1, 2])];
+        assert_eq!(b.outcome(), CellOutcome::Fails);
+        let none = &c[cell_index(&axes, &[0, 1])];
+        assert_eq!((none.planned, none.finished), (1, 0));
+        assert_eq!(none.outcome(), CellOutcome::NoData);
+        // 2 for, 18 against: the opposite holds.
+        let opposite = Cell {
+            for_: 2,
+            against: 18,
+            defined: 20,
+            ..Cell::default()
+        };
+        assert_eq!(opposite.outcome(), CellOutcome::Opposite);
+    }
+
+    #[test]
+    fn cell_indices_run_the_first_axis_slowest() {
+        let axes = [axis(2), axis(3), axis(4)];
+        assert_eq!(cell_index(&axes, &[0, 0, 1]), 1);
+        assert_eq!(cell_index(&axes, &[0, 1, 0]), 4);
+        assert_eq!(cell_index(&axes, &[1, 0, 0]), 12);
+        assert_eq!(cell_index(&axes, &[1, 2, 3]), 23);
     }
 }

@@ -5,13 +5,19 @@
 //!   `id`, `status` (`ok`, `failed`, `missing`: never run or still running, `broken`: a folder
 //!   that is neither finished nor failed), one column per swept key, `seed`; then for every
 //!   condition and window of the points' summary.json the mean and 95 % interval of each
-//!   statistic (`learning.last.collisions_per_robot.mean`, `….lo`, `….hi`); then for every claim
-//!   (column names from its text, `claim.<words>.…`): `holds`, `apart` (intervals apart), `a`
-//!   and `b` (the two means compared: the claim is "a below b") and `effect` = b − a (positive
-//!   when the claim holds); last `error`. A point that did not finish has empty cells.
+//!   statistic (`learning.last.collisions_per_m.mean`, `….lo`, `….hi`) and of each condition's
+//!   robots (`learning.robots.ending_stuck_percent.mean`, `learning.robots.ending_stuck`, …);
+//!   then for every claim (column names from its text, `claim.<words>.…`): `outcome` (`holds`,
+//!   `unsure`, `fails`, `undecided`), `means_agree`, `apart` (intervals apart), `a` and `b`
+//!   (the two means compared: the claim is "a below b"), `effect` = b − a (positive when the
+//!   means agree with the claim), and the repeat-by-repeat counts `for`, `against`, `tied`,
+//!   `undefined` with the sign test's `p`; last `error`. A point that did not finish has empty
+//!   cells.
 //! * `sweep.json`: the same rows (objects keyed by column), the column order, the claims' full
-//!   texts, and the lists of failed, missing and broken points.
-//! * `plots/`: each claim's effect against the swept keys (see [`super::figures`]).
+//!   texts (with whether each is one of the paper's), and the lists of failed, missing and
+//!   broken points.
+//! * `plots/`: a map of every claim over the swept keys, and the region where the paper's
+//!   text claims hold together (see [`super::figures`]).
 //!
 //! The table is a pure function of the points' folders: the same bytes however the points were
 //! split into tasks or where they ran.
@@ -24,16 +30,19 @@ use serde_json::{Map, Value, json};
 
 use super::SweepError;
 use super::exec::{PointState, point_state};
-use super::figures::{ClaimSeries, claim_figures};
+use super::figures::{ClaimSeries, PointClaim, cell_values, claim_figures, region};
 use super::plan::read_plan;
 
 /// The statistics of a window in the order the table lists them (others follow, sorted).
-const STAT_ORDER: [&str; 6] = [
+const STAT_ORDER: [&str; 9] = [
     "mean_d",
     "collisions_per_robot",
-    "contact_fraction",
-    "stuck_fraction",
-    "moved_m",
+    "collisions_per_m",
+    "collisions_per_moving_step",
+    "contact_percent",
+    "stuck_percent",
+    "moving_percent",
+    "moved_mm",
     "gap_cv",
 ];
 
@@ -101,8 +110,9 @@ pub struct Merged {
     pub missing: Vec<String>,
     /// Points whose folder is neither finished nor failed, with why.
     pub broken: Vec<(String, String)>,
-    /// The claims: column slug and full text, in order of first appearance.
-    pub claims: Vec<(String, String)>,
+    /// The claims: column slug, full text and whether it is one of the paper's, in order of
+    /// first appearance.
+    pub claims: Vec<(String, String, bool)>,
 }
 
 /// Reads every point of the sweep in `dir` into the table.
@@ -170,6 +180,21 @@ pub fn collect(
                 })?;
             for c in summary["conditions"].as_array().into_iter().flatten() {
                 let cond = c["condition"].as_str().unwrap_or("condition");
+                if let Some(robots) = c["robots"].as_object() {
+                    for (k, v) in robots {
+                        if let Some(est) = v.as_object() {
+                            for part in ["mean", "lo", "hi"] {
+                                let col = format!("{cond}.robots.{k}.{part}");
+                                stat_cols.add(&col);
+                                row.insert(col, est.get(part).cloned().unwrap_or(Value::Null));
+                            }
+                        } else {
+                            let col = format!("{cond}.robots.{k}");
+                            stat_cols.add(&col);
+                            row.insert(col, v.clone());
+                        }
+                    }
+                }
                 for w in ["first", "last"] {
                     let Some(win) = c[w].as_object() else {
                         continue;
@@ -212,14 +237,17 @@ pub fn collect(
                             n += 1;
                         }
                         claim_slugs.insert(text.clone(), slug.clone());
-                        m.claims.push((slug.clone(), text.clone()));
+                        let paper = c["paper"].as_bool().unwrap_or(false);
+                        m.claims.push((slug.clone(), text.clone(), paper));
                         slug
                     }
                 };
                 let a = c["values"][0].as_f64();
                 let b = c["values"][1].as_f64();
+                let r = &c["repeats"];
                 let cells = [
-                    ("holds", c["holds"].clone()),
+                    ("outcome", c["outcome"].clone()),
+                    ("means_agree", c["means_agree"].clone()),
                     ("apart", c["apart"].clone()),
                     ("a", a.map_or(Value::Null, num)),
                     ("b", b.map_or(Value::Null, num)),
@@ -230,6 +258,11 @@ pub fn collect(
                             _ => Value::Null,
                         },
                     ),
+                    ("for", r["for"].clone()),
+                    ("against", r["against"].clone()),
+                    ("tied", r["tied"].clone()),
+                    ("undefined", r["undefined"].clone()),
+                    ("p", r["p"].clone()),
                 ];
                 for (part, v) in cells {
                     let col = format!("claim.{slug}.{part}");
@@ -291,6 +324,39 @@ pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepErro
     let csv_path = out.join("sweep.csv");
     super::write_atomic(&csv_path, &bytes)?;
 
+    // Each claim's result per point, for the figures.
+    let series: Vec<ClaimSeries> = m
+        .claims
+        .iter()
+        .map(|(slug, text, paper)| ClaimSeries {
+            slug: slug.clone(),
+            text: text.clone(),
+            paper: *paper,
+            per_point: m
+                .rows
+                .iter()
+                .map(|r| {
+                    let n = |part: &str| {
+                        r.get(&format!("claim.{slug}.{part}"))
+                            .and_then(Value::as_u64)
+                            .map(|v| v as u32)
+                    };
+                    let (f, a, t) = (n("for")?, n("against")?, n("tied")?);
+                    Some(PointClaim {
+                        for_: f,
+                        against: a,
+                        defined: f + a + t,
+                        effect: r
+                            .get(&format!("claim.{slug}.effect"))
+                            .and_then(Value::as_f64),
+                    })
+                })
+                .collect(),
+        })
+        .collect();
+    let coords: Vec<Vec<usize>> = lines.iter().map(|l| l.coords.clone()).collect();
+    let paper: Vec<&ClaimSeries> = series.iter().filter(|s| s.paper).collect();
+    let (inside, with_data) = region(&plan.axes, &coords, &paper);
     let ok = m.rows.iter().filter(|r| r["status"] == "ok").count();
     let doc = json!({
         "sweep": plan.sweep,
@@ -304,7 +370,8 @@ pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepErro
             "values": a.values.iter().map(|v| v.iter().map(toml_to_json).collect::<Vec<_>>()).collect::<Vec<_>>(),
         })).collect::<Vec<_>>(),
         "seeds": plan.seeds,
-        "claims": m.claims.iter().map(|(slug, text)| json!({"column": format!("claim.{slug}"), "claim": text})).collect::<Vec<_>>(),
+        "claims": m.claims.iter().map(|(slug, text, paper)| json!({"column": format!("claim.{slug}"), "claim": text, "paper": paper})).collect::<Vec<_>>(),
+        "region": inside.iter().map(|&i| cell_values(&plan.axes, i).into_iter().map(|(k, v)| (k, Value::String(v))).collect::<Map<String, Value>>()).collect::<Vec<_>>(),
         "columns": m.columns,
         "rows": m.rows,
     });
@@ -314,25 +381,6 @@ pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepErro
         + "\n";
     super::write_atomic(&json_path, text.as_bytes())?;
 
-    // Each claim's effect per point, for the figures.
-    let series: Vec<ClaimSeries> = m
-        .claims
-        .iter()
-        .map(|(slug, text)| ClaimSeries {
-            slug: slug.clone(),
-            text: text.clone(),
-            per_point: m
-                .rows
-                .iter()
-                .map(|r| {
-                    let e = r.get(&format!("claim.{slug}.effect"))?.as_f64()?;
-                    let h = r.get(&format!("claim.{slug}.holds"))?.as_bool()?;
-                    Some((e, h))
-                })
-                .collect(),
-        })
-        .collect();
-    let coords: Vec<Vec<usize>> = lines.iter().map(|l| l.coords.clone()).collect();
     let figures = claim_figures(&plan.axes, &coords, &series, &plots)?;
 
     let mut t = String::new();
@@ -361,19 +409,37 @@ pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepErro
             "RUNNING points/{tmp} (a task at work, or left by a killed one)"
         );
     }
-    for (slug, text) in &m.claims {
-        let col = format!("claim.{slug}.holds");
-        let with: Vec<bool> = m
+    for (slug, text, _) in &m.claims {
+        let col = format!("claim.{slug}.outcome");
+        let with: Vec<&str> = m
             .rows
             .iter()
-            .filter_map(|r| r.get(&col).and_then(Value::as_bool))
+            .filter_map(|r| r.get(&col).and_then(Value::as_str))
             .collect();
         let _ = writeln!(
             t,
             "holds in {:>3} of {:>3} points: {text}",
-            with.iter().filter(|h| **h).count(),
+            with.iter().filter(|h| **h == "holds").count(),
             with.len()
         );
+    }
+    if !paper.is_empty() {
+        let cells: usize = plan.axes.iter().map(|a| a.values.len()).product();
+        let _ = writeln!(
+            t,
+            "the paper's {} text claims hold together (pooled over seeds) in {} of {} cells ({} with data for all):",
+            paper.len(),
+            inside.len(),
+            cells,
+            with_data
+        );
+        for &i in &inside {
+            let v: Vec<String> = cell_values(&plan.axes, i)
+                .into_iter()
+                .map(|(k, v)| format!("{k} = {v}"))
+                .collect();
+            let _ = writeln!(t, "  {}", v.join(", "));
+        }
     }
     let _ = writeln!(
         t,
