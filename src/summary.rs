@@ -954,6 +954,46 @@ mod tests {
         );
     }
 
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(300))]
+        /// Bounded quantities keep bounded intervals: a share in 0–100 %, a count at or above
+        /// 0, D in 0–1020 du; the interval holds the mean and stays within the repeats' range.
+        #[test]
+        fn intervals_stay_in_the_quantity_s_range(
+            values in proptest::collection::vec(
+                proptest::prop_oneof![
+                    0.0..=100.0f64,
+                    proptest::strategy::Just(0.0),
+                    proptest::strategy::Just(100.0)
+                ],
+                1..40,
+            ),
+            upper in proptest::prop_oneof![
+                proptest::strategy::Just(100.0f64),
+                proptest::strategy::Just(1020.0),
+                proptest::strategy::Just(1.0)
+            ],
+            seed in proptest::prelude::any::<u64>(),
+        ) {
+            let v: Vec<f64> = values.iter().map(|x| x / 100.0 * upper).collect();
+            let e = Estimate::of(&v, seed);
+            let (min, max) = v
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| (a.min(x), b.max(x)));
+            proptest::prop_assert_eq!(e.n, v.len());
+            match (e.lo, e.hi) {
+                (Some(lo), Some(hi)) => {
+                    proptest::prop_assert!(v.len() >= 2);
+                    proptest::prop_assert!(0.0 <= lo && hi <= upper, "{lo}..{hi} out of 0..{upper}");
+                    proptest::prop_assert!(min <= lo && hi <= max, "{lo}..{hi} out of {min}..{max}");
+                    proptest::prop_assert!(lo <= e.mean + 1e-9 && e.mean <= hi + 1e-9);
+                }
+                (None, None) => proptest::prop_assert_eq!(v.len(), 1),
+                _ => proptest::prop_assert!(false, "half an interval"),
+            }
+        }
+    }
+
     /// A run whose every step has the given metrics (`robots` robots, `steps` steps, windows of
     /// `win`), with its robots' tallies.
     fn run_of(

@@ -407,7 +407,7 @@ impl Grid {
             for p in &panels {
                 for i in 0..a.values.len() {
                     let sep = if p.is_empty() { "" } else { ", " };
-                    next.push(format!("{p}{sep}{} = {}", a.name(), a.label(i)));
+                    next.push(format!("{p}{sep}{} = {}", short_name(a), a.label(i)));
                 }
             }
             panels = next;
@@ -422,12 +422,21 @@ impl Grid {
     }
 }
 
+/// An axis' name without its keys' table prefixes (`world.mu_wall` → `mu_wall`).
+fn short_name(a: &Axis) -> String {
+    a.keys
+        .iter()
+        .map(|k| k.rsplit('.').next().unwrap_or(k))
+        .collect::<Vec<_>>()
+        .join("+")
+}
+
 /// Cell size, pixels.
 const CELL_W: i32 = 104;
 const CELL_H: i32 = 62;
 /// Room for the row labels left of a panel and the panel's title above it.
 const PANEL_LEFT: i32 = 96;
-const PANEL_TOP: i32 = 34;
+const PANEL_TOP: i32 = 50;
 /// Space between panels.
 const PANEL_GAP: i32 = 26;
 
@@ -518,8 +527,13 @@ fn draw_map_on(
     for (p, name) in g.panels.iter().enumerate() {
         let px = 20 + (p % g.per_row) as i32 * (panel_w + PANEL_GAP);
         let py = top + (p / g.per_row) as i32 * (panel_h + PANEL_GAP);
-        if !name.is_empty() {
-            root.draw_text(name, &(FONT, 15).into_font().color(&INK), (px, py + 4))
+        let panel_font = (FONT, 14).into_font().color(&INK);
+        for (k, l) in wrap(name, (panel_w as usize / 8).max(20))
+            .iter()
+            .take(2)
+            .enumerate()
+        {
+            root.draw_text(l, &panel_font, (px, py + 2 + 18 * k as i32))
                 .map_err(e)?;
         }
         let x0 = px + PANEL_LEFT;
