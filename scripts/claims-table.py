@@ -1,12 +1,14 @@
 #!/usr/bin/env python3
 """The claims of the paper over seeds: reads OUT/<name>-seed<k>/summary.json (as written by
-scripts/paper-runs.sh) and prints, per setting and claim, the two means of every seed, how many
-seeds the claim holds in (means) and in how many the 95 % intervals are apart, and the window
-means (mean over seeds of the per-seed means over 20 repeats) of every condition.
+scripts/paper-runs.sh) and prints, per setting, the window means of every condition (mean over
+seeds of each seed's mean over its repeats), the robots ending stuck, and per claim each seed's
+outcome (repeats for the claim of those with a value) with the outcome pooled over the seeds
+(the repeats' counts added, the same one-sided sign test at p < 0.05).
 
     python3 scripts/claims-table.py OUT
 """
 import json
+import math
 import pathlib
 import re
 import sys
@@ -22,39 +24,69 @@ for d in sorted(out.iterdir()):
 
 
 def fmt(v):
+    if v is None or (isinstance(v, float) and math.isnan(v)):
+        return "–"
     return f"{v:.3g}" if abs(v) < 10 else f"{v:.0f}"
+
+
+def sign_p(k, n):
+    """P(X >= k), X ~ Binomial(n, 1/2)."""
+    if k == 0:
+        return 1.0
+    return sum(math.comb(n, j) for j in range(k, n + 1)) / 2**n
+
+
+def pooled(f, a):
+    n = f + a
+    if n == 0:
+        return "undecided"
+    if sign_p(f, n) < 0.05:
+        return "holds"
+    if sign_p(a, n) < 0.05:
+        return "the opposite"
+    return "unsure" if f > a else "fails"
 
 
 for name, seeds in runs.items():
     ks = sorted(seeds)
+    first = seeds[ks[0]]
     print(f"### {name} (seeds {', '.join(map(str, ks))}, "
-          f"{seeds[ks[0]]['conditions'][0]['first']['mean_d']['n']} repeats each)")
+          f"{first['conditions'][0]['first']['mean_d']['n']} repeats each)")
     print()
-    print("| condition | window | mean D | collisions/robot | contact time | stuck | moved/step | gap CV |")
-    print("|---|---|---|---|---|---|---|---|")
-    conds = [c["condition"] for c in seeds[ks[0]]["conditions"]]
+    print("| condition | window | D (du) | coll./robot | coll./m | contact % | stuck % | moving % | moved mm/step | gap CV |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    conds = [c["condition"] for c in first["conditions"]]
     for ci, cname in enumerate(conds):
         for w in ("first", "last"):
-            def avg(key, scale=1.0):
+            def avg(key):
                 vals = [seeds[k]["conditions"][ci][w].get(key) for k in ks]
-                if any(v is None for v in vals):
-                    return "–"
-                return fmt(sum(v["mean"] for v in vals) / len(vals) * scale)
+                vals = [v["mean"] for v in vals if v is not None and v["mean"] is not None]
+                return fmt(sum(vals) / len(vals)) if vals else "–"
             print(f"| {cname} | {w} | {avg('mean_d')} | {avg('collisions_per_robot')} | "
-                  f"{avg('contact_fraction', 100)} % | {avg('stuck_fraction', 100)} % | "
-                  f"{avg('moved_m', 1000)} mm | {avg('gap_cv')} |")
+                  f"{avg('collisions_per_m')} | {avg('contact_percent')} | {avg('stuck_percent')} | "
+                  f"{avg('moving_percent')} | {avg('moved_mm')} | {avg('gap_cv')} |")
     print()
-    print("| the paper's claim | " + " | ".join(f"seed {k}" for k in ks) + " | holds (means) | apart |")
-    print("|---|" + "---|" * len(ks) + "---|---|")
-    claims = [c["claim"] for c in seeds[ks[0]]["claims"]]
-    for qi, q in enumerate(claims):
-        cells, holds, apart = [], 0, 0
+    print("| condition | robots ending the run stuck | with a lasting stuck spell |")
+    print("|---|---|---|")
+    for ci, cname in enumerate(conds):
+        r = [seeds[k]["conditions"][ci]["robots"] for k in ks]
+        n = sum(x["robots"] for x in r)
+        print(f"| {cname} | {sum(x['ending_stuck'] for x in r)} of {n} | "
+              f"{sum(x['with_lasting_spell'] for x in r)} of {n} |")
+    print()
+    print("| claim | " + " | ".join(f"seed {k}" for k in ks) + " | pooled over the seeds |")
+    print("|---|" + "---|" * len(ks) + "---|")
+    for qi, q in enumerate(first["claims"]):
+        cells, f_all, a_all, n_all = [], 0, 0, 0
         for k in ks:
             c = seeds[k]["claims"][qi]
-            holds += c["holds"]
-            apart += c["holds"] and c["apart"]
-            mark = "✓" if c["holds"] else "✗"
-            mark += " apart" if c["apart"] else ""
-            cells.append(f"{fmt(c['values'][0])} vs {fmt(c['values'][1])} {mark}")
-        print(f"| {q} | " + " | ".join(cells) + f" | {holds}/{len(ks)} | {apart}/{len(ks)} |")
+            r = c["repeats"]
+            n = r["for"] + r["against"] + r["tied"]
+            f_all += r["for"]
+            a_all += r["against"]
+            n_all += n
+            cells.append(f"{c['outcome']} {r['for']}/{n}")
+        tag = " (paper)" if q["paper"] else ""
+        print(f"| {q['claim']}{tag} | " + " | ".join(cells)
+              + f" | {pooled(f_all, a_all)} {f_all}/{n_all} |")
     print()

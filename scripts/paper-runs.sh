@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Reproduces the README's "The swarm experiment": the paper's two settings (arena, corridor)
-# with seeds 1-5 x 20 repeats each, for both sensor mountings (the default 8 cm set-back and
-# the body surface), then the claims table over the seeds (scripts/claims-table.py).
+# The paper's two settings (arena, corridor) with their controls, seeds 1-5 x 20 repeats each,
+# for both sensor mountings (the default 8 cm set-back and the body surface), then the claims
+# table over the seeds (scripts/claims-table.py; docs/claims.md says how claims are judged).
 #
 #   scripts/paper-runs.sh [OUT] [THREADS]   (default OUT: out/paper, THREADS: 2)
 #
@@ -17,7 +17,7 @@ for scenario in arena corridor scenarios/arena-surface.toml scenarios/corridor-s
     for seed in 1 2 3 4 5; do
         echo "## $name seed $seed"
         "$bin" run "$scenario" --repeats 20 --seed "$seed" --threads "$threads" \
-            --out "$out/$name-seed$seed" | sed -n '/^wall/p;/^HOLDS\|^FAILS/p'
+            --out "$out/$name-seed$seed" | grep -E "^(wall|HOLDS|UNSURE|FAILS|UNDECIDED)"
     done
 done
 python3 scripts/claims-table.py "$out"
