@@ -197,6 +197,12 @@ impl RobotTally {
         }
     }
 
+    /// Whether the detector says stuck now (at the latest step recorded).
+    #[must_use]
+    pub fn stuck_now(&self) -> bool {
+        self.spell.is_some()
+    }
+
     /// Closes the run: a spell still going at the end is lasting.
     pub fn finish(&mut self) {
         if let Some((onset, _)) = self.spell

@@ -126,6 +126,8 @@ pub struct RunOutput {
     pub dead: Vec<(usize, String)>,
     /// Each robot's record over the run (distance, collisions, stuck spells), by index.
     pub robots: Vec<RobotTally>,
+    /// With a recorder: the frames recorded and the frames with weights.
+    pub recorded: Option<(u32, Vec<u32>)>,
 }
 
 /// Sums of a run's per-step metrics over a span of steps: the summary's and the figure's
@@ -391,6 +393,8 @@ pub struct Swarm {
     keep_going: bool,
     /// Why each dead robot died.
     dead: Vec<Option<String>>,
+    /// The replay recorder and how many robots it records, when the run is recorded.
+    recorder: Option<(crate::recording::Recorder, usize)>,
 }
 
 impl Swarm {
@@ -459,6 +463,7 @@ impl Swarm {
             last_xy: Vec::new(),
             keep_going: false,
             dead: vec![None; n],
+            recorder: None,
         })
     }
 
@@ -481,6 +486,11 @@ impl Swarm {
                 .from_writer(std::io::BufWriter::new(file)),
         });
         Ok(())
+    }
+
+    /// Records the run for the viewer: the first `robots` robots, into `recorder`.
+    pub fn set_recorder(&mut self, recorder: crate::recording::Recorder, robots: usize) {
+        self.recorder = Some((recorder, robots.min(self.robots.len())));
     }
 
     /// Whether a robot whose controller fails is marked dead and the run goes on (default:
@@ -624,16 +634,25 @@ impl Swarm {
         let period_states =
             self.scenario.timing.step_period_s * f64::from(self.scenario.timing.clock_hz);
         let (mut sum_d, mut sum_load, mut live) = (0.0, 0.0, 0usize);
+        let recording = self.recorder.is_some();
+        let mut stepped: Vec<(i16, bool, f64)> = Vec::new();
+        let mut behaviours: Vec<u8> = Vec::new();
         for (i, res) in results.into_iter().enumerate() {
+            let mut this = (0, false, 0.0);
             match res {
                 Some(Ok((rep, busy))) => {
                     self.saves += u64::from(rep.saved);
                     sum_d += f64::from(rep.d);
-                    sum_load += busy as f64 / period_states * 100.0;
+                    let load = busy as f64 / period_states * 100.0;
+                    sum_load += load;
                     live += 1;
+                    this = (rep.d, rep.saved, load);
                 }
                 Some(Err(e)) => self.fail(i, e)?,
                 None => {}
+            }
+            if recording {
+                stepped.push(this);
             }
         }
         for (i, r) in self.robots.iter_mut().enumerate() {
@@ -654,7 +673,31 @@ impl Swarm {
                     )
             };
             self.drove[i] = drives(&left) || drives(&right);
+            if recording {
+                behaviours.push(crate::recording::behaviour_of(&left, &right));
+            }
             self.world.set_wheels(i, left, right)?;
+        }
+        if let Some((rec, count)) = self.recorder.as_mut() {
+            let mut frame = Vec::with_capacity(*count);
+            for (i, &(d, saved, load)) in stepped.iter().enumerate().take(*count) {
+                let p = self.world.pose(i)?;
+                frame.push(crate::recording::RobotStep {
+                    x_m: p.x_m,
+                    y_m: p.y_m,
+                    heading_rad: p.heading_rad,
+                    behaviour: behaviours[i],
+                    bumpers: senses[i].1,
+                    p: self.robots[i].readings_du(),
+                    d,
+                    stuck: self.tallies[i].stuck_now(),
+                    saved,
+                    dead: self.dead[i].is_some(),
+                    load_percent: load,
+                });
+            }
+            let robots = &self.robots;
+            rec.step(k, &frame, &mut |i| robots[i].weights())?;
         }
         let live_f = live.max(1) as f64;
         let mean_d = sum_d / live_f;
@@ -774,6 +817,10 @@ impl Swarm {
         for t in &mut self.tallies {
             t.finish();
         }
+        let recorded = match self.recorder.take() {
+            Some((rec, _)) => Some(rec.finish()?),
+            None => None,
+        };
         Ok(RunOutput {
             condition: self.condition,
             repeat: self.repeat,
@@ -782,6 +829,7 @@ impl Swarm {
             saves: self.saves,
             dead,
             robots: self.tallies,
+            recorded,
         })
     }
 }
@@ -825,6 +873,8 @@ pub struct RunOptions {
     pub rows: Option<std::path::PathBuf>,
     /// Probes on one robot: a pin trace written as VCD, a GDB client's control.
     pub probes: RobotProbes,
+    /// Record the run for the viewer: the recorder and how many robots it records.
+    pub replay: Option<(crate::recording::Recorder, usize)>,
 }
 
 /// Runs one condition of one repeat. `progress` is called with the number of steps done since
@@ -846,6 +896,9 @@ pub fn run_one(
     swarm.set_keep_going(opts.keep_going);
     if let Some(path) = &opts.rows {
         swarm.set_rows(path)?;
+    }
+    if let Some((rec, robots)) = opts.replay {
+        swarm.set_recorder(rec, robots);
     }
     let probes = opts.probes;
     let debugged = probes.gdb.as_ref().map(|(k, _)| *k);

@@ -16,6 +16,7 @@ pub mod experiment;
 pub mod fit;
 pub mod fit_cmd;
 pub mod plot;
+pub mod recording;
 pub mod replay;
 pub mod robot;
 pub mod run_cmd;

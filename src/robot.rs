@@ -125,6 +125,11 @@ pub struct Robot {
     trace_ends_at_sensing: bool,
     /// A pin trace that ended, not yet taken ([`Robot::take_pin_trace`]).
     finished_trace: Option<RobotTrace>,
+    /// Where a firmware robot keeps the pointer to its weights (the symbol `net_w`), when its
+    /// image has one.
+    net_w: Option<u32>,
+    /// How many weights the learner has (N × M).
+    weights_len: usize,
 }
 
 /// A robot's pin trace: the MCU's signals and the firmware's phases.
@@ -258,10 +263,12 @@ impl Robot {
         )
         .context("timing.clock_hz")?;
         let mut cfg = controller_config(s, stream(0, Purpose::Weights))?;
+        let weights_len = cfg.n_inputs() * cfg.behaviours;
         if condition != Condition::Learning {
             cfg.params = Params::new(0, s.learner.threshold).context("learner.threshold")?;
         }
         let mut cfg_status = None;
+        let mut net_w = None;
         let (brain, walk) = match images {
             None => {
                 let mut controller = Controller::new(cfg)?;
@@ -280,6 +287,7 @@ impl Robot {
                 }
                 let block = fw.has_config_block().then_some(block);
                 cfg_status = block.and(fw.symbols.addr("cfg_status"));
+                net_w = block.and(fw.symbols.addr("net_w"));
                 let controller = FirmwareController::start(fw, &mut mcu, block.as_ref())
                     .with_context(|| format!("robot {index}: {}", fw.name))?;
                 (Brain::Firmware(Box::new(controller)), None)
@@ -295,6 +303,8 @@ impl Robot {
             cfg_status,
             trace_ends_at_sensing: false,
             finished_trace: None,
+            net_w,
+            weights_len,
         };
         robot.records = robot.records_written();
         Ok(robot)
@@ -461,14 +471,37 @@ impl Robot {
     /// D as the firmware computes it from the A/D codes it read: the du table of the upper
     /// byte of each sensor's result register.
     fn sensed_d(&self) -> i16 {
-        let channels = self.mcu.board().channels;
-        channels
-            .iter()
-            .map(|&ch| {
-                let code8 = (self.mcu.adc().data(usize::from(ch & 3)) >> 8) as usize;
-                i16::from(sensors::DU_TABLE[code8])
-            })
-            .sum()
+        self.readings_du().iter().map(|&p| i16::from(p)).sum()
+    }
+
+    /// The four readings of the latest step (front, rear, left, right) in du, as the
+    /// controller made them: the du table of the upper byte of each sensor's A/D result.
+    #[must_use]
+    pub fn readings_du(&self) -> [u8; 4] {
+        self.mcu.board().channels.map(|ch| {
+            let code8 = (self.mcu.adc().data(usize::from(ch & 3)) >> 8) as usize;
+            sensors::DU_TABLE[code8]
+        })
+    }
+
+    /// The learner's weights (M rows of N, Q15 bits): the model's own, or read from a firmware
+    /// robot's RAM through its `net_w` symbol; none for an image without it.
+    #[must_use]
+    pub fn weights(&self) -> Option<Vec<i16>> {
+        match &self.brain {
+            Brain::Model(c) => Some(c.learner().weights().iter().map(|q| q.to_bits()).collect()),
+            Brain::Firmware(_) => {
+                let at = self.net_w?;
+                let peek = |a: u32| self.mcu.peek(a);
+                let base = (0..4).fold(0u32, |v, i| (v << 8) | u32::from(peek(at + i)));
+                let n = self.weights_len;
+                Some(
+                    (0..n as u32)
+                        .map(|k| i16::from_be_bytes([peek(base + 2 * k), peek(base + 2 * k + 1)]))
+                        .collect(),
+                )
+            }
+        }
     }
 
     /// The MCU's busy states since the last call: the step's work, the tick interrupts and

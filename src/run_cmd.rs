@@ -86,6 +86,80 @@ pub struct RunArgs {
     /// The robot --gdb controls (default 0).
     #[arg(long, value_name = "K", requires = "gdb")]
     pub gdb_robot: Option<usize>,
+    /// Record the runs for the browser viewer: writes replay.html (one self-contained page to
+    /// open from the file system) with repeat 0 of every condition, every robot.
+    #[arg(long)]
+    pub replay: bool,
+    /// Steps between two recorded frames (default: every step for runs up to 5 000 steps,
+    /// else about 5 000 frames a run).
+    #[arg(long, value_name = "N", requires = "replay")]
+    pub replay_stride: Option<u32>,
+    /// The repeats recorded: a list such as `0,2`, or `all` (default 0).
+    #[arg(long, value_name = "LIST", requires = "replay")]
+    pub replay_repeats: Option<String>,
+    /// Record only the first K robots (default: all).
+    #[arg(long, value_name = "K", requires = "replay")]
+    pub replay_robots: Option<usize>,
+}
+
+/// What `--replay` asks for, checked.
+#[derive(Clone, Debug)]
+struct ReplayPlan {
+    opts: crate::recording::RecordOptions,
+    repeats: Vec<u32>,
+    robots: usize,
+}
+
+/// Checks the `--replay` options against the scenario.
+fn replay_plan(a: &RunArgs, s: &Scenario) -> Result<Option<ReplayPlan>> {
+    if !a.replay {
+        return Ok(None);
+    }
+    if a.replay_stride == Some(0) {
+        bail!("--replay-stride 0: give at least 1 (record every step)");
+    }
+    let repeats: Vec<u32> = match a.replay_repeats.as_deref().map(str::trim) {
+        None => vec![0],
+        Some("all") => (0..s.repeats).collect(),
+        Some(list) => {
+            let mut v = Vec::new();
+            for part in list.split(',') {
+                let r: u32 = part.trim().parse().map_err(|_| {
+                    anyhow::anyhow!(
+                        "--replay-repeats `{}`: `{}` is not a repeat: give repeats 0 to {} separated by commas, or `all`",
+                        crate::sweep::spec::one_line(list),
+                        crate::sweep::spec::one_line(part),
+                        s.repeats - 1
+                    )
+                })?;
+                if r >= s.repeats {
+                    bail!(
+                        "--replay-repeats: repeat {r} does not exist: the run has {} repeats (valid: 0 to {})",
+                        s.repeats,
+                        s.repeats - 1
+                    );
+                }
+                if !v.contains(&r) {
+                    v.push(r);
+                }
+            }
+            v.sort_unstable();
+            v
+        }
+    };
+    let robots = a.replay_robots.unwrap_or(s.robots);
+    if robots == 0 || robots > s.robots {
+        bail!(
+            "--replay-robots {robots}: the run has {} robots (valid: 1 to {})",
+            s.robots,
+            s.robots
+        );
+    }
+    Ok(Some(ReplayPlan {
+        opts: crate::recording::RecordOptions::for_steps(s.steps, a.replay_stride),
+        repeats,
+        robots,
+    }))
 }
 
 /// Steps `--vcd` traces unless `--vcd-steps` says otherwise.
@@ -504,7 +578,7 @@ impl Stage {
 
 /// Every file `h8swarm run` writes into its output folder (`arena.png` for the square arena,
 /// `spacetime.png` for the corridor; the others always).
-pub const OUTPUT_FILES: [&str; 8] = [
+pub const OUTPUT_FILES: [&str; 9] = [
     "metrics.csv",
     "robots.csv",
     "summary.json",
@@ -513,6 +587,7 @@ pub const OUTPUT_FILES: [&str; 8] = [
     "learning.svg",
     "arena.png",
     "spacetime.png",
+    "replay.html",
 ];
 
 /// Runs the experiment, writing its files into `stage`; returns the text to print and the
@@ -567,6 +642,11 @@ fn run_into(
     // Each run writes its rows as its steps complete into a file of its own in the staging
     // folder; they are joined in run order into metrics.csv at the end.
     let rows_path = |c: Condition, r: u32| stage.path(&format!(".rows-{}-{r}.csv", c.name()));
+    let replay = replay_plan(a, s)?;
+    let recorded = |c: Condition, r: u32| -> bool {
+        replay.as_ref().is_some_and(|p| p.repeats.contains(&r)) && kinds.contains(&c)
+    };
+    let floor = crate::experiment::arena_of(s)?;
     let runs: Vec<RunOutput> = pool.install(|| {
         jobs.par_iter()
             .map(|&(c, r)| {
@@ -576,6 +656,17 @@ fn run_into(
                     probes.lock().ok().and_then(|mut p| p.take())
                 } else {
                     None
+                };
+                let replay = match replay.as_ref().filter(|_| recorded(c, r)) {
+                    Some(p) => Some((
+                        crate::recording::Recorder::new(
+                            p.opts.clone(),
+                            (floor.width_m(), floor.height_m()),
+                            crate::recording::part_paths(&stage.dir, c, r),
+                        )?,
+                        p.robots,
+                    )),
+                    None => None,
                 };
                 run_one(
                     s,
@@ -588,6 +679,7 @@ fn run_into(
                         keep_going: a.keep_going,
                         rows: Some(rows_path(c, r)),
                         probes: probes.unwrap_or_default(),
+                        replay,
                     },
                 )
             })
@@ -662,6 +754,17 @@ fn run_into(
     ]
     .map(String::from)
     .to_vec();
+    if let Some(plan) = &replay {
+        write_replay(
+            s,
+            &stage.path("replay.html"),
+            &stage.dir,
+            plan,
+            &floor,
+            &runs,
+        )?;
+        names.push("replay.html".into());
+    }
     if let Some(track) = runs.iter().find_map(|r| r.track.as_ref()) {
         if s.arena == crate::scenario::ArenaKind::Corridor {
             spacetime_figure(&spacetime(s, track), &stage.path("spacetime.png")).map_err(drawn)?;
@@ -711,6 +814,94 @@ fn run_into(
     let _ = writeln!(t);
     let _ = writeln!(t, "fit: {}", fit.verdict);
     Ok((t, names))
+}
+
+/// Writes the viewer page with the recorded runs (in run order).
+fn write_replay(
+    s: &Scenario,
+    html: &Path,
+    stage: &Path,
+    plan: &ReplayPlan,
+    arena: &world::Arena,
+    runs: &[RunOutput],
+) -> Result<()> {
+    use crate::recording::{CurveHeader, Header, MountHeader, RunHeader, part_paths};
+    let mut headers = Vec::new();
+    let mut parts = Vec::new();
+    for r in runs {
+        if let Some((frames, weight_frames)) = &r.recorded {
+            headers.push(RunHeader {
+                condition: r.condition.name().to_string(),
+                repeat: r.repeat,
+                frames: *frames,
+                weight_frames: weight_frames.clone(),
+            });
+            parts.push(part_paths(stage, r.condition, r.repeat));
+        }
+    }
+    let fig = learning(s, runs);
+    let find = |panel: &[Series], label: &str| -> Vec<f64> {
+        panel
+            .iter()
+            .find(|x| x.label == label)
+            .map(|x| x.mean.clone())
+            .unwrap_or_default()
+    };
+    let curves = fig
+        .d
+        .iter()
+        .map(|d| CurveHeader {
+            condition: d.label.clone(),
+            x: d.x.clone(),
+            mean_d: d.mean.clone(),
+            collisions_per_robot: find(&fig.collisions, &d.label),
+            stuck_percent: find(&fig.stuck, &d.label),
+        })
+        .collect();
+    let params = crate::experiment::world_params(s);
+    let n_in = crate::robot::controller_config(s, 0)?.n_inputs();
+    let header = Header {
+        version: crate::recording::VERSION,
+        name: s.name.clone(),
+        arena: match s.arena {
+            crate::scenario::ArenaKind::Corridor => "corridor".into(),
+            crate::scenario::ArenaKind::Square => "square".into(),
+        },
+        width_m: arena.width_m(),
+        height_m: arena.height_m(),
+        quantum_m: crate::recording::quantum_m(arena.width_m(), arena.height_m()),
+        walls: arena
+            .walls()
+            .iter()
+            .map(|w| [w.a.0, w.a.1, w.b.0, w.b.1])
+            .collect(),
+        body_m: [params.body_length_m, params.body_width_m],
+        sensors: params
+            .sensor_mounts
+            .iter()
+            .map(|m| MountHeader {
+                x_m: m.x_m,
+                y_m: m.y_m,
+                angle_rad: m.angle_rad,
+            })
+            .collect(),
+        du_m: sensors::du::MM_PER_DU / 1000.0,
+        robots: plan.robots,
+        steps: s.steps,
+        stride: plan.opts.stride,
+        step_period_s: s.timing.step_period_s,
+        controller: match s.controller.kind {
+            crate::fit::ControllerKind::Firmware => "firmware".into(),
+            crate::fit::ControllerKind::Model => "model".into(),
+        },
+        seed: s.seed,
+        weights_shape: [n_in, s.learner.behaviours],
+        behaviours: s.learner.behaviours,
+        threshold: s.learner.threshold,
+        runs: headers,
+        curves,
+    };
+    crate::recording::write_viewer(html, &header, &parts)
 }
 
 /// `n` and the noun, plural when `n` is not 1.

@@ -1016,6 +1016,7 @@ mod tests {
             saves: 0,
             dead: Vec::new(),
             robots,
+            recorded: None,
         }
     }
 
