@@ -323,9 +323,19 @@ impl Default for ControlSpec {
     }
 }
 
+/// The arena's learning rate: the paper's η = 0.001 gives a learning rate far too small for
+/// these formats and initial weights (half the robots end their runs stuck against a wall);
+/// the claim map's rule (`docs/claims.md`: inside the region where the paper's text claims
+/// hold together, the cell nearest the paper's η and T) picks 0.03 (30× the paper's).
+pub const ARENA_ETA: f64 = 0.03;
+/// The arena's wall friction, by the same rule (the paper gives none; 0.3, the world's default,
+/// elsewhere).
+pub const ARENA_MU_WALL: f64 = 0.1;
+
 impl Scenario {
-    /// Paper env. 2: three robots in the 1.8 m square, all four behaviours, η = 0.001, T = 10,
-    /// 0.45 s steps, 10 000 steps, 5 repeats.
+    /// Paper env. 2: three robots in the 1.8 m square, all four behaviours, T = 10, 0.45 s
+    /// steps, 10 000 steps, 5 repeats; η = [`ARENA_ETA`] and the wall friction
+    /// [`ARENA_MU_WALL`] from the claim map (`scenarios/arena-paper.toml` has the paper's η).
     #[must_use]
     pub fn arena() -> Self {
         Self {
@@ -338,7 +348,7 @@ impl Scenario {
             window: 500,
             learner: LearnerSpec {
                 behaviours: 4,
-                eta: 0.001,
+                eta: ARENA_ETA,
                 threshold: 10,
                 history: 1,
                 bias: false,
@@ -348,7 +358,10 @@ impl Scenario {
                 step_period_s: 0.45,
                 clock_hz: 25_000_000,
             },
-            world: WorldSpec::default(),
+            world: WorldSpec {
+                mu_wall: ARENA_MU_WALL,
+                ..WorldSpec::default()
+            },
             sensors: SensorSpec::default(),
             controls: ControlSpec::default(),
             controller: ControllerSpec::default(),
@@ -373,6 +386,9 @@ impl Scenario {
                 step_period_s: 0.60,
                 ..Self::arena().timing
             },
+            // The claim map finds no region in the corridor: the paper's numbers and the
+            // world's defaults stay.
+            world: WorldSpec::default(),
             ..Self::arena()
         }
     }
@@ -643,9 +659,13 @@ mod tests {
             (a.robots, a.steps, a.repeats, a.learner.behaviours),
             (3, 10_000, 5, 4)
         );
-        assert_eq!(a.eta_q15(), 33);
+        assert_eq!(a.eta_q15(), 983, "eta 0.03, by the claim map's rule");
+        assert_eq!(a.world.mu_wall, 0.1);
+        let paper = Scenario::load("scenarios/arena-paper.toml").unwrap();
+        assert_eq!((paper.eta_q15(), paper.world.mu_wall), (33, 0.3));
         let c = Scenario::corridor();
         assert_eq!((c.steps, c.learner.behaviours, c.eta_q15()), (500, 2, 3277));
+        assert_eq!(c.world.mu_wall, 0.3);
         assert_eq!(c.timing.step_period_s, 0.60);
         a.check().unwrap();
         c.check().unwrap();
