@@ -283,6 +283,7 @@ pub fn run(a: &RunArgs) -> Result<String> {
     check_memory(&s, threads_or_all(a.threads), a.max_memory)?;
     // Fail now if the robots do not fit the arena, or a probe's option is bad.
     build_world(&s, 0)?;
+    let replay = replay_plan(a, &s)?;
     let probes = std::sync::Mutex::new(Some(probes(a, &s)?));
     // Every file is written into a staging folder beside `out` and moved into place only
     // when the whole run succeeded; a failure before that leaves `out` as it was.
@@ -291,7 +292,7 @@ pub fn run(a: &RunArgs) -> Result<String> {
         a,
         &s,
         images.as_ref(),
-        &probes,
+        (&probes, replay.as_ref()),
         &stage,
         threads_or_all(a.threads),
     );
@@ -596,7 +597,10 @@ fn run_into(
     a: &RunArgs,
     s: &Scenario,
     images: Option<&crate::robot::Images>,
-    probes: &std::sync::Mutex<Option<crate::experiment::RobotProbes>>,
+    (probes, replay): (
+        &std::sync::Mutex<Option<crate::experiment::RobotProbes>>,
+        Option<&ReplayPlan>,
+    ),
     stage: &Stage,
     threads: usize,
 ) -> Result<(String, Vec<String>)> {
@@ -642,9 +646,8 @@ fn run_into(
     // Each run writes its rows as its steps complete into a file of its own in the staging
     // folder; they are joined in run order into metrics.csv at the end.
     let rows_path = |c: Condition, r: u32| stage.path(&format!(".rows-{}-{r}.csv", c.name()));
-    let replay = replay_plan(a, s)?;
     let recorded = |c: Condition, r: u32| -> bool {
-        replay.as_ref().is_some_and(|p| p.repeats.contains(&r)) && kinds.contains(&c)
+        replay.is_some_and(|p| p.repeats.contains(&r)) && kinds.contains(&c)
     };
     let floor = crate::experiment::arena_of(s)?;
     let runs: Vec<RunOutput> = pool.install(|| {
@@ -657,7 +660,7 @@ fn run_into(
                 } else {
                     None
                 };
-                let replay = match replay.as_ref().filter(|_| recorded(c, r)) {
+                let replay = match replay.filter(|_| recorded(c, r)) {
                     Some(p) => Some((
                         crate::recording::Recorder::new(
                             p.opts.clone(),
@@ -754,7 +757,7 @@ fn run_into(
     ]
     .map(String::from)
     .to_vec();
-    if let Some(plan) = &replay {
+    if let Some(plan) = replay {
         write_replay(
             s,
             &stage.path("replay.html"),

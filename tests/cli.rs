@@ -338,7 +338,7 @@ fn run_writes_identical_metrics_for_any_thread_count() {
             assert!(stdout.contains("learning.png"), "{stdout}");
             for f in h8swarm::run_cmd::OUTPUT_FILES
                 .iter()
-                .filter(|f| **f != "spacetime.png")
+                .filter(|f| !matches!(**f, "spacetime.png" | "replay.html"))
             {
                 assert!(dir.join(f).exists(), "{f} written");
             }
@@ -464,7 +464,7 @@ fn a_failed_run_leaves_the_earlier_results_untouched() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let before: Vec<(String, Vec<u8>)> = h8swarm::run_cmd::OUTPUT_FILES
         .iter()
-        .filter(|f| **f != "spacetime.png")
+        .filter(|f| !matches!(**f, "spacetime.png" | "replay.html"))
         .map(|f| (f.to_string(), std::fs::read(out.join(f)).expect("written")))
         .collect();
     // A program that is no robot firmware: it halts at once, so the run fails at its first
@@ -554,4 +554,98 @@ fn writes_to_a_full_device_and_endless_lines_have_their_statuses() {
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{stderr}");
     assert!(stderr.contains("longer than 1048576 bytes"), "{stderr}");
+}
+
+/// `--replay` changes nothing else: every other file byte for byte as without it; and the
+/// page itself is the same for one thread and two.
+#[test]
+fn replay_changes_no_other_output_and_is_the_same_for_any_thread_count() {
+    let run = |name: &str, extra: &[&str]| {
+        let dir = temp_dir(name);
+        let mut args = vec![
+            "run",
+            "arena",
+            "--steps",
+            "150",
+            "--repeats",
+            "2",
+            "--robots",
+            "4",
+            "--out",
+        ];
+        let d = dir.to_str().unwrap().to_string();
+        args.push(&d);
+        args.extend_from_slice(extra);
+        let o = h8swarm(&args, None);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        dir
+    };
+    let plain = run("replay-off", &["--threads", "1"]);
+    let rec1 = run("replay-on-1", &["--threads", "1", "--replay"]);
+    let rec2 = run(
+        "replay-on-2",
+        &["--threads", "2", "--replay", "--replay-repeats", "all"],
+    );
+    let rec2b = run(
+        "replay-on-2b",
+        &["--threads", "1", "--replay", "--replay-repeats", "0,1"],
+    );
+    for f in h8swarm::run_cmd::OUTPUT_FILES {
+        if f == "replay.html" || f == "spacetime.png" {
+            continue;
+        }
+        let a = std::fs::read(plain.join(f)).unwrap();
+        assert_eq!(
+            a,
+            std::fs::read(rec1.join(f)).unwrap(),
+            "{f} changed by --replay"
+        );
+    }
+    assert!(!plain.join("replay.html").exists());
+    let page = std::fs::read(rec2.join("replay.html")).unwrap();
+    assert_eq!(
+        page,
+        std::fs::read(rec2b.join("replay.html")).unwrap(),
+        "the page differs between 1 and 2 threads"
+    );
+    let decoded = h8swarm::recording::decode(&String::from_utf8(page).unwrap()).unwrap();
+    assert_eq!(decoded.header.runs.len(), 6, "3 conditions x 2 repeats");
+    assert_eq!(decoded.frames[0].len(), 150);
+    assert_eq!(decoded.frames[0][0].len(), 4);
+    // No staging leftovers.
+    for d in [&plain, &rec1, &rec2, &rec2b] {
+        let stray: Vec<_> = std::fs::read_dir(d)
+            .unwrap()
+            .flatten()
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .filter(|n| n.starts_with('.'))
+            .collect();
+        assert!(stray.is_empty(), "{stray:?}");
+        let _ = std::fs::remove_dir_all(d);
+    }
+    // Bad replay options are one line and status 2.
+    for (args, expected) in [
+        (
+            vec!["run", "--replay", "--replay-stride", "0"],
+            "--replay-stride 0",
+        ),
+        (
+            vec!["run", "--replay", "--replay-repeats", "7"],
+            "repeat 7 does not exist",
+        ),
+        (
+            vec!["run", "--replay", "--replay-repeats", "x"],
+            "is not a repeat",
+        ),
+        (
+            vec!["run", "--replay", "--replay-robots", "9"],
+            "--replay-robots 9",
+        ),
+        (vec!["run", "--replay-stride", "3"], "--replay"),
+    ] {
+        let o = h8swarm(&args, None);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(expected), "{args:?}: {err}");
+    }
 }
