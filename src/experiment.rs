@@ -315,14 +315,8 @@ pub fn world_params(s: &Scenario) -> WorldParams {
 /// More robots than the arena holds, or a placement that gives up.
 pub fn build_world(s: &Scenario, repeat: u32) -> Result<World> {
     let seed = world_seed(s.seed, repeat);
-    World::new(arena_of(s)?, world_params(s), s.robots, seed).with_context(|| {
-        format!(
-            "cannot place {} robots in the {} (robots = {})",
-            s.robots,
-            arena_of(s).map(|a| a.describe()).unwrap_or_default(),
-            s.robots
-        )
-    })
+    // The world's error names the robots, the arena and how many fit.
+    World::new(arena_of(s)?, world_params(s), s.robots, seed).context("placing the robots")
 }
 
 /// One run in progress: the world and its robots, stepped one step at a time.

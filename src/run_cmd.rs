@@ -323,12 +323,17 @@ fn check_memory(s: &Scenario, threads: usize, max: Option<u64>) -> Result<()> {
     Ok(())
 }
 
-fn show_bytes(b: u64) -> String {
-    if b >= 1 << 30 {
-        format!("{:.1} GiB", b as f64 / f64::from(1u32 << 30))
-    } else {
-        format!("{:.0} MiB", b as f64 / f64::from(1u32 << 20))
+/// A size for a message: bytes below 1 KiB, else KiB, MiB or GiB with one decimal (never
+/// "0 MiB" for a size that is not 0).
+#[must_use]
+pub fn show_bytes(b: u64) -> String {
+    const UNITS: [(u32, &str); 3] = [(30, "GiB"), (20, "MiB"), (10, "KiB")];
+    for (shift, unit) in UNITS {
+        if b >= 1 << shift {
+            return format!("{:.1} {unit}", b as f64 / (1u64 << shift) as f64);
+        }
     }
+    format!("{b} bytes")
 }
 
 /// `--max-memory`: a whole number of bytes, or with a suffix K, M, G or T (powers of 1024).
@@ -928,6 +933,18 @@ mod tests {
         assert!(estimated_memory(&big, 1) > 15 << 30);
         assert!(check_memory(&big, 1, Some(8 << 30)).is_err());
         assert!(check_memory(&s, 1, Some(8 << 30)).is_ok());
+    }
+
+    #[test]
+    fn sizes_in_messages_are_never_rounded_to_nothing() {
+        assert_eq!(show_bytes(1), "1 bytes");
+        assert_eq!(show_bytes(1023), "1023 bytes");
+        assert_eq!(show_bytes(1024), "1.0 KiB");
+        assert_eq!(show_bytes(1536), "1.5 KiB");
+        assert_eq!(show_bytes(64 << 20), "64.0 MiB");
+        assert_eq!(show_bytes(22 << 30), "22.0 GiB");
+        let e = check_memory(&Scenario::arena(), 1, Some(1024)).unwrap_err();
+        assert!(e.to_string().contains("--max-memory is 1.0 KiB"), "{e}");
     }
 
     #[test]

@@ -52,7 +52,8 @@ pub enum PointState {
     Ok,
     /// Ran and failed, with why.
     Failed(String),
-    /// A folder that is neither: no or a bad `status.json`, or another scenario.
+    /// A folder that is neither: no or a bad `status.json`, another scenario, or a finished
+    /// point whose `summary.json` cannot be read.
     Broken(String),
 }
 
@@ -76,7 +77,10 @@ pub fn point_state(points: &Path, line: &PlanLine) -> PointState {
         _ => return PointState::Broken("its scenario.toml is not the planned one".into()),
     }
     match (status.id == line.id, status.status.as_str()) {
-        (true, "ok") => PointState::Ok,
+        (true, "ok") => match super::merge::read_summary(&dir.join("summary.json")) {
+            Ok(_) => PointState::Ok,
+            Err(why) => PointState::Broken(format!("finished, but {why}")),
+        },
         (true, "failed") => PointState::Failed(status.error.unwrap_or_default()),
         _ => PointState::Broken(format!("status.json says {:?}", status.status)),
     }
@@ -265,7 +269,7 @@ pub fn run_task(
             }
         };
         // One line per point as it ends, for Slurm's log (standard output holds the totals).
-        eprintln!("{line_text}");
+        eprintln!("{}", super::spec::printable(&line_text));
     }
     let _ = writeln!(
         t,

@@ -10,8 +10,10 @@
 //!   and `b` (the two means compared: the claim is "a below b") and `effect` = b − a (positive
 //!   when the claim holds); last `error`. A point that did not finish has empty cells.
 //! * `sweep.json`: the same rows (objects keyed by column), the column order, the claims' full
-//!   texts, and the lists of failed, missing and broken points.
-//! * `plots/`: each claim's effect against the swept keys (see [`super::figures`]).
+//!   texts, the lists of failed, missing and broken points, and the figures it drew
+//!   (`figures`: the next merge into the same folder replaces exactly those).
+//! * `plots/`: each claim's effect against the swept keys (see [`super::figures`]). Merge
+//!   never clears a folder: a user's own files in `OUT` or `OUT/plots` stay.
 //!
 //! The table is a pure function of the points' folders: the same bytes however the points were
 //! split into tasks or where they ran.
@@ -26,6 +28,7 @@ use super::SweepError;
 use super::exec::{PointState, point_state};
 use super::figures::{ClaimSeries, claim_figures};
 use super::plan::read_plan;
+use super::spec::printable;
 
 /// The statistics of a window in the order the table lists them (others follow, sorted).
 const STAT_ORDER: [&str; 6] = [
@@ -108,7 +111,8 @@ pub struct Merged {
 /// Reads every point of the sweep in `dir` into the table.
 ///
 /// # Errors
-/// Not a sweep folder (input); a finished point whose summary.json cannot be read (tool).
+/// Not a sweep folder (input). A finished point whose summary.json cannot be read is listed
+/// as broken, not an error.
 pub fn collect(
     dir: &Path,
 ) -> Result<(super::plan::Plan, Vec<super::plan::PlanLine>, Merged), SweepError> {
@@ -156,18 +160,22 @@ pub fn collect(
             }
         };
         row.insert("status".into(), json!(status));
-        if status == "ok" {
+        let summary = if status == "ok" {
             let path = points.join(&line.id).join("summary.json");
-            let summary: Value = std::fs::read_to_string(&path)
-                .ok()
-                .and_then(|t| serde_json::from_str(&t).ok())
-                .ok_or_else(|| {
-                    SweepError::tool(format!(
-                        "point {} is finished but `{}` cannot be read as JSON",
-                        line.id,
-                        path.display()
-                    ))
-                })?;
+            match read_summary(&path) {
+                Ok(v) => Some(v),
+                Err(why) => {
+                    // A finished point whose summary cannot be read: listed, not fatal.
+                    row.insert("status".into(), json!("broken"));
+                    row.insert("error".into(), json!(why));
+                    m.broken.push((line.id.clone(), why));
+                    None
+                }
+            }
+        } else {
+            None
+        };
+        if let Some(summary) = summary {
             for c in summary["conditions"].as_array().into_iter().flatten() {
                 let cond = c["condition"].as_str().unwrap_or("condition");
                 for w in ["first", "last"] {
@@ -248,6 +256,19 @@ pub fn collect(
     Ok((plan, lines, m))
 }
 
+/// A finished point's `summary.json`, or why it cannot be read (an object with its
+/// `conditions` and `claims`).
+pub(crate) fn read_summary(path: &Path) -> Result<Value, String> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| format!("its summary.json cannot be read: {e}"))?;
+    let v: Value =
+        serde_json::from_str(&text).map_err(|e| format!("its summary.json is not JSON: {e}"))?;
+    if !(v["conditions"].is_array() && v["claims"].is_array()) {
+        return Err("its summary.json has no `conditions` and `claims` lists".into());
+    }
+    Ok(v)
+}
+
 /// Leftover temporary folders under `points/` (tasks running now, or killed).
 fn temporaries(points: &Path) -> Vec<String> {
     let mut out: Vec<String> = std::fs::read_dir(points)
@@ -261,6 +282,29 @@ fn temporaries(points: &Path) -> Vec<String> {
     out
 }
 
+/// The figures an earlier merge into `out` wrote (the `figures` of its sweep.json): names
+/// `plots/NAME.png` only, so nothing outside `out/plots` can be named.
+fn earlier_figures(out: &Path) -> Vec<String> {
+    let Ok(text) = std::fs::read_to_string(out.join("sweep.json")) else {
+        return Vec::new();
+    };
+    let Ok(doc) = serde_json::from_str::<Value>(&text) else {
+        return Vec::new();
+    };
+    doc["figures"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .filter_map(Value::as_str)
+        .filter(|n| {
+            n.strip_prefix("plots/").is_some_and(|f| {
+                f.ends_with(".png") && !f.starts_with('.') && !f.contains(['/', '\\'])
+            })
+        })
+        .map(str::to_string)
+        .collect()
+}
+
 /// Merges the sweep in `dir` into `out` (default `DIR/merged`); returns what to print and
 /// whether every point finished.
 ///
@@ -270,10 +314,10 @@ pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepErro
     let (plan, lines, m) = collect(dir)?;
     let out: PathBuf = out.map_or_else(|| dir.join("merged"), Path::to_path_buf);
     let plots = out.join("plots");
-    if plots.exists() {
-        std::fs::remove_dir_all(&plots)
-            .map_err(|e| SweepError::tool(format!("cannot clear `{}`: {e}", plots.display())))?;
-    }
+    // Only merge's own files are replaced: the figures of an earlier merge into `out` (its
+    // sweep.json lists them) that this one does not draw again are removed; anything else in
+    // `out` or `out/plots` is the user's and stays.
+    let earlier = earlier_figures(&out);
     std::fs::create_dir_all(&plots)
         .map_err(|e| SweepError::tool(format!("cannot create `{}`: {e}", plots.display())))?;
 
@@ -308,13 +352,8 @@ pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepErro
         "columns": m.columns,
         "rows": m.rows,
     });
-    let json_path = out.join("sweep.json");
-    let text = serde_json::to_string_pretty(&doc)
-        .map_err(|e| SweepError::tool(format!("writing sweep.json: {e}")))?
-        + "\n";
-    super::write_atomic(&json_path, text.as_bytes())?;
-
-    // Each claim's effect per point, for the figures.
+    // Each claim's effect per point, for the figures (drawn before sweep.json, which lists
+    // them).
     let series: Vec<ClaimSeries> = m
         .claims
         .iter()
@@ -334,6 +373,29 @@ pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepErro
         .collect();
     let coords: Vec<Vec<usize>> = lines.iter().map(|l| l.coords.clone()).collect();
     let figures = claim_figures(&plan.axes, &coords, &series, &plots)?;
+    let figure_names: Vec<String> = figures
+        .iter()
+        .filter_map(|p| p.file_name())
+        .map(|n| format!("plots/{}", n.to_string_lossy()))
+        .collect();
+    for old in earlier.iter().filter(|n| !figure_names.contains(n)) {
+        let p = out.join(old);
+        if p.is_file() {
+            std::fs::remove_file(&p).map_err(|e| {
+                SweepError::tool(format!(
+                    "cannot remove the earlier figure `{}`: {e}",
+                    p.display()
+                ))
+            })?;
+        }
+    }
+    let mut doc = doc;
+    doc["figures"] = json!(figure_names);
+    let json_path = out.join("sweep.json");
+    let text = serde_json::to_string_pretty(&doc)
+        .map_err(|e| SweepError::tool(format!("writing sweep.json: {e}")))?
+        + "\n";
+    super::write_atomic(&json_path, text.as_bytes())?;
 
     let mut t = String::new();
     let _ = writeln!(
@@ -347,13 +409,17 @@ pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepErro
         m.broken.len()
     );
     for (id, why) in &m.failed {
-        let _ = writeln!(t, "FAILED  {id}: {why}");
+        let _ = writeln!(t, "FAILED  {id}: {}", printable(why));
     }
     for id in &m.missing {
         let _ = writeln!(t, "MISSING {id}");
     }
     for (id, why) in &m.broken {
-        let _ = writeln!(t, "BROKEN  {id}: {why} (the next `sweep run` redoes it)");
+        let _ = writeln!(
+            t,
+            "BROKEN  {id}: {} (the next `sweep run` redoes it)",
+            printable(why)
+        );
     }
     for tmp in temporaries(&dir.join("points")) {
         let _ = writeln!(
@@ -370,20 +436,21 @@ pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepErro
             .collect();
         let _ = writeln!(
             t,
-            "holds in {:>3} of {:>3} points: {text}",
+            "holds in {:>3} of {:>3} points: {}",
             with.iter().filter(|h| **h).count(),
-            with.len()
+            with.len(),
+            printable(text)
         );
     }
     let _ = writeln!(
         t,
         "wrote {} ({} rows x {} columns) and {}; {} figures in {}",
-        csv_path.display(),
+        printable(&csv_path.display().to_string()),
         m.rows.len(),
         m.columns.len(),
-        json_path.display(),
+        printable(&json_path.display().to_string()),
         figures.len(),
-        plots.display()
+        printable(&plots.display().to_string())
     );
     if !plan.axes.is_empty() && figures.is_empty() && ok > 0 {
         let _ = writeln!(t, "(no claim had values to draw)");
