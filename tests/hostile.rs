@@ -7,8 +7,14 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
+/// The binary under test: this build's, or `H8SWARM_BIN` (to see the tests fail on another
+/// build, e.g. one from before a fix).
+fn bin() -> String {
+    std::env::var("H8SWARM_BIN").unwrap_or_else(|_| env!("CARGO_BIN_EXE_h8swarm").to_string())
+}
+
 fn h8swarm(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_h8swarm"))
+    Command::new(bin())
         .args(args)
         .current_dir(env!("CARGO_MANIFEST_DIR"))
         .env_remove("SLURM_ARRAY_TASK_ID")
@@ -160,4 +166,105 @@ fn merge_lists_a_finished_point_with_a_corrupt_summary_as_broken_and_goes_on() {
     let printed = ok(&["sweep", "run", s(&dir), "--threads", "1"]);
     assert!(printed.contains("1 run, 1 skipped"), "{printed}");
     ok(&["sweep", "merge", s(&dir), "--require-complete"]);
+}
+
+/// No control character in `text` but the line ends (the text a terminal gets).
+fn assert_printable(text: &str, what: &str) {
+    assert!(
+        !text
+            .chars()
+            .any(|c| c.is_control() && c != '\n' || ('\u{80}'..='\u{9f}').contains(&c)),
+        "{what}: {text:?}"
+    );
+}
+
+#[test]
+fn control_characters_from_files_and_arguments_never_reach_the_terminal() {
+    let root = fresh("escapes");
+    // A symbol file whose bad line holds ESC sequences (retitle, clear screen).
+    let sym = root.join("evil.sym");
+    std::fs::write(&sym, "00000100 T start\n\u{1b}]0;owned\u{7} \u{1b}[2J\n").unwrap();
+    let (code, _, err) = status(&[
+        "emu",
+        "firmware/robot.mot",
+        "--symbols",
+        s(&sym),
+        "--max-states",
+        "1000",
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert_printable(&err, "emu --symbols");
+    assert!(err.contains("\\e]0;owned"), "{err}");
+    // A scenario file with ESC in a bad value and in its name.
+    let sc = root.join("evil.toml");
+    std::fs::write(&sc, "robots = \"\u{1b}[31mred\"\n").unwrap();
+    let (code, _, err) = status(&["run", s(&sc), "--out", s(&root.join("o"))]);
+    assert_eq!(code, 2, "{err}");
+    assert_printable(&err, "scenario value");
+    std::fs::write(&sc, "name = \"\\u001b[2Jwiped\"\n").unwrap();
+    let (code, _, err) = status(&["run", s(&sc), "--out", s(&root.join("o"))]);
+    assert_eq!(code, 2, "{err}");
+    assert_printable(&err, "scenario name");
+    assert!(err.contains("control character"), "{err}");
+    // An --out with a newline and ESC: one line, escaped.
+    let weird = root.join("a\nb\u{1b}[2J").join("..");
+    let (code, _, err) = status(&["run", "--out", s(&weird), "--steps", "5"]);
+    assert_ne!(code, 0);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert_printable(&err, "--out");
+    // A sweep value with a newline: one line.
+    let sw = root.join("sweep.toml");
+    std::fs::write(
+        &sw,
+        "[grid]\n\"controller.image\" = [\"a\\nb\\u001b[2J.mot\"]\n[set]\ncontroller.kind = \"firmware\"\n",
+    )
+    .unwrap();
+    let (_, _, err) = status(&["sweep", "plan", s(&sw), "--out", s(&root.join("sw"))]);
+    assert_printable(&err, "sweep value");
+    // A usage error echoing an argument.
+    let (code, _, err) = status(&["run", "--robots", "\u{1b}[2J"]);
+    assert_eq!(code, 2, "{err}");
+    assert_printable(&err, "usage error");
+}
+
+#[test]
+fn small_things_say_what_they_mean() {
+    // A long scenario name is refused at once (drawing it in every title took seconds).
+    let root = fresh("small");
+    let sc = root.join("long.toml");
+    std::fs::write(
+        &sc,
+        format!("name = \"{}\"\nsteps = 5\nwindow = 5\n", "x".repeat(1_000_000)),
+    )
+    .unwrap();
+    let (code, _, err) = status(&["run", s(&sc), "--out", s(&root.join("o"))]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("`name`") && err.contains("at most 200"), "{err}");
+    assert!(err.len() < 1000, "the error echoes the name: {} bytes", err.len());
+    // Tiny memory caps are shown in bytes, not as "0 MiB".
+    for (cap, shown) in [("1", "1 bytes"), ("1K", "1.0 KiB")] {
+        let (code, _, err) = status(&["run", "--max-memory", cap, "--out", s(&root.join("m"))]);
+        assert_eq!(code, 2, "{err}");
+        assert!(err.contains(&format!("--max-memory is {shown}")), "{err}");
+        assert!(!err.contains("0 MiB"), "{err}");
+    }
+    // cost --eta takes the real number scenarios use, or its Q15 integer.
+    let real = ok(&["cost", "--eta", "0.001", "--steps", "20", "--json"]);
+    let q15 = ok(&["cost", "--eta", "33", "--steps", "20", "--json"]);
+    assert_eq!(real, q15);
+    let (code, _, err) = status(&["cost", "--eta", "1.5"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("0.001") && err.contains("33"), "{err}");
+    // Too many robots: said once.
+    let (code, _, err) = status(&[
+        "run",
+        "corridor",
+        "--robots",
+        "40",
+        "--out",
+        s(&root.join("c")),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert_eq!(err.matches("40 robots").count(), 1, "{err}");
+    assert!(err.contains("at most"), "{err}");
 }
