@@ -234,13 +234,23 @@ fn small_things_say_what_they_mean() {
     let sc = root.join("long.toml");
     std::fs::write(
         &sc,
-        format!("name = \"{}\"\nsteps = 5\nwindow = 5\n", "x".repeat(1_000_000)),
+        format!(
+            "name = \"{}\"\nsteps = 5\nwindow = 5\n",
+            "x".repeat(1_000_000)
+        ),
     )
     .unwrap();
     let (code, _, err) = status(&["run", s(&sc), "--out", s(&root.join("o"))]);
     assert_eq!(code, 2, "{err}");
-    assert!(err.contains("`name`") && err.contains("at most 200"), "{err}");
-    assert!(err.len() < 1000, "the error echoes the name: {} bytes", err.len());
+    assert!(
+        err.contains("`name`") && err.contains("at most 200"),
+        "{err}"
+    );
+    assert!(
+        err.len() < 1000,
+        "the error echoes the name: {} bytes",
+        err.len()
+    );
     // Tiny memory caps are shown in bytes, not as "0 MiB".
     for (cap, shown) in [("1", "1 bytes"), ("1K", "1.0 KiB")] {
         let (code, _, err) = status(&["run", "--max-memory", cap, "--out", s(&root.join("m"))]);
@@ -267,4 +277,92 @@ fn small_things_say_what_they_mean() {
     assert_eq!(code, 2, "{err}");
     assert_eq!(err.matches("40 robots").count(), 1, "{err}");
     assert!(err.contains("at most"), "{err}");
+}
+
+#[test]
+fn slurm_values_are_checked_against_slurms_formats_and_limits() {
+    let root = fresh("slurm");
+    let plan = |name: &str, body: &str| {
+        let file = root.join(format!("{name}.toml"));
+        std::fs::write(&file, format!("{body}\n[set]\nsteps = 10\nwindow = 10\n")).unwrap();
+        status(&["sweep", "plan", s(&file), "--out", s(&root.join(name))])
+    };
+    for (name, body, says) in [
+        ("time-x", "[slurm]\ntime = \"-x\"\n", "HH:MM:SS"),
+        ("time-short", "[slurm]\ntime = \"short\"\n", "HH:MM:SS"),
+        (
+            "cpus",
+            "[slurm]\ncpus_per_task = 18446744073709551615\n",
+            "cpus_per_task",
+        ),
+        ("mem", "[slurm]\nmem_mb = 18446744073709551615\n", "mem_mb"),
+        ("array", "seeds = 1002\n", "MaxArraySize"),
+        ("extra", "[slurm]\nextra = [\"--array=0-5\"]\n", "--array"),
+    ] {
+        let (code, _, err) = plan(name, body);
+        assert_eq!(code, 2, "{name}: {err}");
+        assert!(
+            err.starts_with("error: ") && err.contains(says),
+            "{name}: {err}"
+        );
+        assert_eq!(err.lines().count(), 1, "{name}: {err}");
+        assert!(!root.join(name).join("sweep.sbatch").exists(), "{name}");
+    }
+    // 1 002 points fit at 2 a task; every accepted format is written as given.
+    let (code, out, err) = plan(
+        "ok",
+        "seeds = 1002\n[slurm]\npoints_per_task = 2\ntime = \"1-12:00\"\nextra = [\"--qos=long\"]\n",
+    );
+    assert_eq!(code, 0, "{out}{err}");
+    let script = std::fs::read_to_string(root.join("ok/sweep.sbatch")).unwrap();
+    assert!(script.contains("#SBATCH --array=0-500%100\n"), "{script}");
+    assert!(script.contains("#SBATCH --time=1-12:00\n"), "{script}");
+    assert!(script.contains("#SBATCH --qos=long\n"), "{script}");
+}
+
+/// Runs the binary under a virtual-memory limit (`ulimit -v`, KiB) through `sh`.
+fn under_rlimit(kib: u64, args: &[&str]) -> Output {
+    let mut script = format!("ulimit -v {kib} && exec \"$0\"");
+    for i in 1..=args.len() {
+        script.push_str(&format!(" \"${i}\""));
+    }
+    Command::new("sh")
+        .arg("-c")
+        .arg(script)
+        .arg(bin())
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .stdin(Stdio::null())
+        .output()
+        .expect("sh runs")
+}
+
+#[test]
+fn a_plan_of_a_hundred_thousand_points_is_made_in_bounded_memory() {
+    // The run list is written a point at a time: 100 000 points (a 68 MB points.jsonl) plan
+    // within 200 MB of address space (holding them all took over 800 MB).
+    let root = fresh("big-plan");
+    let file = root.join("big.toml");
+    std::fs::write(
+        &file,
+        "seeds = 100000\n[set]\nsteps = 10\nwindow = 10\n[slurm]\npoints_per_task = 100\n",
+    )
+    .unwrap();
+    let o = under_rlimit(
+        200_000,
+        &["sweep", "plan", s(&file), "--out", s(&root.join("d"))],
+    );
+    assert!(
+        o.status.success(),
+        "{:?}: {}{}",
+        o.status,
+        text(&o.stdout),
+        text(&o.stderr)
+    );
+    let lines = std::fs::read_to_string(root.join("d/points.jsonl"))
+        .unwrap()
+        .lines()
+        .count();
+    assert_eq!(lines, 100_000);
+    let _ = std::fs::remove_dir_all(&root);
 }
