@@ -150,6 +150,13 @@ fn main() -> ExitCode {
         Ok(cli) => cli,
         Err(e) => return usage(&e),
     };
+    // A run or a sweep's task removes its staging folders when a signal stops it.
+    if matches!(
+        cli.command,
+        None | Some(Command::Run(_)) | Some(Command::Sweep(_))
+    ) {
+        h8swarm::cleanup::install();
+    }
     let result = match cli.command {
         Some(Command::Learn(args)) => learn(&args),
         Some(Command::Cost(args)) => cost(&args),

@@ -219,7 +219,12 @@ pub fn run(a: &RunArgs) -> Result<String> {
     );
     match result {
         Ok((mut text, names)) => {
-            stage.commit(&names)?;
+            stage.commit(&names).map_err(|e| {
+                e.context(format!(
+                    "the run into `{}` could not be moved into place",
+                    out.display()
+                ))
+            })?;
             let (files, plots): (Vec<&String>, Vec<&String>) = names
                 .iter()
                 .partition(|n| !n.ends_with(".png") && !n.ends_with(".svg"));
@@ -410,10 +415,12 @@ impl std::fmt::Display for OutputError {
 
 impl std::error::Error for OutputError {}
 
-/// A staging folder beside the output folder: `<parent>/.<name>.partial-<pid>`.
+/// A staging folder beside the output folder: `<parent>/.<name>.partial-<pid>`, registered
+/// for removal on SIGINT, SIGTERM and SIGHUP ([`crate::cleanup`]) while it exists.
 struct Stage {
     out: PathBuf,
     dir: PathBuf,
+    registered: Option<crate::cleanup::Staged>,
 }
 
 impl Stage {
@@ -439,6 +446,7 @@ impl Stage {
             _ => PathBuf::from("."),
         };
         let dir = parent.join(format!(".{name}.partial-{}", std::process::id()));
+        let registered = crate::cleanup::Staged::register(&dir);
         std::fs::create_dir_all(&dir)
             .map_err(anyhow::Error::new)
             .context(OutputError(format!(
@@ -448,6 +456,7 @@ impl Stage {
         Ok(Stage {
             out: out.to_path_buf(),
             dir,
+            registered: Some(registered),
         })
     }
 
@@ -455,46 +464,117 @@ impl Stage {
         self.dir.join(file)
     }
 
-    /// Moves the staged files into `out` (replacing earlier ones of the same names, removing
-    /// this tool's files the run did not write) and removes the staging folder.
-    fn commit(&self, names: &[String]) -> Result<()> {
+    /// Moves the staged files into `out`, replacing earlier ones of the same names and
+    /// removing this tool's files the run did not write, all or nothing: every file in the
+    /// way is checked first, the earlier files are moved aside into the staging folder, the
+    /// new ones moved in, and on any failure everything is moved back (and `out` removed again
+    /// if this made it). A signal that arrives meanwhile waits for the move to end.
+    fn commit(mut self, names: &[String]) -> Result<()> {
+        let result = crate::cleanup::while_committing(|| self.move_into_place(names));
+        let kept = match &result {
+            Ok(()) => {
+                let _ = std::fs::remove_dir_all(&self.dir);
+                String::new()
+            }
+            Err(_) => self.remove_or_say(),
+        };
+        self.registered.take();
+        result.map_err(|e| if kept.is_empty() { e } else { e.context(kept) })
+    }
+
+    fn move_into_place(&self, names: &[String]) -> Result<()> {
         let fail =
             |what: String, e: std::io::Error| anyhow::Error::new(e).context(OutputError(what));
+        let replaced: Vec<&str> = OUTPUT_FILES
+            .iter()
+            .copied()
+            .chain(names.iter().map(String::as_str))
+            .collect::<std::collections::BTreeSet<&str>>()
+            .into_iter()
+            .collect();
+        // Checked before anything moves: what is in the way must be a file (ours, earlier).
+        for name in &replaced {
+            let to = self.out.join(name);
+            if let Ok(meta) = std::fs::symlink_metadata(&to)
+                && meta.is_dir()
+            {
+                return Err(anyhow::Error::new(OutputError(format!(
+                    "cannot replace `{}`: it is a folder, not a file h8swarm wrote; move it away and run again (the output folder is unchanged)",
+                    to.display()
+                ))));
+            }
+        }
+        let made_out = !self.out.exists();
         std::fs::create_dir_all(&self.out).map_err(|e| {
             fail(
                 format!("cannot create the output folder `{}`", self.out.display()),
                 e,
             )
         })?;
-        for name in names {
-            let to = self.out.join(name);
-            std::fs::rename(self.dir.join(name), &to).map_err(|e| {
-                fail(
-                    format!("cannot move `{name}` into `{}`", self.out.display()),
-                    e,
-                )
-            })?;
-        }
-        for old in OUTPUT_FILES {
-            if !names.iter().any(|n| n == old) {
-                let stale = self.out.join(old);
-                if stale.is_file() {
-                    std::fs::remove_file(&stale).map_err(|e| {
+        let aside = self.dir.join(".earlier");
+        let mut moved_aside: Vec<&str> = Vec::new();
+        let mut moved_in: Vec<&str> = Vec::new();
+        let moved = (|| -> Result<()> {
+            std::fs::create_dir_all(&aside)
+                .map_err(|e| fail(format!("cannot create `{}`", aside.display()), e))?;
+            for name in &replaced {
+                let from = self.out.join(name);
+                if std::fs::symlink_metadata(&from).is_ok() {
+                    std::fs::rename(&from, aside.join(name)).map_err(|e| {
                         fail(
-                            format!("cannot remove the earlier `{}`", stale.display()),
+                            format!("cannot move the earlier `{}` aside", from.display()),
                             e,
                         )
                     })?;
+                    moved_aside.push(name);
                 }
             }
+            for name in names {
+                std::fs::rename(self.dir.join(name), self.out.join(name)).map_err(|e| {
+                    fail(
+                        format!("cannot move `{name}` into `{}`", self.out.display()),
+                        e,
+                    )
+                })?;
+                moved_in.push(name);
+            }
+            Ok(())
+        })();
+        if moved.is_err() {
+            // Back as it was: the new files out, the earlier ones in.
+            for name in moved_in {
+                let _ = std::fs::rename(self.out.join(name), self.dir.join(name));
+            }
+            for name in moved_aside {
+                let _ = std::fs::rename(aside.join(name), self.out.join(name));
+            }
+            if made_out {
+                let _ = std::fs::remove_dir(&self.out);
+            }
         }
-        let _ = std::fs::remove_dir_all(&self.dir);
-        Ok(())
+        moved
+    }
+
+    /// After a failed commit: removes the staging folder unless earlier files could not be
+    /// moved back out of it; says which.
+    fn remove_or_say(&self) -> String {
+        let aside = self.dir.join(".earlier");
+        let stranded = std::fs::read_dir(&aside).map(|d| d.count()).unwrap_or(0);
+        if stranded == 0 {
+            let _ = std::fs::remove_dir_all(&self.dir);
+            String::new()
+        } else {
+            format!(
+                "{stranded} earlier files could not be moved back: they are in `{}`",
+                aside.display()
+            )
+        }
     }
 
     /// Removes the staging folder after a failure; says what became of `out`.
-    fn abandon(&self) -> String {
+    fn abandon(mut self) -> String {
         let _ = std::fs::remove_dir_all(&self.dir);
+        self.registered.take();
         if self.out.is_dir() {
             "the earlier results there are untouched".to_string()
         } else {

@@ -366,3 +366,144 @@ fn a_plan_of_a_hundred_thousand_points_is_made_in_bounded_memory() {
     assert_eq!(lines, 100_000);
     let _ = std::fs::remove_dir_all(&root);
 }
+
+#[test]
+fn a_commit_that_cannot_finish_leaves_the_output_folder_as_it_was() {
+    let root = fresh("commit");
+    let out = root.join("o");
+    let args = ["run", "--steps", "20", "--robots", "2", "--repeats", "1"];
+    let mut first = args.to_vec();
+    first.extend(["--seed", "1", "--out", s(&out)]);
+    ok(&first);
+    // A folder where the run's summary.json goes, with the user's file in it.
+    std::fs::remove_file(out.join("summary.json")).unwrap();
+    std::fs::create_dir(out.join("summary.json")).unwrap();
+    std::fs::write(out.join("summary.json/mine.txt"), b"mine").unwrap();
+    let before = tree(&root);
+    let mut again = args.to_vec();
+    again.extend(["--seed", "2", "--out", s(&out)]);
+    let (code, _, err) = status(&again);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("summary.json") && err.contains("folder"),
+        "{err}"
+    );
+    assert_eq!(err.lines().count(), 1, "{err}");
+    // Exactly as before: the old metrics.csv, no staging folder beside it.
+    assert_eq!(tree(&root), before);
+}
+
+/// Spawns the binary, waits until `ready` holds (a staging folder appeared), then sends it
+/// `signal` with kill(1); returns its exit status.
+fn signalled(args: &[&str], ready: &dyn Fn() -> bool, signal: &str) -> std::process::ExitStatus {
+    let mut child = Command::new(bin())
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .env_remove("SLURM_ARRAY_TASK_ID")
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("the binary starts");
+    // The run goes on for minutes; it is stopped as soon as its staging folder holds files.
+    let mut waited = 0;
+    while !ready() {
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "{args:?} ended before it was signalled"
+        );
+        waited += 1;
+        assert!(waited < 60_000, "{args:?}: no staging folder appeared");
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    let sent = Command::new("kill")
+        .args([&format!("-{signal}"), &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(sent.success());
+    child.wait().unwrap()
+}
+
+/// Entries of `dir` whose names start with `prefix`.
+fn named(dir: &Path, prefix: &str) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .into_iter()
+        .flatten()
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with(prefix))
+        .collect();
+    v.sort();
+    v
+}
+
+fn has_files(dir: &Path, prefix: &str) -> bool {
+    named(dir, prefix)
+        .iter()
+        .any(|n| std::fs::read_dir(dir.join(n)).is_ok_and(|mut d| d.next().is_some()))
+}
+
+#[test]
+fn sigint_and_sigterm_during_a_run_remove_its_staging_folder() {
+    use std::os::unix::process::ExitStatusExt;
+    for (signal, number) in [("INT", 2), ("TERM", 15), ("HUP", 1)] {
+        let root = fresh(&format!("signal-{signal}"));
+        let out = root.join("o");
+        let st = signalled(
+            &[
+                "run",
+                "--steps",
+                "1000000",
+                "--threads",
+                "2",
+                "--out",
+                s(&out),
+            ],
+            &|| has_files(&root, ".o.partial-"),
+            signal,
+        );
+        assert_eq!(st.signal(), Some(number), "SIG{signal}: {st:?}");
+        assert_eq!(named(&root, ""), Vec::<String>::new(), "SIG{signal}");
+    }
+}
+
+#[test]
+fn a_killed_sweep_task_leaves_folders_that_merge_lists_and_the_next_run_removes() {
+    use std::os::unix::process::ExitStatusExt;
+    let root = fresh("killed-task");
+    let dir = root.join("d");
+    let file = root.join("s.toml");
+    // Task 0 runs a long point, task 1 a short one.
+    std::fs::write(
+        &file,
+        "[set]\nwindow = 10\nrepeats = 1\nrobots = 2\ncontrols.random_walk = false\ncontrols.learning_off = false\n[grid]\nsteps = [1000000, 20]\n",
+    )
+    .unwrap();
+    ok(&["sweep", "plan", s(&file), "--out", s(&dir)]);
+    let points = dir.join("points");
+    let run0 = ["sweep", "run", s(&dir), "--task", "0", "--threads", "1"];
+    // SIGTERM: the task removes its point's folders.
+    let st = signalled(&run0, &|| has_files(&points, "..tmp-"), "TERM");
+    assert_eq!(st.signal(), Some(15));
+    assert_eq!(named(&points, ""), Vec::<String>::new());
+    // SIGKILL leaves them: the point's folder and its run's staging folder.
+    let st = signalled(&run0, &|| has_files(&points, "..tmp-"), "KILL");
+    assert_eq!(st.signal(), Some(9));
+    let left = named(&points, "");
+    assert_eq!(left.len(), 2, "{left:?}");
+    assert!(left[0].starts_with("..tmp-p0000-") && left[1].starts_with(".tmp-p0000-"));
+    let merged = ok(&["sweep", "merge", s(&dir)]);
+    for l in &left {
+        assert!(merged.contains(&format!("LEFTOVER points/{l}")), "{merged}");
+    }
+    // Another task's run removes them (their process is gone), and runs its own point.
+    let o = h8swarm(&["sweep", "run", s(&dir), "--task", "1", "--threads", "1"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(
+        text(&o.stderr).contains("removed points/..tmp-p0000-"),
+        "{}",
+        text(&o.stderr)
+    );
+    assert_eq!(named(&points, "."), Vec::<String>::new());
+    assert_eq!(named(&points, "p"), vec!["p0001-steps20-s1".to_string()]);
+}

@@ -276,7 +276,7 @@ fn temporaries(points: &Path) -> Vec<String> {
         .flatten()
         .flatten()
         .map(|e| e.file_name().to_string_lossy().into_owned())
-        .filter(|n| n.starts_with(".tmp-"))
+        .filter(|n| n.starts_with(".tmp-") || n.starts_with("..tmp-"))
         .collect();
     out.sort();
     out
@@ -421,11 +421,21 @@ pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepErro
             printable(why)
         );
     }
+    let host = super::exec::host_name();
     for tmp in temporaries(&dir.join("points")) {
-        let _ = writeln!(
-            t,
-            "RUNNING points/{tmp} (a task at work, or left by a killed one)"
-        );
+        let _ = if super::exec::is_dead_leftover(&tmp, &host) {
+            writeln!(
+                t,
+                "LEFTOVER points/{} (its task was killed; the next `sweep run` removes it)",
+                printable(&tmp)
+            )
+        } else {
+            writeln!(
+                t,
+                "RUNNING points/{} (a task at work, or left by a killed one)",
+                printable(&tmp)
+            )
+        };
     }
     for (slug, text) in &m.claims {
         let col = format!("claim.{slug}.holds");
