@@ -160,6 +160,10 @@ struct Summary<'a> {
     eeprom_records_written: u64,
     conditions: &'a [ConditionStats],
     claims: &'a [Claim],
+    /// `false` when the user's image has no configuration block (it ran with its own
+    /// settings, not the scenario's); absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    image_configured: Option<bool>,
 }
 
 /// Runs the experiment; returns the text to print.
@@ -185,6 +189,13 @@ pub fn run(a: &RunArgs) -> Result<String> {
     }
     let s = s.with_overrides(a.robots, a.steps, a.repeats, a.seed)?;
     let images = crate::robot::Images::load(&s)?;
+    let unconfigured = unconfigured_image(&s, images.as_ref())?;
+    if let Some(image) = &unconfigured {
+        eprintln!(
+            "warning: {}: the image has no configuration block, so it runs with its own built-in settings, not the scenario's learner, timing and sensor settings (summary.json says \"image_configured\": false); give its symbol table (IMAGE.sym beside it, or controller.symbols) to configure it",
+            crate::sweep::spec::printable(image)
+        );
+    }
     let max_threads = max_threads();
     match a.threads {
         Some(0) => bail!("--threads 0: give at least 1 (or leave it out for all cores)"),
@@ -247,6 +258,36 @@ pub fn run(a: &RunArgs) -> Result<String> {
             Err(e.context(format!("the run into `{}` failed; {kept}", out.display())))
         }
     }
+}
+
+/// The user's image when it has no configuration block (so the scenario cannot configure
+/// it); an error when the scenario's controls need it configured.
+///
+/// The controls differ from learning only through the configuration block: learning off is
+/// η = 0 written into it, the random walk a flag in it. An image without one (a `.mot`
+/// without its `.sym`, or a program of the user's own) would run the same program in all
+/// three conditions and the claims would compare a run with itself, so such a run is refused;
+/// with the controls off it runs, warned about and marked in summary.json.
+///
+/// # Errors
+/// An image without a configuration block and a control condition on.
+fn unconfigured_image(
+    s: &Scenario,
+    images: Option<&crate::robot::Images>,
+) -> Result<Option<String>> {
+    let Some((fw, _)) = images.and_then(|i| i.user.as_ref()) else {
+        return Ok(None);
+    };
+    if fw.has_config_block() {
+        return Ok(None);
+    }
+    let image = s.controller.image.clone().unwrap_or_default();
+    if s.controls.learning_off || s.controls.random_walk {
+        bail!(
+            "`controller.image` = {image}: the image has no configuration block (no symbol table names `config_block` at H'000400: give IMAGE.sym beside the image, or controller.symbols), so the controls cannot reach it: learning off (eta = 0) and the random walk would run the same program as learning. Give the image's symbol table, or turn the controls off (controls.learning_off = false, controls.random_walk = false) to run the image as it is"
+        );
+    }
+    Ok(Some(image))
 }
 
 /// Host memory one robot takes while its run is going (measured: the peak resident size of
@@ -686,6 +727,10 @@ fn run_into(
         eeprom_records_written: saves,
         conditions: &stats,
         claims: &checked,
+        image_configured: images
+            .and_then(|i| i.user.as_ref())
+            .map(|(fw, _)| fw.has_config_block())
+            .filter(|configured| !configured),
     };
     let summary_path = stage.path("summary.json");
     std::fs::write(

@@ -115,7 +115,8 @@ pub struct Claim {
     /// Whether the two 95 % intervals are apart (do not overlap), whichever way.
     pub apart: bool,
     /// In words: "holds, intervals apart", "holds in the means, intervals overlap", "fails:
-    /// the opposite, intervals overlap" or "fails: the opposite, intervals apart".
+    /// the opposite in the means, intervals overlap", "fails: the opposite, intervals apart",
+    /// or "fails: the means are equal" (never "the opposite" for equal values).
     pub verdict: String,
     /// The two values compared (means), in the claim's order.
     pub values: [f64; 2],
@@ -129,11 +130,16 @@ impl Claim {
     pub fn below(claim: &str, a: &Estimate, b: &Estimate) -> Claim {
         let holds = a.mean < b.mean;
         let apart = a.apart_from(b);
-        let verdict = match (holds, apart) {
-            (true, true) => "holds, intervals apart",
-            (true, false) => "holds in the means, intervals overlap",
-            (false, false) => "fails: the opposite in the means, intervals overlap",
-            (false, true) => "fails: the opposite, intervals apart",
+        // "The opposite" only when the means go the other way (strictly): equal means (or a
+        // value that is not a number) fail without one.
+        let opposite = a.mean > b.mean;
+        let verdict = match (holds, opposite, apart) {
+            (true, _, true) => "holds, intervals apart",
+            (true, _, false) => "holds in the means, intervals overlap",
+            (false, true, false) => "fails: the opposite in the means, intervals overlap",
+            (false, true, true) => "fails: the opposite, intervals apart",
+            (false, false, _) if a.mean == b.mean => "fails: the means are equal",
+            (false, false, _) => "fails: the means cannot be compared",
         };
         Claim {
             claim: claim.to_string(),
@@ -312,6 +318,12 @@ mod tests {
             Claim::below("x", &lo, &wide).verdict,
             "holds in the means, intervals overlap"
         );
+        // Equal values are not "the opposite".
+        let same = Estimate::of(&[600.67, 600.67, 600.67]);
+        let c = Claim::below("x", &same, &same.clone());
+        assert!(!c.holds);
+        assert_eq!(c.verdict, "fails: the means are equal");
+        assert!(!c.verdict.contains("opposite"));
     }
 
     #[test]

@@ -507,3 +507,81 @@ fn a_killed_sweep_task_leaves_folders_that_merge_lists_and_the_next_run_removes(
     assert_eq!(named(&points, "."), Vec::<String>::new());
     assert_eq!(named(&points, "p"), vec!["p0001-steps20-s1".to_string()]);
 }
+
+#[test]
+fn an_image_without_its_configuration_block_cannot_run_the_controls() {
+    // The robot firmware copied without its symbol table: nothing says where its
+    // configuration block is, so learning off and the random walk cannot reach it.
+    let root = fresh("no-sym");
+    let image = root.join("robot.mot");
+    std::fs::copy(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("firmware/robot.mot"),
+        &image,
+    )
+    .unwrap();
+    let out = root.join("o");
+    let (code, stdout, err) = status(&[
+        "run",
+        "arena",
+        "--firmware",
+        s(&image),
+        "--steps",
+        "20",
+        "--robots",
+        "2",
+        "--repeats",
+        "1",
+        "--out",
+        s(&out),
+    ]);
+    assert_eq!(code, 2, "{stdout}{err}");
+    assert!(
+        err.contains("no configuration block") && err.contains("controls"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    // With the controls off it runs as it is, said loudly and marked in the summary.
+    let sc = root.join("alone.toml");
+    std::fs::write(
+        &sc,
+        format!(
+            "steps = 20\nwindow = 10\nrobots = 2\nrepeats = 1\n[controls]\nlearning_off = false\nrandom_walk = false\n[controller]\nkind = \"firmware\"\nimage = {:?}\n",
+            s(&image)
+        ),
+    )
+    .unwrap();
+    let (code, stdout, err) = status(&["run", s(&sc), "--out", s(&out)]);
+    assert_eq!(code, 0, "{stdout}{err}");
+    assert!(
+        err.contains("warning:") && err.contains("own built-in settings"),
+        "{err}"
+    );
+    let summary = std::fs::read_to_string(out.join("summary.json")).unwrap();
+    assert!(summary.contains("\"image_configured\": false"), "{summary}");
+    // With its symbol table beside it, the same image runs the controls.
+    std::fs::copy(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("firmware/robot.sym"),
+        root.join("robot.sym"),
+    )
+    .unwrap();
+    let printed = ok(&[
+        "run",
+        "arena",
+        "--firmware",
+        s(&image),
+        "--steps",
+        "20",
+        "--robots",
+        "2",
+        "--repeats",
+        "1",
+        "--out",
+        s(&out),
+    ]);
+    assert!(
+        !printed.contains("the opposite") || !printed.contains("600.67"),
+        "{printed}"
+    );
+    let summary = std::fs::read_to_string(out.join("summary.json")).unwrap();
+    assert!(!summary.contains("image_configured"), "{summary}");
+}
