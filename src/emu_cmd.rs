@@ -139,8 +139,9 @@ pub fn run(o: &EmuOptions<'_>) -> Result<(), Failure> {
     };
     let stdout = io::stdout();
     let mut console = stdout.lock();
-    let stderr = io::stderr();
-    let mut trace_out = BufWriter::new(stderr.lock());
+    // Not locked for the whole run: the GDB stub's thread may have to say on stderr that
+    // its debugger is lost.
+    let mut trace_out = BufWriter::with_capacity(1 << 16, io::stderr());
     let report = run_mcu_probed(
         &mut cpu,
         mcu,

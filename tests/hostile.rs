@@ -585,3 +585,46 @@ fn an_image_without_its_configuration_block_cannot_run_the_controls() {
     let summary = std::fs::read_to_string(out.join("summary.json")).unwrap();
     assert!(!summary.contains("image_configured"), "{summary}");
 }
+
+#[test]
+fn a_debugger_that_goes_away_without_detaching_is_reported() {
+    use std::io::{BufRead, BufReader, Read, Write};
+    let mut child = Command::new(bin())
+        .args([
+            "emu",
+            "firmware/robot.mot",
+            "--gdb",
+            "127.0.0.1:0",
+            "--max-states",
+            "20000000",
+        ])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stderr = BufReader::new(child.stderr.take().unwrap());
+    let mut line = String::new();
+    stderr.read_line(&mut line).unwrap();
+    let addr = line
+        .split_whitespace()
+        .find(|w| w.starts_with("127.0.0.1:"))
+        .unwrap_or_else(|| panic!("no address in {line:?}"))
+        .trim_end_matches(';')
+        .to_string();
+    {
+        let mut s = std::net::TcpStream::connect(&addr).unwrap();
+        s.write_all(b"$?#3f").unwrap();
+        let mut b = [0u8; 1];
+        s.read_exact(&mut b).unwrap();
+        assert_eq!(b[0], b'+');
+        // Gone without a word: the connection closes.
+    }
+    let mut rest = String::new();
+    stderr.read_to_string(&mut rest).unwrap();
+    let st = child.wait().unwrap();
+    assert_eq!(st.code(), Some(124), "{rest}");
+    assert!(rest.contains("debugger") && rest.contains("lost"), "{rest}");
+    assert_printable(&rest, "the stub's report");
+}
