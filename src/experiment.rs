@@ -802,8 +802,10 @@ pub fn run_one(
                     .with_context(|| {
                         format!("--vcd-robot {}: the robots run no firmware", v.robot)
                     })?;
+                let file = std::fs::File::create(&v.path)
+                    .with_context(|| format!("--vcd: cannot create `{}`", v.path.display()))?;
                 robot
-                    .start_pin_trace(names)
+                    .start_pin_trace(names, Box::new(file), &vcd_info(v, s, condition, repeat))
                     .with_context(|| format!("--vcd-robot {}", v.robot))?;
                 tracing = true;
             }
@@ -813,18 +815,18 @@ pub fn run_one(
         }
         swarm.step()?;
         if let Some(v) = &probes.vcd
-            && let Some(t) = swarm.robot_mut(v.robot).and_then(Robot::take_pin_trace)
+            && let Some(written) = swarm.robot_mut(v.robot).and_then(Robot::take_pin_trace)
         {
-            write_robot_vcd(v, s, condition, repeat, &t)?;
+            written.with_context(|| format!("--vcd: cannot write `{}`", v.path.display()))?;
             tracing = false;
         }
         progress(1);
     }
     if let Some(v) = &probes.vcd
         && tracing
-        && let Some(t) = swarm.robot_mut(v.robot).and_then(Robot::finish_pin_trace)
+        && let Some(written) = swarm.robot_mut(v.robot).and_then(Robot::finish_pin_trace)
     {
-        write_robot_vcd(v, s, condition, repeat, &t)?;
+        written.with_context(|| format!("--vcd: cannot write `{}`", v.path.display()))?;
     }
     if let Some(robot) = debugged.and_then(|k| swarm.robot_mut(k)) {
         robot.detach_debugger();
@@ -832,17 +834,14 @@ pub fn run_one(
     swarm.finish()
 }
 
-/// Writes a robot's pin trace as the VCD file of `v`.
-fn write_robot_vcd(
+/// What the VCD file of `v` says of its trace.
+fn vcd_info(
     v: &VcdProbe,
     s: &Scenario,
     condition: Condition,
     repeat: u32,
-    t: &crate::robot::RobotTrace,
-) -> Result<()> {
-    let file = std::fs::File::create(&v.path)
-        .with_context(|| format!("--vcd: cannot create `{}`", v.path.display()))?;
-    let info = emu::chip::vcd::VcdInfo {
+) -> emu::chip::vcd::VcdInfo {
+    emu::chip::vcd::VcdInfo {
         source: format!(
             "robot {} of h8swarm run {} ({} run, repeat {repeat}, seed {}), steps {} to {}",
             v.robot,
@@ -852,9 +851,7 @@ fn write_robot_vcd(
             v.from,
             (v.from + v.steps).min(s.steps) - 1
         ),
-    };
-    emu::chip::vcd::write_vcd(file, &t.pins, Some(&t.phases), &info)
-        .with_context(|| format!("--vcd: cannot write `{}`", v.path.display()))
+    }
 }
 
 /// What a robot's board shows its MCU for a step: each sensor's true distance (mm, `None`

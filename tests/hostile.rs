@@ -628,3 +628,72 @@ fn a_debugger_that_goes_away_without_detaching_is_reported() {
     assert!(rest.contains("debugger") && rest.contains("lost"), "{rest}");
     assert_printable(&rest, "the stub's report");
 }
+
+/// ITU1 in PWM mode at φ with a period of 100 states, then a loop with no register access:
+/// an edge every 50 states, 2 000 000 of them in 10^8 states. Assembled from
+/// `mov.b #0x20,r0l; mov.b r0l,@0x6e:8 (TCR1); mov.w #99,r0; mov.w r0,@0xff74:16 (GRA1);
+/// mov.w #50,r0; mov.w r0,@0xff76:16 (GRB1); mov.b #2,r0l; mov.b r0l,@0x62:8 (TMDR: PWM1);
+/// mov.b #2,r0l; mov.b r0l,@0x60:8 (TSTR: start channel 1); loop: bra loop` at H'000100
+/// (h8300-hms-as), with the reset vector pointing there.
+const FAST_PWM_MOT: &str = "S113000000000100000000000000000000000000EB\nS1130100F820386E790000636B80FF747900003248\nS11101106B80FF76F8023862F802386040FE19\nS9030000FC\n";
+
+#[test]
+fn emu_streams_its_vcd_and_runs_under_a_small_memory_limit() {
+    // Two million pin changes would take more than 40 MB held in memory; streamed, the
+    // program runs to its state budget and the whole trace is on disk.
+    let root = fresh("vcd-stream");
+    let image = root.join("pwm.mot");
+    std::fs::write(&image, FAST_PWM_MOT).unwrap();
+    let vcd = root.join("pwm.vcd");
+    let o = under_rlimit(
+        40_000,
+        &[
+            "emu",
+            s(&image),
+            "--max-states",
+            "100000000",
+            "--vcd",
+            s(&vcd),
+        ],
+    );
+    assert_eq!(o.status.code(), Some(124), "{}", text(&o.stderr));
+    let trace = std::fs::read_to_string(&vcd).unwrap();
+    let edges = trace.lines().filter(|l| *l == "1!" || *l == "0!").count();
+    assert!(edges > 1_900_000, "{edges} edges");
+    let last: u64 = trace
+        .lines()
+        .last()
+        .and_then(|l| l.strip_prefix('#'))
+        .and_then(|n| n.parse().ok())
+        .expect("a last timestamp");
+    assert!(last >= 400_000_000, "{last}");
+    let _ = std::fs::remove_dir_all(&root);
+}
+
+#[test]
+fn a_run_too_big_for_the_process_limit_is_refused_not_aborted() {
+    // 100 000 robots under a 4 GB address-space limit: status 2 and a message naming the
+    // limit, at once (it used to abort with SIGABRT after seconds).
+    let root = fresh("rlimit-run");
+    let o = under_rlimit(
+        4_000_000,
+        &[
+            "run",
+            "arena",
+            "--robots",
+            "100000",
+            "--threads",
+            "1",
+            "--out",
+            s(&root.join("o")),
+        ],
+    );
+    let err = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.starts_with("error: this run needs about"), "{err}");
+    assert!(
+        err.contains("ulimit -v") || err.contains("available"),
+        "{err}"
+    );
+    assert_eq!(err.lines().count(), 1, "{err}");
+}
