@@ -1,10 +1,14 @@
-//! Hostile input, generated (issue 13): scenario TOML, replay lines, S-records and argument
-//! vectors, mutated from valid ones by proptest. Each family runs `H8SWARM_FUZZ_CASES` cases
-//! (default 2 000, the same ones each time; set it for a soak, which draws new ones). The first three go through the library's entry
-//! points (the code the binary runs on them); the argument vectors run the real binary in a
-//! folder of its own. Every case must end without a panic or an abort, with an exit status the
-//! README promises, a one-line error first when it fails, and no file written outside the
-//! folder it ran in.
+//! Hostile input, generated: scenario TOML, replay lines, S-records, argument vectors, sweep
+//! files with Slurm fields, merges of corrupted sweep folders, raw GDB sessions, signals
+//! during runs and runs under a memory limit, mutated from valid ones by proptest. Each family
+//! runs `H8SWARM_FUZZ_CASES` cases (default 2 000, the same ones each time; set it for a
+//! soak, which draws new ones), but for two that start a process per case and run it: the
+//! signals (default 100 cases) and the memory limits (default 300), each case a real run of
+//! 0.1 to 0.5 s, so that their 2 000 would take many minutes in CI; a soak sets their
+//! counts too. The library families go through the entry points the binary runs; the
+//! argument vectors, signals and limits run the real binary in a folder of its own. Every
+//! case must end without a panic or an abort, with an exit status the README promises, a
+//! one-line error first when it fails, and no file written outside the folder it ran in.
 
 use std::cell::{Cell, RefCell};
 use std::io::BufReader;
@@ -16,17 +20,27 @@ use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
 
 fn cases() -> u32 {
+    cases_or(2_000)
+}
+
+/// `H8SWARM_FUZZ_CASES`, else `default`.
+fn cases_or(default: u32) -> u32 {
     std::env::var("H8SWARM_FUZZ_CASES")
         .ok()
         .and_then(|v| v.parse().ok())
-        .unwrap_or(2_000)
+        .unwrap_or(default)
 }
 
 /// The same cases on every CI run (a fixed seed); a soak (`H8SWARM_FUZZ_CASES` set) draws new
 /// ones each time.
 fn runner() -> TestRunner {
+    runner_of(cases())
+}
+
+/// [`runner`] with `cases` cases.
+fn runner_of(cases: u32) -> TestRunner {
     let config = Config {
-        cases: cases(),
+        cases,
         failure_persistence: None,
         ..Config::default()
     };
@@ -491,4 +505,314 @@ fn argument_vectors_end_with_a_promised_status_and_write_only_where_they_ran() {
         statuses.contains_key(&0) && statuses.contains_key(&2),
         "{statuses:?} over {n}"
     );
+}
+
+/// A fresh, empty folder for a family's cases.
+fn family_dir(name: &str) -> std::path::PathBuf {
+    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("fuzz-{name}"));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// [`family_dir`] in memory where the system has it (/dev/shm): a family that makes and
+/// removes thousands of small files spends most of its time making inodes on a disk.
+fn family_dir_in_memory(name: &str) -> std::path::PathBuf {
+    let shm = Path::new("/dev/shm");
+    if !shm.is_dir() {
+        return family_dir(name);
+    }
+    let d = shm.join(format!("h8swarm-fuzz-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// No control character but line ends: what reaches a terminal.
+fn printable_text(text: &str) -> bool {
+    !text
+        .chars()
+        .any(|c| (c.is_control() && c != '\n') || ('\u{80}'..='\u{9f}').contains(&c))
+}
+
+/// A `[slurm]` value: numbers of every size and sign, Slurm's time formats and near misses,
+/// words, control characters.
+fn slurm_value() -> impl Strategy<Value = String> {
+    prop_oneof![
+        Just("0".to_string()),
+        Just("1".to_string()),
+        Just("-1".to_string()),
+        Just("1001".to_string()),
+        Just("1002".to_string()),
+        Just("4096".to_string()),
+        Just("4097".to_string()),
+        Just("18446744073709551615".to_string()),
+        Just("9223372036854775807".to_string()),
+        (0u64..100_000).prop_map(|v| v.to_string()),
+        Just("\"UNLIMITED\"".to_string()),
+        Just("\"infinite\"".to_string()),
+        Just("\"-x\"".to_string()),
+        Just("\"short\"".to_string()),
+        Just("\"1-24\"".to_string()),
+        Just("\"12:00:00\\n#SBATCH --array=0-9\"".to_string()),
+        Just("\"a\\u001b[2Jb\"".to_string()),
+        "[0-9:-]{0,12}".prop_map(|t| format!("\"{t}\"")),
+        "[a-zA-Z0-9_.,:=@/+ -]{0,16}".prop_map(|t| format!("\"{t}\"")),
+        prop::collection::vec("--[a-z-]{1,12}(=[a-z0-9:-]{0,8})?", 0..3)
+            .prop_map(|v| format!("{v:?}")),
+    ]
+}
+
+#[test]
+fn sweep_files_with_slurm_fields_plan_safe_scripts_or_fail_in_one_line() {
+    use h8swarm::sweep::plan::{PLAN_OPTIONS, slurm_time_minutes, write_plan};
+    use h8swarm::sweep::spec::parse;
+    let keys = [
+        "time",
+        "cpus_per_task",
+        "mem_mb",
+        "max_cpus",
+        "points_per_task",
+        "max_parallel",
+        "max_array_size",
+        "partition",
+        "account",
+        "extra",
+        "qos",
+    ];
+    let root = family_dir_in_memory("slurm");
+    let (ok, bad, n) = (Cell::new(0u32), Cell::new(0u32), Cell::new(0u32));
+    runner()
+        .run(
+            &(
+                prop_oneof![9 => 1u32..4, 1 => 495u32..506],
+                prop::collection::vec((0..keys.len(), slurm_value()), 0..5),
+            ),
+            |(seeds, fields)| {
+                n.set(n.get() + 1);
+                let mut text = format!(
+                    "seeds = {seeds}\n[set]\nsteps = 10\nwindow = 10\nrepeats = 1\n[grid]\n\"learner.threshold\" = [10, 20]\n[slurm]\n"
+                );
+                for (k, v) in &fields {
+                    text.push_str(&format!("{} = {v}\n", keys[*k]));
+                }
+                let dir = root.join(format!("c{}", n.get()));
+                let planned = parse(&text, Path::new("fuzz.toml"))
+                    .and_then(|s| write_plan(&s, &text, &dir, Some(Path::new("/bin/h8swarm"))));
+                match planned {
+                    Ok(_) => {
+                        ok.set(ok.get() + 1);
+                        let script = std::fs::read_to_string(dir.join("sweep.sbatch")).unwrap();
+                        prop_assert!(printable_text(&script), "{script:?}");
+                        let mut max_array = 1001u64;
+                        for (k, v) in &fields {
+                            if keys[*k] == "max_array_size" {
+                                max_array = v.parse().unwrap_or(max_array);
+                            }
+                        }
+                        for l in script.lines().filter(|l| l.starts_with("#SBATCH ")) {
+                            let opt = &l["#SBATCH ".len()..];
+                            if let Some(t) = opt.strip_prefix("--time=") {
+                                prop_assert!(slurm_time_minutes(t).is_ok(), "{l}");
+                            }
+                            if let Some(a) = opt.strip_prefix("--array=0-") {
+                                let last: u64 = a.split('%').next().unwrap().parse().unwrap();
+                                prop_assert!(last < max_array, "{l}");
+                            }
+                            let name = opt.split('=').next().unwrap();
+                            let own = PLAN_OPTIONS.contains(&name);
+                            let count = script
+                                .lines()
+                                .filter(|x| x.starts_with(&format!("#SBATCH {name}")))
+                                .count();
+                            prop_assert!(!own || count == 1, "{name} twice: {script}");
+                        }
+                    }
+                    Err(e) => {
+                        bad.set(bad.get() + 1);
+                        let m = e.to_string();
+                        prop_assert!(!m.contains('\n'), "{m}");
+                        prop_assert!(printable_text(&m), "{m:?}");
+                        one_line_first(&m)?;
+                        prop_assert!(!dir.join("sweep.sbatch").exists());
+                    }
+                }
+                let _ = std::fs::remove_dir_all(&dir);
+                Ok(())
+            },
+        )
+        .unwrap();
+    let _ = std::fs::remove_dir_all(&root);
+    let (ok, bad) = (ok.get(), bad.get());
+    eprintln!("fuzz: slurm fields: {ok} planned, {bad} refused");
+    assert!(ok > 0 && bad > 0, "ok {ok}, refused {bad}");
+}
+
+/// One way to damage a sweep folder.
+#[derive(Clone, Debug)]
+enum Damage {
+    /// Remove point k's folder.
+    DeletePoint(usize),
+    /// Overwrite byte p (per mille of the file) of file f of point k.
+    Byte(usize, usize, u16, u8),
+    /// Cut file f of point k to p per mille.
+    Truncate(usize, usize, u16),
+    /// A folder where file f of point k was.
+    Folder(usize, usize),
+    /// A temporary folder of a task under points/, named so.
+    Temporary(String),
+    /// Overwrite byte p of plan.json (0) or points.jsonl (1).
+    PlanByte(usize, u16, u8),
+}
+
+fn damage() -> impl Strategy<Value = Damage> {
+    prop_oneof![
+        2 => any::<usize>().prop_map(Damage::DeletePoint),
+        4 => (any::<usize>(), any::<usize>(), 0u16..1000, any::<u8>())
+            .prop_map(|(k, f, p, b)| Damage::Byte(k, f, p, b)),
+        2 => (any::<usize>(), any::<usize>(), 0u16..1000).prop_map(|(k, f, p)| Damage::Truncate(k, f, p)),
+        1 => (any::<usize>(), any::<usize>()).prop_map(|(k, f)| Damage::Folder(k, f)),
+        2 => prop_oneof![
+            "\\.\\.?tmp-p000[0-2]-s[1-3]-[a-z]{1,6}-[0-9]{1,7}(\\.partial-[0-9]{1,7})?",
+            "\\.tmp-[ -~\u{1b}\n]{0,12}",
+        ]
+        .prop_map(Damage::Temporary),
+        1 => (0usize..2, 0u16..1000, any::<u8>()).prop_map(|(f, p, b)| Damage::PlanByte(f, p, b)),
+    ]
+}
+
+fn poke(path: &Path, per_mille: u16, byte: Option<u8>) {
+    let Ok(mut bytes) = std::fs::read(path) else {
+        return;
+    };
+    let at = (usize::from(per_mille) * bytes.len()) / 1000;
+    match byte {
+        Some(b) if at < bytes.len() => bytes[at] = b,
+        Some(_) => {}
+        None => bytes.truncate(at),
+    }
+    let _ = std::fs::write(path, bytes);
+}
+
+#[test]
+fn merges_of_corrupted_sweep_folders_list_what_is_wrong_and_keep_the_users_files() {
+    use h8swarm::sweep::merge::merge;
+    let root = family_dir_in_memory("merge");
+    let sweep = root.join("s.toml");
+    std::fs::write(
+        &sweep,
+        "seeds = 3\n[set]\nsteps = 10\nwindow = 10\nrepeats = 1\nrobots = 2\n",
+    )
+    .unwrap();
+    let pristine = root.join("pristine");
+    let text = std::fs::read_to_string(&sweep).unwrap();
+    let s = h8swarm::sweep::spec::parse(&text, &sweep).unwrap();
+    h8swarm::sweep::plan::write_plan(&s, &text, &pristine, Some(Path::new("/bin/true"))).unwrap();
+    h8swarm::sweep::exec::run_task(&pristine, None, Some(1)).unwrap();
+    let ids: Vec<String> = (0..3).map(|i| format!("p000{i}-s{}", i + 1)).collect();
+    let files = ["status.json", "scenario.toml", "summary.json"];
+    // What merge reads: the plan, the run list, and three files of each point.
+    let mut kept: Vec<(String, Vec<u8>)> = Vec::new();
+    for f in ["plan.json", "points.jsonl"] {
+        kept.push((f.to_string(), std::fs::read(pristine.join(f)).unwrap()));
+    }
+    for id in &ids {
+        for f in files {
+            let rel = format!("points/{id}/{f}");
+            kept.push((rel.clone(), std::fs::read(pristine.join(&rel)).unwrap()));
+        }
+    }
+    let (complete, listed, refused) = (Cell::new(0u32), Cell::new(0u32), Cell::new(0u32));
+    let n = Cell::new(0u32);
+    runner()
+        .run(&prop::collection::vec(damage(), 0..5), |damages| {
+            n.set(n.get() + 1);
+            // One folder for every case, put back as it was (rewriting files in place is
+            // much cheaper than making folders afresh).
+            let dir = root.join("case");
+            for e in std::fs::read_dir(dir.join("points"))
+                .into_iter()
+                .flatten()
+                .flatten()
+            {
+                if !ids.iter().any(|id| e.file_name() == id.as_str()) {
+                    let _ = std::fs::remove_dir_all(e.path());
+                }
+            }
+            for (rel, bytes) in &kept {
+                let p = dir.join(rel);
+                if p.is_dir() {
+                    std::fs::remove_dir_all(&p).unwrap();
+                }
+                std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+                if std::fs::read(&p).ok().as_deref() != Some(bytes.as_slice()) {
+                    std::fs::write(&p, bytes).unwrap();
+                }
+            }
+            for d in &damages {
+                let file =
+                    |k: usize, f: usize| dir.join("points").join(&ids[k % 3]).join(files[f % 3]);
+                match d {
+                    Damage::DeletePoint(k) => {
+                        let _ = std::fs::remove_dir_all(dir.join("points").join(&ids[k % 3]));
+                    }
+                    Damage::Byte(k, f, p, b) => poke(&file(*k, *f), *p, Some(*b)),
+                    Damage::Truncate(k, f, p) => poke(&file(*k, *f), *p, None),
+                    Damage::Folder(k, f) => {
+                        let p = file(*k, *f);
+                        if p.parent().is_some_and(Path::exists) {
+                            let _ = std::fs::remove_file(&p);
+                            let _ = std::fs::create_dir_all(p.join("x"));
+                        }
+                    }
+                    Damage::Temporary(name) => {
+                        let _ = std::fs::create_dir_all(dir.join("points").join(name));
+                    }
+                    Damage::PlanByte(f, p, b) => {
+                        poke(&dir.join(["plan.json", "points.jsonl"][*f]), *p, Some(*b));
+                    }
+                }
+            }
+            let out = dir.join("report");
+            if !out.join("notes.txt").exists() {
+                std::fs::create_dir_all(out.join("plots")).unwrap();
+                std::fs::write(out.join("plots/mine.pdf"), b"mine").unwrap();
+                std::fs::write(out.join("notes.txt"), b"notes").unwrap();
+            }
+            match merge(&dir, Some(&out)) {
+                Ok((text, all)) => {
+                    if all {
+                        complete.set(complete.get() + 1);
+                    } else {
+                        listed.set(listed.get() + 1);
+                    }
+                    prop_assert!(printable_text(&text), "{text:?}");
+                    let csv = std::fs::read_to_string(out.join("sweep.csv")).unwrap();
+                    prop_assert_eq!(csv.lines().count(), 4, "{}", csv);
+                    let doc: serde_json::Value = serde_json::from_str(
+                        &std::fs::read_to_string(out.join("sweep.json")).unwrap(),
+                    )
+                    .unwrap();
+                    let listed_ids = ["failed", "missing", "broken"]
+                        .iter()
+                        .map(|k| doc[k].as_array().map_or(0, Vec::len))
+                        .sum::<usize>();
+                    prop_assert_eq!(listed_ids + doc["ok"].as_u64().unwrap() as usize, 3);
+                }
+                Err(e) => {
+                    refused.set(refused.get() + 1);
+                    let m = e.to_string();
+                    prop_assert!(!m.contains('\n') && printable_text(&m), "{m:?}");
+                    one_line_first(&m)?;
+                }
+            }
+            prop_assert_eq!(std::fs::read(out.join("plots/mine.pdf")).unwrap(), b"mine");
+            prop_assert_eq!(std::fs::read(out.join("notes.txt")).unwrap(), b"notes");
+            Ok(())
+        })
+        .unwrap();
+    let _ = std::fs::remove_dir_all(&root);
+    let (c, l, r) = (complete.get(), listed.get(), refused.get());
+    eprintln!("fuzz: merges: {c} complete, {l} with points listed, {r} refused");
+    assert!(c > 0 && l > 0 && r > 0, "{c} {l} {r}");
 }
