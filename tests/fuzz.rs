@@ -816,3 +816,237 @@ fn merges_of_corrupted_sweep_folders_list_what_is_wrong_and_keep_the_users_files
     eprintln!("fuzz: merges: {c} complete, {l} with points listed, {r} refused");
     assert!(c > 0 && l > 0 && r > 0, "{c} {l} {r}");
 }
+
+/// One thing a GDB client sends: a packet body (sent with a right checksum), or raw bytes.
+#[derive(Clone, Debug)]
+enum Wire {
+    /// `$body#xx`, expecting `+` and a reply.
+    Packet(String),
+    /// `$body#00` with a wrong checksum, expecting `-`.
+    BadSum(String),
+    /// A packet longer than the stub takes, expecting `+` and `E07`.
+    Long(usize),
+    /// Bytes no reply is promised to (junk, Ctrl-C, `+`).
+    Raw(Vec<u8>),
+    /// `-`: the last reply again, if there was one.
+    Nak,
+}
+
+fn wire() -> impl Strategy<Value = Wire> {
+    let addr = prop_oneof![
+        Just(0u32),
+        Just(0x100),
+        Just(0xFF_DF10),
+        Just(0xFF_E000),
+        Just(0xFF_FF00),
+        any::<u32>()
+    ];
+    let body = prop_oneof![
+        Just("?".to_string()),
+        Just("g".to_string()),
+        Just("qSupported".to_string()),
+        Just("qSupported:multiprocess+;swbreak+;hwbreak+".to_string()),
+        Just("qSupported:;".to_string()),
+        Just("qXfer:features:read:target.xml:0,fff".to_string()),
+        Just("qRcmd,636c6f636b".to_string()),
+        Just("qRcmd,zz".to_string()),
+        Just("qAttached".to_string()),
+        Just("qC".to_string()),
+        Just("Hg0".to_string()),
+        Just("vCont?".to_string()),
+        Just("s".to_string()),
+        Just("vCont;s".to_string()),
+        Just("p9".to_string()),
+        Just("G00".to_string()),
+        (addr.clone(), 0usize..300).prop_map(|(a, n)| format!("m{a:x},{n:x}")),
+        (addr.clone(), prop::collection::vec(any::<u8>(), 0..8)).prop_map(|(a, b)| format!(
+            "M{a:x},{:x}:{}",
+            b.len(),
+            b.iter().map(|x| format!("{x:02x}")).collect::<String>()
+        )),
+        (0u8..5, addr.clone(), 0u32..9).prop_map(|(k, a, n)| format!("Z{k},{a:x},{n:x}")),
+        (0u8..5, addr, 0u32..9).prop_map(|(k, a, n)| format!("z{k},{a:x},{n:x}")),
+        "[ -~]{0,24}".prop_filter("no framing bytes", |t| !t.contains(['$', '#', '}', '*'])),
+    ];
+    prop_oneof![
+        8 => body.clone().prop_map(Wire::Packet),
+        1 => body.prop_map(Wire::BadSum),
+        1 => (4_100usize..20_000).prop_map(Wire::Long),
+        1 => prop_oneof![
+            prop::collection::vec(
+                any::<u8>().prop_filter("not a packet start or a NAK", |b| *b != b'$' && *b != b'-'),
+                1..40
+            ),
+            Just(vec![0x03]),
+            Just(b"+".to_vec()),
+        ]
+        .prop_map(Wire::Raw),
+        1 => Just(Wire::Nak),
+    ]
+}
+
+fn rsp_packet(body: &[u8]) -> Vec<u8> {
+    let sum = body.iter().fold(0u8, |a, b| a.wrapping_add(*b));
+    let mut p = vec![b'$'];
+    p.extend_from_slice(body);
+    p.extend_from_slice(format!("#{sum:02x}").as_bytes());
+    p
+}
+
+/// Reads one byte; `None` when the stub closed the connection.
+fn rsp_byte(s: &mut std::net::TcpStream) -> Option<u8> {
+    use std::io::Read;
+    let mut b = [0u8; 1];
+    match s.read(&mut b) {
+        Ok(1) => Some(b[0]),
+        Ok(_) => None,
+        Err(e) if e.kind() == std::io::ErrorKind::ConnectionReset => None,
+        Err(e) => panic!("the stub does not answer: {e}"),
+    }
+}
+
+/// The next reply packet's body (acknowledged), skipping anything before its `$`.
+fn rsp_reply(s: &mut std::net::TcpStream) -> Option<String> {
+    use std::io::Write;
+    while rsp_byte(s)? != b'$' {}
+    let mut body = Vec::new();
+    loop {
+        match rsp_byte(s)? {
+            b'#' => break,
+            b => body.push(b),
+        }
+    }
+    rsp_byte(s)?;
+    rsp_byte(s)?;
+    let _ = s.write_all(b"+");
+    Some(String::from_utf8_lossy(&body).into_owned())
+}
+
+#[test]
+fn raw_gdb_sessions_get_protocol_answers_and_never_hang_the_stub() {
+    use emu::board::firmware::Firmware;
+    use emu::chip::gdb::GdbListener;
+    use emu::chip::mcu::{Mcu, McuConfig, NullBoard};
+    use emu::chip::run::{Probes, RunOptions, run_mcu_probed};
+    use std::io::Write;
+    let fw = Firmware::robot().unwrap();
+    let (alive, ended) = (Cell::new(0u32), Cell::new(0u32));
+    runner()
+        .run(&prop::collection::vec(wire(), 0..10), |items| {
+            let listener = GdbListener::bind("127.0.0.1:0").unwrap();
+            let addr = listener.local_addr();
+            let fw = fw.clone();
+            let run = std::thread::spawn(move || {
+                let mut debugger = listener.accept().unwrap();
+                let mut mcu = Mcu::new(McuConfig::default(), NullBoard).unwrap();
+                let mut cpu = emu::core::cpu::Cpu::new();
+                fw.install(&mut mcu, &mut cpu, None).unwrap();
+                run_mcu_probed(
+                    &mut cpu,
+                    &mut mcu,
+                    &RunOptions {
+                        max_states: Some(1_000_000),
+                    },
+                    &mut std::io::sink(),
+                    Probes {
+                        debugger: Some(&mut debugger),
+                        ..Probes::default()
+                    },
+                )
+                .map(|r| r.outcome)
+            });
+            let mut s = std::net::TcpStream::connect(addr).unwrap();
+            // A stub that stops answering fails the case instead of hanging the test.
+            s.set_read_timeout(Some(Duration::from_secs(60))).unwrap();
+            // Small writes go at once (as a debugger sends them), not held for an ACK.
+            s.set_nodelay(true).unwrap();
+            let mut open = true;
+            let mut last: Option<String> = None;
+            for item in &items {
+                if !open {
+                    break;
+                }
+                match item {
+                    Wire::Packet(body) => {
+                        s.write_all(&rsp_packet(body.as_bytes())).unwrap();
+                        match rsp_byte(&mut s) {
+                            Some(b'+') => loop {
+                                // Console output (`O…`, a monitor command's) comes first.
+                                match rsp_reply(&mut s) {
+                                    Some(r) if r.starts_with('O') && r != "OK" => {}
+                                    Some(r) => {
+                                        last = Some(r);
+                                        break;
+                                    }
+                                    None => {
+                                        open = false;
+                                        break;
+                                    }
+                                }
+                            },
+                            Some(other) => prop_assert!(false, "{body}: {:?}", other as char),
+                            None => open = false,
+                        }
+                    }
+                    Wire::BadSum(body) => {
+                        let mut p = rsp_packet(body.as_bytes());
+                        let n = p.len();
+                        let bad = if &p[n - 2..] == b"00" { b"01" } else { b"00" };
+                        p[n - 2..].copy_from_slice(bad);
+                        s.write_all(&p).unwrap();
+                        match rsp_byte(&mut s) {
+                            Some(b) => prop_assert_eq!(b, b'-', "{}", body),
+                            None => open = false,
+                        }
+                    }
+                    Wire::Long(n) => {
+                        s.write_all(&rsp_packet(&vec![b'm'; *n])).unwrap();
+                        prop_assert_eq!(rsp_byte(&mut s), Some(b'+'));
+                        let r = rsp_reply(&mut s);
+                        prop_assert_eq!(r.as_deref(), Some("E07"));
+                        last = r;
+                    }
+                    Wire::Nak => {
+                        s.write_all(b"-").unwrap();
+                        if let Some(want) = &last {
+                            let again = rsp_reply(&mut s);
+                            prop_assert_eq!(again.as_ref(), Some(want));
+                        }
+                    }
+                    Wire::Raw(bytes) => {
+                        let _ = s.write_all(bytes);
+                    }
+                }
+            }
+            // Still answering: a request whose reply is unmistakable, then detach.
+            if open {
+                let _ = s.write_all(&rsp_packet(b"qXfer:features:read:target.xml:0,fff"));
+                let mut answered = false;
+                while let Some(r) = rsp_reply(&mut s) {
+                    if r.contains("<?xml") || r.starts_with('W') || r.starts_with('X') {
+                        answered = true;
+                        break;
+                    }
+                }
+                if answered {
+                    alive.set(alive.get() + 1);
+                    let _ = s.write_all(&rsp_packet(b"D"));
+                } else {
+                    ended.set(ended.get() + 1);
+                }
+            } else {
+                ended.set(ended.get() + 1);
+            }
+            drop(s);
+            let outcome = run.join();
+            prop_assert!(outcome.is_ok(), "the program's side panicked");
+            prop_assert!(outcome.unwrap().is_ok());
+            Ok(())
+        })
+        .unwrap();
+    let (alive, ended) = (alive.get(), ended.get());
+    eprintln!(
+        "fuzz: gdb sessions: {alive} still answering at the end, {ended} ended by the program"
+    );
+    assert!(alive > 0, "{alive} {ended}");
+}
