@@ -10,6 +10,7 @@
 //! `sweep run` removes (a folder whose process is gone) and `sweep merge` lists.
 
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Mutex, MutexGuard, Once};
 
 use signal_hook::consts::signal::{SIGHUP, SIGINT, SIGTERM};
@@ -18,6 +19,24 @@ use signal_hook::consts::signal::{SIGHUP, SIGINT, SIGTERM};
 static STAGING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 /// Held while finished files move into place (and by the cleanup, which so waits for it).
 static COMMIT: Mutex<()> = Mutex::new(());
+/// Set when a signal's cleanup has begun: the process is about to die of it.
+static SIGNALLED: AtomicBool = AtomicBool::new(false);
+
+/// Whether a signal's cleanup has begun. The work it stops may fail first (its staging
+/// folder is gone): such a failure is not reported, the process waits for the signal to end
+/// it ([`wait_if_signalled`]).
+#[must_use]
+pub fn signalled() -> bool {
+    SIGNALLED.load(Ordering::SeqCst)
+}
+
+/// Never returns when a signal's cleanup has begun (the signal ends the process); returns at
+/// once otherwise.
+pub fn wait_if_signalled() {
+    while signalled() {
+        std::thread::park_timeout(std::time::Duration::from_secs(1));
+    }
+}
 
 fn staging() -> MutexGuard<'static, Vec<PathBuf>> {
     STAGING
@@ -39,6 +58,7 @@ pub fn install() -> bool {
             .name("h8swarm-signals".into())
             .spawn(move || {
                 if let Some(signal) = signals.forever().next() {
+                    SIGNALLED.store(true, Ordering::SeqCst);
                     // Waits for a commit under way; nothing else moves in or out after this.
                     let _held = COMMIT
                         .lock()

@@ -174,6 +174,9 @@ fn main() -> ExitCode {
         Some(Command::Sweep(args)) => sweep(&args),
         None => run(&run_cmd::RunArgs::default()),
     };
+    // A signal is ending the process: what failed because its cleanup removed the staging
+    // folders is not an error to report; the signal says how the process ended.
+    h8swarm::cleanup::wait_if_signalled();
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(Failure::Program(status)) => ExitCode::from(status),

@@ -1050,3 +1050,256 @@ fn raw_gdb_sessions_get_protocol_answers_and_never_hang_the_stub() {
     );
     assert!(alive > 0, "{alive} {ended}");
 }
+
+/// Waits for `child` at most 120 s (a case may not hang); its exit status.
+fn wait_bounded(child: &mut std::process::Child, what: &str) -> std::process::ExitStatus {
+    let started = Instant::now();
+    loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            return s;
+        }
+        if started.elapsed() > Duration::from_secs(120) {
+            let _ = child.kill();
+            panic!("{what} did not end within 120 s");
+        }
+        std::thread::sleep(Duration::from_millis(2));
+    }
+}
+
+/// Files of `dir` (names and bytes), sorted.
+fn files_of(dir: &Path) -> Vec<(std::ffi::OsString, Vec<u8>)> {
+    let mut v: Vec<_> = std::fs::read_dir(dir)
+        .into_iter()
+        .flatten()
+        .flatten()
+        .filter(|e| e.path().is_file())
+        .map(|e| (e.file_name(), std::fs::read(e.path()).unwrap_or_default()))
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn signals_during_runs_leave_the_old_results_or_the_new_ones_and_no_staging_folder() {
+    use std::os::unix::process::ExitStatusExt;
+    let root = family_dir("signals");
+    // The results of an earlier run, to be kept or replaced whole.
+    let earlier = root.join("earlier");
+    let run_args = |out: &Path, seed: &str, steps: &str| -> Vec<String> {
+        [
+            "run",
+            "--steps",
+            steps,
+            "--robots",
+            "3",
+            "--repeats",
+            "1",
+            "--threads",
+            "2",
+            "--seed",
+            seed,
+            "--out",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .chain([out.display().to_string()])
+        .collect()
+    };
+    let st = Command::new(env!("CARGO_BIN_EXE_h8swarm"))
+        .args(run_args(&earlier, "1", "40"))
+        .stdout(Stdio::null())
+        .status()
+        .unwrap();
+    assert!(st.success());
+    let old = files_of(&earlier);
+    let (finished, stopped) = (Cell::new(0u32), Cell::new(0u32));
+    let n = Cell::new(0u32);
+    runner_of(cases_or(100))
+        .run(
+            &(
+                prop_oneof![Just("INT"), Just("TERM"), Just("HUP")],
+                0u64..400,
+                prop_oneof![Just("40"), Just("400"), Just("4000")],
+            ),
+            |(signal, delay_ms, steps)| {
+                n.set(n.get() + 1);
+                let case = root.join(format!("c{}", n.get()));
+                let out = case.join("o");
+                std::fs::create_dir_all(&out).unwrap();
+                for (name, bytes) in &old {
+                    std::fs::write(out.join(name), bytes).unwrap();
+                }
+                let mut child = Command::new(env!("CARGO_BIN_EXE_h8swarm"))
+                    .args(run_args(&out, "2", steps))
+                    .stdin(Stdio::null())
+                    .stdout(Stdio::null())
+                    .stderr(Stdio::null())
+                    .spawn()
+                    .unwrap();
+                // The signal comes at a drawn moment: before, during or after the work.
+                std::thread::sleep(Duration::from_millis(delay_ms));
+                let _ = Command::new("kill")
+                    .args([&format!("-{signal}"), &child.id().to_string()])
+                    .stderr(Stdio::null())
+                    .status();
+                let st = wait_bounded(&mut child, "a signalled run");
+                let number = match signal {
+                    "INT" => 2,
+                    "TERM" => 15,
+                    _ => 1,
+                };
+                if st.success() {
+                    finished.set(finished.get() + 1);
+                } else {
+                    stopped.set(stopped.get() + 1);
+                    prop_assert_eq!(st.signal(), Some(number), "{:?}", st);
+                }
+                // Nothing beside the output folder, and in it the old files or the new ones.
+                let beside: Vec<_> = entries(&case);
+                prop_assert_eq!(beside, vec![std::ffi::OsString::from("o")]);
+                let now = files_of(&out);
+                if now != old {
+                    let summary: serde_json::Value =
+                        serde_json::from_slice(&std::fs::read(out.join("summary.json")).unwrap())
+                            .unwrap();
+                    prop_assert_eq!(summary["scenario"]["seed"].as_u64(), Some(2));
+                    for f in ["metrics.csv", "fit.json", "learning.png", "learning.svg"] {
+                        prop_assert!(out.join(f).is_file(), "{} missing", f);
+                    }
+                }
+                let _ = std::fs::remove_dir_all(&case);
+                Ok(())
+            },
+        )
+        .unwrap();
+    let _ = std::fs::remove_dir_all(&root);
+    let (f, s) = (finished.get(), stopped.get());
+    eprintln!("fuzz: signals: {f} runs finished first, {s} stopped by the signal");
+    assert!(s > 0, "{f} {s}");
+}
+
+/// ITU1 driving a PWM edge every 50 states while the CPU loops: see tests/hostile.rs.
+const FAST_PWM_MOT: &str = "S113000000000100000000000000000000000000EB\nS1130100F820386E790000636B80FF747900003248\nS11101106B80FF76F8023862F802386040FE19\nS9030000FC\n";
+
+#[test]
+fn runs_under_a_memory_limit_finish_or_are_refused_never_aborted() {
+    use std::os::unix::process::ExitStatusExt;
+    let root = family_dir("rlimit");
+    let pwm = root.join("pwm.mot");
+    std::fs::write(&pwm, FAST_PWM_MOT).unwrap();
+    let statuses = RefCell::new(std::collections::BTreeMap::new());
+    let n = Cell::new(0u32);
+    let command = prop_oneof![
+        3 => (
+            prop_oneof![Just("1"), Just("3"), Just("10"), Just("20000"), Just("100000")],
+            prop_oneof![Just("5"), Just("20")],
+            prop_oneof![Just("1"), Just("2"), Just("16")],
+            prop_oneof![Just("model"), Just("firmware")],
+        )
+            .prop_map(|(robots, steps, threads, kind)| {
+                // Firmware robots are slow: only few of them run.
+                let robots = if kind == "firmware" && robots == "10" { "3" } else { robots };
+                vec![
+                    "run".to_string(),
+                    "--robots".into(),
+                    robots.into(),
+                    "--steps".into(),
+                    steps.into(),
+                    "--repeats".into(),
+                    "1".into(),
+                    "--threads".into(),
+                    threads.into(),
+                    "--controller".into(),
+                    kind.into(),
+                ]
+            }),
+        1 => prop_oneof![Just("1000000"), Just("30000000")].prop_map(|states| {
+            vec![
+                "emu".to_string(),
+                "PWM".into(),
+                "--max-states".into(),
+                states.into(),
+                "--vcd".into(),
+                "VCD".into(),
+            ]
+        }),
+    ];
+    // Address-space limits from far too small to plenty, KiB.
+    let limit = prop_oneof![
+        50_000u64..150_000,
+        150_000u64..600_000,
+        600_000u64..4_000_000
+    ];
+    runner_of(cases_or(300))
+        .run(&(command, limit), |(args, kib)| {
+            n.set(n.get() + 1);
+            let case = root.join(format!("c{}", n.get()));
+            std::fs::create_dir_all(&case).unwrap();
+            let mut args: Vec<String> = args
+                .into_iter()
+                .map(|a| match a.as_str() {
+                    "PWM" => pwm.display().to_string(),
+                    "VCD" => case.join("t.vcd").display().to_string(),
+                    _ => a,
+                })
+                .collect();
+            if args[0] == "run" {
+                args.push("--out".into());
+                args.push(case.join("o").display().to_string());
+            }
+            let mut script = format!("ulimit -v {kib} && exec \"$0\"");
+            for i in 1..=args.len() {
+                script.push_str(&format!(" \"${{{i}}}\""));
+            }
+            let mut child = Command::new("sh")
+                .arg("-c")
+                .arg(script)
+                .arg(env!("CARGO_BIN_EXE_h8swarm"))
+                .args(&args)
+                .current_dir(&case)
+                .stdin(Stdio::null())
+                .stdout(Stdio::null())
+                .stderr(Stdio::piped())
+                .spawn()
+                .unwrap();
+            let st = wait_bounded(&mut child, "a run under a memory limit");
+            let mut err = String::new();
+            use std::io::Read;
+            child
+                .stderr
+                .take()
+                .unwrap()
+                .read_to_string(&mut err)
+                .unwrap();
+            prop_assert!(
+                st.signal().is_none(),
+                "{args:?} under {kib} KiB: killed by signal {:?}: {err}",
+                st.signal()
+            );
+            let code = st.code().unwrap();
+            // 127: the shell could not even start the program in so little space.
+            let promised = matches!(code, 0..=2 | 127) || (args[0] == "emu" && code == 124);
+            prop_assert!(promised, "{args:?} under {kib} KiB: status {code}: {err}");
+            prop_assert!(
+                !err.contains("panicked") && !err.contains("memory allocation"),
+                "{err}"
+            );
+            if (1..=2).contains(&code) {
+                prop_assert!(err.starts_with("error:"), "{args:?}: {err}");
+            }
+            if code == 0 && args[0] == "run" {
+                prop_assert!(case.join("o/summary.json").is_file());
+            }
+            *statuses.borrow_mut().entry(code).or_insert(0u32) += 1;
+            let _ = std::fs::remove_dir_all(&case);
+            Ok(())
+        })
+        .unwrap();
+    let _ = std::fs::remove_dir_all(&root);
+    let statuses = statuses.into_inner();
+    eprintln!("fuzz: memory limits: exit statuses {statuses:?}");
+    assert!(
+        statuses.contains_key(&0) && statuses.contains_key(&2),
+        "{statuses:?}"
+    );
+}

@@ -324,7 +324,7 @@ fn slurm_values_are_checked_against_slurms_formats_and_limits() {
 fn under_rlimit(kib: u64, args: &[&str]) -> Output {
     let mut script = format!("ulimit -v {kib} && exec \"$0\"");
     for i in 1..=args.len() {
-        script.push_str(&format!(" \"${i}\""));
+        script.push_str(&format!(" \"${{{i}}}\""));
     }
     Command::new("sh")
         .arg("-c")
