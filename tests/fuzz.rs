@@ -897,11 +897,14 @@ fn rsp_packet(body: &[u8]) -> Vec<u8> {
 fn rsp_byte(s: &mut std::net::TcpStream) -> Option<u8> {
     use std::io::Read;
     let mut b = [0u8; 1];
-    match s.read(&mut b) {
-        Ok(1) => Some(b[0]),
-        Ok(_) => None,
-        Err(e) if e.kind() == std::io::ErrorKind::ConnectionReset => None,
-        Err(e) => panic!("the stub does not answer: {e}"),
+    loop {
+        return match s.read(&mut b) {
+            Ok(1) => Some(b[0]),
+            Ok(_) => None,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            Err(e) if e.kind() == std::io::ErrorKind::ConnectionReset => None,
+            Err(e) => panic!("the stub does not answer: {e}"),
+        };
     }
 }
 
