@@ -59,7 +59,7 @@ struct EmuArgs {
     #[arg(long)]
     stats: bool,
     /// Write a pin trace of the run (PWM, H-bridge, I2C lines, A/D, tick, sleep, the function
-    /// that runs) to FILE as VCD, for GTKWave or sigrok (written when the run ends).
+    /// that runs) to FILE as VCD, for GTKWave or sigrok (written as the run goes).
     #[arg(long, value_name = "FILE")]
     vcd: Option<std::path::PathBuf>,
     /// Wait for a GDB client on this loopback address (127.0.0.1:PORT; port 0 picks a free
