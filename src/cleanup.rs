@@ -2,7 +2,8 @@
 //! `.NAME.partial-PID` beside its output folder, a sweep point's `points/.tmp-ID-HOST-PID`) it
 //! is registered here; when SIGINT, SIGTERM or SIGHUP arrives, a thread of its own removes
 //! every registered folder and then lets the signal end the process as it would have (so a
-//! shell still sees 130 for Ctrl-C and 143 for SIGTERM).
+//! shell still sees 130 for Ctrl-C and 143 for SIGTERM). A signal the process was started
+//! ignoring (under `nohup`, or SIGINT for a background job of a script) stays ignored.
 //!
 //! Moving a finished run's files into place holds the same lock as the cleanup
 //! ([`while_committing`]): a signal that arrives during the move waits for it, so an output
@@ -51,7 +52,17 @@ pub fn install() -> bool {
     static ONCE: Once = Once::new();
     let mut installed = false;
     ONCE.call_once(|| {
-        let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) else {
+        // A signal the process was started ignoring (`nohup`, a background job of a script)
+        // stays ignored: handling it would make it end the process.
+        let ignored = ignored_signals();
+        let wanted: Vec<i32> = [SIGINT, SIGTERM, SIGHUP]
+            .into_iter()
+            .filter(|&s| !ignored.contains(&s))
+            .collect();
+        if wanted.is_empty() {
+            return;
+        }
+        let Ok(mut signals) = signal_hook::iterator::Signals::new(wanted) else {
             return;
         };
         installed = std::thread::Builder::new()
@@ -75,6 +86,18 @@ pub fn install() -> bool {
             .is_ok();
     });
     installed
+}
+
+/// The signals this process ignores (the `SigIgn` mask of /proc/self/status; none where it
+/// cannot be read).
+fn ignored_signals() -> Vec<i32> {
+    let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
+    let mask = status
+        .lines()
+        .find_map(|l| l.strip_prefix("SigIgn:"))
+        .and_then(|m| u64::from_str_radix(m.trim(), 16).ok())
+        .unwrap_or(0);
+    (1..=64).filter(|s| mask & (1u64 << (s - 1)) != 0).collect()
 }
 
 /// Removes `dir` and everything in it; workers still writing into it may add a file while it
@@ -125,4 +148,17 @@ pub fn while_committing<T>(f: impl FnOnce() -> T) -> T {
         .lock()
         .unwrap_or_else(std::sync::PoisonError::into_inner);
     f()
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn the_ignored_signals_are_read_from_the_status() {
+        // Whatever this process ignores, the list holds signal numbers only.
+        assert!(
+            super::ignored_signals()
+                .iter()
+                .all(|s| (1..=64).contains(s))
+        );
+    }
 }

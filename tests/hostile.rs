@@ -697,3 +697,46 @@ fn a_run_too_big_for_the_process_limit_is_refused_not_aborted() {
     );
     assert_eq!(err.lines().count(), 1, "{err}");
 }
+
+#[test]
+fn a_signal_the_run_was_started_ignoring_stays_ignored() {
+    use std::os::unix::process::ExitStatusExt;
+    // As under nohup: SIGHUP ignored from the start does not stop the run; SIGTERM does.
+    let root = fresh("nohup");
+    let out = root.join("o");
+    let mut child = Command::new("sh")
+        .arg("-c")
+        .arg("trap '' HUP && exec \"$0\" run --steps 1000000 --threads 2 --out \"$1\"")
+        .arg(bin())
+        .arg(s(&out))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let mut waited = 0;
+    while !has_files(&root, ".o.partial-") {
+        waited += 1;
+        assert!(waited < 60_000, "no staging folder appeared");
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    let pid = child.id().to_string();
+    let kill = |sig: &str| {
+        assert!(
+            Command::new("kill")
+                .args([sig, &pid])
+                .status()
+                .unwrap()
+                .success()
+        );
+    };
+    kill("-HUP");
+    // Still running a while after the HUP (a HUP that ended it would have by then).
+    std::thread::sleep(std::time::Duration::from_millis(200));
+    assert!(child.try_wait().unwrap().is_none(), "SIGHUP ended the run");
+    kill("-TERM");
+    let st = child.wait().unwrap();
+    assert_eq!(st.signal(), Some(15));
+    assert_eq!(named(&root, ""), Vec::<String>::new());
+}
