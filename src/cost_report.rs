@@ -302,9 +302,49 @@ pub fn render(r: &CostReport) -> String {
     s
 }
 
+/// `cost --eta`: the learning rate as a real number (`0.001`, `1e-3`: anything with a decimal
+/// point or an exponent; 0 to 32767/32768, rounded to Q15 as a scenario's `learner.eta` is) or
+/// as a Q15 integer (`33`: a whole number, 0 to 32767). Both name the same η: `0.001` is 33.
+///
+/// # Errors
+/// Anything else, saying both forms.
+pub fn parse_eta(text: &str) -> Result<i32, String> {
+    let t = text.trim();
+    let valid = "give a real number from 0 to 0.99997 (e.g. 0.001) or a Q15 integer from 0 to 32767 (e.g. 33)";
+    if t.contains(['.', 'e', 'E']) {
+        let v: f64 = t
+            .parse()
+            .map_err(|_| format!("`{t}` is not a learning rate: {valid}"))?;
+        if !(v.is_finite() && (0.0..=32767.0 / 32768.0).contains(&v)) {
+            return Err(format!("`{t}` is out of range: {valid}"));
+        }
+        Ok((v * 32768.0).round() as i32)
+    } else {
+        match t.parse::<i64>() {
+            Ok(v) if (0..=32767).contains(&v) => Ok(v as i32),
+            Ok(_) => Err(format!("`{t}` is out of range: {valid}")),
+            Err(_) => Err(format!("`{t}` is not a learning rate: {valid}")),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn eta_is_a_real_number_or_a_q15_integer() {
+        assert_eq!(parse_eta("0.001"), Ok(33));
+        assert_eq!(parse_eta("1e-3"), Ok(33));
+        assert_eq!(parse_eta("33"), Ok(33));
+        assert_eq!(parse_eta("0.1"), Ok(3277));
+        assert_eq!(parse_eta("0"), Ok(0));
+        assert_eq!(parse_eta("32767"), Ok(32767));
+        for bad in ["1.0", "32768", "-1", "-0.5", "nan", "inf", "x", ""] {
+            let e = parse_eta(bad).unwrap_err();
+            assert!(e.contains("0.001") && e.contains("33"), "{bad}: {e}");
+        }
+    }
 
     #[test]
     fn streamed_statistics_equal_those_of_the_whole_list() {

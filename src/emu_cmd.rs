@@ -20,9 +20,10 @@ use std::sync::Arc;
 use emu::board::symbols::SymbolTable;
 use emu::chip::gdb::{GdbError, GdbListener};
 use emu::chip::machine::Machine;
-use emu::chip::run::{Outcome, Probes, RunOptions, run_mcu_probed};
+use emu::chip::run::{Outcome, Probes, RunOptions, drain_into, run_mcu_probed};
 use emu::chip::trace::{CodeNames, PhaseRecorder};
-use emu::chip::vcd::{VcdInfo, write_vcd};
+use emu::chip::vcd::{VcdInfo, VcdStream};
+use emu::core::bus::Bus;
 use emu::core::cpu::Cpu;
 use emu::core::srec;
 
@@ -128,19 +129,46 @@ pub fn run(o: &EmuOptions<'_>) -> Result<(), Failure> {
     cpu.reset(&mut machine);
     let mcu = machine.mcu_mut();
     let mut phases = None;
-    if vcd_file.is_some() {
+    let vcd_failure = |e: io::Error| {
+        Failure::Tool(anyhow::Error::new(e).context(format!(
+            "writing the VCD file `{}`",
+            o.vcd.map(|p| p.display().to_string()).unwrap_or_default()
+        )))
+    };
+    // The trace is written as the run makes it (never held whole).
+    let mut stream = None;
+    if let Some(file) = vcd_file.take() {
         mcu.start_trace(cpu.sleeping());
+        let mut phase_at_start = None;
         if let Some(n) = &names {
-            phases = Some(PhaseRecorder::new(n.clone()));
+            let mut p = PhaseRecorder::new(n.clone());
+            p.observe(mcu.now(), cpu.pc());
+            phase_at_start = p.drain_before(mcu.now() + 1).pop().map(|(_, name)| name);
+            phases = Some(p);
         }
+        let (start, initial) = mcu.trace_beginning().unwrap_or_default();
+        stream = Some(
+            VcdStream::start(
+                Box::new(file),
+                mcu.clock_hz(),
+                start,
+                initial,
+                phase_at_start.as_deref(),
+                &VcdInfo {
+                    source: format!("{image} on h8swarm emu"),
+                },
+            )
+            .map_err(vcd_failure)?,
+        );
     }
     let options = RunOptions {
         max_states: o.max_states,
     };
     let stdout = io::stdout();
     let mut console = stdout.lock();
-    let stderr = io::stderr();
-    let mut trace_out = BufWriter::new(stderr.lock());
+    // Not locked for the whole run: the GDB stub's thread may have to say on stderr that
+    // its debugger is lost.
+    let mut trace_out = BufWriter::with_capacity(1 << 16, io::stderr());
     let report = run_mcu_probed(
         &mut cpu,
         mcu,
@@ -151,33 +179,25 @@ pub fn run(o: &EmuOptions<'_>) -> Result<(), Failure> {
             names: names.as_deref().map(|n| n as &dyn CodeNames),
             phases: phases.as_mut(),
             debugger: debugger.as_mut(),
+            vcd: stream.as_mut(),
         },
     );
     let _ = trace_out.flush();
     drop(trace_out);
-    if let (Some(file), Some(trace)) = (vcd_file.as_mut(), mcu.finish_trace()) {
-        let changes = phases.as_mut().map(PhaseRecorder::take);
-        write_vcd(
-            file,
-            &trace,
-            changes.as_deref(),
-            &VcdInfo {
-                source: format!("{image} on h8swarm emu"),
-            },
-        )
-        .map_err(|e| {
-            Failure::Tool(anyhow::Error::new(e).context(format!(
-                "writing the VCD file `{}`",
-                o.vcd.map(|p| p.display().to_string()).unwrap_or_default()
-            )))
-        })?;
+    if let Some(mut v) = stream {
+        drain_into(&mut v, mcu, phases.as_mut()).map_err(vcd_failure)?;
+        if let Some(rest) = mcu.finish_trace() {
+            let changes = phases.as_mut().map(PhaseRecorder::take).unwrap_or_default();
+            v.finish(&rest.changes, &changes, rest.end)
+                .map_err(vcd_failure)?;
+        }
     }
     let report = match report {
         Ok(r) => r,
         Err(e) if e.kind() == io::ErrorKind::BrokenPipe => return Ok(()),
         Err(e) => {
             return Err(Failure::Tool(
-                anyhow::Error::new(e).context("writing the console"),
+                anyhow::Error::new(e).context("writing the console or the VCD file"),
             ));
         }
     };

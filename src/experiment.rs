@@ -346,14 +346,8 @@ pub fn world_params(s: &Scenario) -> WorldParams {
 /// More robots than the arena holds, or a placement that gives up.
 pub fn build_world(s: &Scenario, repeat: u32) -> Result<World> {
     let seed = world_seed(s.seed, repeat);
-    World::new(arena_of(s)?, world_params(s), s.robots, seed).with_context(|| {
-        format!(
-            "cannot place {} robots in the {} (robots = {})",
-            s.robots,
-            arena_of(s).map(|a| a.describe()).unwrap_or_default(),
-            s.robots
-        )
-    })
+    // The world's error names the robots, the arena and how many fit.
+    World::new(arena_of(s)?, world_params(s), s.robots, seed).context("placing the robots")
 }
 
 /// One run in progress: the world and its robots, stepped one step at a time.
@@ -925,8 +919,10 @@ pub fn run_one(
                     .with_context(|| {
                         format!("--vcd-robot {}: the robots run no firmware", v.robot)
                     })?;
+                let file = std::fs::File::create(&v.path)
+                    .with_context(|| format!("--vcd: cannot create `{}`", v.path.display()))?;
                 robot
-                    .start_pin_trace(names)
+                    .start_pin_trace(names, Box::new(file), &vcd_info(v, s, condition, repeat))
                     .with_context(|| format!("--vcd-robot {}", v.robot))?;
                 tracing = true;
             }
@@ -936,18 +932,18 @@ pub fn run_one(
         }
         swarm.step()?;
         if let Some(v) = &probes.vcd
-            && let Some(t) = swarm.robot_mut(v.robot).and_then(Robot::take_pin_trace)
+            && let Some(written) = swarm.robot_mut(v.robot).and_then(Robot::take_pin_trace)
         {
-            write_robot_vcd(v, s, condition, repeat, &t)?;
+            written.with_context(|| format!("--vcd: cannot write `{}`", v.path.display()))?;
             tracing = false;
         }
         progress(1);
     }
     if let Some(v) = &probes.vcd
         && tracing
-        && let Some(t) = swarm.robot_mut(v.robot).and_then(Robot::finish_pin_trace)
+        && let Some(written) = swarm.robot_mut(v.robot).and_then(Robot::finish_pin_trace)
     {
-        write_robot_vcd(v, s, condition, repeat, &t)?;
+        written.with_context(|| format!("--vcd: cannot write `{}`", v.path.display()))?;
     }
     if let Some(robot) = debugged.and_then(|k| swarm.robot_mut(k)) {
         robot.detach_debugger();
@@ -955,17 +951,14 @@ pub fn run_one(
     swarm.finish()
 }
 
-/// Writes a robot's pin trace as the VCD file of `v`.
-fn write_robot_vcd(
+/// What the VCD file of `v` says of its trace.
+fn vcd_info(
     v: &VcdProbe,
     s: &Scenario,
     condition: Condition,
     repeat: u32,
-    t: &crate::robot::RobotTrace,
-) -> Result<()> {
-    let file = std::fs::File::create(&v.path)
-        .with_context(|| format!("--vcd: cannot create `{}`", v.path.display()))?;
-    let info = emu::chip::vcd::VcdInfo {
+) -> emu::chip::vcd::VcdInfo {
+    emu::chip::vcd::VcdInfo {
         source: format!(
             "robot {} of h8swarm run {} ({} run, repeat {repeat}, seed {}), steps {} to {}",
             v.robot,
@@ -975,9 +968,7 @@ fn write_robot_vcd(
             v.from,
             (v.from + v.steps).min(s.steps) - 1
         ),
-    };
-    emu::chip::vcd::write_vcd(file, &t.pins, Some(&t.phases), &info)
-        .with_context(|| format!("--vcd: cannot write `{}`", v.path.display()))
+    }
 }
 
 /// What a robot's board shows its MCU for a step: each sensor's true distance (mm, `None`

@@ -17,6 +17,7 @@ use std::io::{self, BufRead, BufReader, BufWriter, Write};
 use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand};
+use h8swarm::sweep::spec::printable;
 
 /// Hardware-faithful, fixed-point emulator of the Hartono–Kakita (2008) swarm of H8/3052F robots
 /// that learn obstacle avoidance together.
@@ -58,7 +59,7 @@ struct EmuArgs {
     #[arg(long)]
     stats: bool,
     /// Write a pin trace of the run (PWM, H-bridge, I2C lines, A/D, tick, sleep, the function
-    /// that runs) to FILE as VCD, for GTKWave or sigrok (written when the run ends).
+    /// that runs) to FILE as VCD, for GTKWave or sigrok (written as the run goes).
     #[arg(long, value_name = "FILE")]
     vcd: Option<std::path::PathBuf>,
     /// Wait for a GDB client on this loopback address (127.0.0.1:PORT; port 0 picks a free
@@ -96,8 +97,9 @@ struct CostArgs {
     /// Add the bias input +127.
     #[arg(long)]
     bias: bool,
-    /// Learning rate η as a Q15 integer (0.001 = 33, 0.1 = 3277).
-    #[arg(long, default_value_t = 33, value_parser = clap::value_parser!(i32).range(0..=32767))]
+    /// Learning rate η: a real number (0.001, as scenarios give it) or a Q15 integer (33);
+    /// 0.001 = 33, 0.1 = 3277.
+    #[arg(long, default_value_t = 33, value_parser = cost_report::parse_eta)]
     eta: i32,
     /// Dead-zone threshold T in distance units.
     #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(i32).range(0..=32767))]
@@ -148,6 +150,13 @@ fn main() -> ExitCode {
         Ok(cli) => cli,
         Err(e) => return usage(&e),
     };
+    // A run or a sweep's task removes its staging folders when a signal stops it.
+    if matches!(
+        cli.command,
+        None | Some(Command::Run(_)) | Some(Command::Sweep(_))
+    ) {
+        h8swarm::cleanup::install();
+    }
     let result = match cli.command {
         Some(Command::Learn(args)) => learn(&args),
         Some(Command::Cost(args)) => cost(&args),
@@ -165,15 +174,18 @@ fn main() -> ExitCode {
         Some(Command::Sweep(args)) => sweep(&args),
         None => run(&run_cmd::RunArgs::default()),
     };
+    // A signal is ending the process: what failed because its cleanup removed the staging
+    // folders is not an error to report; the signal says how the process ended.
+    h8swarm::cleanup::wait_if_signalled();
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(Failure::Program(status)) => ExitCode::from(status),
         Err(Failure::Input(e)) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", printable(&format!("{e:#}")));
             ExitCode::from(2)
         }
         Err(Failure::Tool(e)) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", printable(&format!("{e:#}")));
             ExitCode::from(1)
         }
     }
@@ -186,7 +198,20 @@ fn usage(e: &clap::Error) -> ExitCode {
         // clap prints the help alone: say first, in one line, what is wrong.
         eprintln!("error: a subcommand or argument is missing: see the usage below");
     }
-    let printed = e.print().and_then(|()| io::stdout().flush());
+    let printed = if e.use_stderr() {
+        // A usage error echoes what was typed: shown without its control characters (each
+        // of clap's lines made printable, so a value's ESC cannot reach the terminal).
+        let text: String = e
+            .render()
+            .to_string()
+            .lines()
+            .map(|l| printable(l) + "\n")
+            .collect();
+        io::stderr().lock().write_all(text.as_bytes())
+    } else {
+        e.print()
+    }
+    .and_then(|()| io::stdout().flush());
     match printed {
         Err(w) if w.kind() != io::ErrorKind::BrokenPipe => {
             eprintln!("error: writing the output: {w}");
@@ -282,14 +307,17 @@ fn fit(args: &fit_cmd::FitArgs) -> Result<(), Failure> {
 
 fn sweep(args: &h8swarm::sweep::SweepArgs) -> Result<(), Failure> {
     use h8swarm::sweep::SweepError;
-    let text = h8swarm::sweep::command(args).map_err(|e| match e {
-        SweepError::Input(m) => Failure::Input(anyhow::anyhow!(m)),
-        SweepError::Tool(m) => Failure::Tool(anyhow::anyhow!(m)),
-    })?;
+    // What the command found is printed even when it ends in an error (the points a run
+    // did, a merge's table of an incomplete sweep); the error line follows on stderr.
+    let (text, result) = h8swarm::sweep::command(args);
     io::stdout()
         .lock()
         .write_all(text.as_bytes())
-        .or_else(write_failure)
+        .or_else(write_failure)?;
+    result.map_err(|e| match e {
+        SweepError::Input(m) => Failure::Input(anyhow::anyhow!(m)),
+        SweepError::Tool(m) => Failure::Tool(anyhow::anyhow!(m)),
+    })
 }
 
 /// An error of `run`: a tool failure when some output could not be written

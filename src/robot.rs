@@ -16,7 +16,8 @@ use emu::board::model::{Controller, ControllerConfig};
 use emu::board::wiring::{Bridge, MotorDrive};
 use emu::chip::gdb::Debugger;
 use emu::chip::mcu::{Board, Mcu, McuConfig};
-use emu::chip::trace::{CodeNames, PinTrace};
+use emu::chip::trace::CodeNames;
+use emu::chip::vcd::{VcdInfo, VcdStream};
 use emu::core::bus::Bus;
 use nn_q15::{Behaviour, InputLayout, Params};
 use rand::{RngExt, SeedableRng};
@@ -123,8 +124,11 @@ pub struct Robot {
     cfg_status: Option<u32>,
     /// A pin trace under way ends when the next step's sensing begins.
     trace_ends_at_sensing: bool,
-    /// A pin trace that ended, not yet taken ([`Robot::take_pin_trace`]).
-    finished_trace: Option<RobotTrace>,
+    /// The pin trace under way, written to its VCD file step by step.
+    vcd: Option<VcdStream<'static>>,
+    /// A pin trace that ended, not yet taken ([`Robot::take_pin_trace`]): whether its file
+    /// was written.
+    finished_trace: Option<std::io::Result<()>>,
     /// Where a firmware robot keeps the pointer to its weights (the symbol `net_w`), when its
     /// image has one.
     net_w: Option<u32>,
@@ -132,13 +136,17 @@ pub struct Robot {
     weights_len: usize,
 }
 
-/// A robot's pin trace: the MCU's signals and the firmware's phases.
-#[derive(Clone, Debug)]
-pub struct RobotTrace {
-    /// The pins.
-    pub pins: PinTrace,
-    /// Which function ran, as it changed: (instant in states, name).
-    pub phases: Vec<(u64, String)>,
+/// Ends the MCU's pin trace and writes the rest of it (and of the phases) into `vcd`.
+fn finish_stream(
+    mcu: &mut Mcu<RobotBoard>,
+    c: &mut FirmwareController,
+    vcd: Option<VcdStream<'static>>,
+) -> Option<std::io::Result<()>> {
+    let mut v = vcd?;
+    let drained = emu::chip::run::drain_into(&mut v, mcu, c.phases_mut());
+    let rest = mcu.finish_trace()?;
+    let phases = c.take_phases();
+    Some(drained.and_then(|()| v.finish(&rest.changes, &phases, rest.end)))
 }
 
 /// The images a swarm's firmware robots run, loaded once.
@@ -302,6 +310,7 @@ impl Robot {
             busy_states: 0,
             cfg_status,
             trace_ends_at_sensing: false,
+            vcd: None,
             finished_trace: None,
             net_w,
             weights_len,
@@ -342,13 +351,18 @@ impl Robot {
             Brain::Firmware(c) => {
                 c.run_to_sensing(&mut self.mcu)?;
                 self.busy_states += c.take_busy();
-                if std::mem::take(&mut self.trace_ends_at_sensing)
-                    && let Some(pins) = self.mcu.finish_trace()
+                // The trace's step goes to its file; it is never held longer.
+                if let Some(v) = self.vcd.as_mut()
+                    && let Err(e) = emu::chip::run::drain_into(v, &mut self.mcu, c.phases_mut())
                 {
-                    self.finished_trace = Some(RobotTrace {
-                        pins,
-                        phases: c.take_phases(),
-                    });
+                    self.vcd = None;
+                    self.finished_trace = Some(Err(e));
+                    self.mcu.finish_trace();
+                    c.take_phases();
+                }
+                if std::mem::take(&mut self.trace_ends_at_sensing) {
+                    self.finished_trace = finish_stream(&mut self.mcu, c, self.vcd.take())
+                        .or(self.finished_trace.take());
                 }
                 // Booted: a configuration block the firmware rejected is an error.
                 if let Some(addr) = self.cfg_status.take()
@@ -371,14 +385,33 @@ impl Robot {
     ///
     /// # Errors
     /// A robot whose controller is the model (it has no firmware whose pins could be traced).
-    pub fn start_pin_trace(&mut self, names: Arc<dyn CodeNames + Send + Sync>) -> Result<()> {
+    pub fn start_pin_trace(
+        &mut self,
+        names: Arc<dyn CodeNames + Send + Sync>,
+        out: Box<dyn std::io::Write + Send>,
+        info: &VcdInfo,
+    ) -> Result<()> {
         let Brain::Firmware(c) = &mut self.brain else {
             anyhow::bail!(
                 "its controller is the Rust model: only firmware robots have pins to trace"
             );
         };
         self.mcu.start_trace(c.cpu().sleeping());
-        c.record_phases(names, self.mcu.now());
+        let now = self.mcu.now();
+        c.record_phases(names, now);
+        let phase = c
+            .phases_mut()
+            .and_then(|p| p.drain_before(now + 1).pop())
+            .map_or_else(|| emu::chip::trace::UNNAMED_PHASE.to_string(), |(_, n)| n);
+        let (start, initial) = self.mcu.trace_beginning().unwrap_or_default();
+        self.vcd = Some(VcdStream::start(
+            out,
+            self.mcu.clock_hz(),
+            start,
+            initial,
+            Some(&phase),
+            info,
+        )?);
         self.trace_ends_at_sensing = false;
         Ok(())
     }
@@ -390,20 +423,19 @@ impl Robot {
         self.trace_ends_at_sensing = self.mcu.tracing();
     }
 
-    /// The pin trace that ended at a step's sensing, if one did and was not taken yet.
-    pub fn take_pin_trace(&mut self) -> Option<RobotTrace> {
+    /// The pin trace that ended at a step's sensing, if one did and was not taken yet:
+    /// whether its VCD file was written whole.
+    pub fn take_pin_trace(&mut self) -> Option<std::io::Result<()>> {
         self.finished_trace.take()
     }
 
-    /// Ends the pin trace under way now and returns it (`None` when none is).
-    pub fn finish_pin_trace(&mut self) -> Option<RobotTrace> {
+    /// Ends the pin trace under way now and finishes its file (`None` when none is).
+    pub fn finish_pin_trace(&mut self) -> Option<std::io::Result<()>> {
         self.trace_ends_at_sensing = false;
-        let pins = self.mcu.finish_trace()?;
-        let phases = match &mut self.brain {
-            Brain::Firmware(c) => c.take_phases(),
-            Brain::Model(_) => Vec::new(),
-        };
-        Some(RobotTrace { pins, phases })
+        match &mut self.brain {
+            Brain::Firmware(c) => finish_stream(&mut self.mcu, c, self.vcd.take()),
+            Brain::Model(_) => None,
+        }
     }
 
     /// Puts a firmware robot under a GDB client's control (see

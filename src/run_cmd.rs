@@ -238,6 +238,10 @@ struct Summary<'a> {
     conditions: &'a [ConditionStats],
     pairings: &'a [Pairing],
     claims: &'a [Claim],
+    /// `false` when the user's image has no configuration block (it ran with its own
+    /// settings, not the scenario's); absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    image_configured: Option<bool>,
 }
 
 /// Runs the experiment; returns the text to print.
@@ -263,6 +267,13 @@ pub fn run(a: &RunArgs) -> Result<String> {
     }
     let s = s.with_overrides(a.robots, a.steps, a.repeats, a.seed)?;
     let images = crate::robot::Images::load(&s)?;
+    let unconfigured = unconfigured_image(&s, images.as_ref())?;
+    if let Some(image) = &unconfigured {
+        eprintln!(
+            "warning: {}: the image has no configuration block, so it runs with its own built-in settings, not the scenario's learner, timing and sensor settings (summary.json says \"image_configured\": false); give its symbol table (IMAGE.sym beside it, or controller.symbols) to configure it",
+            crate::sweep::spec::printable(image)
+        );
+    }
     let max_threads = max_threads();
     match a.threads {
         Some(0) => bail!("--threads 0: give at least 1 (or leave it out for all cores)"),
@@ -280,7 +291,12 @@ pub fn run(a: &RunArgs) -> Result<String> {
         }
         Path::new("out").join(name)
     });
-    check_memory(&s, threads_or_all(a.threads), a.max_memory)?;
+    let trace_buffers = if a.vcd.is_some() {
+        emu::chip::vcd::STREAM_BUFFER_BYTES
+    } else {
+        0
+    };
+    check_memory(&s, threads_or_all(a.threads), a.max_memory, trace_buffers)?;
     // Fail now if the robots do not fit the arena, or a probe's option is bad.
     build_world(&s, 0)?;
     let replay = replay_plan(a, &s)?;
@@ -298,7 +314,12 @@ pub fn run(a: &RunArgs) -> Result<String> {
     );
     match result {
         Ok((mut text, names)) => {
-            stage.commit(&names)?;
+            stage.commit(&names).map_err(|e| {
+                e.context(format!(
+                    "the run into `{}` could not be moved into place",
+                    out.display()
+                ))
+            })?;
             let (files, plots): (Vec<&String>, Vec<&String>) = names
                 .iter()
                 .partition(|n| !n.ends_with(".png") && !n.ends_with(".svg"));
@@ -321,6 +342,36 @@ pub fn run(a: &RunArgs) -> Result<String> {
             Err(e.context(format!("the run into `{}` failed; {kept}", out.display())))
         }
     }
+}
+
+/// The user's image when it has no configuration block (so the scenario cannot configure
+/// it); an error when the scenario's controls need it configured.
+///
+/// The controls differ from learning only through the configuration block: learning off is
+/// η = 0 written into it, the random walk a flag in it. An image without one (a `.mot`
+/// without its `.sym`, or a program of the user's own) would run the same program in all
+/// three conditions and the claims would compare a run with itself, so such a run is refused;
+/// with the controls off it runs, warned about and marked in summary.json.
+///
+/// # Errors
+/// An image without a configuration block and a control condition on.
+fn unconfigured_image(
+    s: &Scenario,
+    images: Option<&crate::robot::Images>,
+) -> Result<Option<String>> {
+    let Some((fw, _)) = images.and_then(|i| i.user.as_ref()) else {
+        return Ok(None);
+    };
+    if fw.has_config_block() {
+        return Ok(None);
+    }
+    let image = s.controller.image.clone().unwrap_or_default();
+    if s.controls.learning_off || s.controls.random_walk {
+        bail!(
+            "`controller.image` = {image}: the image has no configuration block (no symbol table names `config_block` at H'000400: give IMAGE.sym beside the image, or controller.symbols), so the controls cannot reach it: learning off (eta = 0) and the random walk would run the same program as learning. Give the image's symbol table, or turn the controls off (controls.learning_off = false, controls.random_walk = false) to run the image as it is"
+        );
+    }
+    Ok(Some(image))
 }
 
 /// Host memory one robot takes while its run is going (measured: the peak resident size of
@@ -378,36 +429,198 @@ fn available_memory() -> Option<u64> {
     Some(kb.saturating_mul(1024))
 }
 
-/// Refuses a run estimated to need more than `max` (default: the available memory).
-fn check_memory(s: &Scenario, threads: usize, max: Option<u64>) -> Result<()> {
-    let Some(limit) = max.or_else(available_memory) else {
-        return Ok(());
+/// Address space a run takes beyond the memory it uses: the program's own mappings and
+/// thread stacks, and the allocator's reservations (an arena of 64 MiB a thread at most).
+/// Only compared with an address-space limit (`ulimit -v`), which counts reservations too.
+pub const ADDRESS_SPACE_BASE_BYTES: u64 = 192 << 20;
+/// See [`ADDRESS_SPACE_BASE_BYTES`]: per worker thread.
+pub const ADDRESS_SPACE_PER_THREAD_BYTES: u64 = 66 << 20;
+
+/// The limits the kernel holds this process to, besides the machine's memory.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ProcessLimits {
+    /// The soft address-space limit (`ulimit -v`, RLIMIT_AS), bytes.
+    pub address_space: Option<u64>,
+    /// What the process's control groups still let it use: the least, over its cgroup and
+    /// every cgroup above it, of the limit less the usage (cgroup v2 `memory.max` less
+    /// `memory.current`, or v1 `memory.limit_in_bytes` less `memory.usage_in_bytes`). Slurm's
+    /// `--mem` is such a limit.
+    pub cgroup_room: Option<u64>,
+}
+
+impl ProcessLimits {
+    /// This process's limits, from /proc/self/limits, /proc/self/cgroup and /sys/fs/cgroup
+    /// (none where they cannot be read: another system, or no limit).
+    #[must_use]
+    pub fn read() -> ProcessLimits {
+        let limits = std::fs::read_to_string("/proc/self/limits").unwrap_or_default();
+        let cgroups = std::fs::read_to_string("/proc/self/cgroup").unwrap_or_default();
+        ProcessLimits {
+            address_space: address_space_limit(&limits),
+            cgroup_room: cgroup_room(Path::new("/sys/fs/cgroup"), &cgroups),
+        }
+    }
+}
+
+/// The soft "Max address space" of a /proc/PID/limits text (`None`: unlimited or absent).
+#[must_use]
+pub fn address_space_limit(limits: &str) -> Option<u64> {
+    let line = limits
+        .lines()
+        .find(|l| l.starts_with("Max address space"))?;
+    line["Max address space".len()..]
+        .split_whitespace()
+        .next()?
+        .parse()
+        .ok()
+}
+
+/// The memory the control groups of a /proc/PID/cgroup text still allow, read under `root`
+/// (normally /sys/fs/cgroup): v2 (`0::PATH`, `memory.max` and `memory.current`, also under
+/// `unified/` on hybrid systems) and v1 (`N:memory:PATH` or `N:…,memory,…:PATH`,
+/// `memory/…/memory.limit_in_bytes` and `memory.usage_in_bytes`), each cgroup from the
+/// process's own up to the root; a cgroup path the mount does not show is looked up from the
+/// mount's root (a container sees its own cgroup there). `None` when no limit is found.
+#[must_use]
+pub fn cgroup_room(root: &Path, cgroups: &str) -> Option<u64> {
+    let read = |p: PathBuf| -> Option<u64> {
+        let t = std::fs::read_to_string(p).ok()?;
+        t.trim().parse().ok()
     };
-    let need = estimated_memory(s, threads);
-    if need > limit {
-        let what = if max.is_some() {
-            "--max-memory"
-        } else {
-            "the memory available on this machine"
+    let mut room: Option<u64> = None;
+    let mut consider = |limit: Option<u64>, used: Option<u64>| {
+        // v1 writes "no limit" as a huge number near 2^63.
+        if let Some(limit) = limit.filter(|&l| l < 1 << 60) {
+            let left = limit.saturating_sub(used.unwrap_or(0));
+            room = Some(room.map_or(left, |r| r.min(left)));
+        }
+    };
+    for line in cgroups.lines() {
+        let mut parts = line.splitn(3, ':');
+        let (Some(_), Some(controllers), Some(path)) = (parts.next(), parts.next(), parts.next())
+        else {
+            continue;
         };
+        let (bases, max_file, used_file): (Vec<PathBuf>, &str, &str) = if controllers.is_empty() {
+            (
+                vec![root.to_path_buf(), root.join("unified")],
+                "memory.max",
+                "memory.current",
+            )
+        } else if controllers.split(',').any(|c| c == "memory") {
+            (
+                vec![root.join("memory")],
+                "memory.limit_in_bytes",
+                "memory.usage_in_bytes",
+            )
+        } else {
+            continue;
+        };
+        for base in bases {
+            let own = base.join(path.trim_start_matches('/'));
+            let start = if own.is_dir() { own } else { base.clone() };
+            let mut dir = Some(start.as_path());
+            while let Some(d) = dir {
+                if !d.starts_with(&base) {
+                    break;
+                }
+                consider(read(d.join(max_file)), read(d.join(used_file)));
+                dir = d.parent();
+            }
+        }
+    }
+    room
+}
+
+/// Refuses a run estimated to need more than `max` (default: the available memory), or than
+/// the process's own limits allow ([`ProcessLimits`]: a cgroup's room, and for the address
+/// space the need with [`ADDRESS_SPACE_BASE_BYTES`] and [`ADDRESS_SPACE_PER_THREAD_BYTES`]);
+/// `extra` is memory the run holds besides the estimate (a pin trace's buffers).
+fn check_memory(s: &Scenario, threads: usize, max: Option<u64>, extra: u64) -> Result<()> {
+    check_memory_within(s, threads, max, extra, &ProcessLimits::read())
+}
+
+fn check_memory_within(
+    s: &Scenario,
+    threads: usize,
+    max: Option<u64>,
+    extra: u64,
+    limits: &ProcessLimits,
+) -> Result<()> {
+    let need = estimated_memory(s, threads).saturating_add(extra);
+    let address_space = need
+        .saturating_add(ADDRESS_SPACE_BASE_BYTES)
+        .saturating_add((threads as u64).saturating_mul(ADDRESS_SPACE_PER_THREAD_BYTES));
+    let machine = max.or_else(available_memory);
+    let refusal = if let Some(limit) = machine.filter(|&l| need > l) {
+        Some((
+            need,
+            if max.is_some() {
+                "--max-memory"
+            } else {
+                "the memory available on this machine"
+            },
+            limit,
+            "raise --max-memory",
+        ))
+    } else if let Some(room) = limits.cgroup_room.filter(|&r| need > r) {
+        Some((
+            need,
+            "the memory its control group still allows (cgroup memory.max, as Slurm's --mem sets it)",
+            room,
+            "ask for more memory (Slurm: --mem)",
+        ))
+    } else {
+        limits
+            .address_space
+            .filter(|&l| address_space > l)
+            .map(|l| {
+                (
+                    address_space,
+                    "the address-space limit of this process (ulimit -v)",
+                    l,
+                    "raise ulimit -v",
+                )
+            })
+    };
+    if let Some((need, what, limit, raise)) = refusal {
         let (runs, at_once) = run_counts(s, threads);
+        let with_space = if need == address_space {
+            format!(
+                " of address space (with {} for the program and {} a thread)",
+                show_bytes(ADDRESS_SPACE_BASE_BYTES),
+                show_bytes(ADDRESS_SPACE_PER_THREAD_BYTES)
+            )
+        } else {
+            " of memory".to_string()
+        };
         bail!(
-            "this run needs about {} of memory ({} robots x {at_once} runs at once, {} steps x {runs} runs of metrics) but {what} is {}: use fewer robots, threads, steps or repeats, or raise --max-memory",
+            "this run needs about {}{with_space} ({} robots x {at_once} runs at once, {} steps x {runs} runs of metrics{}) but {what} is {}: use fewer robots, threads, steps or repeats, or {raise}",
             show_bytes(need),
             s.robots,
             s.steps,
+            if extra > 0 {
+                format!(", {} of pin-trace buffers", show_bytes(extra))
+            } else {
+                String::new()
+            },
             show_bytes(limit)
         );
     }
     Ok(())
 }
 
-fn show_bytes(b: u64) -> String {
-    if b >= 1 << 30 {
-        format!("{:.1} GiB", b as f64 / f64::from(1u32 << 30))
-    } else {
-        format!("{:.0} MiB", b as f64 / f64::from(1u32 << 20))
+/// A size for a message: bytes below 1 KiB, else KiB, MiB or GiB with one decimal (never
+/// "0 MiB" for a size that is not 0).
+#[must_use]
+pub fn show_bytes(b: u64) -> String {
+    const UNITS: [(u32, &str); 3] = [(30, "GiB"), (20, "MiB"), (10, "KiB")];
+    for (shift, unit) in UNITS {
+        if b >= 1 << shift {
+            return format!("{:.1} {unit}", b as f64 / (1u64 << shift) as f64);
+        }
     }
+    format!("{b} bytes")
 }
 
 /// `--max-memory`: a whole number of bytes, or with a suffix K, M, G or T (powers of 1024).
@@ -484,10 +697,12 @@ impl std::fmt::Display for OutputError {
 
 impl std::error::Error for OutputError {}
 
-/// A staging folder beside the output folder: `<parent>/.<name>.partial-<pid>`.
+/// A staging folder beside the output folder: `<parent>/.<name>.partial-<pid>`, registered
+/// for removal on SIGINT, SIGTERM and SIGHUP ([`crate::cleanup`]) while it exists.
 struct Stage {
     out: PathBuf,
     dir: PathBuf,
+    registered: Option<crate::cleanup::Staged>,
 }
 
 impl Stage {
@@ -513,6 +728,7 @@ impl Stage {
             _ => PathBuf::from("."),
         };
         let dir = parent.join(format!(".{name}.partial-{}", std::process::id()));
+        let registered = crate::cleanup::Staged::register(&dir);
         std::fs::create_dir_all(&dir)
             .map_err(anyhow::Error::new)
             .context(OutputError(format!(
@@ -522,6 +738,7 @@ impl Stage {
         Ok(Stage {
             out: out.to_path_buf(),
             dir,
+            registered: Some(registered),
         })
     }
 
@@ -529,46 +746,117 @@ impl Stage {
         self.dir.join(file)
     }
 
-    /// Moves the staged files into `out` (replacing earlier ones of the same names, removing
-    /// this tool's files the run did not write) and removes the staging folder.
-    fn commit(&self, names: &[String]) -> Result<()> {
+    /// Moves the staged files into `out`, replacing earlier ones of the same names and
+    /// removing this tool's files the run did not write, all or nothing: every file in the
+    /// way is checked first, the earlier files are moved aside into the staging folder, the
+    /// new ones moved in, and on any failure everything is moved back (and `out` removed again
+    /// if this made it). A signal that arrives meanwhile waits for the move to end.
+    fn commit(mut self, names: &[String]) -> Result<()> {
+        let result = crate::cleanup::while_committing(|| self.move_into_place(names));
+        let kept = match &result {
+            Ok(()) => {
+                let _ = std::fs::remove_dir_all(&self.dir);
+                String::new()
+            }
+            Err(_) => self.remove_or_say(),
+        };
+        self.registered.take();
+        result.map_err(|e| if kept.is_empty() { e } else { e.context(kept) })
+    }
+
+    fn move_into_place(&self, names: &[String]) -> Result<()> {
         let fail =
             |what: String, e: std::io::Error| anyhow::Error::new(e).context(OutputError(what));
+        let replaced: Vec<&str> = OUTPUT_FILES
+            .iter()
+            .copied()
+            .chain(names.iter().map(String::as_str))
+            .collect::<std::collections::BTreeSet<&str>>()
+            .into_iter()
+            .collect();
+        // Checked before anything moves: what is in the way must be a file (ours, earlier).
+        for name in &replaced {
+            let to = self.out.join(name);
+            if let Ok(meta) = std::fs::symlink_metadata(&to)
+                && meta.is_dir()
+            {
+                return Err(anyhow::Error::new(OutputError(format!(
+                    "cannot replace `{}`: it is a folder, not a file h8swarm wrote; move it away and run again (the output folder is unchanged)",
+                    to.display()
+                ))));
+            }
+        }
+        let made_out = !self.out.exists();
         std::fs::create_dir_all(&self.out).map_err(|e| {
             fail(
                 format!("cannot create the output folder `{}`", self.out.display()),
                 e,
             )
         })?;
-        for name in names {
-            let to = self.out.join(name);
-            std::fs::rename(self.dir.join(name), &to).map_err(|e| {
-                fail(
-                    format!("cannot move `{name}` into `{}`", self.out.display()),
-                    e,
-                )
-            })?;
-        }
-        for old in OUTPUT_FILES {
-            if !names.iter().any(|n| n == old) {
-                let stale = self.out.join(old);
-                if stale.is_file() {
-                    std::fs::remove_file(&stale).map_err(|e| {
+        let aside = self.dir.join(".earlier");
+        let mut moved_aside: Vec<&str> = Vec::new();
+        let mut moved_in: Vec<&str> = Vec::new();
+        let moved = (|| -> Result<()> {
+            std::fs::create_dir_all(&aside)
+                .map_err(|e| fail(format!("cannot create `{}`", aside.display()), e))?;
+            for name in &replaced {
+                let from = self.out.join(name);
+                if std::fs::symlink_metadata(&from).is_ok() {
+                    std::fs::rename(&from, aside.join(name)).map_err(|e| {
                         fail(
-                            format!("cannot remove the earlier `{}`", stale.display()),
+                            format!("cannot move the earlier `{}` aside", from.display()),
                             e,
                         )
                     })?;
+                    moved_aside.push(name);
                 }
             }
+            for name in names {
+                std::fs::rename(self.dir.join(name), self.out.join(name)).map_err(|e| {
+                    fail(
+                        format!("cannot move `{name}` into `{}`", self.out.display()),
+                        e,
+                    )
+                })?;
+                moved_in.push(name);
+            }
+            Ok(())
+        })();
+        if moved.is_err() {
+            // Back as it was: the new files out, the earlier ones in.
+            for name in moved_in {
+                let _ = std::fs::rename(self.out.join(name), self.dir.join(name));
+            }
+            for name in moved_aside {
+                let _ = std::fs::rename(aside.join(name), self.out.join(name));
+            }
+            if made_out {
+                let _ = std::fs::remove_dir(&self.out);
+            }
         }
-        let _ = std::fs::remove_dir_all(&self.dir);
-        Ok(())
+        moved
+    }
+
+    /// After a failed commit: removes the staging folder unless earlier files could not be
+    /// moved back out of it; says which.
+    fn remove_or_say(&self) -> String {
+        let aside = self.dir.join(".earlier");
+        let stranded = std::fs::read_dir(&aside).map(|d| d.count()).unwrap_or(0);
+        if stranded == 0 {
+            let _ = std::fs::remove_dir_all(&self.dir);
+            String::new()
+        } else {
+            format!(
+                "{stranded} earlier files could not be moved back: they are in `{}`",
+                aside.display()
+            )
+        }
     }
 
     /// Removes the staging folder after a failure; says what became of `out`.
-    fn abandon(&self) -> String {
+    fn abandon(mut self) -> String {
         let _ = std::fs::remove_dir_all(&self.dir);
+        self.registered.take();
         if self.out.is_dir() {
             "the earlier results there are untouched".to_string()
         } else {
@@ -714,6 +1002,10 @@ fn run_into(
         conditions: &analysis.conditions,
         pairings: &analysis.pairings,
         claims: &analysis.claims,
+        image_configured: images
+            .and_then(|i| i.user.as_ref())
+            .map(|(fw, _)| fw.has_config_block())
+            .filter(|configured| !configured),
     };
     let summary_path = stage.path("summary.json");
     std::fs::write(
@@ -1363,8 +1655,70 @@ mod tests {
             .unwrap();
         // 100 000 model robots on one thread: over 15 GiB.
         assert!(estimated_memory(&big, 1) > 15 << 30);
-        assert!(check_memory(&big, 1, Some(8 << 30)).is_err());
-        assert!(check_memory(&s, 1, Some(8 << 30)).is_ok());
+        assert!(check_memory(&big, 1, Some(8 << 30), 0).is_err());
+        assert!(check_memory(&s, 1, Some(8 << 30), 0).is_ok());
+    }
+
+    #[test]
+    fn sizes_in_messages_are_never_rounded_to_nothing() {
+        assert_eq!(show_bytes(1), "1 bytes");
+        assert_eq!(show_bytes(1023), "1023 bytes");
+        assert_eq!(show_bytes(1024), "1.0 KiB");
+        assert_eq!(show_bytes(1536), "1.5 KiB");
+        assert_eq!(show_bytes(64 << 20), "64.0 MiB");
+        assert_eq!(show_bytes(22 << 30), "22.0 GiB");
+        let e = check_memory(&Scenario::arena(), 1, Some(1024), 0).unwrap_err();
+        assert!(e.to_string().contains("--max-memory is 1.0 KiB"), "{e}");
+    }
+
+    #[test]
+    fn the_process_limits_are_read_and_checked() {
+        let limits = "Limit                     Soft Limit           Hard Limit           Units\nMax data size             unlimited            unlimited            bytes\nMax address space         4096000000           unlimited            bytes\n";
+        assert_eq!(address_space_limit(limits), Some(4_096_000_000));
+        assert_eq!(
+            address_space_limit("Max address space  unlimited  unlimited  bytes\n"),
+            None
+        );
+        // A fake cgroup tree: v2 with a limit on a parent, v1 with its own.
+        let root = std::env::temp_dir().join(format!("h8swarm-cgroups-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&root);
+        let job = root.join("slurm/job_7/step_0");
+        std::fs::create_dir_all(&job).unwrap();
+        std::fs::write(root.join("slurm/job_7/memory.max"), "1073741824\n").unwrap();
+        std::fs::write(root.join("slurm/job_7/memory.current"), "73741824\n").unwrap();
+        std::fs::write(job.join("memory.max"), "max\n").unwrap();
+        assert_eq!(
+            cgroup_room(&root, "0::/slurm/job_7/step_0\n"),
+            Some(1_000_000_000)
+        );
+        assert_eq!(cgroup_room(&root, "0::/elsewhere\n"), None);
+        let v1 = root.join("memory/job");
+        std::fs::create_dir_all(&v1).unwrap();
+        std::fs::write(v1.join("memory.limit_in_bytes"), "536870912\n").unwrap();
+        std::fs::write(v1.join("memory.usage_in_bytes"), "36870912\n").unwrap();
+        std::fs::write(
+            root.join("memory/memory.limit_in_bytes"),
+            "9223372036854771712\n",
+        )
+        .unwrap();
+        assert_eq!(cgroup_room(&root, "4:memory:/job\n"), Some(500_000_000));
+        let _ = std::fs::remove_dir_all(&root);
+        // The checks: a cgroup's room, then the address space.
+        let s = Scenario::arena();
+        let roomy = ProcessLimits::default();
+        assert!(check_memory_within(&s, 2, Some(1 << 40), 0, &roomy).is_ok());
+        let tight = ProcessLimits {
+            cgroup_room: Some(10 << 20),
+            address_space: None,
+        };
+        let e = check_memory_within(&s, 2, Some(1 << 40), 0, &tight).unwrap_err();
+        assert!(e.to_string().contains("control group"), "{e}");
+        let small_as = ProcessLimits {
+            cgroup_room: None,
+            address_space: Some(200 << 20),
+        };
+        let e = check_memory_within(&s, 2, Some(1 << 40), 0, &small_as).unwrap_err();
+        assert!(e.to_string().contains("ulimit -v"), "{e}");
     }
 
     #[test]

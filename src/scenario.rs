@@ -229,6 +229,10 @@ patch!(ControllerPatch for ControllerSpec { kind: crate::fit::ControllerKind, im
 /// The largest scenario or sweep file read (1 MiB; the documented example is 4 KB).
 pub const MAX_FILE_BYTES: u64 = 1 << 20;
 
+/// The longest scenario `name`, in characters: it titles every figure, and drawing a title
+/// costs time with its length (a name of 1 MB took seconds to draw).
+pub const MAX_NAME_CHARS: usize = 200;
+
 /// A text file a user named, at most `limit` bytes of UTF-8 (see
 /// [`emu::board::firmware::read_bounded`]).
 ///
@@ -505,6 +509,18 @@ impl Scenario {
             } else {
                 bail!("`{key}` = {v} is out of range: valid is {lo} to {hi}")
             }
+        }
+        let name_chars = self.name.chars().count();
+        if name_chars > MAX_NAME_CHARS {
+            bail!(
+                "`name` is {name_chars} characters long: give at most {MAX_NAME_CHARS} (it titles the figures and the summary)"
+            );
+        }
+        if let Some(c) = self.name.chars().find(|c| c.is_control()) {
+            bail!(
+                "`name` holds the control character U+{:04X}: give printable text (it is shown on the terminal and in the figures)",
+                u32::from(c)
+            );
         }
         if let Err(e) = emu::board::model::check_sensor_channels(&self.sensors.channels) {
             bail!("`sensors.channels` = {:?}: {e}", self.sensors.channels);

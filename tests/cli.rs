@@ -468,18 +468,24 @@ fn a_failed_run_leaves_the_earlier_results_untouched() {
         .map(|f| (f.to_string(), std::fs::read(out.join(f)).expect("written")))
         .collect();
     // A program that is no robot firmware: it halts at once, so the run fails at its first
-    // step, after the staging folder was made.
+    // step, after the staging folder was made. (It has no configuration block, so it runs
+    // only with the controls off.)
+    let scenario = dir.join("halts.toml");
+    std::fs::write(
+        &scenario,
+        "[controls]\nlearning_off = false\nrandom_walk = false\n[controller]\nkind = \"firmware\"\nimage = \"emu/tests/programs/arith.mot\"\n",
+    )
+    .unwrap();
     let o = h8swarm(
         &[
             "run",
+            scenario.to_str().unwrap(),
             "--steps",
             "30",
             "--repeats",
             "2",
             "--seed",
             "9",
-            "--firmware",
-            "emu/tests/programs/arith.mot",
             "--out",
             out_s,
         ],
@@ -498,7 +504,15 @@ fn a_failed_run_leaves_the_earlier_results_untouched() {
         .unwrap()
         .map(|e| e.unwrap().file_name())
         .collect();
-    assert_eq!(left, vec![std::ffi::OsString::from("results")]);
+    let mut left = left;
+    left.sort();
+    assert_eq!(
+        left,
+        vec![
+            std::ffi::OsString::from("halts.toml"),
+            std::ffi::OsString::from("results")
+        ]
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 

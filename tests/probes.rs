@@ -52,15 +52,21 @@ fn ok(out: &Output) {
     );
 }
 
-/// The VCD header's "Trace from state A to state B".
+/// The trace's span in states: the header's "Trace from state A", to the last timestamp
+/// (4 units a state at 25 MHz).
 fn trace_span(vcd: &str) -> (u64, u64) {
     let at = vcd
         .find("Trace from state ")
         .expect("the span in the header");
     let words: Vec<&str> = vcd[at..].split_whitespace().collect();
     let a = words[3].parse().expect("start");
-    let b = words[6].trim_end_matches('.').parse().expect("end");
-    (a, b)
+    let last: u64 = vcd
+        .lines()
+        .last()
+        .and_then(|l| l.strip_prefix('#'))
+        .and_then(|n| n.parse().ok())
+        .expect("the last timestamp");
+    (a, last / 4)
 }
 
 /// The phase names in the VCD file, in order.

@@ -133,6 +133,21 @@ fn a_users_image_on_chosen_robots_and_a_faulty_one_named() {
     assert!(out.status.success());
     assert_eq!(metrics(&x), metrics(&y));
 
+    // Images without a configuration block run only with the controls off (the controls
+    // could not reach them).
+    let alone = |image: &std::path::Path| {
+        let sc = image.with_extension("toml");
+        std::fs::write(
+            &sc,
+            format!(
+                "[controls]\nlearning_off = false\nrandom_walk = false\n[controller]\nkind = \"firmware\"\nimage = \"{}\"\n",
+                image.display()
+            ),
+        )
+        .unwrap();
+        sc.display().to_string()
+    };
+
     // An image that spins without ever starting the A/D converter: the watchdog names the
     // robot and the PC; with --keep-going the robot dies and the run goes on.
     let spin = dir.join("spin.mot");
@@ -140,9 +155,7 @@ fn a_users_image_on_chosen_robots_and_a_faulty_one_named() {
     let z = dir.join("z");
     let out = h8swarm(&[
         "run",
-        "arena",
-        "--firmware",
-        spin.to_str().unwrap(),
+        &alone(&spin),
         "--steps",
         "5",
         "--repeats",
@@ -167,9 +180,7 @@ fn a_users_image_on_chosen_robots_and_a_faulty_one_named() {
     std::fs::write(&bad, image(&[0x01, 0x50])).unwrap();
     let out = h8swarm(&[
         "run",
-        "arena",
-        "--firmware",
-        bad.to_str().unwrap(),
+        &alone(&bad),
         "--steps",
         "5",
         "--repeats",

@@ -266,7 +266,7 @@ fn reruns_skip_finished_points_and_redo_broken_ones() {
         "{merged}"
     );
     let (code, err) = fails(&["sweep", "merge", s(&dir), "--require-complete"], &[]);
-    assert_eq!(code, 1, "{err}");
+    assert_eq!(code, 2, "{err}");
     let csv = std::fs::read_to_string(dir.join("merged/sweep.csv")).unwrap();
     assert!(
         csv.lines()

@@ -330,6 +330,7 @@ fn the_instruction_trace_and_the_phase_signal_name_the_same_code() {
             names: Some(names.as_ref()),
             phases: Some(&mut phases),
             debugger: None,
+            vcd: None,
         },
     )
     .unwrap();

@@ -52,7 +52,8 @@ pub enum PointState {
     Ok,
     /// Ran and failed, with why.
     Failed(String),
-    /// A folder that is neither: no or a bad `status.json`, or another scenario.
+    /// A folder that is neither: no or a bad `status.json`, another scenario, or a finished
+    /// point whose `summary.json` cannot be read.
     Broken(String),
 }
 
@@ -76,7 +77,10 @@ pub fn point_state(points: &Path, line: &PlanLine) -> PointState {
         _ => return PointState::Broken("its scenario.toml is not the planned one".into()),
     }
     match (status.id == line.id, status.status.as_str()) {
-        (true, "ok") => PointState::Ok,
+        (true, "ok") => match super::merge::read_summary(&dir.join("summary.json")) {
+            Ok(_) => PointState::Ok,
+            Err(why) => PointState::Broken(format!("finished, but {why}")),
+        },
         (true, "failed") => PointState::Failed(status.error.unwrap_or_default()),
         _ => PointState::Broken(format!("status.json says {:?}", status.status)),
     }
@@ -100,11 +104,14 @@ pub fn run_point(
         return Ok(Outcome::Skipped);
     }
     let final_dir = points.join(&line.id);
-    // Leftovers of this point: a broken or failed folder, temporary folders of killed tasks.
+    // Leftovers of this point: a broken or failed folder, temporary folders of killed tasks
+    // (`.tmp-ID-…`) and the staging folders of their runs (`..tmp-ID-….partial-PID`).
     let stale_prefix = format!(".tmp-{}-", line.id);
+    let stale_stage = format!(".{stale_prefix}");
     if let Ok(entries) = std::fs::read_dir(points) {
         for e in entries.flatten() {
-            if e.file_name().to_string_lossy().starts_with(&stale_prefix) {
+            let name = e.file_name().to_string_lossy().into_owned();
+            if name.starts_with(&stale_prefix) || name.starts_with(&stale_stage) {
                 let p = e.path();
                 std::fs::remove_dir_all(&p).map_err(|e| io_err("remove", &p, &e))?;
             }
@@ -113,13 +120,13 @@ pub fn run_point(
     if final_dir.exists() {
         std::fs::remove_dir_all(&final_dir).map_err(|e| io_err("remove", &final_dir, &e))?;
     }
-    let host = super::spec::sanitize(
-        &std::env::var("HOSTNAME")
-            .or_else(|_| std::env::var("SLURMD_NODENAME"))
-            .unwrap_or_else(|_| "host".into()),
-        32,
-    );
-    let tmp = points.join(format!("{stale_prefix}{host}-{}", std::process::id()));
+    let tmp = points.join(format!(
+        "{stale_prefix}{}-{}",
+        host_name(),
+        std::process::id()
+    ));
+    // Removed if a signal stops the task (its run's own staging folder is registered too).
+    let registered = crate::cleanup::Staged::register(&tmp);
     std::fs::create_dir_all(&tmp).map_err(|e| io_err("create", &tmp, &e))?;
     let scenario_path = tmp.join("scenario.toml");
     write_atomic(&scenario_path, line.point().scenario_toml()?.as_bytes())?;
@@ -158,14 +165,74 @@ pub fn run_point(
         .map_err(|e| SweepError::tool(format!("writing status.json: {e}")))?
         + "\n";
     write_atomic(&tmp.join("status.json"), json.as_bytes())?;
-    if let Err(e) = std::fs::rename(&tmp, &final_dir) {
+    let renamed = crate::cleanup::while_committing(|| std::fs::rename(&tmp, &final_dir));
+    if let Err(e) = renamed {
         // Another task finished the same point first: keep its folder if it is complete.
         let _ = std::fs::remove_dir_all(&tmp);
         if point_state(points, line) != PointState::Ok {
             return Err(io_err("rename the finished point into", &final_dir, &e));
         }
     }
+    registered.release();
     Ok(outcome)
+}
+
+/// This machine's name as temporary folders carry it: `HOSTNAME`, else `SLURMD_NODENAME`,
+/// else the kernel's host name, reduced to `[A-Za-z0-9.+-]` (at most 32 characters).
+#[must_use]
+pub fn host_name() -> String {
+    let name = std::env::var("HOSTNAME")
+        .or_else(|_| std::env::var("SLURMD_NODENAME"))
+        .ok()
+        .or_else(|| {
+            std::fs::read_to_string("/proc/sys/kernel/hostname")
+                .ok()
+                .map(|h| h.trim().to_string())
+        })
+        .filter(|h| !h.is_empty())
+        .unwrap_or_else(|| "host".into());
+    super::spec::sanitize(&name, 32)
+}
+
+/// A temporary folder under `points/` (`.tmp-ID-HOST-PID`, or its run's staging folder
+/// `..tmp-ID-HOST-PID.partial-PID`): whether it is a leftover of a process of this machine
+/// that is gone (its PID no longer runs), so that nothing can still be writing into it.
+/// Folders of other machines, and any whose process runs or cannot be told, are not.
+#[must_use]
+pub fn is_dead_leftover(name: &str, host: &str) -> bool {
+    if !(name.starts_with(".tmp-") || name.starts_with("..tmp-")) {
+        return false;
+    }
+    let base = name.split(".partial-").next().unwrap_or(name);
+    let pid_of = |s: &str| s.rsplit('-').next().and_then(|p| p.parse::<u32>().ok());
+    let (Some(pid), Some(base_pid)) = (pid_of(name), pid_of(base)) else {
+        return false;
+    };
+    if !base.ends_with(&format!("-{host}-{base_pid}")) || !Path::new("/proc/self").exists() {
+        return false;
+    }
+    let gone = |p: u32| !Path::new("/proc").join(p.to_string()).exists();
+    gone(pid) && gone(base_pid)
+}
+
+/// Removes the leftovers under `points` of this machine's processes that are gone
+/// ([`is_dead_leftover`]); returns their names.
+///
+/// # Errors
+/// A leftover that cannot be removed (tool).
+pub fn remove_dead_leftovers(points: &Path) -> Result<Vec<String>, SweepError> {
+    let host = host_name();
+    let mut removed = Vec::new();
+    for e in std::fs::read_dir(points).into_iter().flatten().flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        if is_dead_leftover(&name, &host) {
+            let p = e.path();
+            std::fs::remove_dir_all(&p).map_err(|e| io_err("remove", &p, &e))?;
+            removed.push(name);
+        }
+    }
+    removed.sort();
+    Ok(removed)
 }
 
 /// Which task `sweep run` serves: `--task`, else `SLURM_ARRAY_TASK_ID`, else every task.
@@ -227,6 +294,13 @@ pub fn run_task(
     let threads = threads_from(threads);
     let points: PathBuf = dir.join("points");
     std::fs::create_dir_all(&points).map_err(|e| io_err("create", &points, &e))?;
+    // What killed tasks of this machine left (of any point) goes first.
+    for name in remove_dead_leftovers(&points)? {
+        eprintln!(
+            "removed points/{}: left by a task that was killed",
+            super::spec::printable(&name)
+        );
+    }
     let share: Vec<&PlanLine> = lines
         .iter()
         .filter(|l| task.is_none_or(|t| l.task == t))
@@ -265,7 +339,7 @@ pub fn run_task(
             }
         };
         // One line per point as it ends, for Slurm's log (standard output holds the totals).
-        eprintln!("{line_text}");
+        eprintln!("{}", super::spec::printable(&line_text));
     }
     let _ = writeln!(
         t,

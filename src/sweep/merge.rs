@@ -14,10 +14,12 @@
 //!   `undefined` with the sign test's `p`; last `error`. A point that did not finish has empty
 //!   cells.
 //! * `sweep.json`: the same rows (objects keyed by column), the column order, the claims' full
-//!   texts (with whether each is one of the paper's), and the lists of failed, missing and
-//!   broken points.
+//!   texts (with whether each is one of the paper's), the lists of failed, missing and broken
+//!   points, and the figures it drew (`figures`: the next merge into the same folder replaces
+//!   exactly those).
 //! * `plots/`: a map of every claim over the swept keys, and the region where the paper's
-//!   text claims hold together (see [`super::figures`]).
+//!   text claims hold together (see [`super::figures`]). Merge never clears a folder: a user's
+//!   own files in `OUT` or `OUT/plots` stay.
 //!
 //! The table is a pure function of the points' folders: the same bytes however the points were
 //! split into tasks or where they ran.
@@ -32,6 +34,7 @@ use super::SweepError;
 use super::exec::{PointState, point_state};
 use super::figures::{ClaimSeries, PointClaim, cell_values, claim_figures, region};
 use super::plan::read_plan;
+use super::spec::printable;
 
 /// The statistics of a window in the order the table lists them (others follow, sorted).
 const STAT_ORDER: [&str; 9] = [
@@ -118,7 +121,8 @@ pub struct Merged {
 /// Reads every point of the sweep in `dir` into the table.
 ///
 /// # Errors
-/// Not a sweep folder (input); a finished point whose summary.json cannot be read (tool).
+/// Not a sweep folder (input). A finished point whose summary.json cannot be read is listed
+/// as broken, not an error.
 pub fn collect(
     dir: &Path,
 ) -> Result<(super::plan::Plan, Vec<super::plan::PlanLine>, Merged), SweepError> {
@@ -166,18 +170,22 @@ pub fn collect(
             }
         };
         row.insert("status".into(), json!(status));
-        if status == "ok" {
+        let summary = if status == "ok" {
             let path = points.join(&line.id).join("summary.json");
-            let summary: Value = std::fs::read_to_string(&path)
-                .ok()
-                .and_then(|t| serde_json::from_str(&t).ok())
-                .ok_or_else(|| {
-                    SweepError::tool(format!(
-                        "point {} is finished but `{}` cannot be read as JSON",
-                        line.id,
-                        path.display()
-                    ))
-                })?;
+            match read_summary(&path) {
+                Ok(v) => Some(v),
+                Err(why) => {
+                    // A finished point whose summary cannot be read: listed, not fatal.
+                    row.insert("status".into(), json!("broken"));
+                    row.insert("error".into(), json!(why));
+                    m.broken.push((line.id.clone(), why));
+                    None
+                }
+            }
+        } else {
+            None
+        };
+        if let Some(summary) = summary {
             for c in summary["conditions"].as_array().into_iter().flatten() {
                 let cond = c["condition"].as_str().unwrap_or("condition");
                 if let Some(robots) = c["robots"].as_object() {
@@ -281,6 +289,19 @@ pub fn collect(
     Ok((plan, lines, m))
 }
 
+/// A finished point's `summary.json`, or why it cannot be read (an object with its
+/// `conditions` and `claims`).
+pub(crate) fn read_summary(path: &Path) -> Result<Value, String> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| format!("its summary.json cannot be read: {e}"))?;
+    let v: Value =
+        serde_json::from_str(&text).map_err(|e| format!("its summary.json is not JSON: {e}"))?;
+    if !(v["conditions"].is_array() && v["claims"].is_array()) {
+        return Err("its summary.json has no `conditions` and `claims` lists".into());
+    }
+    Ok(v)
+}
+
 /// Leftover temporary folders under `points/` (tasks running now, or killed).
 fn temporaries(points: &Path) -> Vec<String> {
     let mut out: Vec<String> = std::fs::read_dir(points)
@@ -288,10 +309,33 @@ fn temporaries(points: &Path) -> Vec<String> {
         .flatten()
         .flatten()
         .map(|e| e.file_name().to_string_lossy().into_owned())
-        .filter(|n| n.starts_with(".tmp-"))
+        .filter(|n| n.starts_with(".tmp-") || n.starts_with("..tmp-"))
         .collect();
     out.sort();
     out
+}
+
+/// The figures an earlier merge into `out` wrote (the `figures` of its sweep.json): names
+/// `plots/NAME.png` only, so nothing outside `out/plots` can be named.
+fn earlier_figures(out: &Path) -> Vec<String> {
+    let Ok(text) = std::fs::read_to_string(out.join("sweep.json")) else {
+        return Vec::new();
+    };
+    let Ok(doc) = serde_json::from_str::<Value>(&text) else {
+        return Vec::new();
+    };
+    doc["figures"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .filter_map(Value::as_str)
+        .filter(|n| {
+            n.strip_prefix("plots/").is_some_and(|f| {
+                f.ends_with(".png") && !f.starts_with('.') && !f.contains(['/', '\\'])
+            })
+        })
+        .map(str::to_string)
+        .collect()
 }
 
 /// Merges the sweep in `dir` into `out` (default `DIR/merged`); returns what to print and
@@ -303,10 +347,10 @@ pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepErro
     let (plan, lines, m) = collect(dir)?;
     let out: PathBuf = out.map_or_else(|| dir.join("merged"), Path::to_path_buf);
     let plots = out.join("plots");
-    if plots.exists() {
-        std::fs::remove_dir_all(&plots)
-            .map_err(|e| SweepError::tool(format!("cannot clear `{}`: {e}", plots.display())))?;
-    }
+    // Only merge's own files are replaced: the figures of an earlier merge into `out` (its
+    // sweep.json lists them) that this one does not draw again are removed; anything else in
+    // `out` or `out/plots` is the user's and stays.
+    let earlier = earlier_figures(&out);
     std::fs::create_dir_all(&plots)
         .map_err(|e| SweepError::tool(format!("cannot create `{}`: {e}", plots.display())))?;
 
@@ -375,13 +419,30 @@ pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepErro
         "columns": m.columns,
         "rows": m.rows,
     });
+    let figures = claim_figures(&plan.axes, &coords, &series, &plots)?;
+    let figure_names: Vec<String> = figures
+        .iter()
+        .filter_map(|p| p.file_name())
+        .map(|n| format!("plots/{}", n.to_string_lossy()))
+        .collect();
+    for old in earlier.iter().filter(|n| !figure_names.contains(n)) {
+        let p = out.join(old);
+        if p.is_file() {
+            std::fs::remove_file(&p).map_err(|e| {
+                SweepError::tool(format!(
+                    "cannot remove the earlier figure `{}`: {e}",
+                    p.display()
+                ))
+            })?;
+        }
+    }
+    let mut doc = doc;
+    doc["figures"] = json!(figure_names);
     let json_path = out.join("sweep.json");
     let text = serde_json::to_string_pretty(&doc)
         .map_err(|e| SweepError::tool(format!("writing sweep.json: {e}")))?
         + "\n";
     super::write_atomic(&json_path, text.as_bytes())?;
-
-    let figures = claim_figures(&plan.axes, &coords, &series, &plots)?;
 
     let mut t = String::new();
     let _ = writeln!(
@@ -395,19 +456,33 @@ pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepErro
         m.broken.len()
     );
     for (id, why) in &m.failed {
-        let _ = writeln!(t, "FAILED  {id}: {why}");
+        let _ = writeln!(t, "FAILED  {id}: {}", printable(why));
     }
     for id in &m.missing {
         let _ = writeln!(t, "MISSING {id}");
     }
     for (id, why) in &m.broken {
-        let _ = writeln!(t, "BROKEN  {id}: {why} (the next `sweep run` redoes it)");
-    }
-    for tmp in temporaries(&dir.join("points")) {
         let _ = writeln!(
             t,
-            "RUNNING points/{tmp} (a task at work, or left by a killed one)"
+            "BROKEN  {id}: {} (the next `sweep run` redoes it)",
+            printable(why)
         );
+    }
+    let host = super::exec::host_name();
+    for tmp in temporaries(&dir.join("points")) {
+        let _ = if super::exec::is_dead_leftover(&tmp, &host) {
+            writeln!(
+                t,
+                "LEFTOVER points/{} (its task was killed; the next `sweep run` removes it)",
+                printable(&tmp)
+            )
+        } else {
+            writeln!(
+                t,
+                "RUNNING points/{} (a task at work, or left by a killed one)",
+                printable(&tmp)
+            )
+        };
     }
     for (slug, text, _) in &m.claims {
         let col = format!("claim.{slug}.outcome");
@@ -418,9 +493,10 @@ pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepErro
             .collect();
         let _ = writeln!(
             t,
-            "holds in {:>3} of {:>3} points: {text}",
+            "holds in {:>3} of {:>3} points: {}",
             with.iter().filter(|h| **h == "holds").count(),
-            with.len()
+            with.len(),
+            printable(text)
         );
     }
     if !paper.is_empty() {
@@ -444,12 +520,12 @@ pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepErro
     let _ = writeln!(
         t,
         "wrote {} ({} rows x {} columns) and {}; {} figures in {}",
-        csv_path.display(),
+        printable(&csv_path.display().to_string()),
         m.rows.len(),
         m.columns.len(),
-        json_path.display(),
+        printable(&json_path.display().to_string()),
         figures.len(),
-        plots.display()
+        printable(&plots.display().to_string())
     );
     if !plan.axes.is_empty() && figures.is_empty() && ok > 0 {
         let _ = writeln!(t, "(no claim had values to draw)");

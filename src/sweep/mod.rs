@@ -17,7 +17,8 @@
 //! the points are split into tasks, in what order they run, and on which machine.
 //!
 //! Exit status: 2 for bad input (a malformed sweep file, an unknown key, an empty grid, a task
-//! out of range, a folder that is not a sweep's), 1 when the tool fails (a folder that cannot be
+//! out of range, a folder that is not a sweep's, `merge --require-complete` on a sweep with a
+//! point that is not ok), 1 when the tool fails (a folder that cannot be
 //! written) or, for `run`, when a point failed (it is recorded, and `merge` lists it).
 
 pub mod exec;
@@ -115,54 +116,61 @@ pub enum SweepCommand {
         /// Output folder (default DIR/merged).
         #[arg(long, value_name = "OUT")]
         out: Option<PathBuf>,
-        /// Exit with status 1 unless every point finished.
+        /// Exit with status 2 unless every point finished (the table is written all the same).
         #[arg(long)]
         require_complete: bool,
     },
 }
 
-/// Runs a sweep command; returns the text to print.
+/// Runs a sweep command; returns the text to print on standard output and how it ended.
+/// The text is printed whatever the outcome: a run's points and a merge's summary come
+/// before the error that follows them.
 ///
 /// # Errors
-/// [`SweepError::Input`] for bad input, [`SweepError::Tool`] when the tool fails (and, for
-/// `run`, when a point failed; the text of the run is in the message).
-pub fn command(args: &SweepArgs) -> Result<String, SweepError> {
+/// [`SweepError::Input`] for bad input (and `merge --require-complete` on an incomplete
+/// sweep), [`SweepError::Tool`] when the tool fails (and, for `run`, when a point failed).
+pub fn command(args: &SweepArgs) -> (String, Result<(), SweepError>) {
     match &args.command {
         SweepCommand::Plan { sweep, out, bin } => {
-            let max = crate::scenario::MAX_FILE_BYTES;
-            let text = crate::scenario::read_text(sweep, max).map_err(|e| {
-                SweepError::input(format!(
-                    "cannot read sweep file `{}`: {e} (give a .toml sweep file)",
-                    sweep.display()
-                ))
-            })?;
-            let s = spec::parse(&text, sweep)?;
-            plan::write_plan(&s, &text, out, bin.as_deref())
-        }
-        SweepCommand::Run { dir, task, threads } => {
-            let (text, ok) = exec::run_task(dir, *task, *threads)?;
-            if ok {
-                Ok(text)
-            } else {
-                Err(SweepError::tool(format!(
-                    "{}some points failed (each says why in its status.json; `h8swarm sweep merge` lists them)",
-                    text
-                )))
+            let planned = (|| {
+                let max = crate::scenario::MAX_FILE_BYTES;
+                let text = crate::scenario::read_text(sweep, max).map_err(|e| {
+                    SweepError::input(format!(
+                        "cannot read sweep file `{}`: {e} (give a .toml sweep file)",
+                        sweep.display()
+                    ))
+                })?;
+                let s = spec::parse(&text, sweep)?;
+                plan::write_plan(&s, &text, out, bin.as_deref())
+            })();
+            match planned {
+                Ok(text) => (text, Ok(())),
+                Err(e) => (String::new(), Err(e)),
             }
         }
+        SweepCommand::Run { dir, task, threads } => match exec::run_task(dir, *task, *threads) {
+            Ok((text, true)) => (text, Ok(())),
+            Ok((text, false)) => (
+                text,
+                Err(SweepError::tool(
+                    "some points failed (each says why in its status.json; `h8swarm sweep merge` lists them)",
+                )),
+            ),
+            Err(e) => (String::new(), Err(e)),
+        },
         SweepCommand::Merge {
             dir,
             out,
             require_complete,
-        } => {
-            let (text, complete) = merge::merge(dir, out.as_deref())?;
-            if *require_complete && !complete {
-                Err(SweepError::tool(format!(
-                    "{text}the sweep is not complete (--require-complete)"
-                )))
-            } else {
-                Ok(text)
-            }
-        }
+        } => match merge::merge(dir, out.as_deref()) {
+            Ok((text, complete)) if *require_complete && !complete => (
+                text,
+                Err(SweepError::input(
+                    "the sweep is not complete (--require-complete): every point above that is not ok must be run again",
+                )),
+            ),
+            Ok((text, _)) => (text, Ok(())),
+            Err(e) => (String::new(), Err(e)),
+        },
     }
 }

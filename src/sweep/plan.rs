@@ -114,14 +114,100 @@ pub struct Plan {
     pub requests: Requests,
 }
 
-fn positive(v: Option<usize>, default: usize, key: &str) -> Result<usize, SweepError> {
+/// Slurm's default `MaxArraySize`: array indices 0 to 1 000.
+pub const DEFAULT_MAX_ARRAY_SIZE: usize = 1001;
+/// The largest `MaxArraySize` Slurm accepts.
+pub const SLURM_MAX_ARRAY_SIZE: usize = 4_000_001;
+/// The most CPUs a task may ask for (`cpus_per_task`, `max_cpus`).
+pub const MAX_CPUS_PER_TASK: usize = 4096;
+/// The most memory a task may ask for, MB (16 TiB).
+pub const MAX_MEM_MB: u64 = 16 << 20;
+/// The longest time limit, minutes (365 days; `UNLIMITED` asks for none).
+pub const MAX_TIME_MINUTES: u64 = 365 * 24 * 60;
+
+/// The options the plan writes into `sweep.sbatch` itself; `slurm.extra` may not give them
+/// again (the `[slurm]` keys set those that may change).
+pub const PLAN_OPTIONS: [&str; 14] = [
+    "--array",
+    "--output",
+    "--error",
+    "--open-mode",
+    "--requeue",
+    "--no-requeue",
+    "--ntasks",
+    "--job-name",
+    "--cpus-per-task",
+    "--mem",
+    "--mem-per-cpu",
+    "--time",
+    "--partition",
+    "--account",
+];
+
+/// A count from `[slurm]`: `default` when absent, else 1 to `max`.
+fn count_in(v: Option<usize>, default: usize, key: &str, max: usize) -> Result<usize, SweepError> {
     match v {
         None => Ok(default),
-        Some(0) => Err(SweepError::input(format!(
-            "sweep file: `slurm.{key}` = 0: give 1 or more"
+        Some(n) if (1..=max).contains(&n) => Ok(n),
+        Some(n) => Err(SweepError::input(format!(
+            "sweep file: `slurm.{key}` = {n} is out of range: valid is 1 to {max}"
         ))),
-        Some(n) => Ok(n),
     }
+}
+
+/// Checks a `--time` value against the formats `sbatch` takes: `MINUTES`, `MINUTES:SECONDS`,
+/// `HOURS:MINUTES:SECONDS`, `DAYS-HOURS`, `DAYS-HOURS:MINUTES`, `DAYS-HOURS:MINUTES:SECONDS`
+/// (whole numbers; a later field below 60, hours after days below 24), or `UNLIMITED` /
+/// `INFINITE`; the limit must be above 0 and at most 365 days. Returns the minutes (rounded
+/// up; `None` for no limit).
+///
+/// # Errors
+/// Anything else, saying the formats.
+pub fn slurm_time_minutes(text: &str) -> Result<Option<u64>, String> {
+    let formats = "give MINUTES, MM:SS, HH:MM:SS, D-HH, D-HH:MM, D-HH:MM:SS or UNLIMITED (e.g. \"90\", \"12:00:00\", \"2-00:00:00\")";
+    let bad = || format!("`slurm.time` = {text:?} is not a Slurm time limit: {formats}");
+    let t = text.trim();
+    if t.eq_ignore_ascii_case("unlimited") || t.eq_ignore_ascii_case("infinite") {
+        return Ok(None);
+    }
+    let num = |f: &str| -> Result<u64, String> {
+        if f.is_empty() || f.len() > 9 || !f.bytes().all(|b| b.is_ascii_digit()) {
+            return Err(bad());
+        }
+        f.parse::<u64>().map_err(|_| bad())
+    };
+    let (days, clock) = match t.split_once('-') {
+        Some((d, rest)) => (Some(num(d)?), rest),
+        None => (None, t),
+    };
+    let fields = clock
+        .split(':')
+        .map(num)
+        .collect::<Result<Vec<u64>, String>>()?;
+    let below = |v: u64, limit: u64| if v < limit { Ok(v) } else { Err(bad()) };
+    let seconds = match (days, fields.as_slice()) {
+        (None, [m]) => m * 60,
+        (None, [m, s]) => m * 60 + below(*s, 60)?,
+        (None, [h, m, s]) => h * 3600 + below(*m, 60)? * 60 + below(*s, 60)?,
+        (Some(d), [h]) => d * 86_400 + below(*h, 24)? * 3600,
+        (Some(d), [h, m]) => d * 86_400 + below(*h, 24)? * 3600 + below(*m, 60)? * 60,
+        (Some(d), [h, m, s]) => {
+            d * 86_400 + below(*h, 24)? * 3600 + below(*m, 60)? * 60 + below(*s, 60)?
+        }
+        _ => return Err(bad()),
+    };
+    let minutes = seconds.div_ceil(60);
+    if minutes == 0 {
+        return Err(format!(
+            "`slurm.time` = {text:?} is no time at all: give a limit above 0, or UNLIMITED"
+        ));
+    }
+    if minutes > MAX_TIME_MINUTES {
+        return Err(format!(
+            "`slurm.time` = {text:?} is more than 365 days: give less, or UNLIMITED"
+        ));
+    }
+    Ok(Some(minutes))
 }
 
 /// A setting that goes into an `#SBATCH` line: printable ASCII without spaces or quotes.
@@ -139,38 +225,72 @@ fn sbatch_safe(text: &str, key: &str, allowed: &str) -> Result<(), SweepError> {
     }
 }
 
-/// The requests of the points, as the module's docs describe.
+/// What a point costs, for the requests: its runs, robots, steps and controller (16 bytes
+/// a point, the only thing a plan keeps per point).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PointCost {
+    /// Conditions × repeats.
+    pub runs: u32,
+    /// Robots.
+    pub robots: u32,
+    /// Steps per run.
+    pub steps: u32,
+    /// Firmware robots (else model robots).
+    pub firmware: bool,
+}
+
+impl PointCost {
+    /// The cost of a point's scenario.
+    #[must_use]
+    pub fn of(s: &crate::scenario::Scenario) -> PointCost {
+        let runs = (1 + u32::from(s.controls.learning_off) + u32::from(s.controls.random_walk))
+            * s.repeats;
+        PointCost {
+            runs,
+            robots: u32::try_from(s.robots).unwrap_or(u32::MAX),
+            steps: s.steps,
+            firmware: s.controller.kind == ControllerKind::Firmware,
+        }
+    }
+}
+
+/// The requests of the points (their costs, in order), as the module's docs describe.
 ///
 /// # Errors
-/// A bad `[slurm]` value or a point whose scenario does not resolve.
+/// A bad `[slurm]` value.
 pub fn requests(
-    points: &[Point],
+    costs: &[PointCost],
     slurm: &SlurmSpec,
     per_task: usize,
 ) -> Result<Requests, SweepError> {
-    let max_cpus = positive(slurm.max_cpus, DEFAULT_MAX_CPUS, "max_cpus")?;
+    let max_cpus = count_in(
+        slurm.max_cpus,
+        DEFAULT_MAX_CPUS,
+        "max_cpus",
+        MAX_CPUS_PER_TASK,
+    )?;
     let mut cpus = 1usize;
-    let mut scenarios = Vec::with_capacity(points.len());
-    for p in points {
-        let s = p.resolve()?;
-        let runs = (1 + usize::from(s.controls.learning_off) + usize::from(s.controls.random_walk))
-            * s.repeats as usize;
-        let factor = s.robots.div_ceil(crate::experiment::PARALLEL_ROBOTS).max(1);
-        cpus = cpus.max((runs * factor).min(max_cpus));
-        scenarios.push((s, runs));
+    for c in costs {
+        let factor = (c.robots as usize)
+            .div_ceil(crate::experiment::PARALLEL_ROBOTS)
+            .max(1);
+        cpus = cpus.max((c.runs as usize * factor).min(max_cpus));
     }
-    let cpus = match slurm.cpus_per_task {
-        Some(n) => positive(Some(n), 1, "cpus_per_task")?,
-        None => cpus,
-    };
+    let cpus = count_in(
+        slurm.cpus_per_task,
+        cpus,
+        "cpus_per_task",
+        MAX_CPUS_PER_TASK,
+    )?;
     let mut mem_mb = 0.0f64;
-    let mut task_s = Vec::new();
-    for (i, (s, runs)) in scenarios.iter().enumerate() {
-        let firmware = s.controller.kind == ControllerKind::Firmware;
-        let concurrent = cpus.min(*runs).max(1) as f64;
-        let robots = s.robots as f64;
-        let steps = f64::from(s.steps);
-        let per_robot = if firmware {
+    let mut worst_task_s = 0.0f64;
+    let mut task_s = 0.0f64;
+    for (i, c) in costs.iter().enumerate() {
+        let runs = c.runs as usize;
+        let concurrent = cpus.min(runs).max(1) as f64;
+        let robots = f64::from(c.robots);
+        let steps = f64::from(c.steps);
+        let per_robot = if c.firmware {
             FIRMWARE_ROBOT_MB
         } else {
             MODEL_ROBOT_MB
@@ -178,37 +298,35 @@ pub fn requests(
         let tracked = robots.min(crate::experiment::TRACKED_ROBOTS as f64);
         let mem = BASE_MEM_MB
             + concurrent * robots * per_robot
-            + (*runs as f64 * steps * 72.0 + steps * tracked * 16.0) / 1_048_576.0;
+            + (runs as f64 * steps * 72.0 + steps * tracked * 16.0) / 1_048_576.0;
         mem_mb = mem_mb.max(mem);
-        let rate = if firmware {
+        let rate = if c.firmware {
             FIRMWARE_ROBOT_STEPS_PER_S
         } else {
             MODEL_ROBOT_STEPS_PER_S
         };
-        let secs = 20.0 + *runs as f64 * steps * robots / (rate * concurrent);
-        let task = i / per_task;
-        if task_s.len() <= task {
-            task_s.push(0.0);
+        if i % per_task == 0 {
+            task_s = 0.0;
         }
-        task_s[task] += secs;
+        task_s += 20.0 + runs as f64 * steps * robots / (rate * concurrent);
+        worst_task_s = worst_task_s.max(task_s);
     }
     let mem_mb = match slurm.mem_mb {
-        Some(0) => {
-            return Err(SweepError::input(
-                "sweep file: `slurm.mem_mb` = 0: give 1 or more (MB)",
-            ));
+        Some(m) if (1..=MAX_MEM_MB).contains(&m) => m,
+        Some(m) => {
+            return Err(SweepError::input(format!(
+                "sweep file: `slurm.mem_mb` = {m} is out of range: valid is 1 to {MAX_MEM_MB} (MB, 16 TiB)"
+            )));
         }
-        Some(m) => m,
-        None => ((mem_mb * 1.5 / 64.0).ceil() as u64).max(1) * 64,
+        None => ((mem_mb * 1.5 / 64.0).ceil() as u64).clamp(1, MAX_MEM_MB / 64) * 64,
     };
     let time = match &slurm.time {
         Some(t) => {
-            sbatch_safe(t, "time", ":-")?;
-            t.clone()
+            slurm_time_minutes(t).map_err(|e| SweepError::input(format!("sweep file: {e}")))?;
+            t.trim().to_string()
         }
         None => {
-            let worst = task_s.iter().copied().fold(0.0f64, f64::max);
-            let minutes = ((worst * 3.0) / 60.0).ceil() as u64 + 5;
+            let minutes = (((worst_task_s * 3.0) / 60.0).ceil() as u64 + 5).min(MAX_TIME_MINUTES);
             format!(
                 "{}-{:02}:{:02}:00",
                 minutes / 1440,
@@ -296,6 +414,12 @@ pub fn sbatch_script(
                 "sweep file: `slurm.extra` entry {e:?}: give long options, like \"--qos=long\""
             )));
         }
+        let option = e.split('=').next().unwrap_or(e);
+        if PLAN_OPTIONS.contains(&option) {
+            return Err(SweepError::input(format!(
+                "sweep file: `slurm.extra` entry {e:?}: the plan writes {option} itself (set it with the [slurm] keys cpus_per_task, mem_mb, time, partition, account, points_per_task and max_parallel)"
+            )));
+        }
         let _ = writeln!(t, "#SBATCH {e}");
     }
     let _ = writeln!(t, "set -euo pipefail");
@@ -324,40 +448,53 @@ pub fn write_plan(
     bin: Option<&Path>,
 ) -> Result<String, SweepError> {
     let slurm = &sweep.slurm;
-    let per_task = positive(
+    let per_task = count_in(
         slurm.points_per_task,
         DEFAULT_POINTS_PER_TASK,
         "points_per_task",
+        super::spec::MAX_POINTS,
     )?;
-    let max_parallel = positive(slurm.max_parallel, DEFAULT_MAX_PARALLEL, "max_parallel")?;
-    let tasks = sweep.points.len().div_ceil(per_task);
-    let requests = requests(&sweep.points, slurm, per_task)?;
+    let max_array = count_in(
+        slurm.max_array_size,
+        DEFAULT_MAX_ARRAY_SIZE,
+        "max_array_size",
+        SLURM_MAX_ARRAY_SIZE,
+    )?;
+    let max_parallel = count_in(
+        slurm.max_parallel,
+        DEFAULT_MAX_PARALLEL.min(max_array),
+        "max_parallel",
+        max_array,
+    )?;
+    let tasks = sweep.count.div_ceil(per_task);
+    if tasks > max_array {
+        let need = sweep.count.div_ceil(max_array);
+        return Err(SweepError::input(format!(
+            "sweep file: {} points at {per_task} a task make {tasks} array tasks (indices 0 to {}), but Slurm's MaxArraySize of {max_array} allows indices 0 to {} only: set `slurm.points_per_task` to {need} or more, or `slurm.max_array_size` to your cluster's MaxArraySize (`scontrol show config | grep MaxArraySize`)",
+            sweep.count,
+            tasks - 1,
+            max_array - 1
+        )));
+    }
+    // First pass: every point checked, and its cost kept (16 bytes a point) for the requests.
+    let mut costs = Vec::with_capacity(sweep.count);
+    sweep.check_points(|_, s| {
+        costs.push(PointCost::of(s));
+        Ok(())
+    })?;
+    let requests = requests(&costs, slurm, per_task)?;
+    drop(costs);
     let plan = Plan {
         h8swarm_version: env!("CARGO_PKG_VERSION").to_string(),
         sweep: sweep.name.clone(),
         axes: sweep.axes.clone(),
         seeds: sweep.seeds.clone(),
-        points: sweep.points.len(),
+        points: sweep.count,
         points_per_task: per_task,
         tasks,
         max_parallel,
         requests,
     };
-    let mut lines = String::new();
-    for p in &sweep.points {
-        let line = PlanLine {
-            index: p.index,
-            id: p.id.clone(),
-            task: p.index / per_task,
-            coords: p.coords.clone(),
-            seed: p.seed,
-            scenario: p.scenario.clone(),
-        };
-        let json = serde_json::to_string(&line)
-            .map_err(|e| SweepError::tool(format!("writing point {}: {e}", p.id)))?;
-        lines.push_str(&json);
-        lines.push('\n');
-    }
 
     std::fs::create_dir_all(dir).map_err(|e| {
         SweepError::tool(format!(
@@ -368,21 +505,28 @@ pub fn write_plan(
     let dir = dir
         .canonicalize()
         .map_err(|e| SweepError::tool(format!("cannot resolve `{}`: {e}", dir.display())))?;
-    let list_path = dir.join("points.jsonl");
-    if let Ok(old) = std::fs::read_to_string(&list_path)
-        && old != lines
-    {
-        return Err(SweepError::input(format!(
-            "`{}` already holds a different sweep plan (its points.jsonl differs): give --out a new folder, or remove the old one",
-            dir.display()
-        )));
-    }
     let bin: PathBuf = match bin {
         Some(b) => b.to_path_buf(),
         None => std::env::current_exe()
             .map_err(|e| SweepError::tool(format!("cannot find this program's path: {e}")))?,
     };
     let script = sbatch_script(&plan, slurm, &dir, &bin)?;
+    // Second pass: the run list, a point at a time, into a temporary file beside it.
+    let list_path = dir.join("points.jsonl");
+    let tmp = dir.join(format!(".points.jsonl.tmp-{}", std::process::id()));
+    let written = write_list(sweep, per_task, &tmp).and_then(|()| {
+        if list_path.exists() && !same_file_bytes(&list_path, &tmp)? {
+            return Err(SweepError::input(format!(
+                "`{}` already holds a different sweep plan (its points.jsonl differs): give --out a new folder, or remove the old one",
+                dir.display()
+            )));
+        }
+        Ok(())
+    });
+    if let Err(e) = written {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(e);
+    }
     for sub in ["points", "logs"] {
         let p = dir.join(sub);
         std::fs::create_dir_all(&p)
@@ -392,9 +536,13 @@ pub fn write_plan(
         .map_err(|e| SweepError::tool(format!("writing plan.json: {e}")))?
         + "\n";
     write_atomic(&dir.join("sweep.toml"), sweep_text.as_bytes())?;
-    write_atomic(&list_path, lines.as_bytes())?;
+    std::fs::rename(&tmp, &list_path).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        SweepError::tool(format!("cannot write `{}`: {e}", list_path.display()))
+    })?;
     write_atomic(&dir.join("plan.json"), plan_json.as_bytes())?;
     write_atomic(&dir.join("sweep.sbatch"), script.as_bytes())?;
+    let dir_text = super::spec::printable(&dir.display().to_string());
 
     let mut t = String::new();
     let _ = writeln!(
@@ -426,13 +574,70 @@ pub fn write_plan(
     );
     let _ = writeln!(
         t,
-        "wrote {} (plan.json, points.jsonl, sweep.sbatch)",
-        dir.display()
+        "wrote {dir_text} (plan.json, points.jsonl, sweep.sbatch)"
     );
-    let _ = writeln!(t, "on a cluster: sbatch {}/sweep.sbatch", dir.display());
-    let _ = writeln!(t, "on this machine: h8swarm sweep run {}", dir.display());
-    let _ = writeln!(t, "then: h8swarm sweep merge {}", dir.display());
+    let _ = writeln!(t, "on a cluster: sbatch {dir_text}/sweep.sbatch");
+    let _ = writeln!(t, "on this machine: h8swarm sweep run {dir_text}");
+    let _ = writeln!(t, "then: h8swarm sweep merge {dir_text}");
     Ok(t)
+}
+
+/// Writes the run list of `sweep` to `path`, one point at a time.
+fn write_list(sweep: &Sweep, per_task: usize, path: &Path) -> Result<(), SweepError> {
+    use std::io::Write as _;
+    let fail = |e: &dyn std::fmt::Display| {
+        SweepError::tool(format!("cannot write `{}`: {e}", path.display()))
+    };
+    let mut w = std::io::BufWriter::new(std::fs::File::create(path).map_err(|e| fail(&e))?);
+    for p in sweep.points() {
+        let p = p?;
+        let line = PlanLine {
+            index: p.index,
+            id: p.id,
+            task: p.index / per_task,
+            coords: p.coords,
+            seed: p.seed,
+            scenario: p.scenario,
+        };
+        serde_json::to_writer(&mut w, &line).map_err(|e| fail(&e))?;
+        w.write_all(b"\n").map_err(|e| fail(&e))?;
+    }
+    w.flush().map_err(|e| fail(&e))
+}
+
+/// Whether two files hold the same bytes (read a block at a time).
+fn same_file_bytes(a: &Path, b: &Path) -> Result<bool, SweepError> {
+    let open = |p: &Path| {
+        std::fs::File::open(p)
+            .map(std::io::BufReader::new)
+            .map_err(|e| SweepError::tool(format!("cannot read `{}`: {e}", p.display())))
+    };
+    let (mut x, mut y) = (open(a)?, open(b)?);
+    let (mut bx, mut by) = (vec![0u8; 1 << 16], vec![0u8; 1 << 16]);
+    loop {
+        let n = read_full(&mut x, &mut bx)
+            .map_err(|e| SweepError::tool(format!("cannot read `{}`: {e}", a.display())))?;
+        let m = read_full(&mut y, &mut by)
+            .map_err(|e| SweepError::tool(format!("cannot read `{}`: {e}", b.display())))?;
+        if n != m || bx[..n] != by[..m] {
+            return Ok(false);
+        }
+        if n == 0 {
+            return Ok(true);
+        }
+    }
+}
+
+/// Reads until `buf` is full or the end.
+fn read_full(r: &mut impl std::io::Read, buf: &mut [u8]) -> std::io::Result<usize> {
+    let mut n = 0;
+    while n < buf.len() {
+        match r.read(&mut buf[n..])? {
+            0 => break,
+            k => n += k,
+        }
+    }
+    Ok(n)
 }
 
 /// Reads a sweep folder's plan and run list.
@@ -478,4 +683,80 @@ pub fn read_plan(dir: &Path) -> Result<(Plan, Vec<PlanLine>), SweepError> {
         ));
     }
     Ok((plan, lines))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn time_limits_take_slurms_formats_only() {
+        for (t, minutes) in [
+            ("90", Some(90)),
+            ("1:30", Some(2)),
+            ("12:00:00", Some(720)),
+            ("2-00", Some(2880)),
+            ("1-02:03", Some(1563)),
+            ("0-00:00:30", Some(1)),
+            ("UNLIMITED", None),
+            ("infinite", None),
+            ("365-00:00:00", Some(MAX_TIME_MINUTES)),
+        ] {
+            assert_eq!(slurm_time_minutes(t), Ok(minutes), "{t}");
+        }
+        for bad in [
+            "-x",
+            "short",
+            "",
+            "0",
+            "00:00:00",
+            "1:60",
+            "1:00:60",
+            "1-24",
+            "-1",
+            "1--2",
+            "1:2:3:4",
+            "1-2-3",
+            " 5 0",
+            "1e3",
+            "366-00",
+            "99999999999",
+        ] {
+            let e = slurm_time_minutes(bad).unwrap_err();
+            assert!(e.contains("slurm.time"), "{bad}: {e}");
+        }
+    }
+
+    #[test]
+    fn requests_refuse_values_slurm_cannot_take() {
+        let cost = PointCost {
+            runs: 3,
+            robots: 3,
+            steps: 100,
+            firmware: false,
+        };
+        let with = |f: &dyn Fn(&mut SlurmSpec)| {
+            let mut s = SlurmSpec::default();
+            f(&mut s);
+            requests(&[cost], &s, 1).map_err(|e| e.to_string())
+        };
+        assert!(with(&|_| {}).is_ok());
+        let e = with(&|s| s.cpus_per_task = Some(usize::MAX)).unwrap_err();
+        assert!(
+            e.contains("cpus_per_task") && e.contains("1 to 4096"),
+            "{e}"
+        );
+        let e = with(&|s| s.mem_mb = Some(u64::MAX)).unwrap_err();
+        assert!(e.contains("mem_mb"), "{e}");
+        let e = with(&|s| s.mem_mb = Some(0)).unwrap_err();
+        assert!(e.contains("mem_mb"), "{e}");
+        let e = with(&|s| s.time = Some("short".into())).unwrap_err();
+        assert!(e.contains("HH:MM:SS"), "{e}");
+        let e = with(&|s| s.max_cpus = Some(0)).unwrap_err();
+        assert!(e.contains("max_cpus"), "{e}");
+        assert_eq!(
+            with(&|s| s.time = Some("2-00:00:00".into())).unwrap().time,
+            "2-00:00:00"
+        );
+    }
 }

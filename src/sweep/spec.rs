@@ -27,7 +27,9 @@
 //! the sweep's. Points are the Cartesian product of the axes (the first axis varies slowest)
 //! with the seeds innermost, numbered from 0 in that order. A point's id is its number and its
 //! values, reduced to the characters `[A-Za-z0-9.+-]`, so no value can reach outside the sweep
-//! folder. Every point's scenario is checked as `h8swarm run` checks a scenario file, before
+//! folder. Points are made one at a time ([`Sweep::point`]), never all held at once. Every
+//! point's scenario is checked as `h8swarm run` checks a scenario file
+//! ([`Sweep::check_points`], which `sweep plan` runs), before
 //! anything is written.
 
 use std::collections::BTreeSet;
@@ -67,8 +69,13 @@ pub struct SlurmSpec {
     pub partition: Option<String>,
     /// Account (`--account`).
     pub account: Option<String>,
-    /// Further `sbatch` options, one per entry (e.g. `"--qos=long"`).
+    /// Further `sbatch` options, one per entry (e.g. `"--qos=long"`): long options of
+    /// letters, digits and `-_.,:=@/+`, each written as one `#SBATCH` line; not the options
+    /// the plan writes itself (see [`super::plan::PLAN_OPTIONS`]).
     pub extra: Option<Vec<String>>,
+    /// The cluster's `MaxArraySize` (default 1 001, Slurm's default: array indices 0 to
+    /// 1 000); a plan needing more array tasks is refused.
+    pub max_array_size: Option<usize>,
 }
 
 /// The sweep file as written.
@@ -123,8 +130,96 @@ pub struct Sweep {
     pub seeds: Vec<u64>,
     /// The Slurm settings.
     pub slurm: SlurmSpec,
-    /// Every point, in order.
-    pub points: Vec<Point>,
+    /// How many points: the seeds times every axis' length.
+    pub count: usize,
+    /// The base scenario with the `[set]` changes, as a table: every point starts from it.
+    table: toml::Table,
+    /// Whether a point that sets `steps` gets its window cut to it (no `window` set or swept).
+    clamp_window: bool,
+    /// Where the sweep came from, for messages (`sweep file `PATH``).
+    where_: String,
+}
+
+impl Sweep {
+    /// Point `index` (0 to [`Sweep::count`] − 1): its position on each axis, its seed and its
+    /// full scenario. Points are made one at a time, so a plan of a million points never holds
+    /// them all.
+    ///
+    /// # Errors
+    /// A key that cannot be set (a value where a table is needed).
+    pub fn point(&self, index: usize) -> Result<Point, SweepError> {
+        let where_ = &self.where_;
+        let digits = self.count.saturating_sub(1).to_string().len().max(4);
+        let mut coords = vec![0usize; self.axes.len()];
+        let mut rest = index / self.seeds.len();
+        for (c, a) in coords.iter_mut().zip(&self.axes).rev() {
+            *c = rest % a.values.len();
+            rest /= a.values.len();
+        }
+        let seed = self.seeds[index % self.seeds.len()];
+        let mut t = self.table.clone();
+        let mut slug = String::new();
+        for (a, &c) in self.axes.iter().zip(&coords) {
+            for (k, v) in a.keys.iter().zip(&a.values[c]) {
+                set_key(&mut t, k, v.clone())
+                    .map_err(|e| SweepError::input(format!("{where_}: `{k}`: {e}")))?;
+                let short = k.rsplit('.').next().unwrap_or(k);
+                let _ = write!(slug, "-{short}{}", value_text(v));
+            }
+        }
+        if self.clamp_window {
+            clamp_window(&mut t);
+        }
+        let _ = write!(slug, "-s{seed}");
+        let prefix = format!("p{index:0digits$}");
+        let id = format!(
+            "{prefix}{}",
+            sanitize(&slug, MAX_ID_CHARS.saturating_sub(prefix.len()))
+        );
+        // `sanitize` never starts with `.` or `_`, so put the dash back when it trimmed it.
+        let id = if id.len() > prefix.len() && !id[prefix.len()..].starts_with('-') {
+            format!("{prefix}-{}", &id[prefix.len()..])
+        } else {
+            id
+        };
+        t.insert("name".into(), toml::Value::String(id.clone()));
+        t.insert(
+            "seed".into(),
+            toml::Value::Integer(i64::try_from(seed).unwrap_or(i64::MAX)),
+        );
+        Ok(Point {
+            index,
+            id,
+            coords,
+            seed,
+            scenario: t,
+        })
+    }
+
+    /// Every point in order, one at a time.
+    pub fn points(&self) -> impl Iterator<Item = Result<Point, SweepError>> + '_ {
+        (0..self.count).map(|i| self.point(i))
+    }
+
+    /// Checks every point's scenario as `h8swarm run` checks a scenario file, calling `each`
+    /// with each point and its scenario (in order, one at a time).
+    ///
+    /// # Errors
+    /// The first point whose scenario is out of range (naming the point and the key), or
+    /// `each`'s error.
+    pub fn check_points(
+        &self,
+        mut each: impl FnMut(&Point, &Scenario) -> Result<(), SweepError>,
+    ) -> Result<(), SweepError> {
+        for p in self.points() {
+            let p = p?;
+            let s = p
+                .resolve()
+                .map_err(|e| SweepError::input(format!("{}: {e}", self.where_)))?;
+            each(&p, &s)?;
+        }
+        Ok(())
+    }
 }
 
 /// One point of a sweep: a full scenario.
@@ -192,11 +287,46 @@ pub fn toml_error(text: &str, e: &toml::de::Error) -> String {
     )
 }
 
+/// `text` safe to show on a terminal, in one line: every control character (ESC, newline,
+/// carriage return, tab, backspace, DEL, the C1 controls such as CSI) and every Unicode
+/// bidirectional control is written as an escape (`\e`, `\n`, `\r`, `\t`, `\u{9b}`), so
+/// no text from a file or an argument can move the cursor, recolour or retitle the terminal,
+/// or break a one-line message into lines. Everything else is kept as it is.
+///
+/// This is the one place where text that came from a user is made printable: every message
+/// that echoes a path, a value, a line of a file or a message built from them goes through
+/// it (the error line `h8swarm` prints, `sweep merge`'s and `sweep run`'s lists, `emu`'s
+/// reports).
+#[must_use]
+pub fn printable(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            '\u{1b}' => out.push_str("\\e"),
+            '\n' => out.push_str("\\n"),
+            '\r' => out.push_str("\\r"),
+            '\t' => out.push_str("\\t"),
+            c if c.is_control() || is_bidi_control(c) => {
+                let _ = write!(out, "\\u{{{:x}}}", u32::from(c));
+            }
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+/// The Unicode controls that reorder text on display (U+061C, U+200E, U+200F, U+202A to
+/// U+202E, U+2066 to U+2069).
+fn is_bidi_control(c: char) -> bool {
+    matches!(c, '\u{61c}' | '\u{200e}' | '\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}')
+}
+
 /// A message of several lines (the TOML parser's, with its source excerpt) in one: the
-/// excerpt's lines dropped, the rest joined by `: `.
+/// excerpt's lines dropped, the rest joined by `: `, and what is left made [`printable`].
 #[must_use]
 pub fn one_line(text: &str) -> String {
-    text.lines()
+    let joined = text
+        .lines()
         .map(str::trim)
         .filter(|l| {
             !l.is_empty()
@@ -207,7 +337,8 @@ pub fn one_line(text: &str) -> String {
                     .is_some_and(|(n, _)| n.trim().chars().all(|c| c.is_ascii_digit()))
         })
         .collect::<Vec<_>>()
-        .join(": ")
+        .join(": ");
+    printable(&joined)
 }
 
 /// Cuts a point's `window` to its `steps` (a point that shortens the run without naming a
@@ -399,10 +530,11 @@ fn list<'a>(v: &'a toml::Value, where_: &str) -> Result<&'a Vec<toml::Value>, Sw
 /// Parses and checks a sweep file's text; `file` names it in messages and anchors a relative
 /// `base` path.
 ///
+/// The points themselves are checked by [`Sweep::check_points`].
+///
 /// # Errors
 /// Bad TOML, an unknown or misplaced key, an empty or unequal list, a bad seed, too many
-/// points, a point whose scenario is out of range: each naming the file, the key or the point,
-/// and what is valid.
+/// points: each naming the file, the key, and what is valid.
 pub fn parse(text: &str, file: &Path) -> Result<Sweep, SweepError> {
     let where_ = format!("sweep file `{}`", file.display());
     let f: SweepFile = toml::from_str(text)
@@ -555,64 +687,15 @@ pub fn parse(text: &str, file: &Path) -> Result<Sweep, SweepError> {
         )));
     }
 
-    let digits = count.saturating_sub(1).to_string().len().max(4);
-    let mut points = Vec::with_capacity(count);
-    let mut coords = vec![0usize; axes.len()];
-    for index in 0..count {
-        let mut rest = index / seeds.len();
-        for (c, a) in coords.iter_mut().zip(&axes).rev() {
-            *c = rest % a.values.len();
-            rest /= a.values.len();
-        }
-        let seed = seeds[index % seeds.len()];
-        let mut t = table.clone();
-        let mut slug = String::new();
-        for (a, &c) in axes.iter().zip(&coords) {
-            for (k, v) in a.keys.iter().zip(&a.values[c]) {
-                set_key(&mut t, k, v.clone())
-                    .map_err(|e| SweepError::input(format!("{where_}: `{k}`: {e}")))?;
-                let short = k.rsplit('.').next().unwrap_or(k);
-                let _ = write!(slug, "-{short}{}", value_text(v));
-            }
-        }
-        if !window_given && !seen.contains("window") {
-            clamp_window(&mut t);
-        }
-        let _ = write!(slug, "-s{seed}");
-        let prefix = format!("p{index:0digits$}");
-        let id = format!(
-            "{prefix}{}",
-            sanitize(&slug, MAX_ID_CHARS.saturating_sub(prefix.len()))
-        );
-        // `sanitize` never starts with `.` or `_`, so put the dash back when it trimmed it.
-        let id = if id.len() > prefix.len() && !id[prefix.len()..].starts_with('-') {
-            format!("{prefix}-{}", &id[prefix.len()..])
-        } else {
-            id
-        };
-        t.insert("name".into(), toml::Value::String(id.clone()));
-        t.insert(
-            "seed".into(),
-            toml::Value::Integer(i64::try_from(seed).unwrap_or(i64::MAX)),
-        );
-        let p = Point {
-            index,
-            id,
-            coords: coords.clone(),
-            seed,
-            scenario: t,
-        };
-        p.resolve()
-            .map_err(|e| SweepError::input(format!("{where_}: {e}")))?;
-        points.push(p);
-    }
-
     Ok(Sweep {
         name,
         axes,
         seeds,
         slurm: f.slurm.unwrap_or_default(),
-        points,
+        count,
+        clamp_window: !window_given && !seen.contains("window"),
+        table,
+        where_,
     })
 }
 
@@ -620,8 +703,15 @@ pub fn parse(text: &str, file: &Path) -> Result<Sweep, SweepError> {
 mod tests {
     use super::*;
 
+    /// Parses and checks every point, as `sweep plan` does.
     fn sweep(text: &str) -> Result<Sweep, String> {
-        parse(text, Path::new("t.toml")).map_err(|e| e.to_string())
+        let s = parse(text, Path::new("t.toml")).map_err(|e| e.to_string())?;
+        s.check_points(|_, _| Ok(())).map_err(|e| e.to_string())?;
+        Ok(s)
+    }
+
+    fn points(s: &Sweep) -> Vec<Point> {
+        s.points().collect::<Result<_, _>>().unwrap()
     }
 
     #[test]
@@ -630,9 +720,10 @@ mod tests {
             "seeds = [4, 5]\n[set]\nsteps = 50\n[grid]\n\"learner.eta\" = [0, 0.01]\nlearner.history = [0, 1, 2]\n",
         )
         .unwrap();
-        assert_eq!(s.points.len(), 12);
+        assert_eq!(s.count, 12);
         assert_eq!(s.name, "t");
-        let p = &s.points[7];
+        let all = points(&s);
+        let p = &all[7];
         let sc = p.resolve().unwrap();
         assert_eq!(sc.steps, 50);
         assert_eq!(p.seed, 5);
@@ -648,7 +739,7 @@ mod tests {
         assert_eq!(sc.learner.history, p.coords[hist_axis]);
         assert!(p.id.starts_with("p0007-"), "{}", p.id);
         assert!(p.id.ends_with("-s5"), "{}", p.id);
-        let ids: BTreeSet<&str> = s.points.iter().map(|p| p.id.as_str()).collect();
+        let ids: BTreeSet<&str> = all.iter().map(|p| p.id.as_str()).collect();
         assert_eq!(ids.len(), 12);
     }
 
@@ -656,8 +747,8 @@ mod tests {
     fn zipped_keys_move_together() {
         let s = sweep("[[zip]]\nsteps = [40, 80]\nwindow = [10, 20]\n[grid]\nrobots = [3, 4]\n")
             .unwrap();
-        assert_eq!(s.points.len(), 4);
-        for p in &s.points {
+        assert_eq!(s.count, 4);
+        for p in &points(&s) {
             let sc = p.resolve().unwrap();
             assert_eq!(sc.window * 4, sc.steps);
         }
@@ -697,7 +788,7 @@ mod tests {
     fn ids_cannot_leave_the_folder() {
         let s =
             sweep("[grid]\n\"controller.symbols\" = [\"../../etc/passwd\", \"/x y\"]\n").unwrap();
-        for p in &s.points {
+        for p in &points(&s) {
             assert!(
                 !p.id.contains('/') && !p.id.contains(' ') && !p.id.contains(".."),
                 "{}",
@@ -711,5 +802,30 @@ mod tests {
         }
         assert_eq!(sanitize("eta0.001", 40), "eta0.001");
         assert_eq!(sanitize("a b//c", 40), "a_b_c");
+    }
+
+    #[test]
+    fn printable_text_has_no_control_characters_left() {
+        assert_eq!(printable("plain `x` = 1.5"), "plain `x` = 1.5");
+        assert_eq!(printable("a\u{1b}]0;title\u{7}b"), "a\\e]0;title\\u{7}b");
+        assert_eq!(printable("two\nlines\r\t"), "two\\nlines\\r\\t");
+        assert_eq!(
+            printable("\u{9b}31m\u{202e}x\u{7f}"),
+            "\\u{9b}31m\\u{202e}x\\u{7f}"
+        );
+        assert_eq!(printable("Ω é"), "Ω é");
+        for c in (0u32..0x110000).filter_map(char::from_u32) {
+            let p = printable(&c.to_string());
+            assert!(
+                !p.chars().any(|c| c.is_control() || is_bidi_control(c)),
+                "U+{:04X}",
+                u32::from(c)
+            );
+        }
+        // A TOML error with a source excerpt is one printable line.
+        assert_eq!(
+            one_line("TOML parse error at line 1\n  |\n1 | a\u{1b}\n  |\n bad \u{1b}[2J"),
+            "bad \\e[2J"
+        );
     }
 }

@@ -552,6 +552,11 @@ impl FirmwareController {
         self.phases = Some(p);
     }
 
+    /// The phase signal being recorded, if one is (to take its changes as they come).
+    pub fn phases_mut(&mut self) -> Option<&mut PhaseRecorder> {
+        self.phases.as_mut()
+    }
+
     /// Stops recording phases and returns the changes recorded (empty if none were).
     pub fn take_phases(&mut self) -> Vec<(u64, String)> {
         self.phases.take().map(|mut p| p.take()).unwrap_or_default()

@@ -84,6 +84,10 @@ impl SymbolTable {
             let (Some(kind), None) = (kind.next(), kind.next()) else {
                 return Err(bad());
             };
+            // A name is shown in traces and on the terminal: no control characters.
+            if name.chars().any(char::is_control) || kind.is_control() {
+                return Err(bad());
+            }
             symbols.push(Symbol {
                 addr: (addr & 0xFF_FFFF) as u32,
                 kind,

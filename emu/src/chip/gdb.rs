@@ -49,9 +49,9 @@ use std::time::Duration;
 
 use gdbstub::arch::{Arch, RegId, Registers};
 use gdbstub::common::Signal;
-use gdbstub::conn::ConnectionExt;
 use gdbstub::outputln;
-use gdbstub::stub::{DisconnectReason, GdbStub, SingleThreadStopReason, run_blocking};
+use gdbstub::stub::state_machine::GdbStubStateMachine;
+use gdbstub::stub::{DisconnectReason, GdbStub, SingleThreadStopReason};
 use gdbstub::target::ext::base::BaseOps;
 use gdbstub::target::ext::base::singlethread::{
     SingleThreadBase, SingleThreadResume, SingleThreadResumeOps, SingleThreadSingleStep,
@@ -317,10 +317,33 @@ struct RemoteTarget {
     requests: Sender<Request>,
     replies: Receiver<Reply>,
     control: Arc<AtomicU8>,
+    /// A stand-in that answers every request itself and reaches no program: it runs each
+    /// packet through a throwaway stub first, to learn whether the real one can take it.
+    probe: bool,
 }
 
 impl RemoteTarget {
+    /// A stand-in with the real target's abilities ([`RemoteTarget::probe`]).
+    fn probe() -> RemoteTarget {
+        let (requests, _) = mpsc::channel();
+        let (_, replies) = mpsc::channel();
+        RemoteTarget {
+            requests,
+            replies,
+            control: Arc::new(AtomicU8::new(0)),
+            probe: true,
+        }
+    }
+
     fn ask(&mut self, r: Request) -> Result<Reply, &'static str> {
+        if self.probe {
+            return Ok(match r {
+                Request::ReadRegs => Reply::Regs(H8Registers::default()),
+                Request::ReadMem(_, len) => Reply::Mem(vec![0; len.min(1 << 16)]),
+                Request::Monitor(_) => Reply::Text(String::new()),
+                _ => Reply::Done(true),
+            });
+        }
         self.requests
             .send(r)
             .map_err(|_| "the emulated program has ended")?;
@@ -356,6 +379,11 @@ impl Target for RemoteTarget {
 
     fn support_monitor_cmd(&mut self) -> Option<MonitorCmdOps<'_, Self>> {
         Some(self)
+    }
+
+    // Every packet is acknowledged (the framing in front of the stub relies on it).
+    fn use_no_ack_mode(&self) -> bool {
+        false
     }
 }
 
@@ -407,6 +435,9 @@ impl SingleThreadBase for RemoteTarget {
 
 impl SingleThreadResume for RemoteTarget {
     fn resume(&mut self, _signal: Option<Signal>) -> Result<(), Self::Error> {
+        if self.probe {
+            return Ok(());
+        }
         self.requests
             .send(Request::Resume)
             .map_err(|_| "the emulated program has ended")
@@ -419,6 +450,9 @@ impl SingleThreadResume for RemoteTarget {
 
 impl SingleThreadSingleStep for RemoteTarget {
     fn step(&mut self, _signal: Option<Signal>) -> Result<(), Self::Error> {
+        if self.probe {
+            return Ok(());
+        }
         self.requests
             .send(Request::Step)
             .map_err(|_| "the emulated program has ended")
@@ -518,57 +552,412 @@ impl MonitorCmd for RemoteTarget {
     }
 }
 
-/// The blocking event loop of the stub's thread.
-enum StubLoop {}
+/// The largest packet the stub takes, `$`, body, `#` and checksum included: the stub's
+/// packet buffer, which it offers the client as `PacketSize` in its `qSupported` reply (a
+/// client sends no larger packets).
+pub const MAX_PACKET_BYTES: usize = 4096;
 
-impl run_blocking::BlockingEventLoop for StubLoop {
-    type Target = RemoteTarget;
-    type Connection = TcpStream;
-    type StopReason = SingleThreadStopReason<u32>;
+/// The error a packet longer than [`MAX_PACKET_BYTES`] gets (`E07`: E2BIG).
+const E_TOO_LONG: &str = "E07";
+/// The error a packet the stub cannot parse gets (`E16`: EINVAL, 22).
+const E_MALFORMED: &str = "E16";
 
-    #[allow(clippy::type_complexity)]
-    fn wait_for_stop_reason(
-        target: &mut RemoteTarget,
-        conn: &mut TcpStream,
-    ) -> Result<
-        run_blocking::Event<SingleThreadStopReason<u32>>,
-        run_blocking::WaitForStopReasonError<&'static str, io::Error>,
-    > {
-        loop {
-            match target.replies.recv_timeout(Duration::from_millis(5)) {
-                Ok(Reply::Stopped(kind)) => {
-                    return Ok(run_blocking::Event::TargetStopped(kind.reason()));
-                }
-                Ok(_) => {}
-                Err(RecvTimeoutError::Timeout) => match ConnectionExt::peek(conn) {
-                    Ok(Some(_)) => {
-                        let byte = ConnectionExt::read(conn)
-                            .map_err(run_blocking::WaitForStopReasonError::Connection)?;
-                        return Ok(run_blocking::Event::IncomingData(byte));
-                    }
-                    Ok(None) => {}
-                    Err(e) => {
-                        return Err(run_blocking::WaitForStopReasonError::Connection(e));
-                    }
-                },
-                Err(RecvTimeoutError::Disconnected) => {
-                    return Ok(run_blocking::Event::TargetStopped(
-                        SingleThreadStopReason::Terminated(Signal::SIGKILL),
-                    ));
-                }
-            }
+/// What arrived from the client, framed.
+#[derive(Clone, Debug, PartialEq, Eq)]
+enum Incoming {
+    /// A whole packet, `$…#xx` with a right checksum, at most [`MAX_PACKET_BYTES`].
+    Packet(Vec<u8>),
+    /// A packet whose checksum is wrong (or not hex): answered with `-`.
+    BadChecksum,
+    /// A packet with a right checksum, longer than the stub takes.
+    TooLong,
+    /// Ctrl-C (0x03).
+    Interrupt,
+    /// `-`: the client wants the last reply again.
+    Nack,
+}
+
+/// Where the framer is in a packet.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Frame {
+    /// Between packets (bytes other than `$`, 0x03, `+` and `-` are dropped).
+    Idle,
+    /// In a packet's body.
+    Body,
+    /// After `#`: the checksum's first digit comes.
+    Check1,
+    /// The checksum's second digit comes.
+    Check2(u8),
+}
+
+/// Frames the client's bytes into packets in bounded memory: a packet's body is kept up to
+/// [`MAX_PACKET_BYTES`] and only summed beyond, so an endless packet costs reading, not
+/// memory; bytes are read in blocks, not one system call each.
+struct Framer {
+    stream: TcpStream,
+    buf: Vec<u8>,
+    at: usize,
+    len: usize,
+    frame: Frame,
+    packet: Vec<u8>,
+    sum: u8,
+    overflow: bool,
+}
+
+impl Framer {
+    fn new(stream: TcpStream) -> Framer {
+        Framer {
+            stream,
+            buf: vec![0; 16 * 1024],
+            at: 0,
+            len: 0,
+            frame: Frame::Idle,
+            packet: Vec::with_capacity(MAX_PACKET_BYTES),
+            sum: 0,
+            overflow: false,
         }
     }
 
-    fn on_interrupt(
-        target: &mut RemoteTarget,
-    ) -> Result<Option<SingleThreadStopReason<u32>>, &'static str> {
-        // The program's side stops at its next step and reports SIGINT.
-        target.control.fetch_or(CTL_INTERRUPT, Ordering::SeqCst);
-        Ok(None)
+    /// The next thing the client sent; `None` when nothing is there and `wait` is false.
+    ///
+    /// # Errors
+    /// The connection's errors; the end of the stream as `UnexpectedEof`.
+    fn next(&mut self, wait: bool) -> io::Result<Option<Incoming>> {
+        use std::io::Read;
+        loop {
+            while self.at < self.len {
+                let b = self.buf[self.at];
+                self.at += 1;
+                if let Some(item) = self.take(b) {
+                    return Ok(Some(item));
+                }
+            }
+            self.stream.set_nonblocking(!wait)?;
+            let n = match self.stream.read(&mut self.buf) {
+                Ok(0) => {
+                    return Err(io::Error::new(
+                        io::ErrorKind::UnexpectedEof,
+                        "the client closed the connection",
+                    ));
+                }
+                Ok(n) => n,
+                Err(e) if e.kind() == io::ErrorKind::WouldBlock => return Ok(None),
+                Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
+                Err(e) => return Err(e),
+            };
+            self.at = 0;
+            self.len = n;
+        }
+    }
+
+    /// One byte through the framing.
+    fn take(&mut self, b: u8) -> Option<Incoming> {
+        match self.frame {
+            Frame::Idle => match b {
+                b'$' => self.start(),
+                0x03 => return Some(Incoming::Interrupt),
+                b'-' => return Some(Incoming::Nack),
+                _ => {}
+            },
+            // A `$` in a body starts a new packet (the old one was cut off), as GDB does.
+            Frame::Body if b == b'$' => self.start(),
+            Frame::Body if b == b'#' => self.frame = Frame::Check1,
+            Frame::Body => {
+                self.sum = self.sum.wrapping_add(b);
+                if self.packet.len() + 3 < MAX_PACKET_BYTES {
+                    self.packet.push(b);
+                } else {
+                    self.overflow = true;
+                }
+            }
+            Frame::Check1 => self.frame = Frame::Check2(b),
+            Frame::Check2(first) => {
+                self.frame = Frame::Idle;
+                let hex = |c: u8| (c as char).to_digit(16);
+                let given = hex(first).zip(hex(b)).map(|(h, l)| (h * 16 + l) as u8);
+                return Some(if given != Some(self.sum) {
+                    Incoming::BadChecksum
+                } else if self.overflow {
+                    Incoming::TooLong
+                } else {
+                    let mut p = std::mem::take(&mut self.packet);
+                    p.push(b'#');
+                    p.push(first);
+                    p.push(b);
+                    Incoming::Packet(p)
+                });
+            }
+        }
+        None
+    }
+
+    fn start(&mut self) {
+        self.frame = Frame::Body;
+        self.packet.clear();
+        self.packet.push(b'$');
+        self.sum = 0;
+        self.overflow = false;
     }
 }
 
+/// `$body#xx`.
+fn packet(body: &[u8]) -> Vec<u8> {
+    let sum = body.iter().fold(0u8, |a, b| a.wrapping_add(*b));
+    let mut p = Vec::with_capacity(body.len() + 4);
+    p.push(b'$');
+    p.extend_from_slice(body);
+    p.extend_from_slice(format!("#{sum:02x}").as_bytes());
+    p
+}
+
+/// The stub's side of the connection: replies are sent whole when the stub flushes, and the
+/// last one is kept to send again when the client answers it with `-`.
+struct Wire {
+    stream: TcpStream,
+    pending: Vec<u8>,
+    /// The last packet sent (by the stub or by the framing), shared by both writers.
+    last: std::rc::Rc<std::cell::RefCell<Vec<u8>>>,
+}
+
+impl gdbstub::conn::Connection for Wire {
+    type Error = io::Error;
+
+    fn write(&mut self, byte: u8) -> io::Result<()> {
+        self.pending.push(byte);
+        Ok(())
+    }
+
+    fn write_all(&mut self, buf: &[u8]) -> io::Result<()> {
+        self.pending.extend_from_slice(buf);
+        Ok(())
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        if self.pending.is_empty() {
+            return Ok(());
+        }
+        self.stream.set_nonblocking(false)?;
+        io::Write::write_all(&mut self.stream, &self.pending)?;
+        if let Some(at) = self.pending.iter().position(|&b| b == b'$') {
+            *self.last.borrow_mut() = self.pending[at..].to_vec();
+        }
+        self.pending.clear();
+        Ok(())
+    }
+}
+
+impl Wire {
+    /// Acknowledges a packet and answers it with `body` (what the stub does for one it takes).
+    fn answer(&mut self, body: &str) -> io::Result<()> {
+        use gdbstub::conn::Connection;
+        self.write(b'+')?;
+        self.write_all(&packet(body.as_bytes()))?;
+        self.flush()
+    }
+
+    fn send_raw(&mut self, bytes: &[u8]) -> io::Result<()> {
+        self.stream.set_nonblocking(false)?;
+        io::Write::write_all(&mut self.stream, bytes)
+    }
+}
+
+/// A sink for the throwaway stubs' replies.
+struct NullConn;
+
+impl gdbstub::conn::Connection for NullConn {
+    type Error = ();
+
+    fn write(&mut self, _: u8) -> Result<(), ()> {
+        Ok(())
+    }
+
+    fn flush(&mut self) -> Result<(), ()> {
+        Ok(())
+    }
+}
+
+/// Whether the stub can take `p` (a whole packet with a right checksum): it is run through a
+/// throwaway stub whose target answers everything itself. A packet the stub cannot parse
+/// would end the real session, so it is answered with an error instead.
+fn stub_takes(p: &[u8]) -> bool {
+    let mut target = RemoteTarget::probe();
+    let Ok(stub) = GdbStub::<RemoteTarget, NullConn>::builder(NullConn)
+        .packet_buffer_size(MAX_PACKET_BYTES)
+        .build()
+    else {
+        return false;
+    };
+    let Ok(mut sm) = stub.run_state_machine(&mut target) else {
+        return false;
+    };
+    for &b in p {
+        sm = match sm {
+            GdbStubStateMachine::Idle(g) => match g.incoming_data(&mut target, b) {
+                Ok(next) => next,
+                Err(_) => return false,
+            },
+            // The packet ended (a resume, a kill, a detach): it was taken.
+            _ => return true,
+        };
+    }
+    true
+}
+
+/// A bare `qSupported` (the client lists no features, which the protocol allows) as the
+/// stub parses it: the same request with the one feature it knows declined.
+fn normalised(p: Vec<u8>) -> Vec<u8> {
+    if p.starts_with(b"$qSupported#") {
+        packet(b"qSupported:multiprocess-")
+    } else {
+        p
+    }
+}
+
+/// How a session ended.
+#[derive(Debug)]
+enum SessionEnd {
+    /// The client detached, killed the program, or the program ended.
+    Ended(DisconnectReason),
+    /// The connection failed or closed without a detach.
+    Lost(String),
+}
+
+/// Runs the stub on `conn` until the session ends: packets are framed here (bounded, bad
+/// checksums answered with `-`, packets the stub cannot take answered with an error) and fed
+/// to `gdbstub`'s state machine; while the program runs, its stop reports and the client's
+/// bytes are watched in turn.
+fn serve(conn: TcpStream, target: &mut RemoteTarget) -> SessionEnd {
+    use gdbstub::stub::state_machine::GdbStubStateMachine as Sm;
+    let lost = |e: &dyn std::fmt::Display| SessionEnd::Lost(e.to_string());
+    let reader = match conn.try_clone() {
+        Ok(r) => r,
+        Err(e) => return lost(&e),
+    };
+    let mut framer = Framer::new(reader);
+    let last = std::rc::Rc::new(std::cell::RefCell::new(Vec::new()));
+    let mut wire_out = match conn.try_clone() {
+        Ok(w) => Wire {
+            stream: w,
+            pending: Vec::new(),
+            last: std::rc::Rc::clone(&last),
+        },
+        Err(e) => return lost(&e),
+    };
+    let wire = Wire {
+        stream: conn,
+        pending: Vec::new(),
+        last: std::rc::Rc::clone(&last),
+    };
+    let stub = match GdbStub::<RemoteTarget, Wire>::builder(wire)
+        .packet_buffer_size(MAX_PACKET_BYTES)
+        .build()
+    {
+        Ok(s) => s,
+        Err(e) => return lost(&e),
+    };
+    let mut sm = match stub.run_state_machine(target) {
+        Ok(sm) => sm,
+        Err(e) => return lost(&e),
+    };
+    loop {
+        let incoming = match sm {
+            Sm::Disconnected(mut g) => {
+                // What the stub wrote last and did not flush (the acknowledgement of a kill).
+                let _ = gdbstub::conn::Connection::flush(g.borrow_conn());
+                return SessionEnd::Ended(g.get_reason());
+            }
+            Sm::CtrlCInterrupt(g) => {
+                // The program's side stops at its next step and reports SIGINT.
+                target.control.fetch_or(CTL_INTERRUPT, Ordering::SeqCst);
+                sm = match g.interrupt_handled(target, None::<SingleThreadStopReason<u32>>) {
+                    Ok(next) => next,
+                    Err(e) => return lost(&e),
+                };
+                continue;
+            }
+            Sm::Idle(g) => {
+                sm = Sm::Idle(g);
+                match framer.next(true) {
+                    Ok(Some(i)) => i,
+                    Ok(None) => continue,
+                    Err(e) => return lost(&e),
+                }
+            }
+            Sm::Running(g) => {
+                match target.replies.recv_timeout(Duration::from_millis(5)) {
+                    Ok(Reply::Stopped(kind)) => {
+                        sm = match g.report_stop(target, kind.reason()) {
+                            Ok(next) => next,
+                            Err(e) => return lost(&e),
+                        };
+                        continue;
+                    }
+                    Ok(_) | Err(RecvTimeoutError::Timeout) => {}
+                    Err(RecvTimeoutError::Disconnected) => {
+                        let reason = SingleThreadStopReason::Terminated(Signal::SIGKILL);
+                        sm = match g.report_stop(target, reason) {
+                            Ok(next) => next,
+                            Err(e) => return lost(&e),
+                        };
+                        continue;
+                    }
+                }
+                sm = Sm::Running(g);
+                match framer.next(false) {
+                    Ok(Some(i)) => i,
+                    Ok(None) => continue,
+                    Err(e) => return lost(&e),
+                }
+            }
+        };
+        let bytes = match incoming {
+            Incoming::Packet(p) => {
+                let p = normalised(p);
+                if !stub_takes(&p) {
+                    if let Err(e) = wire_out.answer(E_MALFORMED) {
+                        return lost(&e);
+                    }
+                    continue;
+                }
+                p
+            }
+            Incoming::Interrupt => vec![0x03],
+            Incoming::BadChecksum => {
+                if let Err(e) = wire_out.send_raw(b"-") {
+                    return lost(&e);
+                }
+                continue;
+            }
+            Incoming::TooLong => {
+                if let Err(e) = wire_out.answer(E_TOO_LONG) {
+                    return lost(&e);
+                }
+                continue;
+            }
+            Incoming::Nack => {
+                let again = last.borrow().clone();
+                if !again.is_empty()
+                    && let Err(e) = wire_out.send_raw(&again)
+                {
+                    return lost(&e);
+                }
+                continue;
+            }
+        };
+        for b in bytes {
+            let next = match sm {
+                Sm::Idle(g) => g.incoming_data(target, b),
+                Sm::Running(g) => g.incoming_data(target, b),
+                other => Ok(other),
+            };
+            sm = match next {
+                Ok(next) => next,
+                // Not reached for a packet the probe took; the session cannot go on.
+                Err(e) => return SessionEnd::Lost(format!("a protocol error: {e}")),
+            };
+        }
+    }
+}
 /// How the program's side runs between stops.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum RunMode {
@@ -620,13 +1009,20 @@ impl Debugger {
             requests: req_tx,
             replies: rep_rx,
             control: Arc::clone(&control),
+            probe: false,
         };
+        let peer = conn
+            .peer_addr()
+            .map_or_else(|_| "the client".to_string(), |a| a.to_string());
         let thread = std::thread::spawn(move || {
-            let stub: GdbStub<'_, RemoteTarget, TcpStream> = GdbStub::new(conn);
-            let kill = matches!(
-                stub.run_blocking::<StubLoop>(&mut target),
-                Ok(DisconnectReason::Kill)
-            );
+            let end = serve(conn, &mut target);
+            let kill = matches!(end, SessionEnd::Ended(DisconnectReason::Kill));
+            if let SessionEnd::Lost(why) = &end {
+                // Said where the user sees it: the program goes on without the debugger.
+                eprintln!(
+                    "GDB stub: the debugger at {peer} is lost ({why}) without detaching; the program runs on without it"
+                );
+            }
             target.control.fetch_or(
                 if kill { CTL_KILL | CTL_GONE } else { CTL_GONE },
                 Ordering::SeqCst,

@@ -610,6 +610,57 @@ impl<B: Board> Mcu<B> {
         self.tracer.as_ref().and_then(|t| t.last_accepted())
     }
 
+    /// The pin trace under way: its first instant and every signal's level then.
+    #[must_use]
+    pub fn trace_beginning(&self) -> Option<(u64, [bool; 12])> {
+        self.tracer.as_ref().map(|t| t.beginning())
+    }
+
+    /// Changes of the pin trace under way recorded and not yet drained.
+    #[must_use]
+    pub fn trace_pending(&self) -> usize {
+        self.tracer.as_ref().map_or(0, |t| t.pending())
+    }
+
+    /// Hands the pin trace's changes up to now to `sink`, a slice of at most `slice` states at
+    /// a time (so a long stretch without a register write, e.g. a sleep with the PWM running,
+    /// is never held whole): for each slice, the changes before its end and that end, below
+    /// which the trace is final. The trace goes on; nothing it records changes.
+    ///
+    /// # Errors
+    /// `sink`'s.
+    pub fn drain_trace(
+        &mut self,
+        slice: u64,
+        sink: &mut dyn FnMut(Vec<crate::chip::trace::PinChange>, u64) -> std::io::Result<()>,
+    ) -> std::io::Result<()> {
+        let now = self.now;
+        loop {
+            let Some(t) = self.tracer.as_mut() else {
+                return Ok(());
+            };
+            // A slice never ends before the EEPROM bus's own clock (its logged changes up to
+            // there are taken whole).
+            let to = t
+                .caught_up()
+                .saturating_add(slice.max(1))
+                .max(self.i2c.now())
+                .min(now);
+            t.catch_up(
+                to,
+                ChipView {
+                    ports: &self.ports,
+                    i2c: &mut self.i2c,
+                },
+            );
+            let changes = t.drain_before(to);
+            sink(changes, to)?;
+            if to >= now {
+                return Ok(());
+            }
+        }
+    }
+
     /// Ends the pin trace now and returns it (`None` when none was under way).
     pub fn finish_trace(&mut self) -> Option<PinTrace> {
         let mut tracer = self.tracer.take()?;

@@ -217,6 +217,29 @@ pub struct Probes<'a> {
     /// A GDB client's control of the run ([`crate::chip::gdb::Debugger`]): breakpoints,
     /// watchpoints, single steps; the run waits while the client has the program stopped.
     pub debugger: Option<&'a mut crate::chip::gdb::Debugger>,
+    /// Where the pin trace under way (and the phases) go as the run makes them
+    /// ([`crate::chip::vcd::VcdStream`]): written whenever [`crate::chip::vcd::DRAIN_CHANGES`]
+    /// changes wait or [`crate::chip::vcd::DRAIN_SLICE_STATES`] states passed, so the trace is
+    /// never held whole. What is left at the end is the caller's to finish.
+    pub vcd: Option<&'a mut crate::chip::vcd::VcdStream<'static>>,
+}
+
+/// Writes the pin trace's and the phases' changes up to now into `vcd` (see [`Probes::vcd`]).
+///
+/// # Errors
+/// The file's I/O errors.
+pub fn drain_into<B: Board>(
+    vcd: &mut crate::chip::vcd::VcdStream<'_>,
+    machine: &mut Mcu<B>,
+    mut phases: Option<&mut PhaseRecorder>,
+) -> std::io::Result<()> {
+    machine.drain_trace(crate::chip::vcd::DRAIN_SLICE_STATES, &mut |pins, upto| {
+        let ph = phases
+            .as_deref_mut()
+            .map(|p| p.drain_before(upto))
+            .unwrap_or_default();
+        vcd.write_until(&pins, &ph, upto)
+    })
 }
 
 /// [`run_mcu`] with every probe: an instruction trace naming the code, the phase signal of a
@@ -236,7 +259,9 @@ pub fn run_mcu_probed<B: Board>(
         names,
         mut phases,
         mut debugger,
+        mut vcd,
     } = probes;
+    let mut drained_at = machine.now();
     let deadline = options.max_states.unwrap_or(u64::MAX);
     if let Some(p) = phases.as_deref_mut() {
         p.observe(machine.now(), cpu.pc());
@@ -306,6 +331,16 @@ pub fn run_mcu_probed<B: Board>(
                 }
                 _ => {}
             }
+        }
+        if let Some(v) = vcd.as_deref_mut()
+            && (machine.trace_pending() >= crate::chip::vcd::DRAIN_CHANGES
+                || phases
+                    .as_deref()
+                    .is_some_and(|p| p.pending() >= crate::chip::vcd::DRAIN_CHANGES)
+                || machine.now() - drained_at >= crate::chip::vcd::DRAIN_SLICE_STATES)
+        {
+            drain_into(v, machine, phases.as_deref_mut())?;
+            drained_at = machine.now();
         }
         match event {
             Ok(Event::Executed) => {}

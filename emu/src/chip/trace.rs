@@ -376,6 +376,32 @@ impl Tracer {
         self.interrupts.last().copied()
     }
 
+    /// The trace's first instant and the levels then.
+    pub(crate) fn beginning(&self) -> (u64, [bool; 12]) {
+        (self.start, self.initial)
+    }
+
+    /// Changes recorded and not yet drained.
+    pub(crate) fn pending(&self) -> usize {
+        self.changes.len()
+    }
+
+    /// Changes are recorded up to this instant.
+    pub(crate) fn caught_up(&self) -> u64 {
+        self.caught_up
+    }
+
+    /// Takes the changes before `t` (in time order; the later ones stay) and the interrupts
+    /// accepted before it (only the last is kept, for [`Tracer::last_accepted`]).
+    pub(crate) fn drain_before(&mut self, t: u64) -> Vec<PinChange> {
+        self.changes.sort_by_key(|c| c.t);
+        let n = self.changes.partition_point(|c| c.t < t);
+        let last = self.interrupts.last().copied();
+        self.interrupts.clear();
+        self.interrupts.extend(last);
+        self.changes.drain(..n).collect()
+    }
+
     /// Ends the trace at `now` (after [`Tracer::catch_up`]).
     pub(crate) fn finish(mut self, now: u64, clock_hz: u32, i2c: &mut I2cBus) -> PinTrace {
         i2c.set_line_log(false);
@@ -469,6 +495,18 @@ impl PhaseRecorder {
     #[must_use]
     pub fn changes(&self) -> &[(u64, String)] {
         &self.changes
+    }
+
+    /// Changes recorded and not yet taken.
+    #[must_use]
+    pub fn pending(&self) -> usize {
+        self.changes.len()
+    }
+
+    /// Takes the changes before `t` (the later ones stay; the phase being recorded goes on).
+    pub fn drain_before(&mut self, t: u64) -> Vec<(u64, String)> {
+        let n = self.changes.partition_point(|c| c.0 < t);
+        self.changes.drain(..n).collect()
     }
 
     /// Takes the changes recorded so far and starts afresh (the next observation records

@@ -23,7 +23,7 @@ use std::io::{self, Write};
 
 use vcd::{IdCode, SimulationCommand, TimescaleUnit, Value, VarType, Writer};
 
-use crate::chip::trace::{PinTrace, Signal};
+use crate::chip::trace::{PinChange, PinTrace, Signal};
 
 /// The VCD time unit for a clock: (count, unit) for `$timescale`, and how many such units one
 /// state lasts, or `None` when a state is no whole number of femtoseconds.
@@ -82,129 +82,227 @@ pub struct VcdInfo {
     pub source: String,
 }
 
-/// Writes `trace` (and the phase changes, if any) as a VCD file to `out`.
+/// Memory a streamed trace may hold between two writes, for a run's memory estimate: the pin
+/// changes and phase changes of one drain (a robot's step, or at most
+/// [`DRAIN_CHANGES`] changes and [`DRAIN_SLICE_STATES`] of `h8swarm emu`'s run), with a margin.
+pub const STREAM_BUFFER_BYTES: u64 = 64 << 20;
+/// `h8swarm emu --vcd` writes what it traced once this many changes wait.
+pub const DRAIN_CHANGES: usize = 1 << 16;
+/// ... or once this many states passed since the last write; a trace is also caught up at
+/// most this many states at a time (a long sleep with the PWM running makes its edges a
+/// slice at a time, not all at once).
+pub const DRAIN_SLICE_STATES: u64 = 1 << 20;
+
+/// A VCD file written as the trace is made: the header and the values at the start first,
+/// then the changes below an instant each time [`VcdStream::write_until`] is given them (pin
+/// changes and phase changes, each final below that instant, merged in time order), then
+/// the end ([`VcdStream::finish`]). Nothing but the changes of one write is held, so a trace
+/// of any length takes bounded memory; the file is the same byte for byte as [`write_vcd`]
+/// writes from the whole trace.
+pub struct VcdStream<'w> {
+    w: Writer<io::BufWriter<Box<dyn Write + Send + 'w>>>,
+    clock: Clock,
+    ids: Vec<IdCode>,
+    phase_id: Option<IdCode>,
+    levels: [bool; 12],
+    phase_now: Option<String>,
+    start: u64,
+}
+
+impl std::fmt::Debug for VcdStream<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("VcdStream")
+            .field("start", &self.start)
+            .finish_non_exhaustive()
+    }
+}
+
+impl<'w> VcdStream<'w> {
+    /// Writes the header and the values at `start` (`initial`: each signal's level in
+    /// [`Signal::ALL`] order; `phase`: `Some(name)` for a trace with a phase signal, the
+    /// name at `start`).
+    ///
+    /// # Errors
+    /// The writer's I/O errors.
+    pub fn start(
+        out: Box<dyn Write + Send + 'w>,
+        clock_hz: u32,
+        start: u64,
+        initial: [bool; 12],
+        phase: Option<&str>,
+        info: &VcdInfo,
+    ) -> io::Result<VcdStream<'w>> {
+        let ((count, unit), per_state) = timescale_for(clock_hz);
+        let clock = Clock {
+            hz: clock_hz,
+            per_state,
+        };
+        let mut w = Writer::new(io::BufWriter::with_capacity(1 << 16, out));
+        w.version(concat!("h8swarm ", env!("CARGO_PKG_VERSION")))?;
+        let state_ns = 1e9 / f64::from(clock_hz.max(1));
+        let conversion = match per_state {
+            Some(k) => format!("timestamp = states x {k}"),
+            None => "timestamp = states x 1e15 / phi, rounded to the nearest fs".to_string(),
+        };
+        let mut comment = format!(
+            "H8/3052F pin trace. {source}. Clock phi = {clock_hz} Hz: 1 state = {state_ns} ns; \
+             timescale {count} {unit}, {conversion} (states since the MCU's reset). \
+             Trace from state {start} to the last timestamp.",
+            source = if info.source.is_empty() {
+                "h8swarm"
+            } else {
+                &info.source
+            },
+        );
+        for s in Signal::ALL {
+            comment.push_str(&format!(" {}: {}.", s.name(), s.description()));
+        }
+        if phase.is_some() {
+            comment.push_str(" phase: the function that runs (symbol table).");
+        }
+        w.comment(&comment)?;
+        w.timescale(count, unit)?;
+        w.add_module("h8_3052f")?;
+        let mut ids: Vec<IdCode> = Vec::with_capacity(Signal::ALL.len());
+        for s in Signal::ALL {
+            ids.push(w.add_wire(1, s.name())?);
+        }
+        w.upscope()?;
+        let phase_id = match phase {
+            Some(_) => {
+                w.add_module("firmware")?;
+                let id = w.add_var(VarType::String, 1, "phase", None)?;
+                w.upscope()?;
+                Some(id)
+            }
+            None => None,
+        };
+        w.enddefinitions()?;
+        w.timestamp(clock.stamp(start))?;
+        w.begin(SimulationCommand::Dumpvars)?;
+        for (i, id) in ids.iter().enumerate() {
+            w.change_scalar(*id, bit(initial[i]))?;
+        }
+        if let (Some(id), Some(name)) = (phase_id, phase) {
+            w.change_string(id, name)?;
+        }
+        w.end()?;
+        Ok(VcdStream {
+            w,
+            clock,
+            ids,
+            phase_id,
+            levels: initial,
+            phase_now: phase.map(str::to_string),
+            start,
+        })
+    }
+
+    /// Writes the changes (each list in time order) at instants below `upto`, after `start`;
+    /// at one instant only a signal's last level is written, and only if it changed. Changes
+    /// at `upto` or later are not written: give them again with a later `upto`.
+    ///
+    /// # Errors
+    /// The writer's I/O errors.
+    pub fn write_until(
+        &mut self,
+        pins: &[PinChange],
+        phases: &[(u64, String)],
+        upto: u64,
+    ) -> io::Result<()> {
+        let (mut i, mut k) = (0, 0);
+        // Phases at or before the start are the start's value.
+        while k < phases.len() && phases[k].0 <= self.start {
+            self.phase_now = Some(phases[k].1.clone());
+            k += 1;
+        }
+        loop {
+            let t = match (pins.get(i).map(|c| c.t), phases.get(k).map(|p| p.0)) {
+                (Some(a), Some(b)) => a.min(b),
+                (Some(a), None) => a,
+                (None, Some(b)) => b,
+                (None, None) => break,
+            };
+            if t >= upto {
+                break;
+            }
+            let mut now = self.levels;
+            while let Some(c) = pins.get(i).filter(|c| c.t == t) {
+                now[c.signal as usize] = c.level;
+                i += 1;
+            }
+            let mut phase_at: Option<&str> = self.phase_now.as_deref();
+            while let Some(p) = phases.get(k).filter(|p| p.0 == t) {
+                phase_at = Some(p.1.as_str());
+                k += 1;
+            }
+            let phase_changed = phase_at != self.phase_now.as_deref();
+            if now != self.levels || phase_changed {
+                self.w.timestamp(self.clock.stamp(t))?;
+                for (n, id) in self.ids.iter().enumerate() {
+                    if now[n] != self.levels[n] {
+                        self.w.change_scalar(*id, bit(now[n]))?;
+                    }
+                }
+                if let (true, Some(id), Some(name)) = (phase_changed, self.phase_id, phase_at) {
+                    self.w.change_string(id, name)?;
+                }
+            }
+            self.levels = now;
+            if phase_changed {
+                self.phase_now = phase_at.map(str::to_string);
+            }
+        }
+        Ok(())
+    }
+
+    /// Writes the changes before `end` and the end's timestamp, and flushes the file.
+    ///
+    /// # Errors
+    /// The writer's I/O errors.
+    pub fn finish(
+        mut self,
+        pins: &[PinChange],
+        phases: &[(u64, String)],
+        end: u64,
+    ) -> io::Result<()> {
+        self.write_until(pins, phases, end.saturating_add(1))?;
+        self.w.timestamp(self.clock.stamp(end.max(self.start)))?;
+        self.w.flush()
+    }
+}
+
+/// Writes `trace` (and the phase changes, if any) as a VCD file to `out` (a [`VcdStream`]
+/// given the whole trace at once).
 ///
 /// # Errors
 /// Only the writer's I/O errors.
-pub fn write_vcd<W: Write>(
+pub fn write_vcd<'w, W: Write + Send + 'w>(
     out: W,
     trace: &PinTrace,
     phases: Option<&[(u64, String)]>,
     info: &VcdInfo,
 ) -> io::Result<()> {
-    let ((count, unit), per_state) = timescale_for(trace.clock_hz);
-    let clock = Clock {
-        hz: trace.clock_hz,
-        per_state,
-    };
-    let mut w = Writer::new(io::BufWriter::new(out));
-    w.version(concat!("h8swarm ", env!("CARGO_PKG_VERSION")))?;
-    let state_ns = 1e9 / f64::from(trace.clock_hz.max(1));
-    let conversion = match per_state {
-        Some(k) => format!("timestamp = states x {k}"),
-        None => "timestamp = states x 1e15 / phi, rounded to the nearest fs".to_string(),
-    };
-    let mut comment = format!(
-        "H8/3052F pin trace. {source}. Clock phi = {hz} Hz: 1 state = {state_ns} ns; \
-         timescale {count} {unit}, {conversion} (states since the MCU's reset). \
-         Trace from state {start} to state {end}.",
-        source = if info.source.is_empty() {
-            "h8swarm"
-        } else {
-            &info.source
-        },
-        hz = trace.clock_hz,
-        start = trace.start,
-        end = trace.end,
-    );
-    for s in Signal::ALL {
-        comment.push_str(&format!(" {}: {}.", s.name(), s.description()));
-    }
-    if phases.is_some() {
-        comment.push_str(" phase: the function that runs (symbol table).");
-    }
-    w.comment(&comment)?;
-    w.timescale(count, unit)?;
-    w.add_module("h8_3052f")?;
-    let mut ids: Vec<IdCode> = Vec::with_capacity(Signal::ALL.len());
-    for s in Signal::ALL {
-        ids.push(w.add_wire(1, s.name())?);
-    }
-    w.upscope()?;
-    let phase_id = match phases {
-        Some(_) => {
-            w.add_module("firmware")?;
-            let id = w.add_var(VarType::String, 1, "phase", None)?;
-            w.upscope()?;
-            Some(id)
-        }
-        None => None,
-    };
-    w.enddefinitions()?;
-
-    // Initial values.
-    let phases = phases.unwrap_or(&[]);
-    let mut phase_ix = 0;
-    let mut phase_now: Option<&str> = None;
-    while phase_ix < phases.len() && phases[phase_ix].0 <= trace.start {
-        phase_now = Some(phases[phase_ix].1.as_str());
-        phase_ix += 1;
-    }
-    w.timestamp(clock.stamp(trace.start))?;
-    w.begin(SimulationCommand::Dumpvars)?;
-    let mut levels = trace.initial;
-    for (i, id) in ids.iter().enumerate() {
-        w.change_scalar(*id, bit(levels[i]))?;
-    }
-    if let Some(id) = phase_id {
-        w.change_string(id, phase_now.unwrap_or(crate::chip::trace::UNNAMED_PHASE))?;
-    }
-    w.end()?;
-
-    // Changes, grouped by instant: a signal's last level at an instant, if it differs.
-    let changes = &trace.changes;
-    let mut i = 0;
-    loop {
-        let next_pin = changes.get(i).map(|c| c.t);
-        let next_phase = phases.get(phase_ix).map(|p| p.0);
-        let t = match (next_pin, next_phase) {
-            (Some(a), Some(b)) => a.min(b),
-            (Some(a), None) => a,
-            (None, Some(b)) => b,
-            (None, None) => break,
-        };
-        if t > trace.end {
-            break;
-        }
-        let mut now = levels;
-        while let Some(c) = changes.get(i).filter(|c| c.t == t) {
-            now[c.signal as usize] = c.level;
-            i += 1;
-        }
-        let mut phase_at = phase_now;
-        while let Some(p) = phases.get(phase_ix).filter(|p| p.0 == t) {
-            phase_at = Some(p.1.as_str());
-            phase_ix += 1;
-        }
-        let pins_changed = now != levels;
-        let phase_changed = phase_at != phase_now;
-        if pins_changed || phase_changed {
-            w.timestamp(clock.stamp(t))?;
-            for (k, id) in ids.iter().enumerate() {
-                if now[k] != levels[k] {
-                    w.change_scalar(*id, bit(now[k]))?;
-                }
-            }
-            if let (true, Some(id), Some(name)) = (phase_changed, phase_id, phase_at) {
-                w.change_string(id, name)?;
-            }
-        }
-        levels = now;
-        phase_now = phase_at;
-    }
-    w.timestamp(clock.stamp(trace.end))?;
-    w.flush()?;
-    Ok(())
+    let at_start = phases.map(|p| {
+        p.iter()
+            .take_while(|(t, _)| *t <= trace.start)
+            .last()
+            .map_or(crate::chip::trace::UNNAMED_PHASE, |(_, n)| n.as_str())
+    });
+    let mut v = VcdStream::start(
+        Box::new(out),
+        trace.clock_hz,
+        trace.start,
+        trace.initial,
+        at_start,
+        info,
+    )?;
+    v.write_until(
+        &trace.changes,
+        phases.unwrap_or(&[]),
+        trace.end.saturating_add(1),
+    )?;
+    v.finish(&[], &[], trace.end)
 }
 
 fn bit(level: bool) -> Value {
