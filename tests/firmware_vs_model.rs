@@ -10,6 +10,12 @@ fn scenario(corridor: bool) -> Scenario {
     } else {
         Scenario::arena()
     };
+    // The paper's η: the firmware's boot checks its configuration block with a bit-by-bit
+    // CRC-16 whose time depends on the block's bytes, so the fixed shift asserted below (10 232
+    // states) is that of this configuration (the default η = 0.03 gives 10 568).
+    if !corridor {
+        s.learner.eta = 0.001;
+    }
     // Ideal, noiseless sensors: the same distances give the same codes whatever the instant.
     s.sensors.spread = false;
     s.sensors.noise_sigma_v = 0.0;
