@@ -108,6 +108,8 @@ pub struct RunOutput {
     pub saves: u64,
     /// Robots that died (with `--keep-going`), with why.
     pub dead: Vec<(usize, String)>,
+    /// Firmware robots whose stack left its room under a warning guard, with the first fault.
+    pub stack_warnings: Vec<(usize, String)>,
 }
 
 /// Sums of a run's per-step metrics over a span of steps: the summary's and the figure's
@@ -447,6 +449,14 @@ impl Swarm {
         Ok(())
     }
 
+    /// What the firmware robots' stack guards do when a stack access leaves the stack's room:
+    /// stop the robot with an error (the default) or warn ([`RunOutput::stack_warnings`]).
+    pub fn set_stack_guard_mode(&mut self, mode: emu::core::cpu::StackGuardMode) {
+        for r in &mut self.robots {
+            r.set_stack_guard_mode(mode);
+        }
+    }
+
     /// Whether a robot whose controller fails is marked dead and the run goes on (default:
     /// the run stops with the error).
     pub fn set_keep_going(&mut self, keep_going: bool) {
@@ -711,7 +721,14 @@ impl Swarm {
                 )))?;
         }
         let dead = self.dead();
+        let stack_warnings = self
+            .robots
+            .iter()
+            .enumerate()
+            .filter_map(|(i, r)| r.stack_fault().map(|f| (i, f.to_string())))
+            .collect();
         Ok(RunOutput {
+            stack_warnings,
             condition: self.condition,
             repeat: self.repeat,
             metrics: self.metrics,
@@ -761,6 +778,8 @@ pub struct RunOptions {
     pub rows: Option<std::path::PathBuf>,
     /// Probes on one robot: a pin trace written as VCD, a GDB client's control.
     pub probes: RobotProbes,
+    /// What the firmware robots' stack guards do ([`Swarm::set_stack_guard_mode`]).
+    pub stack_guard: emu::core::cpu::StackGuardMode,
 }
 
 /// Runs one condition of one repeat. `progress` is called with the number of steps done since
@@ -780,6 +799,7 @@ pub fn run_one(
 ) -> Result<RunOutput> {
     let mut swarm = Swarm::new(s, condition, repeat, opts.record_track, images)?;
     swarm.set_keep_going(opts.keep_going);
+    swarm.set_stack_guard_mode(opts.stack_guard);
     if let Some(path) = &opts.rows {
         swarm.set_rows(path)?;
     }

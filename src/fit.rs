@@ -37,7 +37,7 @@ use emu::board::model::{Controller, ControllerConfig, ControllerError, PhaseStat
 use emu::board::profile::{PhaseDef, Profiler, UnknownFunction};
 use emu::chip::mcu::{Board, Mcu, McuConfig, McuError};
 use emu::core::bus::Bus;
-use emu::core::cpu::{Cpu, Event};
+use emu::core::cpu::{Cpu, CpuError, Event, StackFault, StackGuard};
 use emu::core::memmap::{RAM_BYTES, ROM_BYTES};
 
 use crate::seeds::robot_stream;
@@ -251,6 +251,28 @@ pub struct EepromLine {
     pub save_max_states: u64,
 }
 
+/// The stack's room and what the firmware left of it ([`emu::core::cpu::stack`]).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct StackLine {
+    /// The room's low end: the end of the firmware's data and of the arrays it carves at
+    /// boot.
+    pub room_low: u32,
+    /// The stack's top (the initial SP).
+    pub room_top: u32,
+    /// Bytes in the room.
+    pub room_bytes: u32,
+    /// The lowest SP the run saw.
+    pub lowest_sp: u32,
+    /// Bytes between the lowest SP and the room's low end (negative past it).
+    pub left_bytes: i64,
+    /// The first stack access outside the room, if one stopped the measurement.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub overflow: Option<String>,
+    /// Its bytes outside the room.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub overflow_bytes: Option<u32>,
+}
+
 /// The verdict of SPEC §6.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct FitReport {
@@ -303,6 +325,9 @@ pub struct FitReport {
     /// The stack's high-water mark (bytes below the top of RAM), when measured.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub stack_high_water: Option<u32>,
+    /// The stack's room and what was left of it (machine code), when measured.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stack: Option<StackLine>,
     /// ROM items.
     pub rom: Vec<MemLine>,
     /// ROM used, bytes.
@@ -407,6 +432,8 @@ struct Measured {
     busy: Vec<u64>,
     ram: Vec<MemLine>,
     stack_high_water: Option<u32>,
+    /// The stack's room and what the firmware left of it (machine code only).
+    stack: Option<StackLine>,
 }
 
 impl Measured {
@@ -433,6 +460,9 @@ fn measure_firmware(cfg: &FitConfig) -> Result<Measured, FitError> {
     };
     let mut rig = Rig::new(cfg)?;
     let mut cpu = Cpu::new();
+    // The stack guard stops the measurement at a stack access outside the room: the verdict
+    // is then that it does not fit, with how far it went.
+    cpu.set_stack_guard(Some(StackGuard::stop(fw.stack_room())));
     fw.install(&mut rig.mcu, &mut cpu, block.as_ref())?;
     let mut profiler = Profiler::new(&fw.symbols, &cfg.firmware.phases, PHASE_OTHER)?;
     let clock = f64::from(cfg.controller.clock_hz);
@@ -459,30 +489,6 @@ fn measure_firmware(cfg: &FitConfig) -> Result<Measured, FitError> {
         .position(|n| n != PHASE_BOOT && n != PHASE_OTHER)
         .unwrap_or(usize::MAX);
     let boot_limit = (BOOT_LIMIT_S * clock) as u64;
-    if step_phase == usize::MAX {
-        // No phases: count from the first SLEEP instead.
-        while !cpu.sleeping() {
-            if rig.mcu.now() >= boot_limit {
-                return Err(FitError::BootTimeout { pc: cpu.pc() });
-            }
-            step(&mut profiler, &mut cpu, &mut rig.mcu, boot_limit)?;
-        }
-    } else {
-        while profiler.first_entry(step_phase).is_none() {
-            if rig.mcu.now() >= boot_limit {
-                return Err(FitError::BootTimeout { pc: cpu.pc() });
-            }
-            step(&mut profiler, &mut cpu, &mut rig.mcu, boot_limit)?;
-        }
-    }
-    let boot_states: u64 = profiler.states().iter().sum();
-    if let Some(addr) = fw.symbols.addr("cfg_status")
-        && block.is_some()
-        && let ConfigStatus::Rejected { field, code } = ConfigStatus::from_code(rig.mcu.peek(addr))
-    {
-        return Err(FitError::Rejected { field, code });
-    }
-
     let period = match block {
         Some(b) => b.step_period_states(),
         None => ConfigBlock::ARENA.step_period_states(),
@@ -490,41 +496,85 @@ fn measure_firmware(cfg: &FitConfig) -> Result<Measured, FitError> {
     let n_phases = profiler.names().len();
     let mut per_phase: Vec<Vec<u64>> = vec![Vec::with_capacity(cfg.steps as usize); n_phases];
     let mut busy = Vec::with_capacity(cfg.steps as usize);
-    let mut before: Vec<u64> = profiler.states().to_vec();
-    // A step period runs from one step's start (the entry into its first phase) to the next
-    // one's: one step, its ticks and the idle time up to the next (K ticks in steady state;
-    // the first may be shorter when boot outlasted the first tick). Without phases, fixed
-    // windows of K ticks from the first SLEEP.
-    let mut window_end = rig.mcu.now();
-    for k in 0..u64::from(cfg.steps) {
-        // The world moves before each step's A/D scan.
-        rig.move_world();
+    let mut boot_states = 0;
+    // The measurement, up to a stack overflow if there is one.
+    let fault: Option<Box<StackFault>> = 'run: {
         if step_phase == usize::MAX {
-            window_end += period;
-            while rig.mcu.now() < window_end {
-                if step(&mut profiler, &mut cpu, &mut rig.mcu, window_end)? == Event::Asleep {
-                    break;
+            // No phases: count from the first SLEEP instead.
+            while !cpu.sleeping() {
+                if rig.mcu.now() >= boot_limit {
+                    return Err(FitError::BootTimeout { pc: cpu.pc() });
+                }
+                if let Err(e) = step(&mut profiler, &mut cpu, &mut rig.mcu, boot_limit) {
+                    break 'run Some(overflow(e)?);
                 }
             }
         } else {
-            let limit = rig.mcu.now() + 2 * period + boot_limit;
-            while profiler.entries(step_phase) < k + 2 {
-                if rig.mcu.now() >= limit {
-                    return Err(FitError::StepTimeout {
-                        phase: profiler.names()[step_phase].clone(),
-                        pc: cpu.pc(),
-                    });
+            while profiler.first_entry(step_phase).is_none() {
+                if rig.mcu.now() >= boot_limit {
+                    return Err(FitError::BootTimeout { pc: cpu.pc() });
                 }
-                step(&mut profiler, &mut cpu, &mut rig.mcu, limit)?;
+                if let Err(e) = step(&mut profiler, &mut cpu, &mut rig.mcu, boot_limit) {
+                    break 'run Some(overflow(e)?);
+                }
             }
         }
-        let now = profiler.states();
-        for (i, v) in per_phase.iter_mut().enumerate() {
-            v.push(now[i] - before[i]);
+        boot_states = profiler.states().iter().sum();
+        // Booted: what the firmware carved above its data is not the stack's.
+        fw.raise_stack_low(&mut cpu, &rig.mcu);
+        if let Some(addr) = fw.symbols.addr("cfg_status")
+            && block.is_some()
+            && let ConfigStatus::Rejected { field, code } =
+                ConfigStatus::from_code(rig.mcu.peek(addr))
+        {
+            return Err(FitError::Rejected { field, code });
         }
-        busy.push(now.iter().sum::<u64>() - before.iter().sum::<u64>());
-        before = now.to_vec();
-    }
+
+        let mut before: Vec<u64> = profiler.states().to_vec();
+        // A step period runs from one step's start (the entry into its first phase) to the next
+        // one's: one step, its ticks and the idle time up to the next (K ticks in steady state;
+        // the first may be shorter when boot outlasted the first tick). Without phases, fixed
+        // windows of K ticks from the first SLEEP.
+        let mut window_end = rig.mcu.now();
+        for k in 0..u64::from(cfg.steps) {
+            // The world moves before each step's A/D scan.
+            rig.move_world();
+            if step_phase == usize::MAX {
+                window_end += period;
+                while rig.mcu.now() < window_end {
+                    match step(&mut profiler, &mut cpu, &mut rig.mcu, window_end) {
+                        Ok(Event::Asleep) => break,
+                        Ok(_) => {}
+                        Err(e) => break 'run Some(overflow(e)?),
+                    }
+                }
+            } else {
+                let limit = rig.mcu.now() + 2 * period + boot_limit;
+                while profiler.entries(step_phase) < k + 2 {
+                    if rig.mcu.now() >= limit {
+                        return Err(FitError::StepTimeout {
+                            phase: profiler.names()[step_phase].clone(),
+                            pc: cpu.pc(),
+                        });
+                    }
+                    if let Err(e) = step(&mut profiler, &mut cpu, &mut rig.mcu, limit) {
+                        break 'run Some(overflow(e)?);
+                    }
+                }
+            }
+            let now = profiler.states();
+            for (i, v) in per_phase.iter_mut().enumerate() {
+                v.push(now[i] - before[i]);
+            }
+            busy.push(now.iter().sum::<u64>() - before.iter().sum::<u64>());
+            before = now.to_vec();
+        }
+        None
+    };
+    let fault = fault.map(|mut f| {
+        f.function = fw.symbols.function_at(f.pc).map(|s| s.c_name().to_string());
+        *f
+    });
     let phases: Vec<(String, Vec<u64>)> = profiler
         .names()
         .iter()
@@ -537,6 +587,18 @@ fn measure_firmware(cfg: &FitConfig) -> Result<Measured, FitError> {
         .addr("_stack_top")
         .unwrap_or(emu::core::memmap::RAM_END + 1);
     let stack_high_water = stack_top.saturating_sub(profiler.min_sp());
+    let room = cpu
+        .stack_guard()
+        .map_or_else(|| fw.stack_room(), |g| g.room);
+    let stack = StackLine {
+        room_low: room.low,
+        room_top: room.top,
+        room_bytes: room.bytes(),
+        lowest_sp: profiler.min_sp().min(room.top),
+        left_bytes: i64::from(profiler.min_sp().min(room.top)) - i64::from(room.low),
+        overflow: fault.as_ref().map(ToString::to_string),
+        overflow_bytes: fault.as_ref().map(StackFault::bytes_over),
+    };
     Ok(Measured {
         source: fw.name.clone(),
         boot_states,
@@ -544,7 +606,19 @@ fn measure_firmware(cfg: &FitConfig) -> Result<Measured, FitError> {
         busy,
         ram: firmware_ram(fw, &rig.mcu, stack_high_water),
         stack_high_water: Some(stack_high_water),
+        stack: Some(stack),
     })
+}
+
+/// The stack fault an error of the measurement is, or the error itself.
+fn overflow(e: FitError) -> Result<Box<StackFault>, FitError> {
+    match e {
+        FitError::Run {
+            source: RunError::Cpu(CpuError::StackOverflow(f)),
+            ..
+        } => Ok(f),
+        e => Err(e),
+    }
 }
 
 /// A big-endian u32 in RAM.
@@ -664,6 +738,7 @@ fn measure_model(cfg: &FitConfig) -> Result<Measured, FitError> {
         busy: col(&|s| s.0.work() + s.0.isr + s.1),
         ram,
         stack_high_water: None,
+        stack: None,
     })
 }
 
@@ -758,7 +833,7 @@ fn report(cfg: &FitConfig, m: &Measured, other: Option<&Measured>) -> FitReport 
         save_max_states: save_max,
     };
 
-    let margins = [
+    let mut margins = vec![
         (
             "RAM",
             100.0 * (1.0 - f64::from(ram_used) / f64::from(RAM_BYTES)),
@@ -769,13 +844,30 @@ fn report(cfg: &FitConfig, m: &Measured, other: Option<&Measured>) -> FitReport 
         ),
         ("CPU (worst step)", 100.0 - cpu_worst_percent),
     ];
+    // The stack's room: what the lowest SP left of it, or how far past it the first access
+    // outside went (then it does not fit, whatever the RAM total says).
+    let mut stack_note = String::new();
+    if let Some(st) = &m.stack {
+        let room = f64::from(st.room_bytes.max(1));
+        let left = match st.overflow_bytes {
+            Some(over) => -f64::from(over),
+            None => st.left_bytes as f64,
+        };
+        margins.push(("stack", 100.0 * left / room));
+        if let Some(text) = &st.overflow {
+            stack_note = format!(
+                "the stack leaves its room by {} B ({text}); ",
+                st.overflow_bytes.unwrap_or(0)
+            );
+        }
+    }
     let (tightest, tightest_margin_percent) = margins
         .iter()
         .copied()
         .fold(("RAM", f64::INFINITY), |a, b| if b.1 < a.1 { b } else { a });
     let fits = margins.iter().all(|m| m.1 >= 0.0);
     let verdict = format!(
-        "{}: {} x {} network, RAM {} of {} B, ROM {} B of {} KB, worst step {:.2} % of the {} s period (mean {:.3} %); tightest margin: {} with {:.1} % left",
+        "{}: {stack_note}{} x {} network, RAM {} of {} B, ROM {} B of {} KB, worst step {:.2} % of the {} s period (mean {:.3} %); tightest margin: {} with {:.1} % left",
         if fits { "FITS" } else { "DOES NOT FIT" },
         n_in,
         c.behaviours,
@@ -813,6 +905,7 @@ fn report(cfg: &FitConfig, m: &Measured, other: Option<&Measured>) -> FitReport 
         ram: m.ram.clone(),
         ram_used,
         stack_high_water: m.stack_high_water,
+        stack: m.stack.clone(),
         rom,
         rom_used,
         eeprom,

@@ -439,6 +439,25 @@ fn render(s: &mut String, name: &str, r: &FitReport) {
         r.stack_high_water
             .map_or(String::new(), |h| format!("; stack high-water {h} B"))
     );
+    if let Some(st) = &r.stack {
+        match &st.overflow {
+            Some(text) => {
+                let _ = writeln!(s, "stack: OVERFLOW: {text}");
+            }
+            None => {
+                let _ = writeln!(
+                    s,
+                    "stack: room H'{:06X}-H'{:06X} ({} B, the end of the data and the boot-sized arrays to the initial SP); lowest SP H'{:06X}: {} B left ({:.1} %)",
+                    st.room_low,
+                    st.room_top.saturating_sub(1),
+                    st.room_bytes,
+                    st.lowest_sp,
+                    st.left_bytes,
+                    st.left_bytes as f64 / f64::from(st.room_bytes.max(1)) * 100.0
+                );
+            }
+        }
+    }
     let _ = writeln!(s, "ROM (bytes):");
     for m in &r.rom {
         let _ = writeln!(s, "  {:>6}  {}", m.bytes, m.item);

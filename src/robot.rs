@@ -477,6 +477,24 @@ impl Robot {
         std::mem::take(&mut self.busy_states)
     }
 
+    /// What a firmware robot's stack guard does when a stack access leaves the stack's room
+    /// (see [`FirmwareController::set_stack_guard_mode`]); a model robot has no stack to guard.
+    pub fn set_stack_guard_mode(&mut self, mode: emu::core::cpu::StackGuardMode) {
+        if let Brain::Firmware(c) = &mut self.brain {
+            c.set_stack_guard_mode(mode);
+        }
+    }
+
+    /// The first stack access of a firmware robot that left the stack's room (under a
+    /// warning guard).
+    #[must_use]
+    pub fn stack_fault(&self) -> Option<emu::core::cpu::StackFault> {
+        match &self.brain {
+            Brain::Firmware(c) => c.stack_fault(),
+            Brain::Model(_) => None,
+        }
+    }
+
     /// The wheel commands the motor pins give now.
     pub fn wheels(&mut self) -> (WheelCommand, WheelCommand) {
         let pins = emu::board::wiring::motor_pins(&mut self.mcu);

@@ -85,6 +85,30 @@ pub struct RunArgs {
     /// The robot --gdb controls (default 0).
     #[arg(long, value_name = "K", requires = "gdb")]
     pub gdb_robot: Option<usize>,
+    /// What a firmware robot's stack guard does with the first stack access outside the
+    /// stack's room (the end of the firmware's data and boot-sized arrays to its stack's
+    /// top): `stop` the run with an error, or `warn` after the run and go on.
+    #[arg(long, value_enum, value_name = "ACTION")]
+    pub stack_guard: Option<StackGuardArg>,
+}
+
+/// What the stack guard does (`--stack-guard`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum StackGuardArg {
+    /// Stop at the instruction with a one-line error.
+    #[default]
+    Stop,
+    /// Go on; say which robots' stacks left their room, and where first.
+    Warn,
+}
+
+impl From<StackGuardArg> for emu::core::cpu::StackGuardMode {
+    fn from(g: StackGuardArg) -> Self {
+        match g {
+            StackGuardArg::Stop => emu::core::cpu::StackGuardMode::Stop,
+            StackGuardArg::Warn => emu::core::cpu::StackGuardMode::Warn,
+        }
+    }
 }
 
 /// Steps `--vcd` traces unless `--vcd-steps` says otherwise.
@@ -581,6 +605,7 @@ fn run_into(
                         keep_going: a.keep_going,
                         rows: Some(rows_path(c, r)),
                         probes: probes.unwrap_or_default(),
+                        stack_guard: a.stack_guard.unwrap_or_default().into(),
                     },
                 )
             })
@@ -743,6 +768,14 @@ fn run_into(
             let _ = writeln!(
                 t,
                 "DEAD  robot {i} in {} repeat {}: {why}",
+                r.condition.name(),
+                r.repeat
+            );
+        }
+        for (i, fault) in &r.stack_warnings {
+            let _ = writeln!(
+                t,
+                "STACK robot {i} in {} repeat {}: {fault}",
                 r.condition.name(),
                 r.repeat
             );

@@ -492,3 +492,29 @@ fn the_differential_programs_run_under_the_guard_untouched() {
     assert_eq!(r.outcome, Outcome::Halted { exit_status: 0 });
     assert_eq!(r.stack_fault, None);
 }
+
+#[test]
+fn the_robot_firmware_s_room_takes_in_its_boot_sized_arrays_and_is_never_left() {
+    use emu::board::firmware::{ConfigBlock, Firmware, FirmwareController, peek_be};
+    use emu::chip::mcu::{Mcu, McuConfig, NullBoard};
+    let fw = Firmware::robot().unwrap();
+    let mut mcu = Mcu::new(McuConfig::default(), NullBoard).unwrap();
+    let mut c = FirmwareController::start(&fw, &mut mcu, Some(&ConfigBlock::ARENA)).unwrap();
+    let before = c.cpu().stack_guard().unwrap().room;
+    assert_eq!(Some(before.low), fw.symbols.addr("_bss_end"));
+    for _ in 0..30 {
+        c.run_to_sensing(&mut mcu).unwrap();
+        c.run_to_sleep(&mut mcu).unwrap();
+    }
+    let room = c.cpu().stack_guard().unwrap().room;
+    let heap_end = peek_be::<NullBoard, 4>(&mcu, fw.symbols.addr("heap_end").unwrap()) as u32;
+    assert!(heap_end > before.low, "the firmware carved its arrays");
+    assert_eq!(
+        room,
+        StackRoom {
+            low: heap_end,
+            top: 0xFF_FF10
+        }
+    );
+    assert_eq!(c.stack_fault(), None);
+}
