@@ -12,6 +12,7 @@
 
 pub mod collisions;
 pub mod cost_report;
+pub mod energy;
 pub mod experiment;
 pub mod fit;
 pub mod fit_cmd;
