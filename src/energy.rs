@@ -390,6 +390,144 @@ impl FreeWheels {
     }
 }
 
+/// The battery life of one condition of a run: its first and last windows.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct BatteryLine {
+    /// The condition.
+    pub condition: crate::robot::Condition,
+    /// A robot's mean current over the first window, mA (over the repeats).
+    pub first_current_ma: f64,
+    /// Over the last window, mA.
+    pub last_current_ma: f64,
+    /// Hours the pack lasts at the first window's mean energy per step (the interval from the
+    /// energy's).
+    pub first_h: crate::summary::Estimate,
+    /// At the last window's.
+    pub last_h: crate::summary::Estimate,
+}
+
+/// What learning costs or saves in battery life against a control, in the last window.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct BatteryComparison {
+    /// The control.
+    pub against: crate::robot::Condition,
+    /// Learning's battery life less the control's, hours.
+    pub change_h: f64,
+    /// The same in percent of the control's.
+    pub change_percent: f64,
+    /// Whether the two energies' 95 % intervals are apart.
+    pub apart: bool,
+}
+
+/// The battery life of a run's conditions for the paper's pack.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct BatteryReport {
+    /// The pack.
+    pub pack: Pack,
+    /// The paper's figure: "up to 3.5 hours".
+    pub paper_h: f64,
+    /// Per condition.
+    pub conditions: Vec<BatteryLine>,
+    /// Learning against each control present.
+    pub learning_against: Vec<BatteryComparison>,
+    /// A robot's mean current by part over each condition's whole runs, mA.
+    pub by_part: Vec<ConditionParts>,
+}
+
+/// A robot's mean current by part over a condition's whole runs.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ConditionParts {
+    /// The condition.
+    pub condition: crate::robot::Condition,
+    /// ([`Part::key`], mA) in [`Part::ALL`]'s order.
+    pub current_ma: Vec<(&'static str, f64)>,
+}
+
+impl ConditionParts {
+    /// The mean current by part of `runs` (one condition's), each `robot_seconds` long
+    /// (robots × steps × step period).
+    #[must_use]
+    pub fn of(
+        condition: crate::robot::Condition,
+        runs: &[&crate::experiment::RunOutput],
+        robot_seconds: f64,
+    ) -> Self {
+        let mut total = Charge::default();
+        for r in runs {
+            total.add(&r.energy);
+        }
+        let seconds = robot_seconds * runs.len() as f64;
+        ConditionParts {
+            condition,
+            current_ma: Part::ALL
+                .iter()
+                .map(|&p| (p.key(), mean_current_ma(total.of(p), seconds)))
+                .collect(),
+        }
+    }
+}
+
+impl BatteryReport {
+    /// The battery life of each condition of `stats` for `pack`, steps of `step_period_s`.
+    #[must_use]
+    pub fn of(stats: &[crate::summary::ConditionStats], pack: Pack, step_period_s: f64) -> Self {
+        use crate::summary::Estimate;
+        // mJ per step → mA: mJ / V = mC, per second = mA.
+        let ma = |mj: f64| mj / pack.volts() / step_period_s;
+        let life = |e: &Estimate| -> Estimate {
+            let h = |mj: f64| (mj > 0.0).then(|| pack.life_h(ma(mj)));
+            Estimate {
+                mean: h(e.mean).unwrap_or(f64::INFINITY),
+                lo: e.hi.and_then(h),
+                hi: e.lo.and_then(h),
+                n: e.n,
+            }
+        };
+        let conditions: Vec<BatteryLine> = stats
+            .iter()
+            .map(|c| BatteryLine {
+                condition: c.condition,
+                first_current_ma: ma(c.first.energy_per_robot_step_mj.mean),
+                last_current_ma: ma(c.last.energy_per_robot_step_mj.mean),
+                first_h: life(&c.first.energy_per_robot_step_mj),
+                last_h: life(&c.last.energy_per_robot_step_mj),
+            })
+            .collect();
+        let learning = stats
+            .iter()
+            .find(|c| c.condition == crate::robot::Condition::Learning);
+        let learning_against = match learning {
+            None => Vec::new(),
+            Some(l) => stats
+                .iter()
+                .filter(|c| c.condition != crate::robot::Condition::Learning)
+                .map(|c| {
+                    let (hl, hc) = (
+                        life(&l.last.energy_per_robot_step_mj).mean,
+                        life(&c.last.energy_per_robot_step_mj).mean,
+                    );
+                    BatteryComparison {
+                        against: c.condition,
+                        change_h: hl - hc,
+                        change_percent: (hl / hc - 1.0) * 100.0,
+                        apart: l
+                            .last
+                            .energy_per_robot_step_mj
+                            .apart_from(&c.last.energy_per_robot_step_mj),
+                    }
+                })
+                .collect(),
+        };
+        BatteryReport {
+            pack,
+            paper_h: PAPER_BATTERY_LIFE_H,
+            conditions,
+            learning_against,
+            by_part: Vec::new(),
+        }
+    }
+}
+
 /// Mean current, mA, of `charge_uc` over `seconds`.
 #[must_use]
 pub fn mean_current_ma(charge_uc: f64, seconds: f64) -> f64 {

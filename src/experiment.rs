@@ -76,6 +76,10 @@ pub struct StepMetrics {
     /// states (the step, the tick interrupts, the main loop; not the time asleep) over the
     /// period's states, as the robots' own clocks count them.
     pub cpu_load_percent: f64,
+    /// Mean over robots of the energy each drew from its battery pack over this step
+    /// (millijoules at the pack's nominal 12 V): the electronics over the step and the motors
+    /// and bridges over its behaviour ([`crate::energy`]).
+    pub energy_per_robot_mj: f64,
 }
 
 /// Robot paths and outlines for the arena figure.
@@ -110,6 +114,8 @@ pub struct RunOutput {
     pub dead: Vec<(usize, String)>,
     /// Firmware robots whose stack left its room under a warning guard, with the first fault.
     pub stack_warnings: Vec<(usize, String)>,
+    /// The charge every robot drew from its pack over the run, summed, by part.
+    pub energy: crate::energy::Charge,
 }
 
 /// Sums of a run's per-step metrics over a span of steps: the summary's and the figure's
@@ -135,6 +141,8 @@ pub struct WindowSums {
     pub gap_cv_steps: u32,
     /// Sum of [`StepMetrics::cpu_load_percent`].
     pub cpu_load_percent: f64,
+    /// Sum of [`StepMetrics::energy_per_robot_mj`].
+    pub energy_per_robot_mj: f64,
 }
 
 impl WindowSums {
@@ -151,6 +159,7 @@ impl WindowSums {
             self.gap_cv_steps += 1;
         }
         self.cpu_load_percent += m.cpu_load_percent;
+        self.energy_per_robot_mj += m.energy_per_robot_mj;
     }
 
     /// Whether every step summed had a gap CV (and there was at least one step).
@@ -216,6 +225,7 @@ impl RunMetrics {
             gap_cv: 0.0,
             gap_cv_steps: 0,
             cpu_load_percent: 0.0,
+            energy_per_robot_mj: 0.0,
         };
         self.windows.first().unwrap_or(&NONE)
     }
@@ -233,7 +243,7 @@ impl RunMetrics {
 }
 
 /// The columns of `metrics.csv`, one row per step of every run.
-pub const METRICS_HEADER: [&str; 10] = [
+pub const METRICS_HEADER: [&str; 11] = [
     "condition",
     "repeat",
     "step",
@@ -244,11 +254,12 @@ pub const METRICS_HEADER: [&str; 10] = [
     "moved_m",
     "gap_cv",
     "cpu_load_percent",
+    "energy_per_robot_mj",
 ];
 
 /// Step `k`'s row of `metrics.csv` (see [`METRICS_HEADER`]).
 #[must_use]
-pub fn metrics_row(condition: Condition, repeat: u32, k: u32, m: &StepMetrics) -> [String; 10] {
+pub fn metrics_row(condition: Condition, repeat: u32, k: u32, m: &StepMetrics) -> [String; 11] {
     [
         condition.name().to_string(),
         repeat.to_string(),
@@ -260,6 +271,7 @@ pub fn metrics_row(condition: Condition, repeat: u32, k: u32, m: &StepMetrics) -
         format!("{}", m.moved_m),
         m.gap_cv.map(|v| format!("{v}")).unwrap_or_default(),
         format!("{}", m.cpu_load_percent),
+        format!("{}", m.energy_per_robot_mj),
     ]
 }
 
@@ -360,6 +372,13 @@ pub struct Swarm {
     keep_going: bool,
     /// Why each dead robot died.
     dead: Vec<Option<String>>,
+    /// Each robot's motors and bridges, metered over the world's sub-steps.
+    drives: Vec<crate::energy::DriveMeter>,
+    /// The electronics' charge of the step being completed, summed over the live robots, and
+    /// how many robots were live.
+    pending_charge: (f64, usize),
+    /// The charge of the whole run, by part.
+    energy: crate::energy::Charge,
 }
 
 impl Swarm {
@@ -399,6 +418,13 @@ impl Swarm {
                 .map(|w| [(w.a.0, w.a.1), (w.b.0, w.b.1)])
                 .collect(),
         });
+        let drives = (0..n)
+            .map(|i| {
+                world
+                    .motor_gains(i)
+                    .map(|g| crate::energy::DriveMeter::new(s.world.top_speed_m_per_s, g))
+            })
+            .collect::<Result<_, _>>()?;
         Ok(Self {
             scenario: s.clone(),
             condition,
@@ -425,6 +451,9 @@ impl Swarm {
             last_xy: Vec::new(),
             keep_going: false,
             dead: vec![None; n],
+            drives,
+            pending_charge: (0.0, 0),
+            energy: crate::energy::Charge::default(),
         })
     }
 
@@ -590,9 +619,13 @@ impl Swarm {
         let period_states =
             self.scenario.timing.step_period_s * f64::from(self.scenario.timing.clock_hz);
         let (mut sum_d, mut sum_load, mut live) = (0.0, 0.0, 0usize);
+        let mut charge_uc = 0.0;
         for (i, res) in results.into_iter().enumerate() {
             match res {
                 Some(Ok((rep, busy))) => {
+                    let q = self.robots[i].step_charge();
+                    charge_uc += q.total_uc();
+                    self.energy.add(&q);
                     self.saves += u64::from(rep.saved);
                     sum_d += f64::from(rep.d);
                     sum_load += busy as f64 / period_states * 100.0;
@@ -621,7 +654,9 @@ impl Swarm {
             };
             self.drove[i] = drives(&left) || drives(&right);
             self.world.set_wheels(i, left, right)?;
+            self.drives[i].set_commands(left, right);
         }
+        self.pending_charge = (charge_uc, live);
         let live_f = live.max(1) as f64;
         let mean_d = sum_d / live_f;
         let gap_cv = match self.scenario.arena {
@@ -637,6 +672,7 @@ impl Swarm {
             moved_m: 0.0,
             gap_cv,
             cpu_load_percent: sum_load / live_f,
+            energy_per_robot_mj: 0.0,
         });
         Ok(())
     }
@@ -646,8 +682,19 @@ impl Swarm {
     /// robots.
     fn close_step(&mut self, t_states: u64) -> Result<()> {
         let dt = t_states.saturating_sub(self.world.elapsed_states());
-        let (collided, contact_states) =
-            advance_world(&mut self.world, t_states, &mut self.meters, self.parallel)?;
+        let (collided, contact_states) = advance_world(
+            &mut self.world,
+            t_states,
+            &mut self.meters,
+            self.parallel,
+            &mut self.drives,
+        )?;
+        let mut drive_uc = 0.0;
+        for d in &mut self.drives {
+            let q = d.take();
+            drive_uc += q.total_uc();
+            self.energy.add(&q);
+        }
         let n = self.robots.len();
         let (moved, stuck) = self.moved()?;
         if let Some(mut last) = self.pending.take() {
@@ -659,6 +706,12 @@ impl Swarm {
             };
             last.moved_m = moved;
             last.stuck_fraction = stuck as f64 / n as f64;
+            let (electronics_uc, live) = std::mem::take(&mut self.pending_charge);
+            last.energy_per_robot_mj = if live == 0 {
+                0.0
+            } else {
+                crate::energy::Pack::default().energy_mj(electronics_uc + drive_uc) / live as f64
+            };
             let k = self.started - 1;
             self.metrics.add(k, &last);
             if let Some(rows) = self.rows.as_mut() {
@@ -729,6 +782,7 @@ impl Swarm {
             .collect();
         Ok(RunOutput {
             stack_warnings,
+            energy: self.energy,
             condition: self.condition,
             repeat: self.repeat,
             metrics: self.metrics,
@@ -905,20 +959,34 @@ pub fn nominal_substep_states(s: &Scenario) -> u64 {
 }
 
 /// Advances the world to `target_states` in its sub-steps, feeding every robot's bumpers
-/// after each to its meter; returns the collisions counted and the robot-states in contact.
+/// after each to its meter and its wheels' speed over the ground to its drive meter (when
+/// `drives` has one per robot); returns the collisions counted and the robot-states in contact.
 fn advance_world(
     world: &mut World,
     target_states: u64,
     meters: &mut [ContactMeter],
     par: bool,
+    drives: &mut [crate::energy::DriveMeter],
 ) -> Result<(u64, u64)> {
     let (mut collisions, mut contact) = (0u64, 0u64);
     let dt = target_states.saturating_sub(world.elapsed_states());
+    let track_m = world.params().wheel_track_m;
+    let clock_hz = world.params().clock_hz as f64;
+    let mut before = Vec::with_capacity(drives.len());
     for len in world.substep_plan(dt) {
+        before.clear();
+        for i in 0..drives.len() {
+            before.push(world.pose(i)?);
+        }
         if par {
             world.advance_states_par(len);
         } else {
             world.advance_states(len);
+        }
+        let dt_s = len as f64 / clock_hz;
+        for (i, (d, b)) in drives.iter_mut().zip(&before).enumerate() {
+            let v = crate::energy::ground_speeds(b, &world.pose(i)?, dt_s, track_m);
+            d.add_substep(dt_s, v);
         }
         for (i, m) in meters.iter_mut().enumerate() {
             let pressed = world.bumpers(i)?.iter().any(|&b| b);
@@ -998,7 +1066,7 @@ mod tests {
             for len in w.substep_plan(t - w.elapsed_states()) {
                 assert_eq!(len, nominal, "no sliver of a sub-step");
             }
-            let (c, contact) = advance_world(&mut w, t, &mut meters, false).unwrap();
+            let (c, contact) = advance_world(&mut w, t, &mut meters, false, &mut []).unwrap();
             collisions.push((c, contact));
         }
         assert_eq!(w.elapsed_states(), 500 * period, "no drift");
@@ -1031,6 +1099,7 @@ mod tests {
             moved_m: 0.07 / (1.0 + x),
             gap_cv: gap.then_some(0.1 + x * 1e-4),
             cpu_load_percent: 0.3 + x * 1e-6,
+            energy_per_robot_mj: 3500.0 + x.cos(),
         }
     }
 
@@ -1142,6 +1211,7 @@ mod tests {
                     moved_m: f(7),
                     gap_cv: (!r[8].is_empty()).then(|| f(8)),
                     cpu_load_percent: f(9),
+                    energy_per_robot_mj: f(10),
                 },
             );
         }

@@ -125,6 +125,10 @@ pub struct Robot {
     trace_ends_at_sensing: bool,
     /// A pin trace that ended, not yet taken ([`Robot::take_pin_trace`]).
     finished_trace: Option<RobotTrace>,
+    /// The charge meter of the electronics (everything but the motors and their bridges).
+    electronics: crate::energy::ElectronicsMeter,
+    /// The electronics' charge over the latest step ([`Robot::step_charge`]).
+    step_charge: crate::energy::Charge,
 }
 
 /// A robot's pin trace: the MCU's signals and the firmware's phases.
@@ -257,6 +261,7 @@ impl Robot {
             board,
         )
         .context("timing.clock_hz")?;
+        let electronics = crate::energy::ElectronicsMeter::new(&mcu);
         let mut cfg = controller_config(s, stream(0, Purpose::Weights))?;
         if condition != Condition::Learning {
             cfg.params = Params::new(0, s.learner.threshold).context("learner.threshold")?;
@@ -295,6 +300,8 @@ impl Robot {
             cfg_status,
             trace_ends_at_sensing: false,
             finished_trace: None,
+            electronics,
+            step_charge: crate::energy::Charge::default(),
         };
         robot.records = robot.records_written();
         Ok(robot)
@@ -429,6 +436,23 @@ impl Robot {
     /// A save that failed on the bus (the model); the firmware stopped, halted, or did not go
     /// back to sleep within the watchdog's time.
     pub fn step(&mut self, distance_mm: [Option<f64>; 4]) -> Result<StepResult> {
+        let r = self.run_step(distance_mm)?;
+        // The electronics since the previous step's work ended: its busy states are those
+        // the step's sleep and work counted.
+        self.step_charge = self.electronics.take(&self.mcu, self.busy_states);
+        Ok(r)
+    }
+
+    /// The charge the electronics (the MCU, its A/D converter, the IR sensors, the EEPROMs,
+    /// the regulator) drew from the end of the previous step's work to the end of the latest
+    /// one's ([`crate::energy`]).
+    #[must_use]
+    pub fn step_charge(&self) -> crate::energy::Charge {
+        self.step_charge
+    }
+
+    /// [`Robot::step`] without the charge meter.
+    fn run_step(&mut self, distance_mm: [Option<f64>; 4]) -> Result<StepResult> {
         self.mcu.board_mut().distance_mm = distance_mm;
         match &mut self.brain {
             Brain::Model(c) => {

@@ -85,6 +85,10 @@ pub struct RunArgs {
     /// The robot --gdb controls (default 0).
     #[arg(long, value_name = "K", requires = "gdb")]
     pub gdb_robot: Option<usize>,
+    /// Capacity of one cell of the paper's pack (ten 1.2 V NiMH cells), mAh, for the battery
+    /// life the summary gives (default: 2 000 mAh, a typical AA NiMH cell of 2008).
+    #[arg(long, value_name = "MAH")]
+    pub capacity_mah: Option<f64>,
     /// What a firmware robot's stack guard does with the first stack access outside the
     /// stack's room (the end of the firmware's data and boot-sized arrays to its stack's
     /// top): `stop` the run with an error, or `warn` after the run and go on.
@@ -184,6 +188,7 @@ struct Summary<'a> {
     eeprom_records_written: u64,
     conditions: &'a [ConditionStats],
     claims: &'a [Claim],
+    battery: &'a crate::energy::BatteryReport,
 }
 
 /// Runs the experiment; returns the text to print.
@@ -208,6 +213,7 @@ pub fn run(a: &RunArgs) -> Result<String> {
         s.controller.image = Some(image.display().to_string());
     }
     let s = s.with_overrides(a.robots, a.steps, a.repeats, a.seed)?;
+    crate::fit_cmd::parse_capacity(a.capacity_mah)?;
     let images = crate::robot::Images::load(&s)?;
     let max_threads = max_threads();
     match a.threads {
@@ -619,6 +625,7 @@ fn run_into(
     let stats = conditions(&runs, s.steps, s.window);
     let checked = claims(&stats);
     let saves: u64 = runs.iter().map(|r| r.saves).sum();
+    let battery = battery_report(a, s, &stats, &runs)?;
     let summary = Summary {
         h8swarm_version: env!("CARGO_PKG_VERSION"),
         scenario: s,
@@ -626,6 +633,7 @@ fn run_into(
         eeprom_records_written: saves,
         conditions: &stats,
         claims: &checked,
+        battery: &battery,
     };
     let summary_path = stage.path("summary.json");
     std::fs::write(
@@ -751,6 +759,7 @@ fn run_into(
         "(windows of {} steps; mean over repeats [95 % interval])",
         s.window
     );
+    render_battery(&mut t, &battery);
     let _ = writeln!(t);
     for c in &checked {
         let _ = writeln!(
@@ -784,6 +793,75 @@ fn run_into(
     let _ = writeln!(t);
     let _ = writeln!(t, "fit: {}", fit.verdict);
     Ok((t, names))
+}
+
+/// The battery life of each condition ([`crate::energy::BatteryReport`]) for the pack
+/// `--capacity-mah` gives.
+fn battery_report(
+    a: &RunArgs,
+    s: &Scenario,
+    stats: &[ConditionStats],
+    runs: &[RunOutput],
+) -> Result<crate::energy::BatteryReport> {
+    let pack = crate::energy::Pack::paper(crate::fit_cmd::parse_capacity(a.capacity_mah)?);
+    let mut b = crate::energy::BatteryReport::of(stats, pack, s.timing.step_period_s);
+    let robot_seconds = s.robots as f64 * f64::from(s.steps) * s.timing.step_period_s;
+    for c in stats {
+        let of_c: Vec<&RunOutput> = runs.iter().filter(|r| r.condition == c.condition).collect();
+        b.by_part.push(crate::energy::ConditionParts::of(
+            c.condition,
+            &of_c,
+            robot_seconds,
+        ));
+    }
+    Ok(b)
+}
+
+/// The battery lines of the summary: each condition's battery life in its first and last
+/// windows, its mean current by part, and what learning costs or saves against the controls.
+fn render_battery(t: &mut String, b: &crate::energy::BatteryReport) {
+    let _ = writeln!(t);
+    let _ = writeln!(
+        t,
+        "battery life, {} x {} V NiMH of {:.0} mAh (the paper: up to {} h); a robot's mean current:",
+        b.pack.cells, b.pack.cell_volts, b.pack.capacity_mah, b.paper_h
+    );
+    for (c, parts) in b.conditions.iter().zip(&b.by_part) {
+        let _ = writeln!(
+            t,
+            "{:<14} {} h ({:.0} mA) -> {} h ({:.0} mA)",
+            c.condition.name(),
+            fmt_est(&c.first_h),
+            c.first_current_ma,
+            fmt_est(&c.last_h),
+            c.last_current_ma
+        );
+        let list: Vec<String> = parts
+            .current_ma
+            .iter()
+            .map(|(k, ma)| format!("{k} {ma:.1}"))
+            .collect();
+        let _ = writeln!(t, "{:<14} whole run, mA: {}", "", list.join(", "));
+    }
+    for cmp in &b.learning_against {
+        let _ = writeln!(
+            t,
+            "learning {} {:.1} % of battery life ({:+.2} h) against {} in the last window ({})",
+            if cmp.change_h >= 0.0 {
+                "saves"
+            } else {
+                "costs"
+            },
+            cmp.change_percent.abs(),
+            cmp.change_h,
+            cmp.against.name(),
+            if cmp.apart {
+                "energy intervals apart"
+            } else {
+                "energy intervals overlap"
+            }
+        );
+    }
 }
 
 fn fmt_est(e: &Estimate) -> String {

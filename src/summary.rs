@@ -92,6 +92,9 @@ pub struct WindowStats {
     /// Corridor: mean gap CV over the window.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub gap_cv: Option<Estimate>,
+    /// Mean energy a robot drew from its pack per step over the window, mJ at the pack's
+    /// nominal 12 V ([`crate::energy`]).
+    pub energy_per_robot_step_mj: Estimate,
 }
 
 /// First and last window of a condition.
@@ -175,6 +178,7 @@ pub fn window(sums: &[&WindowSums], from: u32, to: u32) -> WindowStats {
         contact_fraction: Estimate::of(&per_run(&|w| w.contact_fraction, true)),
         stuck_fraction: Estimate::of(&per_run(&|w| w.stuck_fraction, true)),
         gap_cv: gap,
+        energy_per_robot_step_mj: Estimate::of(&per_run(&|w| w.energy_per_robot_mj, true)),
     }
 }
 
