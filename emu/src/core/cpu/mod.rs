@@ -40,6 +40,12 @@
 //!   ([`Cpu::skipped_instructions`]); registers, flags, clock and memory are what stepping
 //!   reaches at the same instruction boundary. [`Cpu::step`] never skips.
 //!
+//! The stack guard ([`stack`], [`Cpu::set_stack_guard`]) checks every stack access (pushes,
+//! calls, returns, interrupt entries, loads and stores through ER7) and every instruction that
+//! sets SP against the stack's room, on both paths: the fast path gives loads and stores
+//! through ER7 handlers of their own and leaves the instructions that set SP as a register to
+//! the reference executor, so no other instruction pays for it.
+//!
 //! The decode caches are emptied whenever the bus's token changes (the flash was written:
 //! loading an image, poking), and by [`Cpu::flush_decode_cache`]. Tests run random programs,
 //! the C programs and the robot firmware both ways and compare the complete state after every
