@@ -7,6 +7,13 @@
 //! (`emu::chip::gdb`). Symbols (for the phase names): `--symbols`, else IMAGE.sym beside the
 //! image if present.
 //!
+//! The stack guard (`emu::core::cpu::stack`) watches every stack access: its room runs from
+//! the end of the image's data to its stack's top when the symbols say where they are
+//! (`__bss_end`, `__stack_top`), else over the whole on-chip RAM. By default the first access
+//! outside stops the program with a one-line error naming the instruction, its function, SP
+//! and the bytes over (exit status 125); `--stack-guard warn` lets it run on and prints the
+//! first one as a warning at the end.
+//!
 //! Exit status: the program's (low byte of R0) when it halts with SLEEP under CCR.I = 1; 124
 //! when the state budget runs out; 125 when the core stops on an error (the message names the PC
 //! and the bytes); 126 when the program sleeps with interrupts enabled and nothing that could
@@ -24,7 +31,7 @@ use emu::chip::run::{Outcome, Probes, RunOptions, drain_into, run_mcu_probed};
 use emu::chip::trace::{CodeNames, PhaseRecorder};
 use emu::chip::vcd::{VcdInfo, VcdStream};
 use emu::core::bus::Bus;
-use emu::core::cpu::Cpu;
+use emu::core::cpu::{Cpu, StackGuard, StackGuardMode, StackRoom};
 use emu::core::srec;
 
 use crate::Failure;
@@ -54,6 +61,8 @@ pub struct EmuOptions<'a> {
     pub gdb: Option<&'a str>,
     /// The image's symbol table (nm -n output); default IMAGE.sym beside the image if present.
     pub symbols: Option<&'a Path>,
+    /// What the stack guard does when a stack access leaves the stack's room.
+    pub stack_guard: StackGuardMode,
 }
 
 fn input(msg: String) -> Failure {
@@ -126,6 +135,13 @@ pub fn run(o: &EmuOptions<'_>) -> Result<(), Failure> {
     };
     let mut debugger = debugger;
     let mut cpu = Cpu::new();
+    let room = names
+        .as_deref()
+        .map_or(StackRoom::RAM, SymbolTable::stack_room);
+    cpu.set_stack_guard(Some(StackGuard {
+        room,
+        mode: o.stack_guard,
+    }));
     cpu.reset(&mut machine);
     let mcu = machine.mcu_mut();
     let mut phases = None;
@@ -203,6 +219,9 @@ pub fn run(o: &EmuOptions<'_>) -> Result<(), Failure> {
     };
     if o.stats {
         eprintln!("{}", report.to_json());
+    }
+    if let Some(f) = &report.stack_fault {
+        eprintln!("warning: image `{image}`: {f}");
     }
     match report.outcome {
         Outcome::Halted { exit_status: 0 } => Ok(()),

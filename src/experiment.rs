@@ -79,6 +79,10 @@ pub struct StepMetrics {
     /// states (the step, the tick interrupts, the main loop; not the time asleep) over the
     /// period's states, as the robots' own clocks count them.
     pub cpu_load_percent: f64,
+    /// Mean over robots of the energy each drew from its battery pack over this step
+    /// (millijoules at the pack's nominal 12 V): the electronics over the step and the motors
+    /// and bridges over its behaviour ([`crate::energy`]).
+    pub energy_per_robot_mj: f64,
 }
 
 /// Robot paths and outlines for the arena figure.
@@ -128,6 +132,10 @@ pub struct RunOutput {
     pub robots: Vec<RobotTally>,
     /// With a recorder: the frames recorded and the frames with weights.
     pub recorded: Option<(u32, Vec<u32>)>,
+    /// Firmware robots whose stack left its room under a warning guard, with the first fault.
+    pub stack_warnings: Vec<(usize, String)>,
+    /// The charge every robot drew from its pack over the run, summed, by part.
+    pub energy: crate::energy::Charge,
 }
 
 /// Sums of a run's per-step metrics over a span of steps: the summary's and the figure's
@@ -155,6 +163,8 @@ pub struct WindowSums {
     pub gap_cv_steps: u32,
     /// Sum of [`StepMetrics::cpu_load_percent`].
     pub cpu_load_percent: f64,
+    /// Sum of [`StepMetrics::energy_per_robot_mj`].
+    pub energy_per_robot_mj: f64,
 }
 
 impl WindowSums {
@@ -172,6 +182,7 @@ impl WindowSums {
             self.gap_cv_steps += 1;
         }
         self.cpu_load_percent += m.cpu_load_percent;
+        self.energy_per_robot_mj += m.energy_per_robot_mj;
     }
 
     /// Whether every step summed had a gap CV (and there was at least one step).
@@ -238,6 +249,7 @@ impl RunMetrics {
             gap_cv: 0.0,
             gap_cv_steps: 0,
             cpu_load_percent: 0.0,
+            energy_per_robot_mj: 0.0,
         };
         self.windows.first().unwrap_or(&NONE)
     }
@@ -255,7 +267,7 @@ impl RunMetrics {
 }
 
 /// The columns of `metrics.csv`, one row per step of every run.
-pub const METRICS_HEADER: [&str; 11] = [
+pub const METRICS_HEADER: [&str; 12] = [
     "condition",
     "repeat",
     "step",
@@ -267,11 +279,12 @@ pub const METRICS_HEADER: [&str; 11] = [
     "moved_mm",
     "gap_cv",
     "cpu_load_percent",
+    "energy_per_robot_mj",
 ];
 
 /// Step `k`'s row of `metrics.csv` (see [`METRICS_HEADER`]).
 #[must_use]
-pub fn metrics_row(condition: Condition, repeat: u32, k: u32, m: &StepMetrics) -> [String; 11] {
+pub fn metrics_row(condition: Condition, repeat: u32, k: u32, m: &StepMetrics) -> [String; 12] {
     [
         condition.name().to_string(),
         repeat.to_string(),
@@ -284,6 +297,7 @@ pub fn metrics_row(condition: Condition, repeat: u32, k: u32, m: &StepMetrics) -
         format!("{}", m.moved_mm),
         m.gap_cv.map(|v| format!("{v}")).unwrap_or_default(),
         format!("{}", m.cpu_load_percent),
+        format!("{}", m.energy_per_robot_mj),
     ]
 }
 
@@ -389,6 +403,13 @@ pub struct Swarm {
     dead: Vec<Option<String>>,
     /// The replay recorder and how many robots it records, when the run is recorded.
     recorder: Option<(crate::recording::Recorder, usize)>,
+    /// Each robot's motors and bridges, metered over the world's sub-steps.
+    drives: Vec<crate::energy::DriveMeter>,
+    /// The electronics' charge of the step being completed, summed over the live robots, and
+    /// how many robots were live.
+    pending_charge: (f64, usize),
+    /// The charge of the whole run, by part.
+    energy: crate::energy::Charge,
 }
 
 impl Swarm {
@@ -429,6 +450,13 @@ impl Swarm {
                 .collect(),
             spacetime: vec![Vec::new(); tracked],
         });
+        let drives = (0..n)
+            .map(|i| {
+                world
+                    .motor_gains(i)
+                    .map(|g| crate::energy::DriveMeter::new(s.world.top_speed_m_per_s, g))
+            })
+            .collect::<Result<_, _>>()?;
         Ok(Self {
             scenario: s.clone(),
             condition,
@@ -458,6 +486,9 @@ impl Swarm {
             keep_going: false,
             dead: vec![None; n],
             recorder: None,
+            drives,
+            pending_charge: (0.0, 0),
+            energy: crate::energy::Charge::default(),
         })
     }
 
@@ -485,6 +516,14 @@ impl Swarm {
     /// Records the run for the viewer: the first `robots` robots, into `recorder`.
     pub fn set_recorder(&mut self, recorder: crate::recording::Recorder, robots: usize) {
         self.recorder = Some((recorder, robots.min(self.robots.len())));
+    }
+
+    /// What the firmware robots' stack guards do when a stack access leaves the stack's room:
+    /// stop the robot with an error (the default) or warn ([`RunOutput::stack_warnings`]).
+    pub fn set_stack_guard_mode(&mut self, mode: emu::core::cpu::StackGuardMode) {
+        for r in &mut self.robots {
+            r.set_stack_guard_mode(mode);
+        }
     }
 
     /// Whether a robot whose controller fails is marked dead and the run goes on (default:
@@ -631,10 +670,14 @@ impl Swarm {
         let recording = self.recorder.is_some();
         let mut stepped: Vec<(i16, bool, f64)> = Vec::new();
         let mut behaviours: Vec<u8> = Vec::new();
+        let mut charge_uc = 0.0;
         for (i, res) in results.into_iter().enumerate() {
             let mut this = (0, false, 0.0);
             match res {
                 Some(Ok((rep, busy))) => {
+                    let q = self.robots[i].step_charge();
+                    charge_uc += q.total_uc();
+                    self.energy.add(&q);
                     self.saves += u64::from(rep.saved);
                     sum_d += f64::from(rep.d);
                     let load = busy as f64 / period_states * 100.0;
@@ -671,6 +714,7 @@ impl Swarm {
                 behaviours.push(crate::recording::behaviour_of(&left, &right));
             }
             self.world.set_wheels(i, left, right)?;
+            self.drives[i].set_commands(left, right);
         }
         if let Some((rec, count)) = self.recorder.as_mut() {
             let mut frame = Vec::with_capacity(*count);
@@ -693,6 +737,7 @@ impl Swarm {
             let robots = &self.robots;
             rec.step(k, &frame, &mut |i| robots[i].weights())?;
         }
+        self.pending_charge = (charge_uc, live);
         let live_f = live.max(1) as f64;
         let mean_d = sum_d / live_f;
         let gap_cv = match self.scenario.arena {
@@ -709,6 +754,7 @@ impl Swarm {
             moved_mm: 0.0,
             gap_cv,
             cpu_load_percent: sum_load / live_f,
+            energy_per_robot_mj: 0.0,
         });
         Ok(())
     }
@@ -724,7 +770,14 @@ impl Swarm {
             &mut self.meters,
             &mut self.collided,
             self.parallel,
+            &mut self.drives,
         )?;
+        let mut drive_uc = 0.0;
+        for d in &mut self.drives {
+            let q = d.take();
+            drive_uc += q.total_uc();
+            self.energy.add(&q);
+        }
         let n = self.robots.len();
         let moved = self.moved()?;
         if let Some(mut last) = self.pending.take() {
@@ -748,6 +801,12 @@ impl Swarm {
             last.moved_mm = 1000.0 * sum_m / n as f64;
             last.stuck_percent = share(stuck);
             last.moving_percent = share(moving);
+            let (electronics_uc, live) = std::mem::take(&mut self.pending_charge);
+            last.energy_per_robot_mj = if live == 0 {
+                0.0
+            } else {
+                crate::energy::Pack::default().energy_mj(electronics_uc + drive_uc) / live as f64
+            };
             self.metrics.add(k, &last);
             if let Some(rows) = self.rows.as_mut() {
                 rows.w
@@ -815,7 +874,15 @@ impl Swarm {
             Some((rec, _)) => Some(rec.finish()?),
             None => None,
         };
+        let stack_warnings = self
+            .robots
+            .iter()
+            .enumerate()
+            .filter_map(|(i, r)| r.stack_fault().map(|f| (i, f.to_string())))
+            .collect();
         Ok(RunOutput {
+            stack_warnings,
+            energy: self.energy,
             condition: self.condition,
             repeat: self.repeat,
             metrics: self.metrics,
@@ -869,6 +936,8 @@ pub struct RunOptions {
     pub probes: RobotProbes,
     /// Record the run for the viewer: the recorder and how many robots it records.
     pub replay: Option<(crate::recording::Recorder, usize)>,
+    /// What the firmware robots' stack guards do ([`Swarm::set_stack_guard_mode`]).
+    pub stack_guard: emu::core::cpu::StackGuardMode,
 }
 
 /// Runs one condition of one repeat. `progress` is called with the number of steps done since
@@ -888,6 +957,7 @@ pub fn run_one(
 ) -> Result<RunOutput> {
     let mut swarm = Swarm::new(s, condition, repeat, opts.record_track, images)?;
     swarm.set_keep_going(opts.keep_going);
+    swarm.set_stack_guard_mode(opts.stack_guard);
     if let Some(path) = &opts.rows {
         swarm.set_rows(path)?;
     }
@@ -993,7 +1063,8 @@ pub fn nominal_substep_states(s: &Scenario) -> u64 {
 }
 
 /// Advances the world to `target_states` in its sub-steps, feeding every robot's bumpers
-/// after each to its meter; adds each robot's collisions to `per_robot` and returns the
+/// after each to its meter and its wheels' speed over the ground to its drive meter (when
+/// `drives` has one per robot); adds each robot's collisions to `per_robot` and returns the
 /// collisions counted and the robot-states in contact.
 fn advance_world(
     world: &mut World,
@@ -1001,14 +1072,27 @@ fn advance_world(
     meters: &mut [ContactMeter],
     per_robot: &mut [u64],
     par: bool,
+    drives: &mut [crate::energy::DriveMeter],
 ) -> Result<(u64, u64)> {
     let (mut collisions, mut contact) = (0u64, 0u64);
     let dt = target_states.saturating_sub(world.elapsed_states());
+    let track_m = world.params().wheel_track_m;
+    let clock_hz = world.params().clock_hz as f64;
+    let mut before = Vec::with_capacity(drives.len());
     for len in world.substep_plan(dt) {
+        before.clear();
+        for i in 0..drives.len() {
+            before.push(world.pose(i)?);
+        }
         if par {
             world.advance_states_par(len);
         } else {
             world.advance_states(len);
+        }
+        let dt_s = len as f64 / clock_hz;
+        for (i, (d, b)) in drives.iter_mut().zip(&before).enumerate() {
+            let v = crate::energy::ground_speeds(b, &world.pose(i)?, dt_s, track_m);
+            d.add_substep(dt_s, v);
         }
         for (i, m) in meters.iter_mut().enumerate() {
             let pressed = world.bumpers(i)?.iter().any(|&b| b);
@@ -1091,7 +1175,7 @@ mod tests {
                 assert_eq!(len, nominal, "no sliver of a sub-step");
             }
             let (c, contact) =
-                advance_world(&mut w, t, &mut meters, &mut per_robot, false).unwrap();
+                advance_world(&mut w, t, &mut meters, &mut per_robot, false, &mut []).unwrap();
             collisions.push((c, contact));
         }
         assert_eq!(w.elapsed_states(), 500 * period, "no drift");
@@ -1126,6 +1210,7 @@ mod tests {
             moved_mm: 70.0 / (1.0 + x),
             gap_cv: gap.then_some(0.1 + x * 1e-4),
             cpu_load_percent: 0.3 + x * 1e-6,
+            energy_per_robot_mj: 3500.0 + x.cos(),
         }
     }
 
@@ -1238,6 +1323,7 @@ mod tests {
                     moved_mm: f(8),
                     gap_cv: (!r[9].is_empty()).then(|| f(9)),
                     cpu_load_percent: f(10),
+                    energy_per_robot_mj: f(11),
                 },
             );
         }

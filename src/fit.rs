@@ -37,9 +37,13 @@ use emu::board::model::{Controller, ControllerConfig, ControllerError, PhaseStat
 use emu::board::profile::{PhaseDef, Profiler, UnknownFunction};
 use emu::chip::mcu::{Board, Mcu, McuConfig, McuError};
 use emu::core::bus::Bus;
-use emu::core::cpu::{Cpu, Event};
+use emu::core::cpu::{Cpu, CpuError, Event, StackFault, StackGuard};
 use emu::core::memmap::{RAM_BYTES, ROM_BYTES};
 
+use crate::energy::{
+    Charge, DriveMeter, ElectronicsMeter, FreeWheels, PAPER_BATTERY_LIFE_H, Pack, Part,
+    mean_current_ma,
+};
 use crate::seeds::robot_stream;
 
 /// Endurance of a 24LC256 page: 1 000 000 write cycles (SPEC §3.6; Microchip DS21203).
@@ -251,6 +255,124 @@ pub struct EepromLine {
     pub save_max_states: u64,
 }
 
+/// The stack's room and what the firmware left of it ([`emu::core::cpu::stack`]).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct StackLine {
+    /// The room's low end: the end of the firmware's data and of the arrays it carves at
+    /// boot.
+    pub room_low: u32,
+    /// The stack's top (the initial SP).
+    pub room_top: u32,
+    /// Bytes in the room.
+    pub room_bytes: u32,
+    /// The lowest SP the run saw.
+    pub lowest_sp: u32,
+    /// Bytes between the lowest SP and the room's low end (negative past it).
+    pub left_bytes: i64,
+    /// The first stack access outside the room, if one stopped the measurement.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub overflow: Option<String>,
+    /// Its bytes outside the room.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub overflow_bytes: Option<u32>,
+}
+
+/// One part's draw from the pack.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct PartLine {
+    /// The part ([`Part::key`]).
+    pub part: &'static str,
+    /// The part in words.
+    pub name: &'static str,
+    /// Its mean current, mA.
+    pub mean_current_ma: f64,
+    /// Its energy per step period at the pack's voltage, mJ.
+    pub energy_per_step_mj: f64,
+}
+
+/// What the robot draws from its pack with the measured controller, and how long the pack
+/// lasts ([`crate::energy`]).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct EnergyReport {
+    /// The pack.
+    pub pack: Pack,
+    /// The step period, s.
+    pub step_period_s: f64,
+    /// By part, the wheels free (no obstacle: each follows its command with the world's lag).
+    pub parts: Vec<PartLine>,
+    /// The robot's mean current, mA.
+    pub mean_current_ma: f64,
+    /// Its energy per step period, mJ.
+    pub energy_per_step_mj: f64,
+    /// Hours the pack lasts.
+    pub battery_life_h: f64,
+    /// The motors' mean current with the wheels held still (a robot pressed against a wall
+    /// the whole time, still driving), mA.
+    pub held_motors_current_ma: f64,
+    /// The robot's mean current so, mA.
+    pub held_mean_current_ma: f64,
+    /// Hours the pack lasts so.
+    pub held_battery_life_h: f64,
+    /// The paper's figure: "up to 3.5 hours".
+    pub paper_battery_life_h: f64,
+    /// The capacity a cell would need for the paper's 3.5 h at the free-running current, mAh.
+    pub capacity_for_paper_mah: f64,
+}
+
+impl EnergyReport {
+    fn new(m: &Metered, pack: Pack, step_period_s: f64) -> EnergyReport {
+        let mut free = m.electronics;
+        free.add(&m.free);
+        let parts = Part::ALL
+            .iter()
+            .map(|&p| PartLine {
+                part: p.key(),
+                name: p.name(),
+                mean_current_ma: mean_current_ma(free.of(p), m.seconds),
+                energy_per_step_mj: 0.0,
+            })
+            .collect();
+        let held_motors = mean_current_ma(m.held.of(Part::Motors), m.seconds);
+        let held_rest = mean_current_ma(
+            free.total_uc() - free.of(Part::Motors) - free.of(Part::Bridges)
+                + m.held.of(Part::Bridges),
+            m.seconds,
+        );
+        EnergyReport {
+            pack,
+            step_period_s,
+            parts,
+            mean_current_ma: 0.0,
+            energy_per_step_mj: 0.0,
+            battery_life_h: 0.0,
+            held_motors_current_ma: held_motors,
+            held_mean_current_ma: held_rest + held_motors,
+            held_battery_life_h: 0.0,
+            paper_battery_life_h: PAPER_BATTERY_LIFE_H,
+            capacity_for_paper_mah: 0.0,
+        }
+        .with_pack(pack)
+    }
+
+    /// The same draw from another pack (a different capacity).
+    #[must_use]
+    pub fn with_pack(&self, pack: Pack) -> EnergyReport {
+        let mut r = self.clone();
+        r.pack = pack;
+        // mA × s = mC; at the pack's volts, mJ.
+        let per_step = |ma: f64| ma * self.step_period_s * pack.volts();
+        for p in &mut r.parts {
+            p.energy_per_step_mj = per_step(p.mean_current_ma);
+        }
+        r.mean_current_ma = r.parts.iter().map(|p| p.mean_current_ma).sum();
+        r.energy_per_step_mj = per_step(r.mean_current_ma);
+        r.battery_life_h = pack.life_h(r.mean_current_ma);
+        r.held_battery_life_h = pack.life_h(r.held_mean_current_ma);
+        r.capacity_for_paper_mah = Pack::capacity_for_h(r.mean_current_ma, PAPER_BATTERY_LIFE_H);
+        r
+    }
+}
+
 /// The verdict of SPEC §6.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct FitReport {
@@ -303,6 +425,14 @@ pub struct FitReport {
     /// The stack's high-water mark (bytes below the top of RAM), when measured.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub stack_high_water: Option<u32>,
+    /// The stack's room and what was left of it (machine code), when measured.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stack: Option<StackLine>,
+    /// What the robot draws from its pack and how long the pack lasts (the paper's pack, with
+    /// cells of [`crate::energy::DEFAULT_CAPACITY_MAH`] unless the command says otherwise),
+    /// when the measurement ran to its end.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub energy: Option<EnergyReport>,
     /// ROM items.
     pub rom: Vec<MemLine>,
     /// ROM used, bytes.
@@ -407,6 +537,71 @@ struct Measured {
     busy: Vec<u64>,
     ram: Vec<MemLine>,
     stack_high_water: Option<u32>,
+    /// The stack's room and what the firmware left of it (machine code only).
+    stack: Option<StackLine>,
+    /// The charge over the measured step periods.
+    energy: Option<Metered>,
+}
+
+/// What the charge meter saw over the measured step periods.
+struct Metered {
+    /// The electronics (MCU, A/D converter, sensors, EEPROMs, regulator).
+    electronics: Charge,
+    /// The motors and bridges with the wheels free.
+    free: Charge,
+    /// The motors and bridges with the wheels held still.
+    held: Charge,
+    /// The measured time, s.
+    seconds: f64,
+}
+
+/// The fit's energy meter: the electronics from the MCU's counters, and the motors under the
+/// controller's commands twice over, once with the wheels free and once held still (a robot
+/// pressed against a wall).
+struct FitMeter {
+    electronics: ElectronicsMeter,
+    free: (DriveMeter, FreeWheels),
+    held: (DriveMeter, FreeWheels),
+    start: u64,
+}
+
+impl FitMeter {
+    fn new<B: Board>(mcu: &Mcu<B>) -> FitMeter {
+        let top = world::params::TOP_SPEED_M_PER_S;
+        let wheels = || FreeWheels::new(top, world::params::MOTOR_TIME_CONSTANT_S);
+        FitMeter {
+            electronics: ElectronicsMeter::new(mcu),
+            free: (DriveMeter::new(top, [1.0; 2]), wheels()),
+            held: (DriveMeter::new(top, [1.0; 2]), wheels()),
+            start: mcu.now(),
+        }
+    }
+
+    /// A step period of `seconds` has run under the motor commands its step set (the motor
+    /// pins now, before the next step sets them).
+    fn period<B: Board>(&mut self, mcu: &mut Mcu<B>, seconds: f64) {
+        let pins = emu::board::wiring::motor_pins(mcu);
+        let (l, r) = (
+            crate::robot::wheel(&pins.left),
+            crate::robot::wheel(&pins.right),
+        );
+        for (meter, wheels, held) in [
+            (&mut self.free.0, &mut self.free.1, false),
+            (&mut self.held.0, &mut self.held.1, true),
+        ] {
+            meter.set_commands(l, r);
+            wheels.run(meter, seconds, world::params::MAX_SUBSTEP_S, held);
+        }
+    }
+
+    fn finish<B: Board>(mut self, mcu: &Mcu<B>, busy_states: u64) -> Metered {
+        Metered {
+            electronics: self.electronics.take(mcu, busy_states),
+            free: self.free.0.take(),
+            held: self.held.0.take(),
+            seconds: (mcu.now() - self.start) as f64 / f64::from(mcu.clock_hz()),
+        }
+    }
 }
 
 impl Measured {
@@ -433,6 +628,9 @@ fn measure_firmware(cfg: &FitConfig) -> Result<Measured, FitError> {
     };
     let mut rig = Rig::new(cfg)?;
     let mut cpu = Cpu::new();
+    // The stack guard stops the measurement at a stack access outside the room: the verdict
+    // is then that it does not fit, with how far it went.
+    cpu.set_stack_guard(Some(StackGuard::stop(fw.stack_room())));
     fw.install(&mut rig.mcu, &mut cpu, block.as_ref())?;
     let mut profiler = Profiler::new(&fw.symbols, &cfg.firmware.phases, PHASE_OTHER)?;
     let clock = f64::from(cfg.controller.clock_hz);
@@ -459,30 +657,6 @@ fn measure_firmware(cfg: &FitConfig) -> Result<Measured, FitError> {
         .position(|n| n != PHASE_BOOT && n != PHASE_OTHER)
         .unwrap_or(usize::MAX);
     let boot_limit = (BOOT_LIMIT_S * clock) as u64;
-    if step_phase == usize::MAX {
-        // No phases: count from the first SLEEP instead.
-        while !cpu.sleeping() {
-            if rig.mcu.now() >= boot_limit {
-                return Err(FitError::BootTimeout { pc: cpu.pc() });
-            }
-            step(&mut profiler, &mut cpu, &mut rig.mcu, boot_limit)?;
-        }
-    } else {
-        while profiler.first_entry(step_phase).is_none() {
-            if rig.mcu.now() >= boot_limit {
-                return Err(FitError::BootTimeout { pc: cpu.pc() });
-            }
-            step(&mut profiler, &mut cpu, &mut rig.mcu, boot_limit)?;
-        }
-    }
-    let boot_states: u64 = profiler.states().iter().sum();
-    if let Some(addr) = fw.symbols.addr("cfg_status")
-        && block.is_some()
-        && let ConfigStatus::Rejected { field, code } = ConfigStatus::from_code(rig.mcu.peek(addr))
-    {
-        return Err(FitError::Rejected { field, code });
-    }
-
     let period = match block {
         Some(b) => b.step_period_states(),
         None => ConfigBlock::ARENA.step_period_states(),
@@ -490,41 +664,95 @@ fn measure_firmware(cfg: &FitConfig) -> Result<Measured, FitError> {
     let n_phases = profiler.names().len();
     let mut per_phase: Vec<Vec<u64>> = vec![Vec::with_capacity(cfg.steps as usize); n_phases];
     let mut busy = Vec::with_capacity(cfg.steps as usize);
-    let mut before: Vec<u64> = profiler.states().to_vec();
-    // A step period runs from one step's start (the entry into its first phase) to the next
-    // one's: one step, its ticks and the idle time up to the next (K ticks in steady state;
-    // the first may be shorter when boot outlasted the first tick). Without phases, fixed
-    // windows of K ticks from the first SLEEP.
-    let mut window_end = rig.mcu.now();
-    for k in 0..u64::from(cfg.steps) {
-        // The world moves before each step's A/D scan.
-        rig.move_world();
+    let mut boot_states = 0;
+    let mut meter = None;
+    // The measurement, up to a stack overflow if there is one.
+    let fault: Option<Box<StackFault>> = 'run: {
         if step_phase == usize::MAX {
-            window_end += period;
-            while rig.mcu.now() < window_end {
-                if step(&mut profiler, &mut cpu, &mut rig.mcu, window_end)? == Event::Asleep {
-                    break;
+            // No phases: count from the first SLEEP instead.
+            while !cpu.sleeping() {
+                if rig.mcu.now() >= boot_limit {
+                    return Err(FitError::BootTimeout { pc: cpu.pc() });
+                }
+                if let Err(e) = step(&mut profiler, &mut cpu, &mut rig.mcu, boot_limit) {
+                    break 'run Some(overflow(e)?);
                 }
             }
         } else {
-            let limit = rig.mcu.now() + 2 * period + boot_limit;
-            while profiler.entries(step_phase) < k + 2 {
-                if rig.mcu.now() >= limit {
-                    return Err(FitError::StepTimeout {
-                        phase: profiler.names()[step_phase].clone(),
-                        pc: cpu.pc(),
-                    });
+            while profiler.first_entry(step_phase).is_none() {
+                if rig.mcu.now() >= boot_limit {
+                    return Err(FitError::BootTimeout { pc: cpu.pc() });
                 }
-                step(&mut profiler, &mut cpu, &mut rig.mcu, limit)?;
+                if let Err(e) = step(&mut profiler, &mut cpu, &mut rig.mcu, boot_limit) {
+                    break 'run Some(overflow(e)?);
+                }
             }
         }
-        let now = profiler.states();
-        for (i, v) in per_phase.iter_mut().enumerate() {
-            v.push(now[i] - before[i]);
+        boot_states = profiler.states().iter().sum();
+        // Booted: what the firmware carved above its data is not the stack's.
+        fw.raise_stack_low(&mut cpu, &rig.mcu);
+        if let Some(addr) = fw.symbols.addr("cfg_status")
+            && block.is_some()
+            && let ConfigStatus::Rejected { field, code } =
+                ConfigStatus::from_code(rig.mcu.peek(addr))
+        {
+            return Err(FitError::Rejected { field, code });
         }
-        busy.push(now.iter().sum::<u64>() - before.iter().sum::<u64>());
-        before = now.to_vec();
-    }
+
+        let mut before: Vec<u64> = profiler.states().to_vec();
+        meter = Some(FitMeter::new(&rig.mcu));
+        // A step period runs from one step's start (the entry into its first phase) to the next
+        // one's: one step, its ticks and the idle time up to the next (K ticks in steady state;
+        // the first may be shorter when boot outlasted the first tick). Without phases, fixed
+        // windows of K ticks from the first SLEEP.
+        let mut window_end = rig.mcu.now();
+        for k in 0..u64::from(cfg.steps) {
+            // The world moves before each step's A/D scan.
+            rig.move_world();
+            if step_phase == usize::MAX {
+                window_end += period;
+                while rig.mcu.now() < window_end {
+                    match step(&mut profiler, &mut cpu, &mut rig.mcu, window_end) {
+                        Ok(Event::Asleep) => break,
+                        Ok(_) => {}
+                        Err(e) => break 'run Some(overflow(e)?),
+                    }
+                }
+            } else {
+                let limit = rig.mcu.now() + 2 * period + boot_limit;
+                while profiler.entries(step_phase) < k + 2 {
+                    if rig.mcu.now() >= limit {
+                        return Err(FitError::StepTimeout {
+                            phase: profiler.names()[step_phase].clone(),
+                            pc: cpu.pc(),
+                        });
+                    }
+                    if let Err(e) = step(&mut profiler, &mut cpu, &mut rig.mcu, limit) {
+                        break 'run Some(overflow(e)?);
+                    }
+                }
+            }
+            let now = profiler.states();
+            for (i, v) in per_phase.iter_mut().enumerate() {
+                v.push(now[i] - before[i]);
+            }
+            busy.push(now.iter().sum::<u64>() - before.iter().sum::<u64>());
+            before = now.to_vec();
+            if let Some(m) = meter.as_mut() {
+                let seconds = period as f64 / clock;
+                m.period(&mut rig.mcu, seconds);
+            }
+        }
+        None
+    };
+    let energy = match (fault.is_none(), meter) {
+        (true, Some(m)) => Some(m.finish(&rig.mcu, busy.iter().sum())),
+        _ => None,
+    };
+    let fault = fault.map(|mut f| {
+        f.function = fw.symbols.function_at(f.pc).map(|s| s.c_name().to_string());
+        *f
+    });
     let phases: Vec<(String, Vec<u64>)> = profiler
         .names()
         .iter()
@@ -537,6 +765,18 @@ fn measure_firmware(cfg: &FitConfig) -> Result<Measured, FitError> {
         .addr("_stack_top")
         .unwrap_or(emu::core::memmap::RAM_END + 1);
     let stack_high_water = stack_top.saturating_sub(profiler.min_sp());
+    let room = cpu
+        .stack_guard()
+        .map_or_else(|| fw.stack_room(), |g| g.room);
+    let stack = StackLine {
+        room_low: room.low,
+        room_top: room.top,
+        room_bytes: room.bytes(),
+        lowest_sp: profiler.min_sp().min(room.top),
+        left_bytes: i64::from(profiler.min_sp().min(room.top)) - i64::from(room.low),
+        overflow: fault.as_ref().map(ToString::to_string),
+        overflow_bytes: fault.as_ref().map(StackFault::bytes_over),
+    };
     Ok(Measured {
         source: fw.name.clone(),
         boot_states,
@@ -544,7 +784,20 @@ fn measure_firmware(cfg: &FitConfig) -> Result<Measured, FitError> {
         busy,
         ram: firmware_ram(fw, &rig.mcu, stack_high_water),
         stack_high_water: Some(stack_high_water),
+        stack: Some(stack),
+        energy,
     })
+}
+
+/// The stack fault an error of the measurement is, or the error itself.
+fn overflow(e: FitError) -> Result<Box<StackFault>, FitError> {
+    match e {
+        FitError::Run {
+            source: RunError::Cpu(CpuError::StackOverflow(f)),
+            ..
+        } => Ok(f),
+        e => Err(e),
+    }
 }
 
 /// A big-endian u32 in RAM.
@@ -622,11 +875,14 @@ fn measure_model(cfg: &FitConfig) -> Result<Measured, FitError> {
     // from one step's tick to the next).
     let mut per_step: Vec<(PhaseStates, u64, u64)> = Vec::with_capacity(cfg.steps as usize);
     controller.sleep_until_step(&mut rig.mcu)?;
+    let mut meter = FitMeter::new(&rig.mcu);
+    let period_s = cfg.controller.step_period_s;
     for _ in 0..cfg.steps {
         rig.move_world();
         let step = controller.step(&mut rig.mcu)?;
         let sleep = controller.sleep_until_step(&mut rig.mcu)?;
         per_step.push((step.phases, sleep.busy_states, sleep.ticks));
+        meter.period(&mut rig.mcu, period_s);
     }
     let isr = controller.isr_states().unwrap_or(0);
     let col = |f: &dyn Fn(&(PhaseStates, u64, u64)) -> u64| -> Vec<u64> {
@@ -657,13 +913,17 @@ fn measure_model(cfg: &FitConfig) -> Result<Measured, FitError> {
             bytes: p.bytes,
         })
         .collect();
+    let busy = col(&|s| s.0.work() + s.0.isr + s.1);
+    let energy = Some(meter.finish(&rig.mcu, busy.iter().sum()));
     Ok(Measured {
         source: "model".to_string(),
         boot_states: boot.states,
         phases,
-        busy: col(&|s| s.0.work() + s.0.isr + s.1),
+        busy,
         ram,
         stack_high_water: None,
+        stack: None,
+        energy,
     })
 }
 
@@ -758,7 +1018,7 @@ fn report(cfg: &FitConfig, m: &Measured, other: Option<&Measured>) -> FitReport 
         save_max_states: save_max,
     };
 
-    let margins = [
+    let mut margins = vec![
         (
             "RAM",
             100.0 * (1.0 - f64::from(ram_used) / f64::from(RAM_BYTES)),
@@ -769,13 +1029,30 @@ fn report(cfg: &FitConfig, m: &Measured, other: Option<&Measured>) -> FitReport 
         ),
         ("CPU (worst step)", 100.0 - cpu_worst_percent),
     ];
+    // The stack's room: what the lowest SP left of it, or how far past it the first access
+    // outside went (then it does not fit, whatever the RAM total says).
+    let mut stack_note = String::new();
+    if let Some(st) = &m.stack {
+        let room = f64::from(st.room_bytes.max(1));
+        let left = match st.overflow_bytes {
+            Some(over) => -f64::from(over),
+            None => st.left_bytes as f64,
+        };
+        margins.push(("stack", 100.0 * left / room));
+        if let Some(text) = &st.overflow {
+            stack_note = format!(
+                "the stack leaves its room by {} B ({text}); ",
+                st.overflow_bytes.unwrap_or(0)
+            );
+        }
+    }
     let (tightest, tightest_margin_percent) = margins
         .iter()
         .copied()
         .fold(("RAM", f64::INFINITY), |a, b| if b.1 < a.1 { b } else { a });
     let fits = margins.iter().all(|m| m.1 >= 0.0);
     let verdict = format!(
-        "{}: {} x {} network, RAM {} of {} B, ROM {} B of {} KB, worst step {:.2} % of the {} s period (mean {:.3} %); tightest margin: {} with {:.1} % left",
+        "{}: {stack_note}{} x {} network, RAM {} of {} B, ROM {} B of {} KB, worst step {:.2} % of the {} s period (mean {:.3} %); tightest margin: {} with {:.1} % left",
         if fits { "FITS" } else { "DOES NOT FIT" },
         n_in,
         c.behaviours,
@@ -813,6 +1090,11 @@ fn report(cfg: &FitConfig, m: &Measured, other: Option<&Measured>) -> FitReport 
         ram: m.ram.clone(),
         ram_used,
         stack_high_water: m.stack_high_water,
+        stack: m.stack.clone(),
+        energy: m
+            .energy
+            .as_ref()
+            .map(|e| EnergyReport::new(e, Pack::default(), c.step_period_s)),
         rom,
         rom_used,
         eeprom,

@@ -97,6 +97,10 @@ pub struct FitArgs {
     /// Print the reports as JSON.
     #[arg(long)]
     pub json: bool,
+    /// Capacity of one cell of the paper's pack (ten 1.2 V NiMH cells), mAh, for the battery
+    /// life (default: 2 000 mAh, a typical AA NiMH cell of 2008).
+    #[arg(long, value_name = "MAH")]
+    pub capacity_mah: Option<f64>,
 }
 
 impl FitArgs {
@@ -237,6 +241,21 @@ fn parse_budget(text: &str) -> Result<f64> {
     Ok(v)
 }
 
+/// `--capacity-mah`: a capacity from 1 mAh to 100 Ah (default
+/// [`crate::energy::DEFAULT_CAPACITY_MAH`]).
+///
+/// # Errors
+/// A value outside that range, or not a number.
+pub fn parse_capacity(given: Option<f64>) -> Result<f64> {
+    match given {
+        None => Ok(crate::energy::DEFAULT_CAPACITY_MAH),
+        Some(c) if c.is_finite() && (1.0..=100_000.0).contains(&c) => Ok(c),
+        Some(c) => bail!(
+            "--capacity-mah {c}: give a cell's capacity from 1 to 100000 mAh (AA NiMH cells hold 1 900-2 700 mAh)"
+        ),
+    }
+}
+
 /// The most steps `fit` measures (1 million: under 100 MB of per-step states, about two
 /// minutes on the firmware).
 pub const MAX_FIT_STEPS: u32 = 1_000_000;
@@ -253,6 +272,7 @@ pub fn run(a: &FitArgs) -> Result<String> {
         );
     }
     let budget = a.cpu_budget.as_deref().map(parse_budget).transpose()?;
+    let pack = crate::energy::Pack::paper(parse_capacity(a.capacity_mah)?);
     let settings: Vec<Setting> = match (a.setting, a.what_if()) {
         (Some(s), _) => vec![s],
         (None, true) => vec![Setting::Arena],
@@ -276,7 +296,10 @@ pub fn run(a: &FitArgs) -> Result<String> {
     let mut reports = Vec::new();
     for setting in &settings {
         let fit = config(apply_what_ifs(base_config(*setting, a.seed), a)?);
-        let report = measure(&fit).map_err(anyhow::Error::new)?;
+        let mut report = measure(&fit).map_err(anyhow::Error::new)?;
+        if let Some(e) = report.energy.as_mut() {
+            *e = e.with_pack(pack);
+        }
         let name = match (setting, a.what_if()) {
             (Setting::Arena, false) => "arena (paper env. 2; the default network)".to_string(),
             (Setting::Corridor, false) => "corridor (paper env. 1)".to_string(),
@@ -439,6 +462,25 @@ fn render(s: &mut String, name: &str, r: &FitReport) {
         r.stack_high_water
             .map_or(String::new(), |h| format!("; stack high-water {h} B"))
     );
+    if let Some(st) = &r.stack {
+        match &st.overflow {
+            Some(text) => {
+                let _ = writeln!(s, "stack: OVERFLOW: {text}");
+            }
+            None => {
+                let _ = writeln!(
+                    s,
+                    "stack: room H'{:06X}-H'{:06X} ({} B, the end of the data and the boot-sized arrays to the initial SP); lowest SP H'{:06X}: {} B left ({:.1} %)",
+                    st.room_low,
+                    st.room_top.saturating_sub(1),
+                    st.room_bytes,
+                    st.lowest_sp,
+                    st.left_bytes,
+                    st.left_bytes as f64 / f64::from(st.room_bytes.max(1)) * 100.0
+                );
+            }
+        }
+    }
     let _ = writeln!(s, "ROM (bytes):");
     for m in &r.rom {
         let _ = writeln!(s, "  {:>6}  {}", m.bytes, m.item);
@@ -461,5 +503,48 @@ fn render(s: &mut String, name: &str, r: &FitReport) {
         e.save_max_states,
         us(e.save_max_states as f64) / 1000.0
     );
+    if let Some(en) = &r.energy {
+        render_energy(s, en);
+    }
     let _ = writeln!(s, "verdict: {}", r.verdict);
+}
+
+fn render_energy(s: &mut String, e: &crate::fit::EnergyReport) {
+    let _ = writeln!(
+        s,
+        "energy from the pack ({} x {} V NiMH, {} V, {:.0} mAh), wheels free (each at its command's speed):",
+        e.pack.cells,
+        e.pack.cell_volts,
+        e.pack.volts(),
+        e.pack.capacity_mah
+    );
+    let _ = writeln!(
+        s,
+        "  {:<32} {:>10} {:>14}",
+        "part",
+        "mean mA",
+        format!("mJ per {} s", e.step_period_s)
+    );
+    for p in &e.parts {
+        let _ = writeln!(
+            s,
+            "  {:<32} {:>10.3} {:>14.2}",
+            p.name, p.mean_current_ma, p.energy_per_step_mj
+        );
+    }
+    let _ = writeln!(
+        s,
+        "  {:<32} {:>10.3} {:>14.2}",
+        "total", e.mean_current_ma, e.energy_per_step_mj
+    );
+    let _ = writeln!(
+        s,
+        "battery life: {:.2} h with the wheels free (the paper: up to {} h, which {:.0} mAh cells would give at this current); {:.2} h pressed against a wall the whole time (motors {:.0} mA, total {:.0} mA)",
+        e.battery_life_h,
+        e.paper_battery_life_h,
+        e.capacity_for_paper_mah,
+        e.held_battery_life_h,
+        e.held_motors_current_ma,
+        e.held_mean_current_ma
+    );
 }

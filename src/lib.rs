@@ -13,6 +13,7 @@
 pub mod cleanup;
 pub mod collisions;
 pub mod cost_report;
+pub mod energy;
 pub mod experiment;
 pub mod fit;
 pub mod fit_cmd;

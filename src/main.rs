@@ -67,9 +67,33 @@ struct EmuArgs {
     #[arg(long, value_name = "ADDR")]
     gdb: Option<String>,
     /// The image's symbol table (`h8300-hms-nm -n` output) for function names in --trace and
-    /// --vcd (default: IMAGE.sym beside the image, if present).
+    /// --vcd and the stack guard's room (default: IMAGE.sym beside the image, if present).
     #[arg(long, value_name = "FILE")]
     symbols: Option<std::path::PathBuf>,
+    /// What the stack guard does with the first stack access outside the stack's room (the
+    /// end of the image's data to its stack's top, or the whole RAM without symbols): `stop`
+    /// the program with an error (exit status 125), or `warn` at the end and let it run.
+    #[arg(long, value_enum, value_name = "ACTION", default_value_t = GuardArg::Stop)]
+    stack_guard: GuardArg,
+}
+
+/// What the stack guard does (`--stack-guard`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+enum GuardArg {
+    /// Stop the program at the instruction, with a one-line error.
+    #[default]
+    Stop,
+    /// Let it run on; print the first fault as a warning.
+    Warn,
+}
+
+impl From<GuardArg> for emu::core::cpu::StackGuardMode {
+    fn from(g: GuardArg) -> Self {
+        match g {
+            GuardArg::Stop => emu::core::cpu::StackGuardMode::Stop,
+            GuardArg::Warn => emu::core::cpu::StackGuardMode::Warn,
+        }
+    }
 }
 
 #[derive(Args, Debug)]
@@ -168,6 +192,7 @@ fn main() -> ExitCode {
             vcd: args.vcd.as_deref(),
             gdb: args.gdb.as_deref(),
             symbols: args.symbols.as_deref(),
+            stack_guard: args.stack_guard.into(),
         }),
         Some(Command::Fit(args)) => fit(&args),
         Some(Command::Run(args)) => run(&args),

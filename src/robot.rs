@@ -134,6 +134,10 @@ pub struct Robot {
     net_w: Option<u32>,
     /// How many weights the learner has (N × M).
     weights_len: usize,
+    /// The charge meter of the electronics (everything but the motors and their bridges).
+    electronics: crate::energy::ElectronicsMeter,
+    /// The electronics' charge over the latest step ([`Robot::step_charge`]).
+    step_charge: crate::energy::Charge,
 }
 
 /// Ends the MCU's pin trace and writes the rest of it (and of the phases) into `vcd`.
@@ -270,6 +274,7 @@ impl Robot {
             board,
         )
         .context("timing.clock_hz")?;
+        let electronics = crate::energy::ElectronicsMeter::new(&mcu);
         let mut cfg = controller_config(s, stream(0, Purpose::Weights))?;
         let weights_len = cfg.n_inputs() * cfg.behaviours;
         if condition != Condition::Learning {
@@ -314,6 +319,8 @@ impl Robot {
             finished_trace: None,
             net_w,
             weights_len,
+            electronics,
+            step_charge: crate::energy::Charge::default(),
         };
         robot.records = robot.records_written();
         Ok(robot)
@@ -471,6 +478,23 @@ impl Robot {
     /// A save that failed on the bus (the model); the firmware stopped, halted, or did not go
     /// back to sleep within the watchdog's time.
     pub fn step(&mut self, distance_mm: [Option<f64>; 4]) -> Result<StepResult> {
+        let r = self.run_step(distance_mm)?;
+        // The electronics since the previous step's work ended: its busy states are those
+        // the step's sleep and work counted.
+        self.step_charge = self.electronics.take(&self.mcu, self.busy_states);
+        Ok(r)
+    }
+
+    /// The charge the electronics (the MCU, its A/D converter, the IR sensors, the EEPROMs,
+    /// the regulator) drew from the end of the previous step's work to the end of the latest
+    /// one's ([`crate::energy`]).
+    #[must_use]
+    pub fn step_charge(&self) -> crate::energy::Charge {
+        self.step_charge
+    }
+
+    /// [`Robot::step`] without the charge meter.
+    fn run_step(&mut self, distance_mm: [Option<f64>; 4]) -> Result<StepResult> {
         self.mcu.board_mut().distance_mm = distance_mm;
         match &mut self.brain {
             Brain::Model(c) => {
@@ -540,6 +564,24 @@ impl Robot {
     /// the main loop around them (not the time asleep).
     pub fn take_busy_states(&mut self) -> u64 {
         std::mem::take(&mut self.busy_states)
+    }
+
+    /// What a firmware robot's stack guard does when a stack access leaves the stack's room
+    /// (see [`FirmwareController::set_stack_guard_mode`]); a model robot has no stack to guard.
+    pub fn set_stack_guard_mode(&mut self, mode: emu::core::cpu::StackGuardMode) {
+        if let Brain::Firmware(c) = &mut self.brain {
+            c.set_stack_guard_mode(mode);
+        }
+    }
+
+    /// The first stack access of a firmware robot that left the stack's room (under a
+    /// warning guard).
+    #[must_use]
+    pub fn stack_fault(&self) -> Option<emu::core::cpu::StackFault> {
+        match &self.brain {
+            Brain::Firmware(c) => c.stack_fault(),
+            Brain::Model(_) => None,
+        }
     }
 
     /// The wheel commands the motor pins give now.

@@ -100,6 +100,34 @@ pub struct RunArgs {
     /// Record only the first K robots (default: all).
     #[arg(long, value_name = "K", requires = "replay")]
     pub replay_robots: Option<usize>,
+    /// Capacity of one cell of the paper's pack (ten 1.2 V NiMH cells), mAh, for the battery
+    /// life the summary gives (default: 2 000 mAh, a typical AA NiMH cell of 2008).
+    #[arg(long, value_name = "MAH")]
+    pub capacity_mah: Option<f64>,
+    /// What a firmware robot's stack guard does with the first stack access outside the
+    /// stack's room (the end of the firmware's data and boot-sized arrays to its stack's
+    /// top): `stop` the run with an error, or `warn` after the run and go on.
+    #[arg(long, value_enum, value_name = "ACTION")]
+    pub stack_guard: Option<StackGuardArg>,
+}
+
+/// What the stack guard does (`--stack-guard`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum StackGuardArg {
+    /// Stop at the instruction with a one-line error.
+    #[default]
+    Stop,
+    /// Go on; say which robots' stacks left their room, and where first.
+    Warn,
+}
+
+impl From<StackGuardArg> for emu::core::cpu::StackGuardMode {
+    fn from(g: StackGuardArg) -> Self {
+        match g {
+            StackGuardArg::Stop => emu::core::cpu::StackGuardMode::Stop,
+            StackGuardArg::Warn => emu::core::cpu::StackGuardMode::Warn,
+        }
+    }
 }
 
 /// What `--replay` asks for, checked.
@@ -242,6 +270,7 @@ struct Summary<'a> {
     /// settings, not the scenario's); absent otherwise.
     #[serde(skip_serializing_if = "Option::is_none")]
     image_configured: Option<bool>,
+    battery: &'a crate::energy::BatteryReport,
 }
 
 /// Runs the experiment; returns the text to print.
@@ -266,6 +295,7 @@ pub fn run(a: &RunArgs) -> Result<String> {
         s.controller.image = Some(image.display().to_string());
     }
     let s = s.with_overrides(a.robots, a.steps, a.repeats, a.seed)?;
+    crate::fit_cmd::parse_capacity(a.capacity_mah)?;
     let images = crate::robot::Images::load(&s)?;
     let unconfigured = unconfigured_image(&s, images.as_ref())?;
     if let Some(image) = &unconfigured {
@@ -971,6 +1001,7 @@ fn run_into(
                         rows: Some(rows_path(c, r)),
                         probes: probes.unwrap_or_default(),
                         replay,
+                        stack_guard: a.stack_guard.unwrap_or_default().into(),
                     },
                 )
             })
@@ -992,6 +1023,7 @@ fn run_into(
     );
     let warnings = warnings(s);
     let saves: u64 = runs.iter().map(|r| r.saves).sum();
+    let battery = battery_report(a, s, &analysis.conditions, &runs)?;
     let summary = Summary {
         h8swarm_version: env!("CARGO_PKG_VERSION"),
         scenario: s,
@@ -1006,6 +1038,7 @@ fn run_into(
             .and_then(|i| i.user.as_ref())
             .map(|(fw, _)| fw.has_config_block())
             .filter(|configured| !configured),
+        battery: &battery,
     };
     let summary_path = stage.path("summary.json");
     std::fs::write(
@@ -1094,6 +1127,7 @@ fn run_into(
     for w in &warnings {
         let _ = writeln!(t, "WARNING {w}");
     }
+    render_battery(&mut t, &battery);
     let _ = writeln!(t);
     report(&mut t, s, &analysis);
     for r in &runs {
@@ -1101,6 +1135,14 @@ fn run_into(
             let _ = writeln!(
                 t,
                 "DEAD  robot {i} in {} repeat {}: {why}",
+                r.condition.name(),
+                r.repeat
+            );
+        }
+        for (i, fault) in &r.stack_warnings {
+            let _ = writeln!(
+                t,
+                "STACK robot {i} in {} repeat {}: {fault}",
                 r.condition.name(),
                 r.repeat
             );
@@ -1391,6 +1433,75 @@ fn fmt_mean(e: &Estimate) -> String {
         "none".to_string()
     } else {
         format!("{:.2}", e.mean)
+    }
+}
+
+/// The battery life of each condition ([`crate::energy::BatteryReport`]) for the pack
+/// `--capacity-mah` gives.
+fn battery_report(
+    a: &RunArgs,
+    s: &Scenario,
+    stats: &[ConditionStats],
+    runs: &[RunOutput],
+) -> Result<crate::energy::BatteryReport> {
+    let pack = crate::energy::Pack::paper(crate::fit_cmd::parse_capacity(a.capacity_mah)?);
+    let mut b = crate::energy::BatteryReport::of(stats, pack, s.timing.step_period_s);
+    let robot_seconds = s.robots as f64 * f64::from(s.steps) * s.timing.step_period_s;
+    for c in stats {
+        let of_c: Vec<&RunOutput> = runs.iter().filter(|r| r.condition == c.condition).collect();
+        b.by_part.push(crate::energy::ConditionParts::of(
+            c.condition,
+            &of_c,
+            robot_seconds,
+        ));
+    }
+    Ok(b)
+}
+
+/// The battery lines of the summary: each condition's battery life in its first and last
+/// windows, its mean current by part, and what learning costs or saves against the controls.
+fn render_battery(t: &mut String, b: &crate::energy::BatteryReport) {
+    let _ = writeln!(t);
+    let _ = writeln!(
+        t,
+        "battery life, {} x {} V NiMH of {:.0} mAh (the paper: up to {} h); a robot's mean current:",
+        b.pack.cells, b.pack.cell_volts, b.pack.capacity_mah, b.paper_h
+    );
+    for (c, parts) in b.conditions.iter().zip(&b.by_part) {
+        let _ = writeln!(
+            t,
+            "{:<14} {} h ({:.0} mA) -> {} h ({:.0} mA)",
+            c.condition.name(),
+            fmt_est(&c.first_h),
+            c.first_current_ma,
+            fmt_est(&c.last_h),
+            c.last_current_ma
+        );
+        let list: Vec<String> = parts
+            .current_ma
+            .iter()
+            .map(|(k, ma)| format!("{k} {ma:.1}"))
+            .collect();
+        let _ = writeln!(t, "{:<14} whole run, mA: {}", "", list.join(", "));
+    }
+    for cmp in &b.learning_against {
+        let _ = writeln!(
+            t,
+            "learning {} {:.1} % of battery life ({:+.2} h) against {} in the last window ({})",
+            if cmp.change_h >= 0.0 {
+                "saves"
+            } else {
+                "costs"
+            },
+            cmp.change_percent.abs(),
+            cmp.change_h,
+            cmp.against.name(),
+            if cmp.apart {
+                "energy intervals apart"
+            } else {
+                "energy intervals overlap"
+            }
+        );
     }
 }
 

@@ -407,6 +407,8 @@ pub enum Quantity {
     MovedMm,
     /// The corridor's gap CV (none in the square arena).
     GapCv,
+    /// Energy a robot draws from its pack per step, mJ.
+    EnergyMj,
 }
 
 impl Quantity {
@@ -423,6 +425,7 @@ impl Quantity {
             Quantity::MovingPercent => "moving_percent",
             Quantity::MovedMm => "moved_mm",
             Quantity::GapCv => "gap_cv",
+            Quantity::EnergyMj => "energy_per_robot_step_mj",
         }
     }
 
@@ -437,6 +440,7 @@ impl Quantity {
             Quantity::ContactPercent | Quantity::StuckPercent | Quantity::MovingPercent => "%",
             Quantity::MovedMm => "mm",
             Quantity::GapCv => "CV",
+            Quantity::EnergyMj => "mJ",
         }
     }
 
@@ -464,6 +468,7 @@ impl Quantity {
             Quantity::MovingPercent => Some(w.moving_percent / steps),
             Quantity::MovedMm => Some(w.moved_mm / steps),
             Quantity::GapCv => w.all_have_gap_cv().then(|| w.gap_cv / steps),
+            Quantity::EnergyMj => Some(w.energy_per_robot_mj / steps),
         }
     }
 }
@@ -495,6 +500,9 @@ pub struct WindowStats {
     /// Corridor: mean gap CV over the window.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub gap_cv: Option<Estimate>,
+    /// Mean energy a robot drew from its pack per step over the window, mJ at the pack's
+    /// nominal 12 V ([`crate::energy`]).
+    pub energy_per_robot_step_mj: Estimate,
 }
 
 /// Each run's value of `q` over the window `win` picks, in repeat order.
@@ -534,6 +542,7 @@ pub fn window(
         moving_percent: est(Quantity::MovingPercent),
         moved_mm: est(Quantity::MovedMm),
         gap_cv: gap,
+        energy_per_robot_step_mj: est(Quantity::EnergyMj),
     }
 }
 
@@ -808,6 +817,17 @@ pub fn claims(runs: &[RunOutput], robots: usize, seed: u64) -> Vec<Claim> {
             last(Q::ContactPercent),
             of(&walk, Q::ContactPercent, last_window),
         ));
+    }
+    for (others, name) in [(&off, "learning off"), (&walk, "the random walk")] {
+        if !others.is_empty() {
+            out.push(claim(
+                &format!("energy per robot-step in the last window: learning below {name} (battery life longer)"),
+                false,
+                Q::EnergyMj,
+                last(Q::EnergyMj),
+                of(others, Q::EnergyMj, last_window),
+            ));
+        }
     }
     if corridor && !off.is_empty() {
         out.push(claim(

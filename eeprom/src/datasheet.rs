@@ -64,6 +64,22 @@ pub const T_WC_MODEL_MIN_NS: u64 = 3_000_000;
 /// ensured by characterization" (DS21203 Table 1-2, param. 18 and Note 4).
 pub const ENDURANCE_CYCLES: u32 = 1_000_000;
 
+/// I_CC read: operating current while the chip is clocked for a read, 400 µA maximum at
+/// VCC = 5.5 V, SCL = 400 kHz (DS21203 Table 1-1, DC characteristics, "I_CC Read"). The
+/// datasheet gives no typical value.
+pub const ICC_READ_MAX_UA: f64 = 400.0;
+/// I_CC write: operating current during a write (the internally timed write cycle), 3 mA
+/// maximum at VCC = 5.5 V (DS21203 Table 1-1, DC characteristics, "I_CC Write").
+pub const ICC_WRITE_MAX_MA: f64 = 3.0;
+/// I_CCS: standby current, 1 µA maximum at VCC = 5.5 V, SCL = SDA = VCC, industrial
+/// temperature range (DS21203 Table 1-1, DC characteristics, "I_CCS").
+pub const ICCS_STANDBY_MAX_UA: f64 = 1.0;
+/// Charge the chip draws per SCL clock it takes part in, nC: I_CC read over the 400 kHz clock
+/// it is specified at (400 µA × 2.5 µs). A CMOS chip's operating current grows with its clock,
+/// so a slower master takes longer per clock at a proportionally smaller current: the charge
+/// per clock stays.
+pub const CHARGE_PER_CLOCK_NC: f64 = ICC_READ_MAX_UA / (F_CLK_MAX_HZ as f64) * 1e3;
+
 /// The 100 kHz (I²C standard-mode) figures: DS21203 Table 1-2, "1.7 V ≤ VCC < 2.5 V" column.
 pub mod standard {
     /// F_CLK: 100 kHz (DS21203 Table 1-2, param. 1, low-voltage column).

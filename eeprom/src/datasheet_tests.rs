@@ -1005,3 +1005,29 @@ mod properties {
         }
     }
 }
+
+// ---- supply current (DS21203 Table 1-1) ------------------------------------------------
+
+#[test]
+fn a_page_write_charges_its_clocks_its_write_cycle_and_standby() {
+    use crate::datasheet::CHARGE_PER_CLOCK_NC;
+    let mut m = robot(31);
+    let before = m.pins().bus().device(0x50).unwrap().stats();
+    let t0 = now(&m);
+    m.page_write(0x50, 0x0040, &[0x5A; PAGE_BYTES]).unwrap();
+    let s = m.pins().bus().device(0x50).unwrap().stats();
+    let t = now(&m) - t0;
+    // Control byte, two address bytes, 64 data bytes: 67 bytes of 9 clocks each.
+    assert_eq!(s.clocks() - before.clocks(), 9 * 67);
+    assert_eq!(s.write_cycles, 1);
+    let (lo, hi) = m.pins().bus().device(0x50).unwrap().t_wc_range_states();
+    assert!((lo..=hi).contains(&s.write_cycle_states));
+    // By hand: 603 clocks at 1 nC, the drawn T_WC at 3 mA, and 1 µA over the interval; at
+    // 25 MHz one state is 40 ns.
+    assert!((CHARGE_PER_CLOCK_NC - 1.0).abs() < 1e-12);
+    let want = 603.0 * 1e-3 + s.write_cycle_states as f64 * 40e-9 * 3e3 + t as f64 * 40e-9 * 1.0;
+    let got = s.charge_since_uc(&before, t, 25_000_000);
+    assert!((got - want).abs() < 1e-9, "{got} vs {want}");
+    // 4 ms of write cycle is about 12 µC: it dominates the 0.6 µC of the clocks.
+    assert!((got - 12.6).abs() < 3.1, "{got}");
+}

@@ -296,6 +296,40 @@ pub struct DeviceStats {
     pub write_cycles: u64,
     /// Write cycles cut by a power loss.
     pub write_cycles_interrupted: u64,
+    /// States of the write cycles started (each its drawn T_WC, counted at the STOP that
+    /// starts it): the time the chip draws its write current.
+    pub write_cycle_states: u64,
+}
+
+impl DeviceStats {
+    /// SCL clocks the chip took part in: nine for every byte it acknowledged, sent or refused
+    /// while busy (the control bytes, addresses and data, the ACK polls it did not answer).
+    #[must_use]
+    pub fn clocks(&self) -> u64 {
+        9 * (self.control_acks + self.busy_nacks + self.bytes_received + self.bytes_sent)
+    }
+
+    /// The chip's charge over the counters `self` less `earlier` and `interval_states` of its
+    /// time at `clock_hz`, µC, from the datasheet's currents: its standby current all the time,
+    /// [`crate::datasheet::CHARGE_PER_CLOCK_NC`] for every clock it took part in, its write
+    /// current through every write cycle.
+    #[must_use]
+    pub fn charge_since_uc(
+        &self,
+        earlier: &DeviceStats,
+        interval_states: u64,
+        clock_hz: u32,
+    ) -> f64 {
+        use crate::datasheet::{CHARGE_PER_CLOCK_NC, ICC_WRITE_MAX_MA, ICCS_STANDBY_MAX_UA};
+        let s = 1.0 / f64::from(clock_hz.max(1));
+        let clocks = self.clocks().saturating_sub(earlier.clocks());
+        let write_states = self
+            .write_cycle_states
+            .saturating_sub(earlier.write_cycle_states);
+        interval_states as f64 * s * ICCS_STANDBY_MAX_UA
+            + clocks as f64 * CHARGE_PER_CLOCK_NC * 1e-3
+            + write_states as f64 * s * ICC_WRITE_MAX_MA * 1e3
+    }
 }
 
 /// A Microchip 24LC256 (32 KB serial EEPROM) at pin level.
@@ -743,6 +777,7 @@ impl Eeprom24lc256 {
         });
         self.loaded = 0;
         self.stats.write_cycles += 1;
+        self.stats.write_cycle_states += t_wc;
     }
 
     /// The time of the next scheduled SDA output change, if any.

@@ -42,6 +42,11 @@ pub const SPIKE_MAX_VOLTS: f64 = 0.200;
 /// The sensor's supply, Vcc = 5 V on the robot (datasheet: 4.5–5.5 V); its output stays within
 /// 0 V … Vcc, so held values and reads are clamped to that range.
 pub const SUPPLY_VOLTS: f64 = 5.0;
+/// Supply current, 33 mA typical (50 mA maximum), drawn all the time: the sensor pulses its
+/// IR LED every measuring period whether or not anyone reads it (Sharp GP2D12 datasheet,
+/// electro-optical characteristics, "average dissipation current I_CC", L = 80 cm; the
+/// GP2Y0A21YK gives 30 mA typical).
+pub const SUPPLY_CURRENT_MA: f64 = 33.0;
 
 /// Parameters of one IR sensor model. [`Default`] gives the datasheet figures; [`IrParams::ideal`]
 /// a noiseless nominal sensor for tests.

@@ -114,4 +114,4 @@ pub use bumpers::{
 pub use curve::{FOLDBACK_CONTACT_VOLTS, NOTHING_HIT_MM, PEAK_VOLTS, nominal_volts};
 pub use du::{DU_TABLE, STEEP_CODES, du_for_code};
 pub use error::SensorError;
-pub use ir::{DEFAULT_CLOCK_HZ, DEFAULT_PERIOD_JITTER_MS, IrParams, IrSensor};
+pub use ir::{DEFAULT_CLOCK_HZ, DEFAULT_PERIOD_JITTER_MS, IrParams, IrSensor, SUPPLY_CURRENT_MA};

@@ -137,6 +137,7 @@
 
 pub mod arena;
 mod contact;
+pub mod dc_motor;
 pub mod error;
 pub mod geometry;
 mod grid;

@@ -9,7 +9,7 @@ use crate::board::symbols::{SymbolError, SymbolTable};
 use crate::chip::gdb::{DebugAction, Debugger};
 use crate::chip::mcu::{Board, LoadError, Mcu};
 use crate::chip::trace::{CodeNames, PhaseRecorder};
-use crate::core::cpu::{Cpu, CpuError, Event};
+use crate::core::cpu::{Cpu, CpuError, Event, StackFault, StackGuard, StackGuardMode, StackRoom};
 use crate::core::srec::{self, SrecError, SrecImage};
 
 /// Where the configuration block sits in the flash (SPEC §8: "say H'000400, after the
@@ -382,6 +382,23 @@ impl Firmware {
             .ok_or_else(|| FirmwareError::MissingSymbol(name.to_string()))
     }
 
+    /// The stack's room its symbols give ([`SymbolTable::stack_room`]; the whole RAM without
+    /// symbols), before the arrays it carves at boot.
+    #[must_use]
+    pub fn stack_room(&self) -> StackRoom {
+        self.symbols.stack_room()
+    }
+
+    /// Raises `cpu`'s stack guard's low end to the end of what the firmware carved above its
+    /// data at boot (its `heap_end` pointer, read from `mcu`'s RAM), when it has one: call it
+    /// once the firmware has booted.
+    pub fn raise_stack_low<B: Board>(&self, cpu: &mut Cpu, mcu: &Mcu<B>) {
+        if let Some(p) = self.symbols.heap_end_pointer() {
+            let end = peek_be::<B, 4>(mcu, p) as u32;
+            cpu.raise_stack_low(end);
+        }
+    }
+
     /// Programs the image into `mcu`'s flash and, when given, the configuration block over it,
     /// and resets `cpu` (PC from the reset vector).
     ///
@@ -407,6 +424,13 @@ impl Firmware {
 #[must_use]
 pub fn peek_be<B: Board, const N: usize>(mcu: &Mcu<B>, addr: u32) -> u64 {
     (0..N as u32).fold(0u64, |v, i| (v << 8) | u64::from(mcu.peek(addr + i)))
+}
+
+/// Names the function of a stack fault the core reported, from `symbols`.
+pub fn name_stack_fault(e: &mut CpuError, symbols: &SymbolTable) {
+    if let CpuError::StackOverflow(f) = e {
+        f.function = symbols.function_at(f.pc).map(|s| s.c_name().to_string());
+    }
 }
 
 /// Why the firmware stopped.
@@ -505,6 +529,11 @@ pub struct FirmwareController {
     phases: Option<PhaseRecorder>,
     /// A GDB client's control of the firmware, while one is attached ([`Self::attach`]).
     debugger: Option<Box<Debugger>>,
+    /// The image's symbols (shared), to name the function of a stack fault and to find the
+    /// end of what the firmware carves at boot.
+    symbols: SymbolTable,
+    /// Whether the stack guard's room still has to take in what the firmware carves at boot.
+    booting: bool,
 }
 
 impl Clone for FirmwareController {
@@ -518,12 +547,17 @@ impl Clone for FirmwareController {
             watchdog_states: self.watchdog_states,
             phases: None,
             debugger: None,
+            symbols: self.symbols.clone(),
+            booting: self.booting,
         }
     }
 }
 
 impl FirmwareController {
-    /// Programs `fw` (and `block`, when given) into `mcu`'s flash and resets the CPU.
+    /// Programs `fw` (and `block`, when given) into `mcu`'s flash and resets the CPU, with a
+    /// stack guard that stops the firmware ([`Self::set_stack_guard_mode`]) over the room its
+    /// symbols give ([`Firmware::stack_room`]), raised to the end of its boot-sized arrays
+    /// once it has booted ([`Firmware::raise_stack_low`]).
     ///
     /// # Errors
     /// [`FirmwareError::Load`] when the image does not fit the flash.
@@ -533,6 +567,7 @@ impl FirmwareController {
         block: Option<&ConfigBlock>,
     ) -> Result<Self, FirmwareError> {
         let mut cpu = Cpu::new();
+        cpu.set_stack_guard(Some(StackGuard::stop(fw.stack_room())));
         fw.install(mcu, &mut cpu, block)?;
         Ok(FirmwareController {
             cpu,
@@ -541,6 +576,36 @@ impl FirmwareController {
             watchdog_states: (WATCHDOG_S * f64::from(mcu.clock_hz())) as u64,
             phases: None,
             debugger: None,
+            symbols: fw.symbols.clone(),
+            booting: true,
+        })
+    }
+
+    /// What the stack guard does when a stack access leaves the room: stop the firmware with
+    /// an error (the default) or keep the first fault ([`Self::stack_fault`]) and go on.
+    pub fn set_stack_guard_mode(&mut self, mode: StackGuardMode) {
+        if let Some(mut g) = self.cpu.stack_guard() {
+            g.mode = mode;
+            self.cpu.set_stack_guard(Some(g));
+        }
+    }
+
+    /// Runs the firmware without a stack guard (to measure what the guard costs; the results
+    /// are the same when nothing overflows).
+    pub fn disable_stack_guard(&mut self) {
+        self.cpu.set_stack_guard(None);
+    }
+
+    /// The first stack access that left the room, with its function (under a warning guard).
+    #[must_use]
+    pub fn stack_fault(&self) -> Option<StackFault> {
+        self.cpu.stack_fault().map(|f| {
+            let mut f = f.clone();
+            f.function = self
+                .symbols
+                .function_at(f.pc)
+                .map(|s| s.c_name().to_string());
+            f
         })
     }
 
@@ -597,6 +662,21 @@ impl FirmwareController {
     /// executed), an interrupt is accepted, or the clock reaches `deadline`; a sleeping CPU
     /// first sleeps until an interrupt wakes it (idle time). Busy states are counted apart.
     fn run<B: Board>(
+        &mut self,
+        mcu: &mut Mcu<B>,
+        deadline: u64,
+        stop: impl FnMut(&Mcu<B>) -> bool,
+    ) -> Result<Event, RunError> {
+        self.run_unnamed(mcu, deadline, stop).map_err(|mut e| {
+            if let RunError::Cpu(c) = &mut e {
+                name_stack_fault(c, &self.symbols);
+            }
+            e
+        })
+    }
+
+    /// [`Self::run`] without naming the function of a stack fault.
+    fn run_unnamed<B: Board>(
         &mut self,
         mcu: &mut Mcu<B>,
         deadline: u64,
@@ -711,6 +791,14 @@ impl FirmwareController {
             let starts = mcu.adc().starts();
             if starts != before {
                 self.adc_starts = starts;
+                if std::mem::take(&mut self.booting)
+                    && let Some(p) = self.symbols.heap_end_pointer()
+                {
+                    // Booted: the arrays the firmware carved above its data are not the
+                    // stack's.
+                    let end = peek_be::<B, 4>(mcu, p) as u32;
+                    self.cpu.raise_stack_low(end);
+                }
                 return Ok(mcu.now());
             }
             if mcu.now() >= deadline {

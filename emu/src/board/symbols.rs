@@ -7,6 +7,10 @@
 //! locals (`.L12`) and section symbols (`.text`) are kept but are never functions.
 
 use std::collections::HashMap;
+use std::sync::Arc;
+
+use crate::core::cpu::StackRoom;
+use crate::core::memmap::{RAM_END, RAM_START};
 
 /// One symbol.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -46,9 +50,15 @@ pub struct SymbolError {
     pub text: String,
 }
 
-/// The symbols of an image, by address and by name.
+/// The symbols of an image, by address and by name. Cloning is cheap: the table is shared.
 #[derive(Clone, Debug, Default)]
 pub struct SymbolTable {
+    inner: Arc<Tables>,
+}
+
+/// What a [`SymbolTable`] shares between its clones.
+#[derive(Debug, Default)]
+struct Tables {
     /// Every symbol, in address order.
     symbols: Vec<Symbol>,
     /// Index into `symbols` by name (the first symbol of that name).
@@ -106,20 +116,52 @@ impl SymbolTable {
             .map(|(i, s)| (s.addr, i))
             .collect();
         Ok(SymbolTable {
-            symbols,
-            by_name,
-            functions,
+            inner: Arc::new(Tables {
+                symbols,
+                by_name,
+                functions,
+            }),
         })
+    }
+
+    /// The stack's room the image's symbols give (see [`crate::core::cpu::stack`]): from the
+    /// end of its data (`__bss_end`, else `_end`/`end`, else the on-chip RAM's start) to its
+    /// stack's top (`__stack_top`, else `__stack`/`_stack`, else one past the RAM's end). The
+    /// arrays a program carves above its data at boot are not in it yet: see
+    /// [`SymbolTable::heap_end_pointer`].
+    #[must_use]
+    pub fn stack_room(&self) -> StackRoom {
+        let in_ram = |a: u32| (RAM_START..=RAM_END + 1).contains(&a);
+        let low = ["_bss_end", "end", "_end"]
+            .iter()
+            .find_map(|n| self.addr(n).filter(|&a| in_ram(a)))
+            .unwrap_or(RAM_START);
+        let top = ["_stack_top", "_stack", "stack"]
+            .iter()
+            .find_map(|n| self.addr(n).filter(|&a| in_ram(a) && a > low))
+            .unwrap_or(RAM_END + 1);
+        StackRoom { low, top }
+    }
+
+    /// The address of the program's `heap_end` variable, when it has one: a pointer to the end
+    /// of the memory it carved above its data at boot (the robot firmware's network arrays),
+    /// which raises the stack room's low end once the program has booted.
+    #[must_use]
+    pub fn heap_end_pointer(&self) -> Option<u32> {
+        self.get("heap_end")
+            .filter(|s| matches!(s.kind, 'b' | 'B' | 'd' | 'D'))
+            .map(|s| s.addr)
     }
 
     /// The symbol called `name`: the C name (`learner_forward`) or the object file's
     /// (`_learner_forward`).
     #[must_use]
     pub fn get(&self, name: &str) -> Option<&Symbol> {
-        self.by_name
+        let t = &*self.inner;
+        t.by_name
             .get(name)
-            .or_else(|| self.by_name.get(&format!("_{name}")))
-            .map(|&i| &self.symbols[i])
+            .or_else(|| t.by_name.get(&format!("_{name}")))
+            .map(|&i| &t.symbols[i])
     }
 
     /// The address of `name` (see [`SymbolTable::get`]).
@@ -131,20 +173,22 @@ impl SymbolTable {
     /// Every symbol in address order.
     #[must_use]
     pub fn symbols(&self) -> &[Symbol] {
-        &self.symbols
+        &self.inner.symbols
     }
 
     /// The function whose code holds `pc`: the last function symbol at or below it.
     #[must_use]
     pub fn function_at(&self, pc: u32) -> Option<&Symbol> {
-        let k = self.functions.partition_point(|&(a, _)| a <= pc);
-        k.checked_sub(1).map(|k| &self.symbols[self.functions[k].1])
+        let t = &*self.inner;
+        let k = t.functions.partition_point(|&(a, _)| a <= pc);
+        k.checked_sub(1).map(|k| &t.symbols[t.functions[k].1])
     }
 
     /// Whether a function starts exactly at `addr`.
     #[must_use]
     pub fn is_function_start(&self, addr: u32) -> bool {
-        self.functions
+        self.inner
+            .functions
             .binary_search_by_key(&addr, |&(a, _)| a)
             .is_ok()
     }

@@ -86,6 +86,34 @@ pub const PB_RIGHT_IN1: u8 = 0x04;
 /// Port-B bit of the right H-bridge's IN2 (PB3).
 pub const PB_RIGHT_IN2: u8 = 0x08;
 
+/// A TA7291P's supply current in forward or reverse mode, outputs open: 8.0 mA typical, 13 mA
+/// maximum (Toshiba TA7291P data sheet, electrical characteristics, I_CC1 "output off, CW/CCW
+/// mode", VCC = 12 V).
+pub const BRIDGE_ICC_DRIVE_MA: f64 = 8.0;
+/// A TA7291P's supply current in brake mode: 6.5 mA typical, 10 mA maximum (the same table,
+/// I_CC3 "output off, brake mode").
+pub const BRIDGE_ICC_BRAKE_MA: f64 = 6.5;
+/// A TA7291P's supply current in stop (coast) mode: 0 typical, 50 µA maximum (the same table,
+/// I_CC2 "output off, stop mode").
+pub const BRIDGE_ICC_STOP_MA: f64 = 0.0;
+/// A TA7291P's saturation voltage, upper plus lower side, at 1.0 A: 1.3 V + 1.2 V typical (the
+/// same table, V_SAT U-3 and L-3). What the bridge can give a motor from a 12 V pack is far
+/// above the 2.2 V the FA-130 runs at; the rest of the pack's voltage drops in the bridge.
+pub const BRIDGE_SATURATION_1A_V: f64 = 2.5;
+
+impl Bridge {
+    /// The bridge's own supply current in this mode, mA ([`BRIDGE_ICC_DRIVE_MA`] and the
+    /// others).
+    #[must_use]
+    pub const fn supply_current_ma(self) -> f64 {
+        match self {
+            Bridge::Forward | Bridge::Reverse => BRIDGE_ICC_DRIVE_MA,
+            Bridge::Brake => BRIDGE_ICC_BRAKE_MA,
+            Bridge::Coast => BRIDGE_ICC_STOP_MA,
+        }
+    }
+}
+
 /// What a TA7291P-class H-bridge does with its two logic inputs (SPEC §3.5).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Bridge {

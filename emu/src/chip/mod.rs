@@ -11,6 +11,7 @@ pub mod gdb;
 pub mod machine;
 pub mod mcu;
 pub mod periph;
+pub mod power;
 pub mod run;
 pub mod trace;
 pub mod vcd;

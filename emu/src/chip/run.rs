@@ -8,6 +8,13 @@
 //! Bytes the program transmits on SCI1 go to the console writer as they leave TDR; the
 //! optional trace writer gets one line per instruction: address, disassembly (objdump's form)
 //! and the states it took.
+//!
+//! The stack guard ([`crate::core::cpu::stack`]) is the CPU's: [`run_image`] sets one over the
+//! whole on-chip RAM (it has no symbol table to know better), a caller of [`run_mcu`] sets
+//! its own (`h8swarm emu` takes the room from the image's symbols). A stopping guard ends the
+//! run with [`Outcome::Error`]; a warning guard's first fault is in
+//! [`RunReport::stack_fault`]. Either way the fault names its function when the probes carry
+//! the code's names.
 
 use std::fmt::Write as _;
 use std::io::Write;
@@ -18,7 +25,7 @@ use crate::chip::mcu::{Board, Mcu};
 use crate::chip::trace::{CodeNames, PhaseRecorder, phase_name};
 use crate::core::bus::Bus;
 use crate::core::cpu::disasm::format_instr;
-use crate::core::cpu::{Cpu, CpuError, Event};
+use crate::core::cpu::{Cpu, CpuError, Event, StackFault, StackGuard, StackRoom};
 use crate::core::srec::{self, SrecError};
 
 /// The system clock φ of the AKI-H8/3052F board: 25 MHz, 1 state = 40 ns (SPEC §4.1).
@@ -77,6 +84,9 @@ pub struct RunReport {
     pub outcome: Outcome,
     /// Counters.
     pub stats: RunStats,
+    /// The first stack access that left the stack's room, under a guard that only warns
+    /// (a stopping guard's fault is the [`Outcome::Error`]).
+    pub stack_fault: Option<StackFault>,
 }
 
 impl RunReport {
@@ -96,6 +106,7 @@ impl RunReport {
             outcome,
             exit_status,
             error,
+            stack_warning: self.stack_fault.as_ref().map(ToString::to_string),
             instructions: self.stats.instructions,
             states: self.stats.states,
             emulated_seconds: self.stats.emulated_seconds,
@@ -114,6 +125,7 @@ struct StatsJson {
     outcome: &'static str,
     exit_status: Option<u8>,
     error: Option<String>,
+    stack_warning: Option<String>,
     instructions: u64,
     states: u64,
     emulated_seconds: f64,
@@ -138,7 +150,7 @@ pub enum RunError {
 }
 
 /// Parses `mot` (S-record text), loads it into a fresh [`Machine`], resets the CPU and runs it
-/// (see [`run_machine`]).
+/// (see [`run_machine`]) under a stopping stack guard over the whole on-chip RAM.
 ///
 /// # Errors
 /// [`RunError`] if the image is malformed or does not fit the flash, or output cannot be
@@ -152,6 +164,7 @@ pub fn run_image(
     let image = srec::parse(mot)?;
     let mut machine = Machine::with_image(&image)?;
     let mut cpu = Cpu::new();
+    cpu.set_stack_guard(Some(StackGuard::stop(StackRoom::RAM)));
     cpu.reset(&mut machine);
     Ok(run_machine(
         &mut cpu,
@@ -356,9 +369,12 @@ pub fn run_mcu_probed<B: Board>(
                 }
                 break Outcome::MaxStates;
             }
-            Err(e) => {
+            Err(mut e) => {
                 if let Some(d) = debugger.as_deref_mut() {
                     d.report_error(cpu, machine);
+                }
+                if let (CpuError::StackOverflow(f), Some(n)) = (&mut e, names) {
+                    f.function = n.name_at(f.pc).map(str::to_string);
                 }
                 break Outcome::Error(e);
             }
@@ -384,7 +400,16 @@ pub fn run_mcu_probed<B: Board>(
         w.flush()?;
     }
     let states = machine.now();
+    let stack_fault = match &outcome {
+        Outcome::Error(CpuError::StackOverflow(_)) => None,
+        _ => cpu.stack_fault().map(|f| {
+            let mut f = f.clone();
+            f.function = names.and_then(|n| n.name_at(f.pc)).map(str::to_string);
+            f
+        }),
+    };
     Ok(RunReport {
+        stack_fault,
         outcome,
         stats: RunStats {
             instructions: cpu.instructions() - start_instructions,

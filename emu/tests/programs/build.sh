@@ -8,6 +8,10 @@
 #   host:   gcc -O2 with console.c mapped to stdio, run  ->  <name>.expected
 #           (the run must exit with status 0, as the emulated run must)
 #
+# and for every program stack/<name>.c listed in STACK_PROGRAMS (the stack guard's test
+# programs, which overflow their stack on purpose and have no host run):
+#   target: as above  ->  stack/<name>.mot, and h8300-hms-nm -n  ->  stack/<name>.sym
+#
 # Usage:
 #   ./build.sh            build into this folder (commit the .mot and .expected files)
 #   ./build.sh --check    rebuild into a temporary folder and fail, listing the
@@ -30,6 +34,7 @@ here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 cd "$here"
 
 PROGRAMS=(arith shifts muldiv bitops structs recursion funcptr switch q15learn crcmacdiv)
+STACK_PROGRAMS=(stack_deep stack_after stack_close)
 SUPPORT_C=(console.c)
 
 H8_PREFIX="${H8_PREFIX:-h8300-hms-}"
@@ -66,6 +71,7 @@ need() {
 }
 need "${H8_PREFIX}gcc"
 need "${H8_PREFIX}objcopy"
+need "${H8_PREFIX}nm"
 need "$HOST_CC"
 
 work="$(mktemp -d)"
@@ -114,6 +120,23 @@ build_all() {
       exit 1
     fi
   done
+
+  # The stack guard's programs: target only, with their symbol tables.
+  mkdir -p "$out/stack"
+  for name in "${STACK_PROGRAMS[@]}"; do
+    "${H8_PREFIX}gcc" "${TARGET_CFLAGS[@]}" -c "stack/$name.c" -o "$obj/$name.o"
+    "${H8_PREFIX}gcc" "${TARGET_CFLAGS[@]}" -T h8-3052f.ld -Wl,-Map,"$obj/$name.map" \
+      "$obj/crt0.o" "$obj/$name.o" "${support_objs[@]}" "$obj/runtime.o" \
+      -o "$obj/$name.coff"
+    (cd "$obj" && "${H8_PREFIX}objcopy" -O srec "$name.coff" "$name.mot")
+    "${H8_PREFIX}nm" -n "$obj/$name.coff" > "$obj/$name.sym"
+    cp "$obj/$name.mot" "$obj/$name.sym" "$out/stack/"
+    chmod 644 "$out/stack/$name.mot" "$out/stack/$name.sym"
+    if [[ -n "$listing_dir" ]]; then
+      "${H8_PREFIX}objdump" -d -j .text "$obj/$name.coff" > "$listing_dir/$name.lst"
+      cp "$obj/$name.map" "$obj/$name.coff" "$listing_dir/"
+    fi
+  done
 }
 
 case "$mode" in
@@ -122,6 +145,10 @@ case "$mode" in
     for name in "${PROGRAMS[@]}"; do
       printf '%-10s %6d bytes .mot  %5d bytes .expected  %s\n' "$name" \
         "$(wc -c < "$name.mot")" "$(wc -c < "$name.expected")" "$(tail -n 1 "$name.expected")"
+    done
+    for name in "${STACK_PROGRAMS[@]}"; do
+      printf 'stack/%-12s %6d bytes .mot  %5d lines .sym\n' "$name" \
+        "$(wc -c < "stack/$name.mot")" "$(wc -l < "stack/$name.sym")"
     done
     ;;
   ubsan)
@@ -144,6 +171,20 @@ case "$mode" in
         fi
       done
     done
+    for name in "${STACK_PROGRAMS[@]}"; do
+      for ext in mot sym; do
+        if [[ ! -f "stack/$name.$ext" ]] || ! cmp -s "$work/fresh/stack/$name.$ext" "stack/$name.$ext"; then
+          differ+=("stack/$name.$ext")
+        fi
+      done
+    done
+    for f in stack/*.mot; do
+      [[ -e "$f" ]] || continue
+      name="$(basename "${f%.mot}")"
+      if [[ ! " ${STACK_PROGRAMS[*]} " == *" $name "* ]]; then
+        differ+=("$f (not built by build.sh)")
+      fi
+    done
     # A committed image without a source in PROGRAMS would be run by the
     # differential test but never rebuilt: flag it too.
     for f in *.mot; do
@@ -158,6 +199,6 @@ case "$mode" in
       printf '  %s\n' "${differ[@]}" >&2
       exit 1
     fi
-    echo "build.sh --check: all ${#PROGRAMS[@]} programs' .mot and .expected files match a fresh build"
+    echo "build.sh --check: all ${#PROGRAMS[@]} programs' .mot and .expected files and the ${#STACK_PROGRAMS[@]} stack programs' .mot and .sym files match a fresh build"
     ;;
 esac

@@ -152,6 +152,16 @@ impl Run {
         self.start + self.timing.first + k * self.timing.next
     }
 
+    /// How long the run converts: one conversion in single mode, until stopped in scan mode.
+    #[inline]
+    fn length(&self) -> u64 {
+        if self.scan {
+            u64::MAX
+        } else {
+            self.timing.first
+        }
+    }
+
     /// Conversions completed by `now` (capped at 1 in single mode).
     #[inline]
     fn completed_by(&self, now: u64) -> u64 {
@@ -196,6 +206,9 @@ pub struct Adc {
     conversions: u64,
     /// Runs started (ADST written 1 while idle) since reset.
     starts: u64,
+    /// States of the runs that have ended (the converter busy: its analog supply draws its
+    /// conversion current), since reset.
+    converting_states: u64,
 }
 
 impl Default for Adc {
@@ -218,6 +231,7 @@ impl Adc {
             run: None,
             conversions: 0,
             starts: 0,
+            converting_states: 0,
         }
     }
 
@@ -247,6 +261,18 @@ impl Adc {
         self.conversions
     }
 
+    /// States the converter has spent converting since reset, up to `now`: from each run's
+    /// ADST = 1 to its end (a single conversion's end, or ADST cleared in scan mode). While it
+    /// converts its analog supply draws the conversion current ([`crate::chip::power`]).
+    /// Call after the MCU was synchronised.
+    #[must_use]
+    pub fn converting_states(&self, now: u64) -> u64 {
+        self.converting_states
+            + self
+                .run
+                .map_or(0, |r| now.saturating_sub(r.start).min(r.length()))
+    }
+
     /// Brings the converter to `now`: stores the results of the conversions that ended by
     /// then, asking `volts(channel, sampling_instant)` for each stored one, in time order.
     pub fn sync(&mut self, now: u64, volts: &mut impl FnMut(u8, u64) -> f64) {
@@ -273,7 +299,12 @@ impl Adc {
             self.adf = true;
         }
         run.done = completed;
-        self.run = if run.scan { Some(run) } else { None };
+        self.run = if run.scan {
+            Some(run)
+        } else {
+            self.converting_states += run.timing.first;
+            None
+        };
     }
 
     /// ADF at `now` without changing anything.
@@ -399,7 +430,11 @@ impl Adc {
                             done: 0,
                         });
                     }
-                    (true, false) => self.run = None,
+                    (true, false) => {
+                        if let Some(r) = self.run.take() {
+                            self.converting_states += now.saturating_sub(r.start).min(r.length());
+                        }
+                    }
                     _ => {}
                 }
             }

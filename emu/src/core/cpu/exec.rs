@@ -8,6 +8,7 @@ use super::decode::{
 use super::timing as t;
 use super::{
     CCR_C, CCR_H, CCR_I, CCR_N, CCR_V, CCR_Z, Cpu, CpuError, Event, LAST_IN_COPY, RunState,
+    StackAccess,
 };
 use crate::core::bus::Bus;
 use crate::core::memmap::{ADDRESS_MASK, Area};
@@ -19,7 +20,7 @@ pub(super) struct Sz {
     msb: u32,
     /// Mask of the bits below the half-carry position (bit 3, 11 or 27 carries out of it).
     half: u32,
-    bytes: u32,
+    pub(super) bytes: u32,
 }
 
 #[inline(always)]
@@ -90,7 +91,54 @@ const fn abs16(a: u16) -> u32 {
     (a as i16 as i32 as u32) & ADDRESS_MASK
 }
 
+/// Whether a memory operand takes its address from ER7: an access to the stack.
+#[inline(always)]
+pub(super) const fn stack_operand(op: Operand) -> bool {
+    match op {
+        Operand::Ind(r)
+        | Operand::PostInc(r)
+        | Operand::PreDec(r)
+        | Operand::Disp16(r, _)
+        | Operand::Disp24(r, _) => r & 7 == 7,
+        _ => false,
+    }
+}
+
+/// Whether `instr` writes ER7 (or a part of it) as a register: it moves SP without accessing
+/// the stack (a frame allocated or released, SP loaded). The fast path leaves these to the
+/// reference executor, which checks SP after them.
+pub(super) const fn writes_sp(instr: Instr) -> bool {
+    let r = match instr {
+        Instr::Mov {
+            dst: Operand::Reg(r),
+            ..
+        }
+        | Instr::Alu { rd: r, .. }
+        | Instr::Inc { rd: r, .. }
+        | Instr::Dec { rd: r, .. }
+        | Instr::Adds { rd: r, .. }
+        | Instr::Subs { rd: r, .. }
+        | Instr::Unary { rd: r, .. }
+        | Instr::MulDiv { rd: r, .. } => r,
+        _ => return false,
+    };
+    r & 7 == 7
+}
+
 impl Cpu {
+    /// The lowest address a stack operand ([`stack_operand`]) of `bytes` bytes will access,
+    /// computed without its side effects (`@-ER7` decrements first).
+    #[inline(always)]
+    pub(super) fn stack_target(&self, op: Operand, bytes: u32) -> u32 {
+        let sp = self.er[7];
+        match op {
+            Operand::PreDec(_) => sp.wrapping_sub(bytes),
+            Operand::Disp16(_, d) => sp.wrapping_add(d as i16 as i32 as u32),
+            Operand::Disp24(_, d) => sp.wrapping_add(d),
+            _ => sp,
+        }
+    }
+
     // ----- registers -------------------------------------------------------------------
 
     #[inline(always)]
@@ -350,9 +398,42 @@ impl Cpu {
         pc: u32,
         next: u32,
     ) -> Result<Event, CpuError> {
+        // The stack guard also watches SP itself: an instruction that moves it out of the room
+        // (a frame allocated below the data) is where a frame-pointer function overflows.
+        let (sp0, ccr0) = (self.er[7], self.ccr);
+        let event = self.exec_operation(bus, d, pc, next)?;
+        if self.er[7] != sp0 && !self.stack_bounds.inside(self.er[7], 0) {
+            let sp = self.er[7];
+            // Under a stopping guard the instruction is undone: SP and the flags as before.
+            self.er[7] = sp0;
+            let ccr = self.ccr;
+            self.ccr = ccr0;
+            self.stack_ok(sp, 0, StackAccess::MoveSp, pc)?;
+            self.er[7] = sp;
+            self.ccr = ccr;
+        }
+        Ok(event)
+    }
+
+    /// [`Cpu::exec_instr`] without the check of SP after it.
+    #[inline]
+    fn exec_operation<B: Bus>(
+        &mut self,
+        bus: &mut B,
+        d: Decoded,
+        pc: u32,
+        next: u32,
+    ) -> Result<Event, CpuError> {
         match d.instr {
             Instr::Nop => {}
             Instr::Mov { size, src, dst } => {
+                let bytes = sz(size).bytes;
+                if stack_operand(src) {
+                    self.stack_ok(self.stack_target(src, bytes), bytes, StackAccess::Read, pc)?;
+                }
+                if stack_operand(dst) {
+                    self.stack_ok(self.stack_target(dst, bytes), bytes, StackAccess::Write, pc)?;
+                }
                 let v = self.read_operand(bus, size, src);
                 self.write_operand(bus, size, dst, v);
                 self.flags_nzv0(sz(size), v);
@@ -379,7 +460,21 @@ impl Cpu {
             Instr::Daa(r) => self.daa(r),
             Instr::Das(r) => self.das(r),
             Instr::MulDiv { op, size, rs, rd } => self.muldiv(bus, op, size, rs, rd),
-            Instr::Bit { op, bit, target } => self.bit(bus, op, bit, target),
+            Instr::Bit { op, bit, target } => {
+                if matches!(target, BitTarget::Ind(r) if r & 7 == 7) {
+                    let writes = matches!(
+                        op,
+                        BitOp::Bset | BitOp::Bclr | BitOp::Bnot | BitOp::Bst | BitOp::Bist
+                    );
+                    let access = if writes {
+                        StackAccess::Write
+                    } else {
+                        StackAccess::Read
+                    };
+                    self.stack_ok(self.er[7], 1, access, pc)?;
+                }
+                self.bit(bus, op, bit, target);
+            }
             Instr::Bcc { cond, disp, long } => {
                 let taken = self.cond(cond);
                 let target = next.wrapping_add(disp as i32 as u32) & ADDRESS_MASK;
@@ -394,7 +489,7 @@ impl Cpu {
             }
             Instr::Bsr { disp, long } => {
                 let target = next.wrapping_add(disp as i32 as u32) & ADDRESS_MASK;
-                self.push32(bus, next);
+                self.push32(bus, next, StackAccess::Call, pc)?;
                 if long {
                     bus.internal(t::N_BRANCH_D16);
                 } else {
@@ -415,7 +510,7 @@ impl Cpu {
                     }
                 };
                 if call {
-                    self.push32(bus, next);
+                    self.push32(bus, next, StackAccess::Call, pc)?;
                 }
                 match tgt {
                     // JMP/JSR @ERn: I = 2 (the target prefetch).
@@ -433,13 +528,13 @@ impl Cpu {
                 self.jump_to(target);
             }
             Instr::Rts => {
-                let ret = self.pop32(bus) & ADDRESS_MASK;
+                let ret = self.pop32(bus, StackAccess::Return, pc)? & ADDRESS_MASK;
                 Self::fetch_charge(bus, ret);
                 bus.internal(t::N_RETURN);
                 self.jump_to(ret);
             }
             Instr::Rte => {
-                let frame = self.pop32(bus);
+                let frame = self.pop32(bus, StackAccess::ReturnFromException, pc)?;
                 self.ccr = (frame >> 24) as u8;
                 let ret = frame & ADDRESS_MASK;
                 Self::fetch_charge(bus, ret);
@@ -448,7 +543,7 @@ impl Cpu {
             }
             Instr::Trapa(n) => {
                 let v = super::VECTOR_TRAPA0 + (n & 3);
-                self.enter_exception(bus, v, next);
+                self.enter_exception(bus, v, next, StackAccess::Trap, pc)?;
                 let target = self.pc;
                 Self::fetch_charge(bus, target);
                 bus.internal(t::N_TRAPA);
@@ -485,6 +580,9 @@ impl Cpu {
                 bus.internal(src_area.byte_states() + dst_area.byte_states());
             }
             Instr::Ldc(src) => {
+                if stack_operand(src) {
+                    self.stack_ok(self.stack_target(src, 2), 2, StackAccess::Read, pc)?;
+                }
                 self.ccr = match src {
                     Operand::Imm(v) => v as u8,
                     Operand::Reg(r) => self.r8(r),
@@ -496,6 +594,11 @@ impl Cpu {
                 self.irq_inhibit = true;
             }
             Instr::Stc(dst) => match dst {
+                _ if stack_operand(dst) => {
+                    self.stack_ok(self.stack_target(dst, 2), 2, StackAccess::Write, pc)?;
+                    let a = self.ea(bus, dst, 2);
+                    bus.write16(a, u16::from_be_bytes([self.ccr, self.ccr]));
+                }
                 Operand::Reg(r) => self.set_r8(r, self.ccr),
                 Operand::Imm(_) => {}
                 mem => {

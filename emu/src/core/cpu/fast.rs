@@ -11,9 +11,9 @@
 //! [`Op::Generic`] and run on the reference executor.
 
 use super::decode::{AluOp, Decoded, Instr, JumpTarget, Operand, Size, UnaryOp};
-use super::exec::{cond_holds, sz};
+use super::exec::{cond_holds, stack_operand, sz, writes_sp};
 use super::timing as t;
-use super::{Cpu, CpuError, Event};
+use super::{Cpu, CpuError, Event, StackAccess};
 use crate::core::bus::Bus;
 use crate::core::memmap::{ADDRESS_MASK, Area};
 
@@ -88,6 +88,18 @@ pub(super) enum Op {
         dst: Operand,
     },
     St32 {
+        rs: u8,
+        dst: Operand,
+    },
+    /// A load through ER7 (a pop, a local, an argument): the stack guard checks it first.
+    LdStack {
+        size: Size,
+        src: Operand,
+        rd: u8,
+    },
+    /// A store through ER7 (a push, a local): the stack guard checks it first.
+    StStack {
+        size: Size,
         rs: u8,
         dst: Operand,
     },
@@ -375,7 +387,13 @@ impl Slot {
     /// The handler of instruction `d` at `pc` (in ROM).
     pub(super) fn new(d: Decoded, pc: u32) -> Slot {
         let next = pc.wrapping_add(d.len_bytes()) & ADDRESS_MASK;
-        let op = op_of(d.instr, next);
+        // An instruction that sets SP as a register runs on the reference executor, which
+        // checks SP after it for the stack guard.
+        let op = if writes_sp(d.instr) {
+            Op::Generic
+        } else {
+            op_of(d.instr, next)
+        };
         let sequential = !matches!(
             op,
             Op::Generic
@@ -431,6 +449,8 @@ fn op_of(instr: Instr, next: u32) -> Op {
                 v: imm(Long, v),
                 rd,
             },
+            (size, src, Reg(rd)) if stack_operand(src) => Op::LdStack { size, src, rd },
+            (size, Reg(rs), dst) if stack_operand(dst) => Op::StStack { size, rs, dst },
             (Byte, src, Reg(rd)) if src.is_memory() => Op::Ld8 { src, rd },
             (Word, src, Reg(rd)) if src.is_memory() => Op::Ld16 { src, rd },
             (Long, src, Reg(rd)) if src.is_memory() => Op::Ld32 { src, rd },
@@ -654,6 +674,16 @@ impl Cpu {
             Op::St8 { rs, dst } => self.store(bus, Size::Byte, rs, dst),
             Op::St16 { rs, dst } => self.store(bus, Size::Word, rs, dst),
             Op::St32 { rs, dst } => self.store(bus, Size::Long, rs, dst),
+            Op::LdStack { size, src, rd } => {
+                let bytes = sz(size).bytes;
+                self.stack_ok(self.stack_target(src, bytes), bytes, StackAccess::Read, pc)?;
+                self.load(bus, size, src, rd);
+            }
+            Op::StStack { size, rs, dst } => {
+                let bytes = sz(size).bytes;
+                self.stack_ok(self.stack_target(dst, bytes), bytes, StackAccess::Write, pc)?;
+                self.store(bus, size, rs, dst);
+            }
             Op::AddR8 { rs, rd } => alu_r!(self, Add, Byte, rs, rd),
             Op::AddR16 { rs, rd } => alu_r!(self, Add, Word, rs, rd),
             Op::AddR32 { rs, rd } => alu_r!(self, Add, Long, rs, rd),
@@ -732,12 +762,12 @@ impl Cpu {
                 target,
                 prefetch_states,
             } => {
-                self.push32(bus, next);
+                self.push32(bus, next, StackAccess::Call, pc)?;
                 bus.internal(u32::from(prefetch_states));
                 self.pc = target;
             }
             Op::Bsr16 { target } => {
-                self.push32(bus, next);
+                self.push32(bus, next, StackAccess::Call, pc)?;
                 bus.internal(t::N_BRANCH_D16);
                 self.pc = target;
             }
@@ -746,7 +776,7 @@ impl Cpu {
                 self.pc = target;
             }
             Op::JsrAbs { target } => {
-                self.push32(bus, next);
+                self.push32(bus, next, StackAccess::Call, pc)?;
                 bus.internal(t::N_JUMP_ABS24);
                 self.pc = target;
             }
@@ -758,12 +788,12 @@ impl Cpu {
             Op::JsrReg { r } => {
                 // The target is read before the push (JSR @ER7 jumps to ER7's old value).
                 let target = self.er[usize::from(r & 7)] & ADDRESS_MASK;
-                self.push32(bus, next);
+                self.push32(bus, next, StackAccess::Call, pc)?;
                 bus.internal(prefetch_states(target));
                 self.jump_to(target);
             }
             Op::Rts => {
-                let ret = self.pop32(bus) & ADDRESS_MASK;
+                let ret = self.pop32(bus, StackAccess::Return, pc)? & ADDRESS_MASK;
                 bus.internal(prefetch_states(ret) + t::N_RETURN);
                 self.jump_to(ret);
             }

@@ -40,6 +40,12 @@
 //!   ([`Cpu::skipped_instructions`]); registers, flags, clock and memory are what stepping
 //!   reaches at the same instruction boundary. [`Cpu::step`] never skips.
 //!
+//! The stack guard ([`stack`], [`Cpu::set_stack_guard`]) checks every stack access (pushes,
+//! calls, returns, interrupt entries, loads and stores through ER7) and every instruction that
+//! sets SP against the stack's room, on both paths: the fast path gives loads and stores
+//! through ER7 handlers of their own and leaves the instructions that set SP as a register to
+//! the reference executor, so no other instruction pays for it.
+//!
 //! The decode caches are emptied whenever the bus's token changes (the flash was written:
 //! loading an image, poking), and by [`Cpu::flush_decode_cache`]. Tests run random programs,
 //! the C programs and the robot firmware both ways and compare the complete state after every
@@ -83,9 +89,11 @@ mod exec;
 mod fast;
 mod ffwd;
 mod idle;
+pub mod stack;
 pub mod timing;
 
 pub use idle::{IdleRun, MAX_CYCLE};
+pub use stack::{StackAccess, StackFault, StackGuard, StackGuardMode, StackRoom};
 
 use crate::core::bus::{Bus, CpuSignal};
 use crate::core::memmap::Area;
@@ -154,6 +162,9 @@ pub enum CpuError {
         /// Why it cannot run.
         why: &'static str,
     },
+    /// A stack access left the stack's room under a guard that stops ([`stack`]).
+    #[error("{0}")]
+    StackOverflow(Box<StackFault>),
 }
 
 /// What one call of [`Cpu::step`] did.
@@ -224,6 +235,12 @@ pub struct Cpu {
     last_index: u32,
     /// The instruction executed last on the reference path.
     last_copy: Decoded,
+    /// The stack guard's bounds ([`stack::Bounds::OFF`] without a guard).
+    stack_bounds: stack::Bounds,
+    /// The stack guard, if one is set.
+    stack_guard: Option<StackGuard>,
+    /// The first stack fault seen under the guard.
+    stack_fault: Option<Box<StackFault>>,
 }
 
 impl Default for Cpu {
@@ -274,6 +291,9 @@ impl Cpu {
             instructions: 0,
             last_index: LAST_IN_COPY,
             last_copy: EMPTY_SLOT,
+            stack_bounds: stack::Bounds::OFF,
+            stack_guard: None,
+            stack_fault: None,
         }
     }
 
@@ -346,6 +366,101 @@ impl Cpu {
                 .get(self.last_index as usize)
                 .copied()
                 .unwrap_or(EMPTY_SLOT)
+        }
+    }
+
+    /// Sets the stack guard (`None`: no guard, the default): from the next instruction on,
+    /// every stack access is checked against the guard's room ([`stack`]). A fault recorded
+    /// before is forgotten.
+    pub fn set_stack_guard(&mut self, guard: Option<StackGuard>) {
+        self.stack_guard = guard;
+        self.stack_bounds = guard.map_or(stack::Bounds::OFF, |g| stack::Bounds::of(g.room));
+        self.stack_fault = None;
+    }
+
+    /// The stack guard, if one is set.
+    #[must_use]
+    pub const fn stack_guard(&self) -> Option<StackGuard> {
+        self.stack_guard
+    }
+
+    /// Raises the low end of the guard's room to `low` (the program has carved memory above
+    /// its data: arrays sized at boot); a lower `low`, or no guard, changes nothing.
+    pub fn raise_stack_low(&mut self, low: u32) {
+        if let Some(g) = self.stack_guard.as_mut()
+            && low > g.room.low
+            && low <= g.room.top
+        {
+            g.room.low = low;
+            self.stack_bounds = stack::Bounds::of(g.room);
+        }
+    }
+
+    /// The first stack access that left the guard's room (under [`StackGuardMode::Warn`]; a
+    /// stopping guard also keeps the fault it stopped at).
+    #[must_use]
+    pub fn stack_fault(&self) -> Option<&StackFault> {
+        self.stack_fault.as_deref()
+    }
+
+    /// Checks a stack access of `bytes` bytes at `addr` by the instruction at `pc` (or the
+    /// interrupt entry before it) against the guard: one add and one compare when it is
+    /// inside.
+    #[inline(always)]
+    fn stack_ok(
+        &mut self,
+        addr: u32,
+        bytes: u32,
+        access: StackAccess,
+        pc: u32,
+    ) -> Result<(), CpuError> {
+        if self.stack_bounds.inside(addr, bytes) {
+            Ok(())
+        } else {
+            self.stack_hit(addr, bytes, access, pc)
+        }
+    }
+
+    /// A stack access left the room: the fault is kept (the first one), and under a stopping
+    /// guard the instruction is undone (PC at it, not counted) and the error returned.
+    #[cold]
+    #[inline(never)]
+    fn stack_hit(
+        &mut self,
+        addr: u32,
+        bytes: u32,
+        access: StackAccess,
+        pc: u32,
+    ) -> Result<(), CpuError> {
+        let Some(guard) = self.stack_guard else {
+            return Ok(());
+        };
+        let instruction = match access {
+            StackAccess::InterruptEntry(_) => String::new(),
+            _ => disasm::format_instr(self.last_executed(), pc).replacen('\t', " ", 1),
+        };
+        let fault = Box::new(StackFault {
+            pc,
+            instruction,
+            sp: self.er[7],
+            addr: addr & crate::core::memmap::ADDRESS_MASK,
+            bytes,
+            access,
+            room: guard.room,
+            function: None,
+        });
+        if self.stack_fault.is_none() {
+            self.stack_fault = Some(fault.clone());
+        }
+        match guard.mode {
+            StackGuardMode::Warn => Ok(()),
+            StackGuardMode::Stop => {
+                if !matches!(access, StackAccess::InterruptEntry(_)) {
+                    self.pc = pc;
+                    self.instructions -= 1;
+                }
+                Err(CpuError::StackOverflow(fault))
+            }
         }
     }
 
@@ -466,16 +581,16 @@ impl Cpu {
     /// accepts a pending interrupt the mask lets through (its exception handling runs) and
     /// returns its vector.
     #[inline(always)]
-    fn take_interrupt<B: Bus>(&mut self, bus: &mut B) -> Option<u8> {
+    fn take_interrupt<B: Bus>(&mut self, bus: &mut B) -> Result<Option<u8>, CpuError> {
         if self.irq_inhibit {
             self.irq_inhibit = false;
         } else if let Some(v) = bus.pending_irq()
             && self.accepts(v)
         {
-            self.interrupt(bus, v);
-            return Some(v);
+            self.interrupt(bus, v)?;
+            return Ok(Some(v));
         }
-        None
+        Ok(None)
     }
 
     /// Runs one step: accepts a pending interrupt, or executes one instruction, or (in sleep
@@ -569,7 +684,7 @@ impl Cpu {
             // not a reload of the one just stored.
             let mut pc = self.pc;
             loop {
-                if let Some(v) = self.take_interrupt(bus) {
+                if let Some(v) = self.take_interrupt(bus)? {
                     return Ok(Event::Interrupt(v));
                 }
                 let idx = (pc >> 1) as usize;
@@ -628,7 +743,7 @@ impl Cpu {
     /// bus's token.
     #[inline(always)]
     fn step_fast<B: Bus>(&mut self, bus: &mut B) -> Result<Event, CpuError> {
-        if let Some(v) = self.take_interrupt(bus) {
+        if let Some(v) = self.take_interrupt(bus)? {
             return Ok(Event::Interrupt(v));
         }
         let pc = self.pc;
@@ -696,7 +811,7 @@ impl Cpu {
                 bus.cpu_signal(CpuSignal::Wake);
             }
         }
-        if let Some(v) = self.take_interrupt(bus) {
+        if let Some(v) = self.take_interrupt(bus)? {
             return Ok(Event::Interrupt(v));
         }
         let d = self.fetch_decode(bus)?;
@@ -712,23 +827,39 @@ impl Cpu {
         self.decode_through_bus(bus)
     }
 
-    /// Pushes a longword on the stack (ER7 -= 4; two word writes).
+    /// Pushes a longword on the stack (ER7 -= 4; two word writes), checked by the stack guard
+    /// first (`access` by the instruction at `pc`).
     #[inline]
-    fn push32<B: Bus>(&mut self, bus: &mut B, v: u32) {
+    fn push32<B: Bus>(
+        &mut self,
+        bus: &mut B,
+        v: u32,
+        access: StackAccess,
+        pc: u32,
+    ) -> Result<(), CpuError> {
         let sp = self.er[7].wrapping_sub(4);
+        self.stack_ok(sp, 4, access, pc)?;
         self.er[7] = sp;
         bus.write16(sp, (v >> 16) as u16);
         bus.write16(sp.wrapping_add(2), v as u16);
+        Ok(())
     }
 
-    /// Pops a longword from the stack (two word reads; ER7 += 4).
+    /// Pops a longword from the stack (two word reads; ER7 += 4), checked by the stack guard
+    /// first.
     #[inline]
-    fn pop32<B: Bus>(&mut self, bus: &mut B) -> u32 {
+    fn pop32<B: Bus>(
+        &mut self,
+        bus: &mut B,
+        access: StackAccess,
+        pc: u32,
+    ) -> Result<u32, CpuError> {
         let sp = self.er[7];
+        self.stack_ok(sp, 4, access, pc)?;
         let hi = u32::from(bus.read16(sp));
         let lo = u32::from(bus.read16(sp.wrapping_add(2)));
         self.er[7] = sp.wrapping_add(4);
-        (hi << 16) | lo
+        Ok((hi << 16) | lo)
     }
 
     /// Reads the 24-bit address in vector `v` (two word reads: J = 2).
@@ -742,15 +873,31 @@ impl Cpu {
 
     /// Exception handling shared by interrupts and TRAPA: push PC and CCR, set I, load PC from
     /// the vector.
-    fn enter_exception<B: Bus>(&mut self, bus: &mut B, v: u8, return_pc: u32) {
+    fn enter_exception<B: Bus>(
+        &mut self,
+        bus: &mut B,
+        v: u8,
+        return_pc: u32,
+        access: StackAccess,
+        pc: u32,
+    ) -> Result<(), CpuError> {
         let frame = (u32::from(self.ccr) << 24) | (return_pc & crate::core::memmap::ADDRESS_MASK);
-        self.push32(bus, frame);
+        self.push32(bus, frame, access, pc)?;
         self.ccr |= CCR_I;
         self.pc = Self::read_vector(bus, v);
+        Ok(())
     }
 
     /// Interrupt exception handling (H8/3052F hardware manual, section 5.4 and Table 5-5).
-    fn interrupt<B: Bus>(&mut self, bus: &mut B, v: u8) {
+    /// The stack guard sees the push before anything happens.
+    fn interrupt<B: Bus>(&mut self, bus: &mut B, v: u8) -> Result<(), CpuError> {
+        let pc = self.pc;
+        self.stack_ok(
+            self.er[7].wrapping_sub(4),
+            4,
+            StackAccess::InterruptEntry(v),
+            pc,
+        )?;
         bus.cpu_signal(CpuSignal::Interrupt(v));
         let external = v == VECTOR_NMI || (VECTOR_IRQ0..=VECTOR_IRQ5).contains(&v);
         bus.internal(if external {
@@ -761,11 +908,12 @@ impl Cpu {
         let ret = self.pc;
         // Prefetch after acceptance (at the return address; not executed).
         Self::fetch_charge(bus, ret);
-        self.enter_exception(bus, v, ret);
+        self.enter_exception(bus, v, ret, StackAccess::InterruptEntry(v), pc)?;
         // Prefetch of the first instruction of the handler.
         let target = self.pc;
         Self::fetch_charge(bus, target);
         bus.internal(timing::N_INTERRUPT_INTERNAL);
+        Ok(())
     }
 
     /// Charges one instruction-fetch cycle at `addr` (a branch-target prefetch: the extra I of
