@@ -1037,6 +1037,8 @@ mod tests {
             dead: Vec::new(),
             robots,
             recorded: None,
+            stack_warnings: Vec::new(),
+            energy: crate::energy::Charge::default(),
         }
     }
 
@@ -1050,6 +1052,7 @@ mod tests {
             moved_mm,
             gap_cv: None,
             cpu_load_percent: 0.3,
+            energy_per_robot_mj: 3000.0,
         }
     }
 
