@@ -812,10 +812,12 @@ impl Swarm {
                 rows.w
                     .write_record(metrics_row(self.condition, self.repeat, k, &last))
                     .map_err(anyhow::Error::new)
-                    .context(crate::run_cmd::OutputError(format!(
-                        "cannot write `{}`",
-                        rows.path.display()
-                    )))?;
+                    .with_context(|| {
+                        crate::run_cmd::OutputError(format!(
+                            "cannot write `{}`",
+                            rows.path.display()
+                        ))
+                    })?;
             }
         }
         Ok(())

@@ -302,7 +302,7 @@ impl Recorder {
         for (i, (buf, out)) in bufs.iter().zip(&mut self.planes).enumerate() {
             out.write_all(buf)
                 .map_err(anyhow::Error::new)
-                .context(output_error(&self.paths[i]))?;
+                .with_context(|| output_error(&self.paths[i]))?;
         }
         self.prev = now;
         if self.frames.is_multiple_of(self.opts.weights_every) {
@@ -331,7 +331,7 @@ impl Recorder {
                 self.weights_out
                     .write_all(&bytes)
                     .map_err(anyhow::Error::new)
-                    .context(output_error(&self.paths[PLANES.len()]))?;
+                    .with_context(|| output_error(&self.paths[PLANES.len()]))?;
                 self.weight_frames.push(self.frames);
             }
         }
@@ -352,7 +352,7 @@ impl Recorder {
         {
             out.flush()
                 .map_err(anyhow::Error::new)
-                .context(output_error(&self.paths[i]))?;
+                .with_context(|| output_error(&self.paths[i]))?;
         }
         Ok((self.frames, self.weight_frames))
     }
@@ -461,7 +461,7 @@ pub fn write_viewer(html: &Path, header: &Header, parts: &[Vec<PathBuf>]) -> Res
             &mut file,
             &base64::engine::general_purpose::STANDARD,
         );
-        let mut gz = flate2::write::GzEncoder::new(b64, flate2::Compression::best());
+        let mut gz = flate2::write::GzEncoder::new(b64, flate2::Compression::new(6));
         let json = serde_json::to_vec(header)?;
         gz.write_all(MAGIC)?;
         gz.write_all(&VERSION.to_le_bytes())?;
