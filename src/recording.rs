@@ -461,7 +461,7 @@ pub fn write_viewer(html: &Path, header: &Header, parts: &[Vec<PathBuf>]) -> Res
             &mut file,
             &base64::engine::general_purpose::STANDARD,
         );
-        let mut gz = flate2::write::GzEncoder::new(b64, flate2::Compression::new(6));
+        let mut gz = flate2::write::GzEncoder::new(b64, flate2::Compression::new(2));
         let json = serde_json::to_vec(header)?;
         gz.write_all(MAGIC)?;
         gz.write_all(&VERSION.to_le_bytes())?;
