@@ -1037,6 +1037,9 @@ mod tests {
             dead: Vec::new(),
             robots,
             recorded: None,
+            stack_warnings: Vec::new(),
+            energy: crate::energy::Charge::default(),
+            motor_cap: crate::energy::CurrentCap::default(),
         }
     }
 
@@ -1050,6 +1053,7 @@ mod tests {
             moved_mm,
             gap_cv: None,
             cpu_load_percent: 0.3,
+            energy_per_robot_mj: 0.0,
         }
     }
 
