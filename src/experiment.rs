@@ -136,6 +136,8 @@ pub struct RunOutput {
     pub stack_warnings: Vec<(usize, String)>,
     /// The charge every robot drew from its pack over the run, summed, by part.
     pub energy: crate::energy::Charge,
+    /// How often the drive voltage's bound cut a motor's current, summed over the robots.
+    pub motor_cap: crate::energy::CurrentCap,
 }
 
 /// Sums of a run's per-step metrics over a span of steps: the summary's and the figure's
@@ -882,9 +884,14 @@ impl Swarm {
             .enumerate()
             .filter_map(|(i, r)| r.stack_fault().map(|f| (i, f.to_string())))
             .collect();
+        let mut motor_cap = crate::energy::CurrentCap::default();
+        for d in &self.drives {
+            motor_cap.add(d.cap());
+        }
         Ok(RunOutput {
             stack_warnings,
             energy: self.energy,
+            motor_cap,
             condition: self.condition,
             repeat: self.repeat,
             metrics: self.metrics,
@@ -1065,9 +1072,9 @@ pub fn nominal_substep_states(s: &Scenario) -> u64 {
 }
 
 /// Advances the world to `target_states` in its sub-steps, feeding every robot's bumpers
-/// after each to its meter and its wheels' speed over the ground to its drive meter (when
-/// `drives` has one per robot); adds each robot's collisions to `per_robot` and returns the
-/// collisions counted and the robot-states in contact.
+/// after each to its meter and its wheels' mean speeds and the forces they transmitted to its
+/// drive meter (when `drives` has one per robot); adds each robot's collisions to `per_robot`
+/// and returns the collisions counted and the robot-states in contact.
 fn advance_world(
     world: &mut World,
     target_states: u64,
@@ -1078,23 +1085,16 @@ fn advance_world(
 ) -> Result<(u64, u64)> {
     let (mut collisions, mut contact) = (0u64, 0u64);
     let dt = target_states.saturating_sub(world.elapsed_states());
-    let track_m = world.params().wheel_track_m;
     let clock_hz = world.params().clock_hz as f64;
-    let mut before = Vec::with_capacity(drives.len());
     for len in world.substep_plan(dt) {
-        before.clear();
-        for i in 0..drives.len() {
-            before.push(world.pose(i)?);
-        }
         if par {
             world.advance_states_par(len);
         } else {
             world.advance_states(len);
         }
         let dt_s = len as f64 / clock_hz;
-        for (i, (d, b)) in drives.iter_mut().zip(&before).enumerate() {
-            let v = crate::energy::ground_speeds(b, &world.pose(i)?, dt_s, track_m);
-            d.add_substep(dt_s, v);
+        for (i, d) in drives.iter_mut().enumerate() {
+            d.add_substep(dt_s, world.wheel_mean_speeds(i)?, world.wheel_forces(i)?);
         }
         for (i, m) in meters.iter_mut().enumerate() {
             let pressed = world.bumpers(i)?.iter().any(|&b| b);

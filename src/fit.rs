@@ -306,8 +306,8 @@ pub struct EnergyReport {
     pub energy_per_step_mj: f64,
     /// Hours the pack lasts.
     pub battery_life_h: f64,
-    /// The motors' mean current with the wheels held still (a robot pressed against a wall
-    /// the whole time, still driving), mA.
+    /// The motors' mean current pressed against a wall the whole time, still driving (the
+    /// body still, each turning wheel slipping at its traction), mA.
     pub held_motors_current_ma: f64,
     /// The robot's mean current so, mA.
     pub held_mean_current_ma: f64,
@@ -317,6 +317,10 @@ pub struct EnergyReport {
     pub paper_battery_life_h: f64,
     /// The capacity a cell would need for the paper's 3.5 h at the free-running current, mAh.
     pub capacity_for_paper_mah: f64,
+    /// How often the drive voltage's bound cut a motor's current, the wheels free.
+    pub motor_cap: crate::energy::CurrentCap,
+    /// The same pressed against a wall.
+    pub held_motor_cap: crate::energy::CurrentCap,
 }
 
 impl EnergyReport {
@@ -350,6 +354,8 @@ impl EnergyReport {
             held_battery_life_h: 0.0,
             paper_battery_life_h: PAPER_BATTERY_LIFE_H,
             capacity_for_paper_mah: 0.0,
+            motor_cap: m.free_cap,
+            held_motor_cap: m.held_cap,
         }
         .with_pack(pack)
     }
@@ -549,15 +555,19 @@ struct Metered {
     electronics: Charge,
     /// The motors and bridges with the wheels free.
     free: Charge,
-    /// The motors and bridges with the wheels held still.
+    /// The motors and bridges pressed against a wall.
     held: Charge,
+    /// How often the drive voltage's bound cut a motor's current, free.
+    free_cap: crate::energy::CurrentCap,
+    /// The same, pressed against a wall.
+    held_cap: crate::energy::CurrentCap,
     /// The measured time, s.
     seconds: f64,
 }
 
 /// The fit's energy meter: the electronics from the MCU's counters, and the motors under the
-/// controller's commands twice over, once with the wheels free and once held still (a robot
-/// pressed against a wall).
+/// controller's commands twice over, once with the wheels free and once pressed against a wall
+/// (the body still, the wheels slipping).
 struct FitMeter {
     electronics: ElectronicsMeter,
     free: (DriveMeter, FreeWheels),
@@ -567,8 +577,9 @@ struct FitMeter {
 
 impl FitMeter {
     fn new<B: Board>(mcu: &Mcu<B>) -> FitMeter {
-        let top = world::params::TOP_SPEED_M_PER_S;
-        let wheels = || FreeWheels::new(top, world::params::MOTOR_TIME_CONSTANT_S);
+        let params = world::WorldParams::default();
+        let top = params.top_speed_m_per_s;
+        let wheels = || FreeWheels::new(&params);
         FitMeter {
             electronics: ElectronicsMeter::new(mcu),
             free: (DriveMeter::new(top, [1.0; 2]), wheels()),
@@ -599,6 +610,8 @@ impl FitMeter {
             electronics: self.electronics.take(mcu, busy_states),
             free: self.free.0.take(),
             held: self.held.0.take(),
+            free_cap: self.free.0.cap(),
+            held_cap: self.held.0.cap(),
             seconds: (mcu.now() - self.start) as f64 / f64::from(mcu.clock_hz()),
         }
     }

@@ -539,7 +539,7 @@ fn render_energy(s: &mut String, e: &crate::fit::EnergyReport) {
     );
     let _ = writeln!(
         s,
-        "battery life: {:.2} h with the wheels free (the paper: up to {} h, which {:.0} mAh cells would give at this current); {:.2} h pressed against a wall the whole time (motors {:.0} mA, total {:.0} mA)",
+        "battery life: {:.2} h with the wheels free (the paper: up to {} h, which {:.0} mAh cells would give at this current); {:.2} h pressed against a wall the whole time, its wheels slipping (motors {:.0} mA, total {:.0} mA)",
         e.battery_life_h,
         e.paper_battery_life_h,
         e.capacity_for_paper_mah,
@@ -547,4 +547,16 @@ fn render_energy(s: &mut String, e: &crate::fit::EnergyReport) {
         e.held_motors_current_ma,
         e.held_mean_current_ma
     );
+    for (cap, how) in [
+        (e.motor_cap, "with the wheels free"),
+        (e.held_motor_cap, "pressed against a wall"),
+    ] {
+        if cap.capped_wheel_substeps > 0 {
+            let _ = writeln!(
+                s,
+                "motor current cut to the drive voltage's bound {how} in {} of {} driven wheel-sub-steps",
+                cap.capped_wheel_substeps, cap.driven_wheel_substeps
+            );
+        }
+    }
 }

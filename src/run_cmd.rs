@@ -1483,6 +1483,14 @@ fn render_battery(t: &mut String, b: &crate::energy::BatteryReport) {
             .map(|(k, ma)| format!("{k} {ma:.1}"))
             .collect();
         let _ = writeln!(t, "{:<14} whole run, mA: {}", "", list.join(", "));
+        let cap = parts.motor_cap;
+        if cap.capped_wheel_substeps > 0 {
+            let _ = writeln!(
+                t,
+                "{:<14} motor current cut to the drive voltage's bound in {} of {} driven wheel-sub-steps",
+                "", cap.capped_wheel_substeps, cap.driven_wheel_substeps
+            );
+        }
     }
     for cmp in &b.learning_against {
         let _ = writeln!(

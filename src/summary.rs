@@ -1039,6 +1039,7 @@ mod tests {
             recorded: None,
             stack_warnings: Vec::new(),
             energy: crate::energy::Charge::default(),
+            motor_cap: crate::energy::CurrentCap::default(),
         }
     }
 

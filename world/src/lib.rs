@@ -61,6 +61,10 @@
 //!   weakly sideways). The 203:1 gear motors could push harder at stall, so a
 //!   blocked robot pushes with its traction and its wheels slip ([`World::wheel_speeds`] still
 //!   shows the motors' speed). A robot touching nothing follows its wheels exactly.
+//!   [`World::wheel_forces`] gives the longitudinal force each wheel transmitted over the latest
+//!   sub-step (a solved robot's wheel impulses over the sub-step; a free robot's m·a split
+//!   between its wheels by the rigid-body equations), what the motors had to push: a robot
+//!   pushing a wall, its traction; one cruising free, nothing.
 //! - **Contacts** (robot–wall, robot–robot; [`SolverStats`] counts what they did): at the start
 //!   of each sub-step every candidate pair and wall gives a contact manifold (reference-face
 //!   clipping, one or two points, Box2D's method) when it is within the *speculative distance*

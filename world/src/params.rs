@@ -421,4 +421,38 @@ impl WorldParams {
         }
         Ok(())
     }
+
+    /// Largest longitudinal force one drive wheel takes from the floor, N: its traction,
+    /// `μ_floor · m·g/2` (half the weight on each drive wheel). Past it the wheel slips.
+    pub fn wheel_traction_n(&self) -> f64 {
+        self.body().wheel_force_n
+    }
+
+    /// The longitudinal forces (left, right), N, along the heading, that a robot touching
+    /// nothing takes from the floor when, over a sub-step of `h_s` seconds, its speed along its
+    /// heading changes by `d_along_m_per_s` and its turn rate by `d_omega_rad_per_s`: the rigid
+    /// body's m·Δv/h = F_l + F_r and I·Δω/h = (F_r − F_l)·track/2, each at most
+    /// [`WorldParams::wheel_traction_n`]. What [`crate::World::wheel_forces`] gives a free
+    /// robot, for a meter without a world.
+    pub fn free_wheel_forces_n(
+        &self,
+        d_along_m_per_s: f64,
+        d_omega_rad_per_s: f64,
+        h_s: f64,
+    ) -> [f64; 2] {
+        self.body()
+            .wheel_forces(d_along_m_per_s, d_omega_rad_per_s, 1.0 / h_s)
+    }
+
+    fn body(&self) -> crate::solver::BodyConst {
+        crate::solver::BodyConst::new(
+            self.mass_kg,
+            self.body_length_m,
+            self.body_width_m,
+            self.wheel_track_m,
+            self.mu_floor,
+            self.mu_robot,
+            self.mu_wall,
+        )
+    }
 }

@@ -153,6 +153,10 @@ pub(crate) struct BodyConst {
     pub wheel_mass_long: f64,
     /// Effective mass of a wheel's sideways row, kg.
     pub wheel_mass_lat: f64,
+    /// Mass, kg.
+    pub mass: f64,
+    /// Moment of inertia over half the wheel track, kg·m.
+    pub inertia_per_half_track: f64,
 }
 
 impl BodyConst {
@@ -179,7 +183,26 @@ impl BodyConst {
             mu_wall,
             wheel_mass_long: 1.0 / (inv_m + inv_i * half_track * half_track),
             wheel_mass_lat: mass_kg,
+            mass: mass_kg,
+            inertia_per_half_track: inertia / half_track,
         }
+    }
+}
+
+impl BodyConst {
+    /// The longitudinal forces (left, right), N, the floor gives the two drive wheels of a body
+    /// whose speed along its heading changes by `d_along` (m/s) and whose turn rate changes by
+    /// `d_omega` (rad/s) in a sub-step of `1 / inv_h` seconds: from m·a = F_l + F_r and
+    /// I·α = (F_r − F_l)·half_track, each at most the wheel's traction.
+    #[inline]
+    pub(crate) fn wheel_forces(&self, d_along: f64, d_omega: f64, inv_h: f64) -> [f64; 2] {
+        let sum = self.mass * d_along * inv_h;
+        let diff = self.inertia_per_half_track * d_omega * inv_h;
+        let cap = self.wheel_force_n;
+        [
+            (0.5 * (sum - diff)).clamp(-cap, cap),
+            (0.5 * (sum + diff)).clamp(-cap, cap),
+        ]
     }
 }
 

@@ -235,6 +235,9 @@ pub struct World {
     wmean: Vec<[f64; 2]>,
     /// Accumulated wheel impulses of the latest solve (left along, left across, right …).
     wheel_imp: Vec<[f64; 4]>,
+    /// Longitudinal force each drive wheel transmitted to the body over the latest sub-step
+    /// (left, right), N, along the heading (see [`World::wheel_forces`]).
+    wheel_force: Vec<[f64; 2]>,
     bumpers: Vec<u8>,
     /// Normal impulse each bumper face took in the current sub-step, from the solver's
     /// contacts and the position corrections (front, rear, left, right), N·s.
@@ -459,6 +462,7 @@ impl World {
             vel: vec![[0.0; 3]; n],
             wmean: vec![[0.0; 2]; n],
             wheel_imp: vec![[0.0; 4]; n],
+            wheel_force: vec![[0.0; 2]; n],
             pose: poses,
             bumpers: vec![0; n],
             face_impulse: vec![[0.0; 4]; n],
@@ -575,6 +579,30 @@ impl World {
     pub fn wheel_speeds(&self, robot: usize) -> Result<[f64; 2], WorldError> {
         self.check_robot(robot)?;
         Ok(self.motion[robot].speed)
+    }
+
+    /// A robot's mean wheel speeds over the latest sub-step (left, right), m/s: the exact
+    /// integral of the motors' lag, the speeds the body followed if it touched nothing. Like
+    /// [`World::wheel_speeds`], the motors' speed: a blocked wheel slips at it.
+    pub fn wheel_mean_speeds(&self, robot: usize) -> Result<[f64; 2], WorldError> {
+        self.check_robot(robot)?;
+        Ok(self.wmean[robot])
+    }
+
+    /// The longitudinal force each drive wheel transmitted between the floor and the body over
+    /// the latest sub-step (left, right), N, signed along the robot's heading (positive: the
+    /// floor pushes the robot forward). For a robot solved in contact, the solver's accumulated
+    /// rolling impulse of the wheel over the sub-step's length (a blocked robot's slipping
+    /// wheels give their traction, `μ_floor · m·g/2` each, against their slip). For a robot
+    /// touching nothing, the force that gave its body its change of velocity over the sub-step,
+    /// split between the wheels by the rigid body's equations, m·Δv/h = F_l + F_r and
+    /// I·Δω/h = (F_r − F_l)·track/2, each at most the wheel's traction (a body that goes from
+    /// a solved velocity to its wheels' in one sub-step changes it faster than the floor could
+    /// push it): 0 at a steady speed, m·a/2 a wheel while accelerating straight. Reading it
+    /// changes nothing; it is zero before the first sub-step.
+    pub fn wheel_forces(&self, robot: usize) -> Result<[f64; 2], WorldError> {
+        self.check_robot(robot)?;
+        Ok(self.wheel_force[robot])
     }
 
     /// A robot's motor gains (left, right), drawn once from the seed.
@@ -761,6 +789,8 @@ impl World {
             lag: self.lag_for(len),
             inv_track: 1.0 / self.params.wheel_track_m,
             h,
+            inv_h: 1.0 / h,
+            body: self.body,
         };
         // 1. Motors: the wheel speeds over the sub-step.
         if parallel && self.pose.len() > PAR_CHUNK {
@@ -785,18 +815,22 @@ impl World {
         self.find_contacts(spec, h, parallel);
         // 3. Robots touching nothing follow their wheels exactly; the others are solved.
         let flags = &self.flags;
-        let moved_free = |p: &mut [BodyPose], v: &mut [[f64; 3]], w: &[[f64; 2]], f: &[u8]| {
-            drive.free(p, v, w, f)
-        };
         if parallel && self.pose.len() > PAR_CHUNK {
             self.pose
                 .par_chunks_mut(PAR_CHUNK)
                 .zip(self.vel.par_chunks_mut(PAR_CHUNK))
+                .zip(self.wheel_force.par_chunks_mut(PAR_CHUNK))
                 .zip(self.wmean.par_chunks(PAR_CHUNK))
                 .zip(flags.par_chunks(PAR_CHUNK))
-                .for_each(|(((p, v), w), f)| moved_free(p, v, w, f));
+                .for_each(|((((p, v), fw), w), f)| drive.free(p, v, fw, w, f));
         } else {
-            moved_free(&mut self.pose, &mut self.vel, &self.wmean, flags);
+            drive.free(
+                &mut self.pose,
+                &mut self.vel,
+                &mut self.wheel_force,
+                &self.wmean,
+                flags,
+            );
         }
         if !self.active.is_empty() {
             // Warm start from the previous sub-step's impulses of the same contacts and wheels.
@@ -868,10 +902,13 @@ impl World {
                     ));
                 }
             }
+            let inv_h = 1.0 / h;
             for (k, &i) in self.active.iter().enumerate() {
                 let b = &self.island_bodies[k];
                 self.vel[i as usize] = b.vel;
                 self.wheel_imp[i as usize] = b.wheel_imp;
+                // The wheels' rolling impulses over the sub-step, as mean forces.
+                self.wheel_force[i as usize] = [b.wheel_imp[0] * inv_h, b.wheel_imp[2] * inv_h];
             }
             for k in 0..self.active.len() {
                 let i = self.active[k] as usize;
@@ -1693,6 +1730,11 @@ struct Drive {
     lag: LagCoefficients,
     inv_track: f64,
     h: f64,
+    /// 1 / h.
+    inv_h: f64,
+    /// The bodies' mass, inertia, wheel geometry and traction (for the free robots' wheel
+    /// forces).
+    body: BodyConst,
 }
 
 /// The wheel-speed difference below which a wheel is taken to have reached its target speed:
@@ -1729,14 +1771,26 @@ impl Drive {
 
     /// Robots touching nothing (no `ACTIVE` flag) follow their wheels: the exact arc of the
     /// sub-step's mean wheel speeds (exact heading change and, for straight motion, exact
-    /// distance); their velocity becomes the wheels' twist.
-    fn free(&self, pose: &mut [BodyPose], vel: &mut [[f64; 3]], wmean: &[[f64; 2]], flags: &[u8]) {
-        for (((p, v), w), &f) in pose.iter_mut().zip(vel).zip(wmean).zip(flags) {
+    /// distance); their velocity becomes the wheels' twist, and their wheel forces those that
+    /// changed the velocity they had along their heading (see [`World::wheel_forces`]).
+    fn free(
+        &self,
+        pose: &mut [BodyPose],
+        vel: &mut [[f64; 3]],
+        force: &mut [[f64; 2]],
+        wmean: &[[f64; 2]],
+        flags: &[u8],
+    ) {
+        for ((((p, v), fw), w), &f) in pose.iter_mut().zip(vel).zip(force).zip(wmean).zip(flags) {
             if f & ACTIVE != 0 {
                 continue;
             }
             let along = 0.5 * (w[0] + w[1]);
             let omega = (w[1] - w[0]) * self.inv_track;
+            let along0 = v[0] * p.c + v[1] * p.s;
+            *fw = self
+                .body
+                .wheel_forces(along - along0, omega - v[2], self.inv_h);
             let (dx, dy, c, s) = arc_step(p.c, p.s, along, omega, self.h);
             p.x += dx;
             p.y += dy;

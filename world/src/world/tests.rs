@@ -648,6 +648,141 @@ proptest! {
     }
 }
 
+// ----- wheel forces ---------------------------------------------------------------------------
+
+/// The traction of one drive wheel with the default parameters: μ_floor · m·g/2, N.
+fn traction_n() -> f64 {
+    crate::params::MU_FLOOR * crate::params::MASS_KG * crate::params::GRAVITY_M_PER_S2 / 2.0
+}
+
+#[test]
+fn a_robot_pushing_a_wall_at_full_duty_slips_at_its_traction() {
+    // 0.485 m from the wall at 0.15 m/s: there in about 3.3 s, then pushing it.
+    let mut w = world_at(Arena::square(), exact_params(), &[pose(1.2, 0.9, 0.0)]);
+    w.set_wheels(0, WheelCommand::forward(1.0), WheelCommand::forward(1.0))
+        .unwrap();
+    run(&mut w, 4.0, 0.01);
+    assert!(w.bumpers(0).unwrap()[FRONT], "pushing the wall");
+    let f = traction_n();
+    assert!((f - 1.471).abs() < 1e-3, "{f}");
+    assert!((w.params().wheel_traction_n() - f).abs() < 1e-12);
+    for k in 0..100 {
+        w.advance(0.01).unwrap();
+        let [l, r] = w.wheel_forces(0).unwrap();
+        // Forward (the floor pushes the robot into the wall), each wheel at its traction.
+        assert!(
+            (l - f).abs() / f < 0.01,
+            "step {k}: left {l} N against {f} N"
+        );
+        assert!(
+            (r - f).abs() / f < 0.01,
+            "step {k}: right {r} N against {f} N"
+        );
+        // The motors still turn the wheels at their commanded speed: they slip.
+        assert_eq!(w.wheel_mean_speeds(0).unwrap(), [V, V]);
+    }
+    // Reversing into the opposite wall: the forces point backward.
+    let mut w = world_at(Arena::square(), exact_params(), &[pose(0.5, 0.9, 0.0)]);
+    w.set_wheels(0, WheelCommand::reverse(1.0), WheelCommand::reverse(1.0))
+        .unwrap();
+    run(&mut w, 4.0, 0.01);
+    let [l, r] = w.wheel_forces(0).unwrap();
+    assert!(
+        (l + f).abs() / f < 0.01 && (r + f).abs() / f < 0.01,
+        "{l} {r}"
+    );
+}
+
+#[test]
+fn a_free_robot_at_a_steady_speed_takes_no_force_from_the_floor() {
+    let arena = Arena::rectangle(10.0, 10.0).unwrap();
+    for b in [Behaviour::Forward, Behaviour::TurnLeftForward] {
+        let mut w = world_at(arena, exact_params(), &[pose(5.0, 5.0, 0.3)]);
+        set_behaviour(&mut w, 0, b);
+        // Before the first sub-step: nothing.
+        assert_eq!(w.wheel_forces(0).unwrap(), [0.0; 2]);
+        // 1.2 s = 20 τ: the lag has settled (to 2e-9 of the speed).
+        run(&mut w, 1.2, 0.01);
+        let [l, r] = w.wheel_forces(0).unwrap();
+        assert!(l.abs() < 1e-6 && r.abs() < 1e-6, "{b:?}: {l} {r}");
+    }
+}
+
+#[test]
+fn a_robot_accelerating_from_rest_takes_m_a_from_its_wheels() {
+    let arena = Arena::rectangle(10.0, 10.0).unwrap();
+    let params = exact_params();
+    let (m, ht) = (params.mass_kg, 0.5 * params.wheel_track_m);
+    let inertia = m * (BODY_LENGTH_M * BODY_LENGTH_M + BODY_WIDTH_M * BODY_WIDTH_M) / 12.0;
+    let h = 0.01;
+    // Straight ahead, then turning left from rest: both wheels accelerate, the right faster.
+    for b in [Behaviour::Forward, Behaviour::TurnLeftForward] {
+        let mut w = world_at(arena, params.clone(), &[pose(5.0, 5.0, 0.0)]);
+        set_behaviour(&mut w, 0, b);
+        let (mut along0, mut omega0) = (0.0, 0.0);
+        let mut before = w.pose(0).unwrap();
+        for k in 0..20 {
+            w.advance(h).unwrap();
+            let after = w.pose(0).unwrap();
+            // The body's mean speeds over the sub-step, from its poses (the exact arc).
+            let turn = after.heading_rad - before.heading_rad;
+            let chord = (after.x_m - before.x_m).hypot(after.y_m - before.y_m);
+            let along = if turn.abs() < 1e-15 {
+                chord / h
+            } else {
+                chord / (2.0 * (turn / 2.0).sin()) * turn / h
+            };
+            let omega = turn / h;
+            let (a, alpha) = ((along - along0) / h, (omega - omega0) / h);
+            let [l, r] = w.wheel_forces(0).unwrap();
+            // m·a = F_l + F_r, I·α = (F_r − F_l)·track/2.
+            assert!(
+                (l + r - m * a).abs() < 1e-6,
+                "{b:?} step {k}: {l} + {r} vs {}",
+                m * a
+            );
+            assert!(
+                ((r - l) * ht - inertia * alpha).abs() < 1e-7,
+                "{b:?} step {k}: {l}, {r} vs I·α {}",
+                inertia * alpha
+            );
+            if b == Behaviour::Forward {
+                // Straight: m·a/2 a wheel, the first 10 ms 0.296 N (the lag's mean speed over
+                // the first sub-step is v·(1 − τ/h·(1 − e^(−h/τ))) = 11.8 mm/s).
+                assert!((l - r).abs() < 1e-12 && (l - m * a / 2.0).abs() < 1e-6);
+                if k == 0 {
+                    let v1 = V * (1.0 - TAU / h * (1.0 - (-h / TAU).exp()));
+                    assert!((l - m * v1 / h / 2.0).abs() < 1e-9, "{l}");
+                    assert!((l - 0.296).abs() < 1e-3, "{l}");
+                }
+            }
+            assert!(l > 0.0 && r > 0.0, "accelerating forward");
+            (along0, omega0, before) = (along, omega, after);
+        }
+    }
+}
+
+#[test]
+fn wheel_forces_never_exceed_the_traction_in_a_crowd() {
+    let mut w = dense_swarm(5, 20, WorldParams::default());
+    let mut rng = walk_rng(5, 2);
+    let f = traction_n();
+    let mut at_traction = 0;
+    for k in 0..1200 {
+        if k % 45 == 0 {
+            shuffle_behaviours(&mut w, &mut rng);
+        }
+        w.advance(0.01).unwrap();
+        for r in 0..20 {
+            for x in w.wheel_forces(r).unwrap() {
+                assert!(x.is_finite() && x.abs() <= f * (1.0 + 1e-12), "{x}");
+                at_traction += usize::from(x.abs() > 0.99 * f);
+            }
+        }
+    }
+    assert!(at_traction > 0, "some wheels slipped");
+}
+
 // ----- sensor rays --------------------------------------------------------------------------
 
 fn mm(w: &World, robot: usize, sensor: usize) -> f64 {
@@ -1036,6 +1171,7 @@ fn state_bits(w: &World) -> Vec<u64> {
         let b = w.pose[i];
         v.extend([b.x, b.y, b.c, b.s].map(f64::to_bits));
         v.extend(w.motion[i].speed.map(f64::to_bits));
+        v.extend(w.wheel_force[i].map(f64::to_bits));
         v.push(u64::from(w.bumpers[i]));
     }
     v
