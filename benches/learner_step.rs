@@ -39,7 +39,7 @@ fn data<const N: usize, const M: usize>() -> Data<N, M> {
     Data { w, xs, es }
 }
 
-/// The same step in plain `i32`: y, argmax, O (SPEC §2.3), then the update (SPEC §2.4).
+/// The same step in plain `i32`: y, argmax, O (docs/design.md §2.3), then the update (docs/design.md §2.4).
 /// Deliberately the naive indexed loops a C programmer would write first.
 #[inline(never)]
 #[allow(clippy::needless_range_loop)]

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Writes replay-arena.jsonl: a 13 x 4 arena network (eta 0.1 = 3277, T = 10) and 40 steps of
-inputs and evaluations, for `h8swarm learn --replay` (SPEC §2.6). Deterministic: fixed seed."""
+inputs and evaluations, for `h8swarm learn --replay` (docs/design.md §2.6). Deterministic: fixed seed."""
 import json
 import random
 

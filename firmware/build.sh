@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# build.sh - build the robot firmware (SPEC 8) into robot.mot and robot.sym.
+# build.sh - build the robot firmware (docs/design.md §8) into robot.mot and robot.sym.
 #
 #   h8300-hms-gcc -mh -mint32 -O2 -fomit-frame-pointer -fno-optimize-sibling-calls -nostdlib
 #   crt0.S runtime.S robot.c learner.c config.c i2c.c record.c du_table.c, linked with

@@ -7,7 +7,7 @@
 struct config cfg;
 u8 cfg_status;
 
-/* The compiled defaults: the arena (paper env. 2; SPEC 5): four behaviours, history 1, no
+/* The compiled defaults: the arena (paper env. 2; docs/design.md §5): four behaviours, history 1, no
  * bias, eta 0.001 (33), T 10, a record every 20 steps, 0.45 s = 45 ticks of 10 ms at
  * phi = 25 MHz (31 250 counts of phi/8), sensors on AN0-AN3, seed 1. */
 static const struct config defaults = {

@@ -1,5 +1,5 @@
 /*
- * config.h - the configuration block (SPEC 8): one image for every setting.
+ * config.h - the configuration block (docs/design.md §8): one image for every setting.
  *
  * 32 bytes at H'000400 in flash, big-endian (the H8's byte order), written by the emulator
  * into the image at load as a production line writes calibration data:

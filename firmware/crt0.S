@@ -1,10 +1,10 @@
 ; crt0.S - start-up code of the robot firmware on the H8/3052F (H8/300H, advanced mode).
 ;
-;   H'000000  the exception vector table, 61 vectors of 4 bytes (SPEC 4.1): reset -> _start,
+;   H'000000  the exception vector table, 61 vectors of 4 bytes (docs/design.md §4.1): reset -> _start,
 ;             ITU0 IMIA (vector 24) -> _tick_isr, every other vector n -> a stub that ends
 ;             the run with exit status 0x80 + n (an unexpected exception is a fault);
 ;   H'0000F4  _start: stack at the top of RAM, .data copied, .bss cleared, main;
-;   H'000400  the configuration block (SPEC 8), 32 bytes, erased (H'FF) in the image: the
+;   H'000400  the configuration block (docs/design.md §8), 32 bytes, erased (H'FF) in the image: the
 ;             emulator writes it at load; absent or corrupt, the firmware runs its defaults.
 ;
 ; The reset exception leaves CCR.I = 1; main enables interrupts when boot is done.
@@ -57,7 +57,7 @@ _start:
 	jsr	@_main
 	; main never returns; if it did, R0L is the exit status.
 
-; __exit: the halt (SPEC 7). Also the return address the emulator gives a routine it calls
+; __exit: the halt (docs/design.md §7). Also the return address the emulator gives a routine it calls
 ; by its symbol (h8swarm learn --on-core): the run stops here.
 	.global	__exit
 __exit:

@@ -1,5 +1,5 @@
 /*
- * du_table.c - the distance-unit table (SPEC 3.3): du_table[c] is the proximity in du
+ * du_table.c - the distance-unit table (docs/design.md §3.3): du_table[c] is the proximity in du
  * (1 du = 80/255 cm, 255 = 80 cm or more) for the 8-bit A/D code c = ADC10 >> 2.
  * Generated from sensors::DU_TABLE by `cargo run -p sensors --example du_table_c`;
  * do not edit (a test compares the image's table with the Rust one).

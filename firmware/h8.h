@@ -1,7 +1,7 @@
 /*
  * h8.h - fixed-width types and the H8/3052F registers the robot firmware uses.
  *
- * Addresses and bits: SPEC 3.2 and 4.1, from the H8/3052F hardware manual's register
+ * Addresses and bits: docs/design.md §3.2 and 4.1, from the H8/3052F hardware manual's register
  * tables (A/D converter, ITU, I/O ports). The registers sit at H'FFFF1C-H'FFFFFF, so GCC
  * reaches the byte registers with @aa:8 and the word registers with @aa:16.
  */
@@ -47,11 +47,11 @@ typedef unsigned int u32;
 #define P4PCR REG8(0xFFFFDA)
 #define PBDDR REG8(0xFFFFD4)
 #define PBDR REG8(0xFFFFD6)
-/* I2C on port 4 (SPEC 3.6): SDA = P4.7, SCL = P4.6. */
+/* I2C on port 4 (docs/design.md §3.6): SDA = P4.7, SCL = P4.6. */
 #define SDA_BIT 0x80
 #define SCL_BIT 0x40
 
-/* A/D converter (section 15, SPEC 3.2): results left-justified, upper byte first. */
+/* A/D converter (section 15, docs/design.md §3.2): results left-justified, upper byte first. */
 #define ADDRAH_ADDR 0xFFFFE0
 #define ADCSR REG8(0xFFFFE8)
 #define ADCSR_ADF 0x80

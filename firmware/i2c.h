@@ -1,5 +1,5 @@
 /*
- * i2c.h - the bit-banged I2C master on port 4 (SPEC 3.6): SDA = P4.7, SCL = P4.6, open drain
+ * i2c.h - the bit-banged I2C master on port 4 (docs/design.md §3.6): SDA = P4.7, SCL = P4.6, open drain
  * through the DDR (pull = DDR bit 1 with DR = 0, release = DDR bit 0; the on-chip pull-ups
  * take a released line high).
  */

@@ -1,9 +1,9 @@
 /*
- * learner.c - the learner of SPEC 2 in Q15/Q7, written for the H8/300H.
+ * learner.c - the learner of docs/design.md §2 in Q15/Q7, written for the H8/300H.
  *
  * Written as an H8 engineer writes it: 16 x 16 -> 32 products from int16_t operands (GCC emits
  * MULXS.W), 32-bit sums, pointers walked with post-increment, counted do-while loops (DEC and
- * BNE), the division of SPEC 2.3 as one DIVXS.W (32 / 16), no division in an inner loop.
+ * BNE), the division of docs/design.md §2.3 as one DIVXS.W (32 / 16), no division in an inner loop.
  * Every data-dependent path is one the Rust cost model (nn_q15's H8 meter) counts.
  */
 #include "learner.h"

@@ -1,8 +1,8 @@
 /*
- * learner.h - the Hartono-Kakita learner of SPEC 2 in Q15/Q7 on the H8/300H.
+ * learner.h - the Hartono-Kakita learner of docs/design.md §2 in Q15/Q7 on the H8/300H.
  *
- * Bit-exact to the Rust crate nn_q15 (forward pass SPEC 2.3, update SPEC 2.4, input vector
- * SPEC 2.2, step order SPEC 3.5). The network's arrays live in RAM after .bss, carved by
+ * Bit-exact to the Rust crate nn_q15 (forward pass docs/design.md §2.3, update docs/design.md §2.4, input vector
+ * docs/design.md §2.2, step order docs/design.md §3.5). The network's arrays live in RAM after .bss, carved by
  * learner_setup at boot from the configuration block; nothing is allocated after boot.
  *
  * The routines work on the globals below rather than on arguments, so that the emulator can
@@ -14,7 +14,7 @@
 #include "h8.h"
 
 /* Largest network the routines take: 256 inputs (the no-overflow bound of the i32 sum,
- * SPEC 2.1) and 8 outputs (the robot enables 2 or 4 behaviours; up to 8 for what-if shapes). */
+ * docs/design.md §2.1) and 8 outputs (the robot enables 2 or 4 behaviours; up to 8 for what-if shapes). */
 #define NET_MAX_INPUTS 256
 #define NET_MAX_OUTPUTS 8
 
@@ -38,13 +38,13 @@ extern i16 net_d_prev;    /* D(t-1) */
 u8 *learner_setup(u8 *heap, u16 n_in, u8 n_out);
 /* Bytes learner_setup takes for N x M. */
 u32 learner_bytes(u16 n_in, u8 n_out);
-/* One step (SPEC 3.5): D(t) and E(t-1), the update on x(t-1), x(t), the forward pass.
+/* One step (docs/design.md §3.5): D(t) and E(t-1), the update on x(t-1), x(t), the forward pass.
  * Returns the winner. Phase "input" (its callees learner_update and learner_forward are
  * phases of their own). */
 u8 learner_step(const u8 *p);
-/* The update of SPEC 2.4 on net_x with evaluation e and winner net_win. */
+/* The update of docs/design.md §2.4 on net_x with evaluation e and winner net_win. */
 void learner_update(i16 e);
-/* The forward pass of SPEC 2.3 on net_x: net_y, net_o, net_win. */
+/* The forward pass of docs/design.md §2.3 on net_x: net_y, net_o, net_win. */
 void learner_forward(void);
 
 #endif

@@ -1,5 +1,5 @@
 /*
- * record.h - the A/B persistence record on the two 24LC256 (SPEC 3.6), the format of the
+ * record.h - the A/B persistence record on the two 24LC256 (docs/design.md §3.6), the format of the
  * Rust crate eeprom (eeprom/src/persist.rs):
  *
  *   commit page at H'0000 (14 bytes): 'H' 'K', version 1, 0, sequence (u32), payload length

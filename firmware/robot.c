@@ -1,5 +1,5 @@
 /*
- * robot.c - the robot controller (SPEC 3.5, 8): boot, the 10 ms tick, and the step.
+ * robot.c - the robot controller (docs/design.md §3.5, 8): boot, the 10 ms tick, and the step.
  *
  * Boot: the configuration block (or the compiled defaults), ports and pull-ups, ITU0 as the
  * 10 ms tick interrupt, ITU1/ITU2 as the motors' PWM, the network's arrays after .bss, the
@@ -33,7 +33,7 @@ extern u8 _heap_start[];
 extern u8 _stack_top[];
 extern const u8 du_table[256];
 
-/* One row per behaviour (SPEC 3.5): forward (v, v), backward (-v, -v), turn-left-forward
+/* One row per behaviour (docs/design.md §3.5): forward (v, v), backward (-v, -v), turn-left-forward
  * (0.3 v, v), turn-right-forward (v, 0.3 v). */
 struct motor_row {
     u16 left;

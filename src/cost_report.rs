@@ -16,7 +16,7 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
 
-/// The H8/3052F clock of the AKI-H8/3052F board (SPEC §4.1): 25 MHz, 40 ns per state.
+/// The H8/3052F clock of the AKI-H8/3052F board (docs/design.md §4.1): 25 MHz, 40 ns per state.
 pub const PHI_HZ: f64 = 25.0e6;
 
 /// What to measure.

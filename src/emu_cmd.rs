@@ -1,5 +1,5 @@
 //! `h8swarm emu IMAGE.mot [--max-states N] [--trace] [--stats] [--vcd FILE] [--gdb ADDR]
-//! [--symbols FILE]`: runs a program on the emulated H8/3052F (SPEC §7). SCI1 is the console
+//! [--symbols FILE]`: runs a program on the emulated H8/3052F (docs/design.md §7). SCI1 is the console
 //! (standard output); `--trace` writes one line per instruction (address, disassembly, states,
 //! and the function it is in when the image has symbols) and `--stats` a JSON summary, both on
 //! standard error. `--vcd` writes a pin trace of the whole run (`emu::chip::vcd`); `--gdb`

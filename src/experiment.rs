@@ -51,7 +51,7 @@ pub const SNAPSHOT_STEPS: usize = 200;
 /// At most this many robots' paths are recorded for the arena figure.
 pub const TRACKED_ROBOTS: usize = 40;
 
-/// The metrics of one step of one run (SPEC §5).
+/// The metrics of one step of one run (docs/design.md §5).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StepMetrics {
     /// Mean over robots of D(t), du.

@@ -1,5 +1,5 @@
-//! "Does it fit the H8/3052?" (SPEC §6), measured by running the controller on the emulated
-//! MCU: by default the robot firmware (`firmware/robot.mot`, SPEC §8) on the H8/300H core,
+//! "Does it fit the H8/3052?" (docs/design.md §6), measured by running the controller on the emulated
+//! MCU: by default the robot firmware (`firmware/robot.mot`, docs/design.md §8) on the H8/300H core,
 //! with the Rust model of the controller (`emu::board::model`) measured beside it.
 //!
 //! [`measure`] builds an MCU with four modelled IR sensors (`sensors::IrSensor`, datasheet
@@ -46,7 +46,7 @@ use crate::energy::{
 };
 use crate::seeds::robot_stream;
 
-/// Endurance of a 24LC256 page: 1 000 000 write cycles (SPEC §3.6; Microchip DS21203).
+/// Endurance of a 24LC256 page: 1 000 000 write cycles (docs/design.md §3.6; Microchip DS21203).
 pub const ENDURANCE_CYCLES: f64 = 1_000_000.0;
 /// Longest boot the fit waits for before calling the image stuck: 10 s of MCU time.
 pub const BOOT_LIMIT_S: f64 = 10.0;
@@ -83,7 +83,7 @@ impl FirmwareUnderTest {
     }
 }
 
-/// The robot firmware's phases, in report order, and the functions that make them (SPEC §8).
+/// The robot firmware's phases, in report order, and the functions that make them (docs/design.md §8).
 #[must_use]
 pub fn robot_phases() -> Vec<PhaseDef> {
     vec![
@@ -379,7 +379,7 @@ impl EnergyReport {
     }
 }
 
-/// The verdict of SPEC §6.
+/// The verdict of docs/design.md §6.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct FitReport {
     /// The controller measured.

@@ -1,4 +1,4 @@
-//! `h8swarm fit`: the verdict of SPEC §6 for the default network and the paper's two settings,
+//! `h8swarm fit`: the verdict of docs/design.md §6 for the default network and the paper's two settings,
 //! what-ifs, and the largest network within a CPU budget, all measured by running the
 //! controller on the emulated H8/3052F ([`crate::fit`]): by default the robot firmware on the
 //! H8/300H core, with the Rust model's figures beside each phase.

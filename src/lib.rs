@@ -3,8 +3,8 @@
 //! The root package is both the `h8swarm` command-line tool (`src/main.rs`) and this library,
 //! which holds what the commands do, so that benchmarks and tests can drive it directly:
 //! the swarm experiment ([`scenario`], [`robot`], [`experiment`], [`summary`], [`plot`],
-//! [`run_cmd`]), the fit verdict of SPEC §6 ([`fit`], measured on the emulated MCU, and its
-//! command [`fit_cmd`]), the learner's cost summary ([`cost_report`]) and the replay of SPEC §2.6
+//! [`run_cmd`]), the fit verdict of docs/design.md §6 ([`fit`], measured on the emulated MCU, and its
+//! command [`fit_cmd`]), the learner's cost summary ([`cost_report`]) and the replay of docs/design.md §2.6
 //! ([`replay`]). The parts of the robot live in the workspace's other
 //! crates: `nn_q15`, `sensors`, `eeprom`, `emu` and `world`.
 #![forbid(unsafe_code)]

@@ -32,14 +32,14 @@ struct Cli {
 enum Command {
     /// Run the swarm experiment (the default job: the arena, with its controls and plots).
     Run(run_cmd::RunArgs),
-    /// Feed the learner core from JSON Lines and print one JSON line per step (SPEC §2.6).
+    /// Feed the learner core from JSON Lines and print one JSON line per step (docs/design.md §2.6).
     Learn(LearnArgs),
     /// Measure the learner's H8/300H states per step and its RAM footprint (the learner alone).
     Cost(CostArgs),
     /// Run an H8/300H program image (.mot) on the emulated H8/3052F, SCI1 as the console.
     Emu(EmuArgs),
     /// Does the learner fit the H8/3052F? RAM, ROM, states per phase, EEPROM, measured on the
-    /// emulated MCU (SPEC §6).
+    /// emulated MCU (docs/design.md §6).
     Fit(fit_cmd::FitArgs),
     /// Parameter sweeps: plan a grid as a Slurm job array, run its tasks, merge the results.
     Sweep(h8swarm::sweep::SweepArgs),

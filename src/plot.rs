@@ -8,7 +8,7 @@
 //! * [`arena_figure`]: the paper's Fig. 8 — the arena seen from above, in metres at equal aspect
 //!   ratio, with every robot's trajectory and its outline at a few instants ([`Outline`]).
 //!
-//! Choices where the spec is silent (SPEC.md §5 names the metrics, not the drawing):
+//! Choices where the spec is silent (docs/design.md §5 names the metrics, not the drawing):
 //! * **Font.** DejaVu Sans 2.37 (`assets/DejaVuSans.ttf`, licence in
 //!   `assets/DejaVuSans-LICENSE.txt`) is compiled into the binary and registered in plotters'
 //!   `ab_glyph` font table as `"sans-serif"`, so figures render identically on a machine without

@@ -1,5 +1,5 @@
-//! `h8swarm learn --replay FILE`: the learner core of SPEC §2.3–2.4 fed from JSON Lines, one
-//! output line per step (SPEC §2.6), so another implementation can be compared bit for bit.
+//! `h8swarm learn --replay FILE`: the learner core of docs/design.md §2.3–2.4 fed from JSON Lines, one
+//! output line per step (docs/design.md §2.6), so another implementation can be compared bit for bit.
 //!
 //! Input: line 1 is the header
 //! `{"n_in": N, "n_out": M, "eta": η, "threshold": T, "weights": [[w_1,1 … w_N,1], …]}` (one row
@@ -7,12 +7,12 @@
 //! forward pass on x, then the update with evaluation E for that x and its winner. Output, per
 //! step: `{"y": [M], "o": [M], "win": j, "weights": [[…] after the update]}`.
 //!
-//! Choices where SPEC §2.6 is silent: lines holding only white space are skipped (they still
+//! Choices where docs/design.md §2.6 is silent: lines holding only white space are skipped (they still
 //! count for line numbers); unknown fields are errors, so a misspelt key never passes silently;
 //! numbers must be integers (no fraction, no exponent); η and T must be 0 … 32767 (Q15 ≥ 0 and
 //! a non-negative threshold); E may be any i16; M may be 2 to 8 (the learner core's bound; a
 //! robot uses 2 or 4). `--states` adds the H8/300H states the step's forward pass and update
-//! cost (`"states": {"forward": …, "update": …}`); without it the output is exactly SPEC §2.6's.
+//! cost (`"states": {"forward": …, "update": …}`); without it the output is exactly docs/design.md §2.6's.
 //!
 //! Two engines compute the lines: `nn_q15` (the default; states from its H8 meter) and, with
 //! `--on-core`, the robot firmware's own routines `learner_forward` and `learner_update` run on
@@ -66,7 +66,7 @@ pub enum ReplayFailure {
 /// What computes the output lines.
 #[derive(Clone, Debug)]
 pub enum Engine {
-    /// `nn_q15` (SPEC §2.3–2.4), states from its H8 meter.
+    /// `nn_q15` (docs/design.md §2.3–2.4), states from its H8 meter.
     Model,
     /// The firmware's `learner_forward` and `learner_update` on the emulated H8/300H.
     OnCore(Box<Firmware>),

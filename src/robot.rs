@@ -59,7 +59,7 @@ impl Board for RobotBoard {
     }
 }
 
-/// Which run a robot belongs to (SPEC §5: learning and the two controls).
+/// Which run a robot belongs to (docs/design.md §5: learning and the two controls).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Condition {
@@ -327,7 +327,7 @@ impl Robot {
     }
 
     /// EEPROM records written so far: writes of the record slot's commit page (page 0) on
-    /// either chip (SPEC §3.6's A/B records).
+    /// either chip (docs/design.md §3.6's A/B records).
     fn records_written(&self) -> u64 {
         self.mcu
             .i2c()

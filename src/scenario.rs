@@ -1,4 +1,4 @@
-//! Scenarios: every parameter of an experiment (SPEC §3 and §5), as TOML, with the built-in
+//! Scenarios: every parameter of an experiment (docs/design.md §3 and §5), as TOML, with the built-in
 //! `corridor` (paper env. 1) and `arena` (paper env. 2).
 //!
 //! A scenario file lists only what differs from the built-in it names in `base` (default
@@ -12,7 +12,7 @@ use std::path::Path;
 use anyhow::{Context, Result, bail};
 use serde::{Deserialize, Serialize};
 
-/// The arenas of SPEC §5.
+/// The arenas of docs/design.md §5.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum ArenaKind {
@@ -54,7 +54,7 @@ pub struct TimingSpec {
 /// inside the body.
 pub const MAX_SENSOR_SETBACK_M: f64 = 0.08;
 
-/// The physical world (defaults from SPEC §3.5 and the `world` crate).
+/// The physical world (defaults from docs/design.md §3.5 and the `world` crate).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct WorldSpec {
@@ -72,7 +72,7 @@ pub struct WorldSpec {
     pub sensor_range_m: f64,
     /// How far each IR sensor sits inside the body, back from the middle of its side along
     /// its axis, metres (0 = on the side; at most 0.08). Default 0.08: a GP2D12-class sensor
-    /// reads unambiguously only from 8 cm (its curve folds back nearer, SPEC §3.1), so set back
+    /// reads unambiguously only from 8 cm (its curve folds back nearer, docs/design.md §3.1), so set back
     /// by 8 cm an obstacle touching the body reads as near as the curve allows (the peak,
     /// about 3.2 V), where on the surface it would read as 28–42 cm.
     pub sensor_setback_m: f64,
@@ -86,7 +86,7 @@ pub struct WorldSpec {
     pub corridor_clearance_m: f64,
 }
 
-/// The IR sensors (defaults: SPEC §3.1 and the `sensors` crate).
+/// The IR sensors (defaults: docs/design.md §3.1 and the `sensors` crate).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SensorSpec {
@@ -130,7 +130,7 @@ impl Default for ControllerSpec {
     }
 }
 
-/// Which controls run beside learning (SPEC §5).
+/// Which controls run beside learning (docs/design.md §5).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ControlSpec {
@@ -297,7 +297,7 @@ impl Default for WorldSpec {
             // sampled 22 times per 0.45 s step.
             substep_s: world::params::MAX_SUBSTEP_S,
             sensor_range_m: world::params::SENSOR_MAX_RANGE_M,
-            // Set back by the end of the sensor's fold-back zone (SPEC §3.1: the curve peaks at
+            // Set back by the end of the sensor's fold-back zone (docs/design.md §3.1: the curve peaks at
             // 8 cm and falls again nearer), so that an obstacle touching the body reads as near
             // as the curve allows instead of folding back to a far reading.
             sensor_setback_m: sensors::curve::FAR_BRANCH_MIN_MM / 1000.0,

@@ -1,4 +1,4 @@
-//! Drives the real `h8swarm` binary: the replay of SPEC §2.6 checked line by line against an
+//! Drives the real `h8swarm` binary: the replay of docs/design.md §2.6 checked line by line against an
 //! independent reference written here, its error reports, and the cost summary.
 
 use std::io::Write;
@@ -26,7 +26,7 @@ fn h8swarm(args: &[&str], stdin: Option<&str>) -> Output {
     child.wait_with_output().expect("the binary runs")
 }
 
-/// The learner core of SPEC §2.3–2.4 in i64, written from the spec for this test.
+/// The learner core of docs/design.md §2.3–2.4 in i64, written from the spec for this test.
 struct Reference {
     n: usize,
     eta: i64,

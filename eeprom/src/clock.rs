@@ -7,7 +7,7 @@ const NS_PER_S: u128 = 1_000_000_000;
 
 /// The MCU clock φ that every time in this crate is counted in (one state = 1/φ).
 ///
-/// At the default 25 MHz one state is 40 ns (SPEC §4.1).
+/// At the default 25 MHz one state is 40 ns (docs/design.md §4.1).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Clock {
     clock_hz: u32,

@@ -58,7 +58,7 @@ pub const T_SP_MAX_NS: u64 = 50;
 /// T_WC: maximum write cycle time (byte or page), 5 ms (DS21203 Table 1-2, param. 17).
 pub const T_WC_MAX_NS: u64 = 5_000_000;
 /// Lower bound of the modelled write cycle time, 3 ms. Not a datasheet figure (it gives only the
-/// 5 ms maximum): SPEC §3.6 says "model 3–5 ms".
+/// 5 ms maximum): docs/design.md §3.6 says "model 3–5 ms".
 pub const T_WC_MODEL_MIN_NS: u64 = 3_000_000;
 /// Endurance: 1 000 000 write cycles per page at 25 °C, 5.5 V, page mode; "not tested but
 /// ensured by characterization" (DS21203 Table 1-2, param. 18 and Note 4).
@@ -100,8 +100,8 @@ pub mod standard {
     pub const T_BUF_MIN_NS: u64 = 4_700;
 }
 
-/// Default MCU clock φ: 25 MHz, as on the Akizuki AKI-H8/3052F board (SPEC §4.1).
+/// Default MCU clock φ: 25 MHz, as on the Akizuki AKI-H8/3052F board (docs/design.md §4.1).
 pub const DEFAULT_CLOCK_HZ: u32 = 25_000_000;
 /// Highest φ accepted: 25 MHz, the H8/3052F's maximum operating frequency (H8/3052F hardware
-/// manual, electrical characteristics; SPEC §4.1).
+/// manual, electrical characteristics; docs/design.md §4.1).
 pub const MAX_CLOCK_HZ: u32 = 25_000_000;

@@ -67,7 +67,7 @@ pub enum EepromError {
     },
     /// A write cycle time range outside the modelled 3–5 ms, or min > max.
     #[error(
-        "write cycle time range {min_ns}..={max_ns} ns is invalid: valid is 3 000 000 <= min <= max <= 5 000 000 ns (DS21203 T_WC <= 5 ms; SPEC models 3-5 ms)"
+        "write cycle time range {min_ns}..={max_ns} ns is invalid: valid is 3 000 000 <= min <= max <= 5 000 000 ns (DS21203 T_WC <= 5 ms; the design models 3-5 ms)"
     )]
     InvalidWriteCycleTime {
         /// Lower end asked for.

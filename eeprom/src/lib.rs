@@ -1,6 +1,6 @@
 //! The robot's two Microchip 24LC256 serial EEPROMs at pin level, the bit-banged I²C bus they
 //! sit on, the master the H8 firmware runs, and the persistence record that survives power
-//! cuts (SPEC §3.6).
+//! cuts (docs/design.md §3.6).
 //!
 //! # Layers
 //! - [`Eeprom24lc256`]: one chip. It watches SDA/SCL levels over time (time in MCU states of
@@ -19,7 +19,7 @@
 //! - [`persist`]: the record codec (sequence number, opaque payload, CRC-16/CCITT-FALSE), the
 //!   A/B policy (even sequences on 0x50, odd on 0x51), boot-time recovery and the save policy.
 //!
-//! # Modelling choices (where the datasheet or SPEC is silent)
+//! # Modelling choices (where the datasheet or the design is silent)
 //! - **Ideal lines.** Edges are instantaneous; rise/fall times (T_R, T_F ≤ 300 ns) and spike
 //!   suppression (T_SP) are not modelled. On the real board the H8's on-chip MOS pull-ups are
 //!   weak, so real rise times would be far longer than the datasheet's 300 ns; the 100 kHz
@@ -31,7 +31,7 @@
 //!   T_HD:STA, T_SU:STA, T_SU:STO and T_BUF and counts violations; it does not misbehave on
 //!   them. The master here produces none (tested).
 //! - **Write cycle time.** Drawn per write cycle, uniformly in whole states over
-//!   `[t_wc_min_ns, t_wc_max_ns]` (default 3–5 ms, the SPEC's model; 5 ms is the datasheet
+//!   `[t_wc_min_ns, t_wc_max_ns]` (default 3–5 ms, the design's model; 5 ms is the datasheet
 //!   maximum), from the chip's own seeded stream. The cycle starts at the STOP; at state
 //!   `start + t_wc` the page holds the new data and the chip answers again.
 //! - **What a STOP writes.** Only whole data bytes the chip acknowledged; a partial byte before

@@ -58,7 +58,7 @@ pub const BODY_OVERHEAD_BYTES: usize = BODY_HEADER_BYTES + 2;
 /// Default bound on ACK polls after each page: 1 000 polls of ~26 µs each at 400 kHz and
 /// 25 MHz, about five times the datasheet's 5 ms T_WC.
 pub const DEFAULT_MAX_POLLS: u32 = 1_000;
-/// Default save policy: one record every 20 steps (SPEC §3.6).
+/// Default save policy: one record every 20 steps (docs/design.md §3.6).
 pub const DEFAULT_SAVE_EVERY_STEPS: u32 = 20;
 
 /// The chip a record with sequence number `sequence` is written to.
@@ -851,7 +851,7 @@ mod tests {
         assert_eq!(p.writes_per_record_page(1000, 0), [25, 25]);
         assert_eq!(p.writes_per_record_page(1020, 0), [26, 25]);
         assert_eq!(p.writes_per_record_page(1020, 7), [25, 26]);
-        // SPEC §3.6: arena step 0.45 s, one save per 20 steps, A/B: ~5 000 h to 1e6 writes.
+        // docs/design.md §3.6: arena step 0.45 s, one save per 20 steps, A/B: ~5 000 h to 1e6 writes.
         let h = p.endurance_lifetime_hours(0.45, 1_000_000);
         assert!((h - 5_000.0).abs() < 1e-6, "{h}");
         assert!((p.page_writes_per_hour(0.45) - 200.0).abs() < 1e-9);

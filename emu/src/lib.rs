@@ -2,7 +2,7 @@
 //! layers below it.
 //!
 //! 1. [`core`] — the H8/300H core: [`core::memmap`] (the memory map and the access states of
-//!    each area, SPEC §4.1), [`core::bus`] (the clocked [`core::bus::Bus`] every program talks
+//!    each area, docs/design.md §4.1), [`core::bus`] (the clocked [`core::bus::Bus`] every program talks
 //!    through), [`core::cpu`] (decode, execute, timing by the manual's I·S_I + … + N·S_N rule,
 //!    an objdump-form disassembler; generic over the bus) and [`core::srec`] (the Motorola
 //!    S-record loader for `.mot` images). It knows no chip.

@@ -1,5 +1,5 @@
 //! The controller on the emulated MCU: boot, the tick, steps within bounds derived here from
-//! SPEC §4.2, saves and their restore, a power cut in the middle of a save, determinism.
+//! docs/design.md §4.2, saves and their restore, a power cut in the middle of a save, determinism.
 
 use emu::board::model::{Controller, ControllerConfig, ModelBus, StepReport};
 use emu::chip::mcu::{Board, Mcu, McuConfig};
@@ -56,7 +56,7 @@ fn steps_come_every_45_ticks_of_10_ms() {
     assert_eq!(c.ticks_per_step(), 45);
 }
 
-/// States of the forward pass of a 13 × 4 network, bounded from SPEC §4.2 alone: each
+/// States of the forward pass of a 13 × 4 network, bounded from docs/design.md §4.2 alone: each
 /// multiply-accumulate is two post-increment loads (6 + 6), EXTS (2), MULXS.W (24) and ADD.L
 /// (2), and each loop iteration at least a decrement (2) and a branch (4); the rest of the
 /// routine (row set-up, the argmax, the scaling of 4 outputs, its call and return) is at most
@@ -64,7 +64,7 @@ fn steps_come_every_45_ticks_of_10_ms() {
 const MAC_13X4_MIN: u64 = 52 * (6 + 6 + 2 + 24 + 2 + 2 + 4);
 const FORWARD_13X4_MAX: u64 = MAC_13X4_MIN + 4 * 200 + 17 * 14 + 4 * 17 * 8;
 
-/// The A/D phase: a scan of four conversions with CKS = 1 (SPEC §3.2: 134 states; the later
+/// The A/D phase: a scan of four conversions with CKS = 1 (docs/design.md §3.2: 134 states; the later
 /// conversions of a scan 128, H8/3052F hardware manual) at least; at most those plus one more
 /// poll of ADF (MOV.B @aa:8 = 2 + 3 states, BGE = 4), the set-up and the start write
 /// (MOV.B @aa:24 = 8, four register ops, 2 + 3), the stop write and a clear (2 + 5 + 2), four
@@ -330,7 +330,7 @@ fn fast_forward_case(corridor: bool, save_every: u32, steps: u32) {
     assert!(fast_edges < slow_edges / 10, "{fast_edges} vs {slow_edges}");
 }
 
-/// The wheels get what SPEC §3.5 asks of each behaviour: measured on the TIOCA1/TIOCA2 pins
+/// The wheels get what docs/design.md §3.5 asks of each behaviour: measured on the TIOCA1/TIOCA2 pins
 /// themselves, sampled every 8 states (one φ/8 count) over several PWM periods after the
 /// step, not read back from the timer's registers; and the H-bridge inputs on port B.
 #[test]

@@ -1,6 +1,6 @@
 //! The firmware's learner (firmware/learner.c, run on the H8/300H core) against `nn_q15`:
 //! bit-exact step for step (weights, y, O, winner), and the H8 meter's states against the
-//! states the core counts (the calibration of SPEC §2.7's cost model, issue 10 item 5).
+//! states the core counts (the calibration of docs/design.md §2.7's cost model, issue 10 item 5).
 
 use emu::board::firmware::Firmware;
 use emu::board::oncore::LearnerOnCore;

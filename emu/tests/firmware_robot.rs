@@ -1,4 +1,4 @@
-//! The robot firmware (firmware/, SPEC §8) running on the emulated H8/3052F: the image, the
+//! The robot firmware (firmware/, docs/design.md §8) running on the emulated H8/3052F: the image, the
 //! configuration block, boot, steps, motors, EEPROM records, restore after a power cut.
 
 use eeprom::persist::RecordLayout;

@@ -1,7 +1,7 @@
 //! Per-instruction-class tests in the style of mooneye-gb's opcode tests: set registers and
 //! memory, run one instruction (or a few), assert the result, the condition codes and the
 //! states. Condition codes follow the H8/300H Series Programming Manual, section 2 (one page
-//! per instruction); states its Appendix A (and SPEC §4.2, see also `timing.rs`).
+//! per instruction); states its Appendix A (and docs/design.md §4.2, see also `timing.rs`).
 
 mod common;
 

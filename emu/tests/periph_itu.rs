@@ -1,4 +1,4 @@
-//! The ITU: PWM period and duty from GRA/GRB (SPEC §3.5), compare-match and counter-clear
+//! The ITU: PWM period and duty from GRA/GRB (docs/design.md §3.5), compare-match and counter-clear
 //! timing, the flag clearing rule, interrupt vectors, and the lazily computed counter against a
 //! state-by-state reference model.
 
@@ -12,7 +12,7 @@ use emu::chip::periph::ports::{PBDDR, PBDR};
 use emu::core::bus::Bus;
 use proptest::prelude::*;
 
-/// TCR: counter cleared by GRA, φ/8 (the controller's setting, SPEC §3.5).
+/// TCR: counter cleared by GRA, φ/8 (the controller's setting, docs/design.md §3.5).
 const TCR_GRA_PHI8: u8 = 0x23;
 
 fn mcu() -> Mcu<NullBoard> {

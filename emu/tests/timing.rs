@@ -1,4 +1,4 @@
-//! States per instruction against SPEC §4.2 and the H8/300H programming manual (Appendix A:
+//! States per instruction against docs/design.md §4.2 and the H8/300H programming manual (Appendix A:
 //! I·S_I + J·S_J + K·S_K + L·S_L + M·S_M + N·S_N with S = 2 for on-chip ROM/RAM, 3 per byte
 //! cycle for on-chip I/O on its 8-bit bus, S_N = 1).
 //!
@@ -10,108 +10,153 @@ use common::exec;
 
 /// (objdump text, bytes, states, where the figure comes from)
 const TABLE: &[(&str, &[u8], u64, &str)] = &[
-    ("mov.b\tr0l,r1l", &[0x0c, 0x89], 2, "SPEC 4.2 MOV Rs,Rd"),
-    ("add.b\tr0l,r1l", &[0x08, 0x89], 2, "SPEC 4.2 register ALU"),
-    ("add.w\tr0,r1", &[0x09, 0x01], 2, "SPEC 4.2 register ALU"),
-    ("add.l\ter0,er1", &[0x0a, 0x81], 2, "SPEC 4.2 register ALU"),
-    ("adds\t#4,er0", &[0x0b, 0x90], 2, "SPEC 4.2 ADDS"),
-    ("subs\t#2,er0", &[0x1b, 0x80], 2, "SPEC 4.2 SUBS"),
-    ("exts.l\ter0", &[0x17, 0xf0], 2, "SPEC 4.2 EXTS"),
-    ("extu.w\tr0", &[0x17, 0x50], 2, "SPEC 4.2 EXTU"),
-    ("shll.b\tr0l", &[0x10, 0x08], 2, "SPEC 4.2 1-bit shift"),
+    (
+        "mov.b\tr0l,r1l",
+        &[0x0c, 0x89],
+        2,
+        "docs/design.md §4.2 MOV Rs,Rd",
+    ),
+    (
+        "add.b\tr0l,r1l",
+        &[0x08, 0x89],
+        2,
+        "docs/design.md §4.2 register ALU",
+    ),
+    (
+        "add.w\tr0,r1",
+        &[0x09, 0x01],
+        2,
+        "docs/design.md §4.2 register ALU",
+    ),
+    (
+        "add.l\ter0,er1",
+        &[0x0a, 0x81],
+        2,
+        "docs/design.md §4.2 register ALU",
+    ),
+    ("adds\t#4,er0", &[0x0b, 0x90], 2, "docs/design.md §4.2 ADDS"),
+    ("subs\t#2,er0", &[0x1b, 0x80], 2, "docs/design.md §4.2 SUBS"),
+    ("exts.l\ter0", &[0x17, 0xf0], 2, "docs/design.md §4.2 EXTS"),
+    ("extu.w\tr0", &[0x17, 0x50], 2, "docs/design.md §4.2 EXTU"),
+    (
+        "shll.b\tr0l",
+        &[0x10, 0x08],
+        2,
+        "docs/design.md §4.2 1-bit shift",
+    ),
     (
         "mov.w\t#0x1234,r0",
         &[0x79, 0x00, 0x12, 0x34],
         4,
-        "SPEC 4.2 MOV.W #16",
+        "docs/design.md §4.2 MOV.W #16",
     ),
     (
         "add.w\t#0x1234,r0",
         &[0x79, 0x10, 0x12, 0x34],
         4,
-        "SPEC 4.2 ALU.W #16",
+        "docs/design.md §4.2 ALU.W #16",
     ),
     (
         "sub.w\t#0x1,r0",
         &[0x79, 0x30, 0x00, 0x01],
         4,
-        "SPEC 4.2 ALU.W #16",
+        "docs/design.md §4.2 ALU.W #16",
     ),
     (
         "mov.l\t#0x12345678,er0",
         &[0x7a, 0x00, 0x12, 0x34, 0x56, 0x78],
         6,
-        "SPEC 4.2 MOV.L #32",
+        "docs/design.md §4.2 MOV.L #32",
     ),
     (
         "add.l\t#0x1,er0",
         &[0x7a, 0x10, 0x00, 0x00, 0x00, 0x01],
         6,
-        "SPEC 4.2 ALU.L #32",
+        "docs/design.md §4.2 ALU.L #32",
     ),
     (
         "cmp.l\t#0x1,er0",
         &[0x7a, 0x20, 0x00, 0x00, 0x00, 0x01],
         6,
-        "SPEC 4.2 ALU.L #32",
+        "docs/design.md §4.2 ALU.L #32",
     ),
-    ("mov.b\t@er1,r0l", &[0x68, 0x18], 4, "SPEC 4.2 MOV.B @ERs"),
-    ("mov.w\t@er1,r0", &[0x69, 0x10], 4, "SPEC 4.2 MOV.W @ERs"),
+    (
+        "mov.b\t@er1,r0l",
+        &[0x68, 0x18],
+        4,
+        "docs/design.md §4.2 MOV.B @ERs",
+    ),
+    (
+        "mov.w\t@er1,r0",
+        &[0x69, 0x10],
+        4,
+        "docs/design.md §4.2 MOV.W @ERs",
+    ),
     (
         "mov.b\t@(0x10:16,er1),r0l",
         &[0x6e, 0x18, 0x00, 0x10],
         6,
-        "SPEC 4.2 @(d:16,ERs)",
+        "docs/design.md §4.2 @(d:16,ERs)",
     ),
     (
         "mov.w\t@0xe800:16,r0",
         &[0x6b, 0x00, 0xe8, 0x00],
         6,
-        "SPEC 4.2 @aa:16",
+        "docs/design.md §4.2 @aa:16",
     ),
-    ("mov.b\t@er1+,r0l", &[0x6c, 0x18], 6, "SPEC 4.2 @ERs+"),
-    ("mov.w\tr0,@-er1", &[0x6d, 0x90], 6, "SPEC 4.2 @-ERd"),
+    (
+        "mov.b\t@er1+,r0l",
+        &[0x6c, 0x18],
+        6,
+        "docs/design.md §4.2 @ERs+",
+    ),
+    (
+        "mov.w\tr0,@-er1",
+        &[0x6d, 0x90],
+        6,
+        "docs/design.md §4.2 @-ERd",
+    ),
     (
         "mov.b\t@0xffe800:32,r0l",
         &[0x6a, 0x28, 0x00, 0xff, 0xe8, 0x00],
         8,
-        "SPEC 4.2 @aa:24",
+        "docs/design.md §4.2 @aa:24",
     ),
     (
         "mov.b\t@(0x10:32,er1),r0l",
         &[0x78, 0x10, 0x6a, 0x28, 0x00, 0x00, 0x00, 0x10],
         10,
-        "SPEC 4.2 @(d:24,ERs)",
+        "docs/design.md §4.2 @(d:24,ERs)",
     ),
     (
         "mov.l\t@er1,er0",
         &[0x01, 0x00, 0x69, 0x10],
         8,
-        "SPEC 4.2 MOV.L @ERs",
+        "docs/design.md §4.2 MOV.L @ERs",
     ),
     (
         "mov.l\t@(0x10:16,er1),er0",
         &[0x01, 0x00, 0x6f, 0x10, 0x00, 0x10],
         10,
-        "SPEC 4.2 MOV.L @(d:16)",
+        "docs/design.md §4.2 MOV.L @(d:16)",
     ),
     (
         "mov.l\t@er7+,er0",
         &[0x01, 0x00, 0x6d, 0x70],
         10,
-        "SPEC 4.2 POP.L",
+        "docs/design.md §4.2 POP.L",
     ),
     (
         "mov.l\ter0,@-er7",
         &[0x01, 0x00, 0x6d, 0xf0],
         10,
-        "SPEC 4.2 PUSH.L",
+        "docs/design.md §4.2 PUSH.L",
     ),
     (
         "mov.l\t@(0x10:32,er1),er0",
         &[0x01, 0x00, 0x78, 0x10, 0x6b, 0x20, 0x00, 0x00, 0x00, 0x10],
         14,
-        "SPEC 4.2 MOV.L @(d:24)",
+        "docs/design.md §4.2 MOV.L @(d:24)",
     ),
     (
         "mov.l\t@0xe800:16,er0",
@@ -125,8 +170,18 @@ const TABLE: &[(&str, &[u8], u64, &str)] = &[
         12,
         "manual: I=4, M=2",
     ),
-    ("mov.w\tr0,@-er7", &[0x6d, 0xf0], 6, "SPEC 4.2 PUSH.W"),
-    ("mov.w\t@er7+,r0", &[0x6d, 0x70], 6, "SPEC 4.2 POP.W"),
+    (
+        "mov.w\tr0,@-er7",
+        &[0x6d, 0xf0],
+        6,
+        "docs/design.md §4.2 PUSH.W",
+    ),
+    (
+        "mov.w\t@er7+,r0",
+        &[0x6d, 0x70],
+        6,
+        "docs/design.md §4.2 POP.W",
+    ),
     (
         "mov.b\t@0x0:8,r0l",
         &[0x28, 0x00],
@@ -146,47 +201,67 @@ const TABLE: &[(&str, &[u8], u64, &str)] = &[
         20,
         "I/O long: 8 + 4 x 3",
     ),
-    ("mulxu.b\tr0l,r1", &[0x50, 0x81], 14, "SPEC 4.2 MULXU.B"),
-    ("mulxu.w\tr0,er1", &[0x52, 0x01], 22, "SPEC 4.2 MULXU.W"),
+    (
+        "mulxu.b\tr0l,r1",
+        &[0x50, 0x81],
+        14,
+        "docs/design.md §4.2 MULXU.B",
+    ),
+    (
+        "mulxu.w\tr0,er1",
+        &[0x52, 0x01],
+        22,
+        "docs/design.md §4.2 MULXU.W",
+    ),
     (
         "mulxs.b\tr0l,r1",
         &[0x01, 0xc0, 0x50, 0x81],
         16,
-        "SPEC 4.2 MULXS.B",
+        "docs/design.md §4.2 MULXS.B",
     ),
     (
         "mulxs.w\tr0,er1",
         &[0x01, 0xc0, 0x52, 0x01],
         24,
-        "SPEC 4.2 MULXS.W",
+        "docs/design.md §4.2 MULXS.W",
     ),
-    ("divxu.b\tr0l,r1", &[0x51, 0x81], 14, "SPEC 4.2 DIVXU.B"),
-    ("divxu.w\tr0,er1", &[0x53, 0x01], 22, "SPEC 4.2 DIVXU.W"),
+    (
+        "divxu.b\tr0l,r1",
+        &[0x51, 0x81],
+        14,
+        "docs/design.md §4.2 DIVXU.B",
+    ),
+    (
+        "divxu.w\tr0,er1",
+        &[0x53, 0x01],
+        22,
+        "docs/design.md §4.2 DIVXU.W",
+    ),
     (
         "divxs.b\tr0l,r1",
         &[0x01, 0xd0, 0x51, 0x81],
         16,
-        "SPEC 4.2 DIVXS.B",
+        "docs/design.md §4.2 DIVXS.B",
     ),
     (
         "divxs.w\tr0,er1",
         &[0x01, 0xd0, 0x53, 0x01],
         24,
-        "SPEC 4.2 DIVXS.W",
+        "docs/design.md §4.2 DIVXS.W",
     ),
     (
         "eepmov.b\t",
         &[0x7b, 0x5c, 0x59, 0x8f],
         8,
-        "SPEC 4.2 EEPMOV 8 + 4n, n = 0",
+        "docs/design.md §4.2 EEPMOV 8 + 4n, n = 0",
     ),
     (
         "eepmov.w\t",
         &[0x7b, 0xd4, 0x59, 0x8f],
         8,
-        "SPEC 4.2 EEPMOV 8 + 4n, n = 0",
+        "docs/design.md §4.2 EEPMOV 8 + 4n, n = 0",
     ),
-    ("sleep\t", &[0x01, 0x80], 2, "SPEC 4.2 SLEEP"),
+    ("sleep\t", &[0x01, 0x80], 2, "docs/design.md §4.2 SLEEP"),
     ("nop\t", &[0x00, 0x00], 2, "manual: I=1"),
     ("trapa\t#0x1", &[0x57, 0x10], 14, "manual TRAPA page: 14"),
     ("jmp\t@er1", &[0x59, 0x10], 4, "manual: I=2"),
@@ -202,16 +277,26 @@ const TABLE: &[(&str, &[u8], u64, &str)] = &[
         10,
         "manual: I=2, J=2, N=2",
     ),
-    ("jsr\t@er1", &[0x5d, 0x10], 8, "SPEC 4.2 JSR @ERn"),
+    (
+        "jsr\t@er1",
+        &[0x5d, 0x10],
+        8,
+        "docs/design.md §4.2 JSR @ERn",
+    ),
     (
         "jsr\t@0x1000:24",
         &[0x5e, 0x00, 0x10, 0x00],
         10,
-        "SPEC 4.2 JSR @aa:24",
+        "docs/design.md §4.2 JSR @aa:24",
     ),
-    ("jsr\t@@16 (0x10)", &[0x5f, 0x10], 12, "SPEC 4.2 JSR @@aa:8"),
-    ("rts\t", &[0x54, 0x70], 10, "SPEC 4.2 RTS"),
-    ("rte\t", &[0x56, 0x70], 10, "SPEC 4.2 RTE"),
+    (
+        "jsr\t@@16 (0x10)",
+        &[0x5f, 0x10],
+        12,
+        "docs/design.md §4.2 JSR @@aa:8",
+    ),
+    ("rts\t", &[0x54, 0x70], 10, "docs/design.md §4.2 RTS"),
+    ("rte\t", &[0x56, 0x70], 10, "docs/design.md §4.2 RTE"),
     (
         "ldc\t@er1,ccr",
         &[0x01, 0x40, 0x69, 0x10],
@@ -320,7 +405,7 @@ fn states_match_spec_4_2_and_the_manual() {
 
 #[test]
 fn branches_take_the_same_states_taken_or_not() {
-    // beq .+2 (d:8): 4 states; beq d:16: 6 states (SPEC 4.2), whatever Z is.
+    // beq .+2 (d:8): 4 states; beq d:16: 6 states (docs/design.md §4.2), whatever Z is.
     for z in [false, true] {
         let ccr = if z { emu::core::cpu::CCR_Z } else { 0 };
         let s = exec("beq\t.+2 (0x1004)", &[0x47, 0x02], |c, _| c.set_ccr(ccr));
@@ -332,7 +417,7 @@ fn branches_take_the_same_states_taken_or_not() {
         assert_eq!(s.states, 6);
         assert_eq!(s.cpu.pc(), if z { 0x1014 } else { 0x1004 });
     }
-    // BSR d:8 / d:16: 8 / 10 states (SPEC 4.2).
+    // BSR d:8 / d:16: 8 / 10 states (docs/design.md §4.2).
     let s = exec("bsr\t.-4 (0xffe)", &[0x55, 0xfc], |_, _| {});
     assert_eq!((s.states, s.cpu.pc()), (8, 0xffe));
     let s = exec("bsr\t.+256 (0x1104)", &[0x5c, 0x00, 0x01, 0x00], |_, _| {});

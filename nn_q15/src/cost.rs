@@ -1,4 +1,4 @@
-//! H8/300H cost accounting (SPEC §2.7), re-derived from the robot firmware's compiled code.
+//! H8/300H cost accounting (docs/design.md §2.7), re-derived from the robot firmware's compiled code.
 //!
 //! The learner reports what it executes to a [`Meter`] as basic blocks ([`Op`]) of the
 //! firmware's learner routines (`firmware/learner.c`, compiled by `firmware/build.sh` with
@@ -9,7 +9,7 @@
 //! # Where the numbers come from
 //! [`OP_TABLE`] holds, for every block, its instructions as the firmware's listing
 //! (`firmware/build.sh --listing DIR`, `robot.lst`) shows them, and their forms ([`Insn`]), each
-//! with its states for on-chip operands from SPEC §4.2 and the H8/300H manuals' Table A-1
+//! with its states for on-chip operands from docs/design.md §4.2 and the H8/300H manuals' Table A-1
 //! (2 states per fetch or data access to on-chip ROM and RAM; internal states as listed).
 //! Conditional branches cost the same taken or not, so a path's cost is the sum of the blocks
 //! it runs; the learner counts the data-dependent paths (a new maximum, saturations, the
@@ -19,49 +19,49 @@
 //! routines on the H8/300H core over a grid of shapes and inputs and compares every phase with
 //! this meter, so a change of either side shows at once.
 
-/// One H8/300H instruction form with on-chip operands (SPEC §4.2).
+/// One H8/300H instruction form with on-chip operands (docs/design.md §4.2).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Insn {
     /// Register-to-register ALU op (ADD/SUB/CMP/AND/OR/XOR/NEG/NOT/INC/DEC/EXTS/EXTU/MOV Rs,Rd),
     /// ADDS/SUBS, a 1-bit shift, or a byte op with an 8-bit immediate (one instruction word).
-    /// SPEC §4.2: 2 states.
+    /// docs/design.md §4.2: 2 states.
     Reg,
-    /// MOV.W #xx:16 or ALU.W #xx:16 (two words). SPEC §4.2: 4 states.
+    /// MOV.W #xx:16 or ALU.W #xx:16 (two words). docs/design.md §4.2: 4 states.
     ImmW,
-    /// MOV.L #xx:32 or ALU.L #xx:32 (three words). SPEC §4.2: 6 states.
+    /// MOV.L #xx:32 or ALU.L #xx:32 (three words). docs/design.md §4.2: 6 states.
     ImmL,
-    /// MOV.B/MOV.W to or from @ERs. SPEC §4.2: 4 states.
+    /// MOV.B/MOV.W to or from @ERs. docs/design.md §4.2: 4 states.
     MovBwInd,
-    /// MOV.B/MOV.W with @ERs+ or @−ERd. SPEC §4.2: 6 states.
+    /// MOV.B/MOV.W with @ERs+ or @−ERd. docs/design.md §4.2: 6 states.
     MovBwPostInc,
-    /// MOV.B/MOV.W with @aa:16 or @(d:16,ERs). SPEC §4.2: 6 states.
+    /// MOV.B/MOV.W with @aa:16 or @(d:16,ERs). docs/design.md §4.2: 6 states.
     MovBwAbs16,
-    /// MOV.B/MOV.W with @aa:24 (three words, one data access). SPEC §4.2: 8 states.
+    /// MOV.B/MOV.W with @aa:24 (three words, one data access). docs/design.md §4.2: 8 states.
     MovBwAbs24,
-    /// MOV.B/MOV.W with @(d:24,ERs) (four words, one data access). SPEC §4.2: 10 states.
+    /// MOV.B/MOV.W with @(d:24,ERs) (four words, one data access). docs/design.md §4.2: 10 states.
     MovBwDisp24,
-    /// MOV.L to or from @ERs. SPEC §4.2: 8 states.
+    /// MOV.L to or from @ERs. docs/design.md §4.2: 8 states.
     MovLInd,
-    /// MOV.L with @ERs+ or @−ERd. SPEC §4.2: 10 states.
+    /// MOV.L with @ERs+ or @−ERd. docs/design.md §4.2: 10 states.
     MovLPostInc,
-    /// MOV.L with @aa:16 or @(d:16,ERs). SPEC §4.2: 10 states.
+    /// MOV.L with @aa:16 or @(d:16,ERs). docs/design.md §4.2: 10 states.
     MovLAbs16,
     /// MOV.L with @aa:24 (four words, two data accesses): 4 · 2 + 2 · 2 = 12 states
     /// (manual Table A-1).
     MovLAbs24,
-    /// PUSH.L / POP.L (MOV.L with @−ER7 / @ER7+). SPEC §4.2: 10 states.
+    /// PUSH.L / POP.L (MOV.L with @−ER7 / @ER7+). docs/design.md §4.2: 10 states.
     PushPopL,
-    /// Bcc d:8 (BRA included), taken or not. SPEC §4.2: 4 states.
+    /// Bcc d:8 (BRA included), taken or not. docs/design.md §4.2: 4 states.
     Bcc8,
-    /// Bcc d:16 (BRA included), taken or not. SPEC §4.2: 6 states.
+    /// Bcc d:16 (BRA included), taken or not. docs/design.md §4.2: 6 states.
     Bcc16,
-    /// JSR @aa:24. SPEC §4.2: 10 states.
+    /// JSR @aa:24. docs/design.md §4.2: 10 states.
     JsrAbs24,
-    /// RTS. SPEC §4.2: 10 states.
+    /// RTS. docs/design.md §4.2: 10 states.
     Rts,
-    /// MULXS.W Rs,ERd (16 × 16 → 32 signed). SPEC §4.2: 24 states.
+    /// MULXS.W Rs,ERd (16 × 16 → 32 signed). docs/design.md §4.2: 24 states.
     MulxsW,
-    /// DIVXS.W Rs,ERd (32 / 16 → 16 quotient, 16 remainder, signed). SPEC §4.2: 24 states.
+    /// DIVXS.W Rs,ERd (32 / 16 → 16 quotient, 16 remainder, signed). docs/design.md §4.2: 24 states.
     DivxsW,
 }
 
@@ -89,7 +89,7 @@ impl Insn {
         Insn::DivxsW,
     ];
 
-    /// States of the instruction with on-chip operands (SPEC §4.2).
+    /// States of the instruction with on-chip operands (docs/design.md §4.2).
     #[must_use]
     pub const fn states(self) -> u32 {
         match self {
@@ -388,7 +388,7 @@ impl Op {
 pub struct OpSpec {
     /// The block.
     pub op: Op,
-    /// Its instruction forms (states and lengths from SPEC §4.2).
+    /// Its instruction forms (states and lengths from docs/design.md §4.2).
     pub insns: &'static [Insn],
     /// Its instructions (objdump's syntax; `@name:24` for a variable's absolute address).
     pub asm: &'static str,
@@ -780,15 +780,15 @@ const fn op_states_table() -> [u32; Op::COUNT] {
 /// States of every [`Op`], indexed by `op as usize`, computed from [`OP_TABLE`].
 pub const OP_STATES: [u32; Op::COUNT] = op_states_table();
 
-/// The phases of a learner step, in the order the firmware runs them (SPEC §3.5).
+/// The phases of a learner step, in the order the firmware runs them (docs/design.md §3.5).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(u8)]
 pub enum Phase {
     /// D(t), E(t−1) and the input vector for step t.
     Input,
-    /// The update with E(t−1) on x(t−1) (SPEC §2.4).
+    /// The update with E(t−1) on x(t−1) (docs/design.md §2.4).
     Update,
-    /// The forward pass on x(t) (SPEC §2.3).
+    /// The forward pass on x(t) (docs/design.md §2.3).
     Forward,
 }
 
@@ -926,8 +926,8 @@ mod tests {
 
     #[test]
     fn the_mac_is_two_loads_exts_mulxs_add_and_the_loop() {
-        // SPEC §2.7: "one multiply-accumulate: two post-increment loads, EXTS, MULXS.W, ADD.L";
-        // SPEC §4.2: @ERs+ 6, EXTS 2, MULXS.W 24, ADD.L 2; the loop's DEC.W 2 and BNE 4.
+        // docs/design.md §2.7: "one multiply-accumulate: two post-increment loads, EXTS, MULXS.W, ADD.L";
+        // docs/design.md §4.2: @ERs+ 6, EXTS 2, MULXS.W 24, ADD.L 2; the loop's DEC.W 2 and BNE 4.
         assert_eq!(Op::FwdMac.states(), 6 + 6 + 2 + 24 + 2 + 2 + 4);
         assert_eq!(Op::FwdNormDiv.states(), 62);
         // A dead-zone update: entry 52, the second bound test 8, exit 44.

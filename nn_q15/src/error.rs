@@ -7,7 +7,7 @@ use core::fmt;
 /// A network shape or a slice that does not fit it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ShapeError {
-    /// N outside 1 ..= 256 (the no-overflow bound of SPEC §2.1).
+    /// N outside 1 ..= 256 (the no-overflow bound of docs/design.md §2.1).
     Inputs {
         /// The number of inputs asked for.
         got: usize,
@@ -18,7 +18,7 @@ pub enum ShapeError {
         got: usize,
     },
     /// A learner that drives the robot with M outside 2 ..= 4: one output per behaviour, and
-    /// the robot has four (SPEC §2.2).
+    /// the robot has four (docs/design.md §2.2).
     Behaviours {
         /// The number of outputs asked for.
         got: usize,
@@ -114,7 +114,7 @@ impl core::error::Error for ParamError {}
 /// A learner configuration that does not fit together.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ConfigError {
-    /// History depth outside 0 ..= 8 (SPEC §2.2).
+    /// History depth outside 0 ..= 8 (docs/design.md §2.2).
     History {
         /// The depth asked for.
         got: usize,

@@ -1,4 +1,4 @@
-//! The number formats of SPEC §2.1 and the integer helpers every other module shares.
+//! The number formats of docs/design.md §2.1 and the integer helpers every other module shares.
 //!
 //! All formats are two's complement, as the H8/300H computes them:
 //!
@@ -44,7 +44,7 @@ pub const fn sat8(v: i16) -> i8 {
     }
 }
 
-/// `round_half_away_from_zero(v / 2^7)`: the Q15 × Q7 → Q15 rescaling of the update (SPEC §2.4),
+/// `round_half_away_from_zero(v / 2^7)`: the Q15 × Q7 → Q15 rescaling of the update (docs/design.md §2.4),
 /// for |v| ≤ 2^30 (the update's products are at most 32767 · 128 < 2^22).
 ///
 /// Odd-symmetric (`round7(−v) = −round7(v)`), which lets the firmware fold the sign of E into η
@@ -59,21 +59,21 @@ pub const fn round_half_away_shr7(v: i32) -> i32 {
 }
 
 /// A proximity reading in distance units (0 = touching … 255 = 80 cm or more) as a Q7 input:
-/// `p − 128` (SPEC §2.2).
+/// `p − 128` (docs/design.md §2.2).
 #[inline(always)]
 #[must_use]
 pub const fn proximity_to_q7(p: u8) -> i8 {
     (p as i16 - 128) as i8
 }
 
-/// A Q15 output fed back as a Q7 input: `O >> 8`, an arithmetic shift (SPEC §2.2).
+/// A Q15 output fed back as a Q7 input: `O >> 8`, an arithmetic shift (docs/design.md §2.2).
 #[inline(always)]
 #[must_use]
 pub const fn output_to_q7(o: i16) -> i8 {
     (o >> 8) as i8
 }
 
-/// The previous evaluation as a Q7 input: `sat_i8(E >> 3)`, an arithmetic shift (SPEC §2.2).
+/// The previous evaluation as a Q7 input: `sat_i8(E >> 3)`, an arithmetic shift (docs/design.md §2.2).
 #[inline(always)]
 #[must_use]
 pub const fn evaluation_to_q7(e: i16) -> i8 {

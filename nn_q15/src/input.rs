@@ -1,4 +1,4 @@
-//! The input vector of SPEC §2.2.
+//! The input vector of docs/design.md §2.2.
 //!
 //! In this order: the K = 4 current proximities `p_k(t) − 128` as Q7; the same 4 from each of
 //! the H previous steps (H = 1 by default, 0 … 8), newest first; the previous step's outputs
@@ -12,9 +12,9 @@
 
 use crate::error::ConfigError;
 
-/// Number of proximity sensors K (front, rear, left, right: SPEC §1).
+/// Number of proximity sensors K (front, rear, left, right: docs/design.md §1).
 pub const SENSORS: usize = 4;
-/// Deepest history the layout allows (SPEC §2.2: 0 … 8).
+/// Deepest history the layout allows (docs/design.md §2.2: 0 … 8).
 pub const MAX_HISTORY: usize = 8;
 
 /// How the input vector is made up: history depth and bias.

@@ -1,11 +1,11 @@
-//! The learner as the robot runs it: one call per step (SPEC §3.5), and its RAM footprint on the
+//! The learner as the robot runs it: one call per step (docs/design.md §3.5), and its RAM footprint on the
 //! H8/3052F.
 //!
 //! A step at time t, given the proximities p(t):
 //! 1. `D(t) = Σ_k p_k(t)` and, from the second step on, `E(t−1) = D(t) − D(t−1)`;
-//! 2. the update of SPEC §2.4 with E(t−1) on x(t−1) and its winner;
-//! 3. the input vector x(t) of SPEC §2.2;
-//! 4. the forward pass of SPEC §2.3 on x(t), whose winner picks the behaviour.
+//! 2. the update of docs/design.md §2.4 with E(t−1) on x(t−1) and its winner;
+//! 3. the input vector x(t) of docs/design.md §2.2;
+//! 4. the forward pass of docs/design.md §2.3 on x(t), whose winner picks the behaviour.
 
 use crate::cost::{Meter, Op, Phase};
 use crate::error::{ConfigError, ShapeError};
@@ -15,7 +15,7 @@ use crate::net::{
     ForwardOut, MAX_INPUTS, Network, Params, Shape, UpdateKind, forward_core, update_core,
 };
 
-/// The four primitive behaviours (SPEC §2.3 step 4).
+/// The four primitive behaviours (docs/design.md §2.3 step 4).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Behaviour {
     /// Both wheels forward at v.
@@ -147,7 +147,7 @@ struct StepData<'a> {
     delta: &'a mut [i16],
 }
 
-/// One step (SPEC §3.5) on borrowed storage: shared by [`Learner`] and [`DynLearner`].
+/// One step (docs/design.md §3.5) on borrowed storage: shared by [`Learner`] and [`DynLearner`].
 #[inline]
 fn step_core<Mt: Meter>(
     data: StepData<'_>,
@@ -386,7 +386,7 @@ impl<const N: usize, const M: usize> Learner<N, M> {
     }
 }
 
-/// Most behaviours a robot's learner drives: the four primitive behaviours (SPEC §2.2). The
+/// Most behaviours a robot's learner drives: the four primitive behaviours (docs/design.md §2.2). The
 /// learner core takes up to [`crate::MAX_OUTPUTS`] outputs; [`Learner`] and [`DynLearner`] map each
 /// output to a behaviour, so they take at most four.
 pub const MAX_BEHAVIOURS: usize = 4;

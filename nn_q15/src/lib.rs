@@ -1,8 +1,8 @@
 //! # nn_q15 — the Hartono–Kakita embedded learner in fixed point
 //!
 //! The two-layer, continuously learning network of Hartono & Kakita (ICANN 2008), written as the
-//! H8/3052F would run it: Q7 inputs, Q15 weights and outputs, exact i32 sums (SPEC §2.1), the
-//! forward pass of SPEC §2.3 and the reward/punish update of SPEC §2.4, bit-exact to their integer
+//! H8/3052F would run it: Q7 inputs, Q15 weights and outputs, exact i32 sums (docs/design.md §2.1), the
+//! forward pass of docs/design.md §2.3 and the reward/punish update of docs/design.md §2.4, bit-exact to their integer
 //! definitions. `#![no_std]`, no allocation, dependencies `fixed` and `heapless` only: it could be
 //! linked into real firmware.
 //!

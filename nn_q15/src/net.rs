@@ -1,24 +1,24 @@
-//! The two-layer network: the forward pass of SPEC §2.3 and the update of SPEC §2.4, bit-exact to
+//! The two-layer network: the forward pass of docs/design.md §2.3 and the update of docs/design.md §2.4, bit-exact to
 //! the integer definitions there, charged to a [`Meter`] as the H8 routine would spend it.
 //!
 //! Weights are stored row-major, one row of N inputs per output neuron (the layout of the replay
-//! format, SPEC §2.6, and the order the H8 routine walks them with post-increment loads).
+//! format, docs/design.md §2.6, and the order the H8 routine walks them with post-increment loads).
 
 use crate::cost::{Meter, Op, Phase};
 use crate::error::{ParamError, ShapeError};
 use crate::format::{Q7, Q15, Q22, round_half_away_shr7, sat16};
 
 /// Most inputs a network may have: with |w·x| ≤ 2^15 · 2^7 = 2^22 per product, 256 products sum
-/// to at most 2^30, inside an `i32` (SPEC §2.1: "no overflow for N ≤ 256").
+/// to at most 2^30, inside an `i32` (docs/design.md §2.1: "no overflow for N ≤ 256").
 pub const MAX_INPUTS: usize = 256;
-/// Fewest outputs (the corridor's forward and backward, SPEC §2.2).
+/// Fewest outputs (the corridor's forward and backward, docs/design.md §2.2).
 pub const MIN_OUTPUTS: usize = 2;
 /// Most outputs of the learner core (forward pass, update, replay): 8. A robot enables 2 or 4
 /// behaviours ([`crate::MAX_BEHAVIOURS`]); wider shapes are for what-if studies and for the
 /// calibration of the cost model against the firmware, whose routines take up to 8.
 pub const MAX_OUTPUTS: usize = 8;
 /// 1.0 in Q22: a weighted sum at or above it switches the forward pass to Eq. 2's division by
-/// the largest sum (SPEC §2.3 step 3).
+/// the largest sum (docs/design.md §2.3 step 3).
 pub const ONE_Q22: i32 = 1 << 22;
 
 /// A validated network shape: 1 ≤ N ≤ [`MAX_INPUTS`] inputs, [`MIN_OUTPUTS`] ≤ M ≤
@@ -358,7 +358,7 @@ fn charge_update<Mt: Meter>(meter: &mut Mt, t: &UpdateTally) {
     meter.charge(Op::UpdExit, 1);
 }
 
-/// The update of SPEC §2.4 on raw slices, with `delta` as the scratch for σ·Δ_i.
+/// The update of docs/design.md §2.4 on raw slices, with `delta` as the scratch for σ·Δ_i.
 /// The caller guarantees `w.len() == x.len() * n_out` with `1 ≤ x.len() ≤ 256`,
 /// `delta.len() >= x.len()` and `win < n_out`.
 #[inline(always)]
@@ -413,7 +413,7 @@ pub(crate) fn update_core<Mt: Meter>(
 
     let (mut clamp_hi, mut clamp_lo) = (0u32, 0u32);
     for (j, row) in w.chunks_exact_mut(n_in).enumerate() {
-        // |Δ| ≤ 32767, so w ± Δ saturated in i16 is exactly sat16(w ± Δ) of SPEC §2.4: the
+        // |Δ| ≤ 32767, so w ± Δ saturated in i16 is exactly sat16(w ± Δ) of docs/design.md §2.4: the
         // winner's row adds, the others subtract, each a loop of saturating i16 arithmetic.
         let (hi, lo) = if j == win {
             apply_row::<Mt>(row, delta, true)
@@ -480,7 +480,7 @@ fn apply_row<Mt: Meter>(row: &mut [Q15], delta: &[i16], up: bool) -> (u32, u32) 
     (hi, lo)
 }
 
-/// The forward pass on a runtime-shaped network (used by the replay, SPEC §2.6): `w` holds
+/// The forward pass on a runtime-shaped network (used by the replay, docs/design.md §2.6): `w` holds
 /// `shape.n_out()` rows of `shape.n_in()` weights.
 ///
 /// # Errors
@@ -496,7 +496,7 @@ pub fn forward_slice<Mt: Meter>(
     Ok(forward_core(w, x, shape.n_out(), meter))
 }
 
-/// The update on a runtime-shaped network (used by the replay, SPEC §2.6).
+/// The update on a runtime-shaped network (used by the replay, docs/design.md §2.6).
 ///
 /// # Errors
 /// [`ShapeError::Length`] when a slice does not match the shape, [`ShapeError::Winner`] when
@@ -589,13 +589,13 @@ impl<const N: usize, const M: usize> Network<N, M> {
         self.w.as_flattened_mut()
     }
 
-    /// The forward pass of SPEC §2.3 on `x`.
+    /// The forward pass of docs/design.md §2.3 on `x`.
     #[inline]
     pub fn forward<Mt: Meter>(&self, x: &[Q7; N], meter: &mut Mt) -> ForwardOut {
         forward_core(self.w.as_flattened(), x, M, meter)
     }
 
-    /// The update of SPEC §2.4: evaluation `e` for input `x`, whose winner was `win`.
+    /// The update of docs/design.md §2.4: evaluation `e` for input `x`, whose winner was `win`.
     ///
     /// # Errors
     /// [`ShapeError::Winner`] when `win ≥ M`.

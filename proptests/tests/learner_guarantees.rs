@@ -1,4 +1,4 @@
-//! The guarantees of SPEC §2.5 (Eq. 9/10 in fixed point), one named property each, with
+//! The guarantees of docs/design.md §2.5 (Eq. 9/10 in fixed point), one named property each, with
 //! strategies that reach the edges: saturated weights, x = −128 and 127, η = 0 and 32767,
 //! E = ±T and ±(T+1), N up to 256. Every property runs 10 000 cases.
 //!
@@ -16,7 +16,7 @@ use proptest::test_runner::Config;
 const CASES: u32 = 10_000;
 
 // ---------------------------------------------------------------------------------------------
-// The independent reference (i64 throughout, written from SPEC §2.3 without the crate's code).
+// The independent reference (i64 throughout, written from docs/design.md §2.3 without the crate's code).
 
 /// y_j = Σ_i w_ij · x_i in i64; `w` is row-major, one row of `n` per output.
 fn ref_sums(w: &[i16], x: &[i8], n: usize) -> Vec<i64> {
@@ -41,7 +41,7 @@ fn ref_argmax(y: &[i64]) -> usize {
     best
 }
 
-/// O_j per SPEC §2.3 step 3, in i64.
+/// O_j per docs/design.md §2.3 step 3, in i64.
 fn ref_outputs(y: &[i64]) -> Vec<i64> {
     let m = *y.iter().max().unwrap();
     if m < 1 << 22 {
@@ -357,7 +357,7 @@ proptest! {
         }
     }
 
-    /// Every weight moves by exactly ±Δ_i, saturated: the update of SPEC §2.4 bit for bit,
+    /// Every weight moves by exactly ±Δ_i, saturated: the update of docs/design.md §2.4 bit for bit,
     /// against Δ computed here in floating point from its definition.
     #[test]
     fn update_matches_the_definition(
@@ -435,7 +435,7 @@ proptest! {
 
     /// Against the exact ratio 2^15·y/m (before the shift that fits m into 16 bits), O is off by
     /// less than 5 LSB: the shift drops up to one unit of m' ≥ 2^14 from y and from m (each
-    /// worth < 2 LSB) and the division truncates (< 1 LSB). SPEC §2.5 asks for 1 LSB of "the
+    /// worth < 2 LSB) and the division truncates (< 1 LSB). docs/design.md §2.5 asks for 1 LSB of "the
     /// real quotient"; against the exact ratio the spec's own algorithm cannot give that (the
     /// worst case seen is about 3.8 LSB), so this test pins the bound the algorithm does give.
     #[test]

@@ -1,6 +1,6 @@
 //! # seeding — one way to derive every random stream's seed
 //!
-//! Every random draw in h8swarm comes from a seeded generator of its own (ARCHITECTURE: split
+//! Every random draw in h8swarm comes from a seeded generator of its own (docs/design.md §9: split
 //! per robot and per purpose, never a global RNG). This crate is the one rule that names those
 //! streams: the seed of a stream is [`derive()`]`(parent, index, purpose)`, where
 //! - `parent` is the seed of what the stream belongs to (the run's master seed at the top);
@@ -29,11 +29,11 @@
 //!       └─ cost inputs   derive(robot, 0, CostInputs)      (the learner's cost summary)
 //! ```
 //!
-//! Adding a robot, a repeat or a thread therefore changes nobody else's streams (SPEC §5), and
+//! Adding a robot, a repeat or a thread therefore changes nobody else's streams (docs/design.md §5), and
 //! the fit report's robot for `--seed s` is robot 0 of repeat 0 of a run with master seed `s`.
 //!
 //! # Why a crate of its own
-//! `sensors`, `eeprom` and `world` know nothing of each other (ARCHITECTURE), yet each splits the
+//! `sensors`, `eeprom` and `world` know nothing of each other (docs/design.md §9), yet each splits the
 //! seed it is given into several streams of its own (a sensor's spread, timing and noise; a
 //! chip's write-cycle, power-cut and wear streams; the world's placement and per-robot motor
 //! gains). Plain `u64` seeds derived at the root alone would leave those splits to each crate's

@@ -6,7 +6,7 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use sensors::{DU_TABLE, IrParams, IrSensor, adc10_code, code8_from_adc10};
 
 const READS: u64 = 1_000_000;
-/// One A/D conversion with CKS = 0 at φ = 25 MHz (SPEC §3.2): reads 266 states apart, so a
+/// One A/D conversion with CKS = 0 at φ = 25 MHz (docs/design.md §3.2): reads 266 states apart, so a
 /// million reads cover 10.6 s of emulated time and ~280 sample-and-hold refreshes.
 const READ_SPACING_STATES: u64 = 266;
 

@@ -5,7 +5,7 @@
 
 fn main() {
     let mut s = String::new();
-    s.push_str("/*\n * du_table.c - the distance-unit table (SPEC 3.3): du_table[c] is the proximity in du\n");
+    s.push_str("/*\n * du_table.c - the distance-unit table (docs/design.md §3.3): du_table[c] is the proximity in du\n");
     s.push_str(
         " * (1 du = 80/255 cm, 255 = 80 cm or more) for the 8-bit A/D code c = ADC10 >> 2.\n",
     );

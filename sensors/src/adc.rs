@@ -1,4 +1,4 @@
-//! The H8/3052 A/D converter's transfer function and the firmware's 8-bit code (SPEC §3.2).
+//! The H8/3052 A/D converter's transfer function and the firmware's 8-bit code (docs/design.md §3.2).
 //!
 //! The converter is modelled as the *ideal* 10-bit converter of the H8 hardware manuals'
 //! "A/D conversion accuracy definitions" figure: the code steps from `k − 1` to `k` exactly at
@@ -14,24 +14,24 @@
 //! for the float just below a transition, where a plain `floor(V / Vref * 1024)` can round up
 //! (the division can round onto the next integer).
 //!
-//! The result sits left-justified in the 16-bit data register (ADDRA–ADDRD, SPEC §3.2):
+//! The result sits left-justified in the 16-bit data register (ADDRA–ADDRD, docs/design.md §3.2):
 //! `ADDRn = code10 << 6`. The firmware reads only the upper byte, `c = code10 >> 2`, one step
 //! of `Vref / 256` = 19.53 mV.
 
-/// A/D reference voltage AVref = 5.0 V (SPEC §3.2; the AKI-H8/3052F board ties AVref to Vcc).
+/// A/D reference voltage AVref = 5.0 V (docs/design.md §3.2; the AKI-H8/3052F board ties AVref to Vcc).
 pub const ADC_VREF_VOLTS: f64 = 5.0;
-/// Resolution of the H8/3052 A/D converter: 10 bits (SPEC §3.2; H8/3052F manual, A/D section).
+/// Resolution of the H8/3052 A/D converter: 10 bits (docs/design.md §3.2; H8/3052F manual, A/D section).
 pub const ADC_BITS: u32 = 10;
 /// Number of 10-bit codes, 1024.
 pub const ADC10_CODES: u16 = 1 << ADC_BITS;
 /// Largest 10-bit code, 1023.
 pub const ADC10_MAX: u16 = ADC10_CODES - 1;
 /// Left shift of the 10-bit result in ADDRn: results are left-justified in the 16-bit
-/// register (SPEC §3.2), so bits 15–6 hold the code and bits 5–0 read 0.
+/// register (docs/design.md §3.2), so bits 15–6 hold the code and bits 5–0 read 0.
 pub const ADDR_LEFT_SHIFT: u32 = 16 - ADC_BITS;
 /// One 10-bit step, Vref / 1024 = 4.883 mV.
 pub const ADC10_LSB_VOLTS: f64 = ADC_VREF_VOLTS / ADC10_CODES as f64;
-/// One step of the firmware's 8-bit code, Vref / 256 = 19.53 mV (SPEC §3.2).
+/// One step of the firmware's 8-bit code, Vref / 256 = 19.53 mV (docs/design.md §3.2).
 pub const CODE8_LSB_VOLTS: f64 = ADC_VREF_VOLTS / 256.0;
 
 /// The transition voltage into 10-bit code `k`: `k · Vref / 1024` (exact in `f64`).

@@ -1,4 +1,4 @@
-//! The four micro-switch bumpers on port 2 (SPEC §3.4) and the firmware's collision counter.
+//! The four micro-switch bumpers on port 2 (docs/design.md §3.4) and the firmware's collision counter.
 //!
 //! Each switch pulls its pin to ground when pressed; the H8/3052's port-2 MOS pull-ups
 //! (P2PCR) hold it high when released: **active low**. Bit assignment (a choice of this crate;
@@ -12,7 +12,7 @@
 //! | P2.3 | right |
 //! | P2.4–P2.7 | not connected: read 1 through their pull-ups |
 //!
-//! A collision is a released→pressed transition of any bumper (SPEC §3.4). The firmware keeps
+//! A collision is a released→pressed transition of any bumper (docs/design.md §3.4). The firmware keeps
 //! the previous sample and counts one collision per sample in which at least one bumper went
 //! from released to pressed (two bumpers hit in the same sample — a corner — are one collision;
 //! a second bumper pressed in a later sample while the first is still held is another). No

@@ -1,34 +1,34 @@
-//! The nominal output curve of a Sharp GP2Y0A21YK / GP2D12-class IR distance sensor (SPEC §3.1).
+//! The nominal output curve of a Sharp GP2Y0A21YK / GP2D12-class IR distance sensor (docs/design.md §3.1).
 //!
-//! Far branch (d ≥ 8 cm, d in cm): `V(d) = 28.48 / (d + 3.0) + 0.059` V, the SPEC's fit to the
+//! Far branch (d ≥ 8 cm, d in cm): `V(d) = 28.48 / (d + 3.0) + 0.059` V, the design's fit to the
 //! datasheet curve. It is the authority for d ≥ 8 cm, so the modelled peak is
-//! `V(8 cm) = 2.648 V` (SPEC's "≈ 3.2 V at 8 cm" is the formula's value at 6 cm; see the crate
+//! `V(8 cm) = 2.648 V` (the design's "≈ 3.2 V at 8 cm" is the formula's value at 6 cm; see the crate
 //! docs). Beyond 80 cm the same 1/d fall continues (0.402 V at 80 cm, 0.087 V at 10 m).
 //!
 //! Fold-back branch (d < 8 cm): a straight line from [`FOLDBACK_CONTACT_VOLTS`] at contact up
 //! to `V(8 cm)`, continuous with the far branch. Every voltage of the fold-back branch below
 //! `V(8 cm)` is also produced by exactly one far distance: the ambiguity the firmware cannot
-//! resolve (SPEC §3.3).
+//! resolve (docs/design.md §3.3).
 
 use crate::error::SensorError;
 
-/// Numerator of the far-branch fit, 28.48 V·cm (SPEC §3.1, fit to the GP2Y0A21YK datasheet curve).
+/// Numerator of the far-branch fit, 28.48 V·cm (docs/design.md §3.1, fit to the GP2Y0A21YK datasheet curve).
 pub const CURVE_K_VOLT_CM: f64 = 28.48;
-/// Distance offset of the far-branch fit, 3.0 cm (SPEC §3.1).
+/// Distance offset of the far-branch fit, 3.0 cm (docs/design.md §3.1).
 pub const CURVE_D0_CM: f64 = 3.0;
-/// Asymptotic voltage of the far-branch fit, 0.059 V (SPEC §3.1).
+/// Asymptotic voltage of the far-branch fit, 0.059 V (docs/design.md §3.1).
 pub const CURVE_V_INF_VOLTS: f64 = 0.059;
-/// Start of the far branch (the curve's peak), 8 cm = 80 mm (SPEC §3.1).
+/// Start of the far branch (the curve's peak), 8 cm = 80 mm (docs/design.md §3.1).
 pub const FAR_BRANCH_MIN_MM: f64 = 80.0;
-/// Output at contact on the fold-back branch, 0.75 V: the middle of SPEC §3.1's "≈ 0.5–1 V at
+/// Output at contact on the fold-back branch, 0.75 V: the middle of docs/design.md §3.1's "≈ 0.5–1 V at
 /// contact" (an assumption; the datasheet does not specify the curve below 10 cm).
 pub const FOLDBACK_CONTACT_VOLTS: f64 = 0.75;
-/// Near end of the datasheet's valid range, 10 cm = 100 mm (SPEC §3.1; GP2Y0A21YK datasheet).
+/// Near end of the datasheet's valid range, 10 cm = 100 mm (docs/design.md §3.1; GP2Y0A21YK datasheet).
 pub const VALID_RANGE_MIN_MM: f64 = 100.0;
-/// Far end of the datasheet's valid range, 80 cm = 800 mm (SPEC §3.1; GP2Y0A21YK datasheet).
+/// Far end of the datasheet's valid range, 80 cm = 800 mm (docs/design.md §3.1; GP2Y0A21YK datasheet).
 pub const VALID_RANGE_MAX_MM: f64 = 800.0;
 /// The distance that "nothing hit" (`None`) reads as, 10 m: far beyond any arena (1.8 m
-/// square, 3 m corridor, SPEC §5), where the curve is within 3 mV of its asymptote. Distances
+/// square, 3 m corridor, docs/design.md §5), where the curve is within 3 mV of its asymptote. Distances
 /// beyond it read as it, too (a choice of this crate).
 pub const NOTHING_HIT_MM: f64 = 10_000.0;
 
@@ -99,7 +99,7 @@ mod tests {
     fn key_points_of_the_curve() {
         assert!((v(80.0) - 2.6481).abs() < 1e-4, "peak {}", v(80.0));
         assert_eq!(v(80.0), PEAK_VOLTS);
-        // SPEC's "3.2 V" is the formula's value at 6 cm.
+        // the design's "3.2 V" is the formula's value at 6 cm.
         assert!((far_branch_volts_at_cm(6.0) - 3.2234).abs() < 1e-4);
         assert!((v(100.0) - 2.2498).abs() < 1e-4);
         assert!((v(800.0) - 0.4021).abs() < 1e-4);

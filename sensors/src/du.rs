@@ -1,4 +1,4 @@
-//! The firmware's linearisation table: 8-bit A/D code → distance units (SPEC §3.3).
+//! The firmware's linearisation table: 8-bit A/D code → distance units (docs/design.md §3.3).
 //!
 //! `1 du = 80/255 cm ≈ 3.14 mm`; `p = 255` means "80 cm or more". The table inverts the
 //! *nominal* far branch of the curve ([`crate::curve`]), as firmware built from the datasheet
@@ -26,11 +26,11 @@
 use crate::adc::code8_centre_volts;
 use crate::curve::{CURVE_D0_CM, CURVE_K_VOLT_CM, CURVE_V_INF_VOLTS};
 
-/// Distance units per centimetre: 255 du = 80 cm (SPEC §3.3).
+/// Distance units per centimetre: 255 du = 80 cm (docs/design.md §3.3).
 pub const DU_PER_CM: f64 = 255.0 / 80.0;
-/// Millimetres per distance unit, 80/255 cm ≈ 3.137 mm (SPEC §3.3).
+/// Millimetres per distance unit, 80/255 cm ≈ 3.137 mm (docs/design.md §3.3).
 pub const MM_PER_DU: f64 = 800.0 / 255.0;
-/// The largest proximity, meaning "80 cm or more / nothing seen" (SPEC §2.1, §3.3).
+/// The largest proximity, meaning "80 cm or more / nothing seen" (docs/design.md §2.1, §3.3).
 pub const DU_MAX: u8 = 255;
 /// The codes where one code step spans at most one du on the far branch (see the module docs):
 /// there the table is exact to half a du.

@@ -13,31 +13,31 @@ use crate::curve::{
 use crate::error::SensorError;
 use crate::rng::{StreamRng, counter_unit_f64, stream, uniform_f64, unit_f64};
 
-/// Default MCU clock φ = 25 MHz, 1 state = 40 ns (SPEC §4.1, AKI-H8/3052F board).
+/// Default MCU clock φ = 25 MHz, 1 state = 40 ns (docs/design.md §4.1, AKI-H8/3052F board).
 pub const DEFAULT_CLOCK_HZ: u32 = 25_000_000;
 /// Typical output at 80 cm, 0.4 V (GP2Y0A21YK / GP2D12 datasheets, electro-optical table).
 pub const DATASHEET_V_80CM_TYP_VOLTS: f64 = 0.4;
-/// Unit-to-unit spread of the output at 80 cm, ±0.15 V (SPEC §3.1: datasheet 0.25–0.55 V).
+/// Unit-to-unit spread of the output at 80 cm, ±0.15 V (docs/design.md §3.1: datasheet 0.25–0.55 V).
 pub const DATASHEET_V_80CM_SPREAD_VOLTS: f64 = 0.15;
-/// Smallest output difference between 80 cm and 10 cm, 1.75 V (SPEC §3.1, GP2D12 datasheet).
+/// Smallest output difference between 80 cm and 10 cm, 1.75 V (docs/design.md §3.1, GP2D12 datasheet).
 pub const DATASHEET_DV_80_TO_10CM_MIN_VOLTS: f64 = 1.75;
-/// Largest output difference between 80 cm and 10 cm, 2.25 V (SPEC §3.1, GP2D12 datasheet).
+/// Largest output difference between 80 cm and 10 cm, 2.25 V (docs/design.md §3.1, GP2D12 datasheet).
 pub const DATASHEET_DV_80_TO_10CM_MAX_VOLTS: f64 = 2.25;
-/// Typical measuring period, 38.3 ms (SPEC §3.1; GP2Y0A21YK datasheet timing chart, T1).
+/// Typical measuring period, 38.3 ms (docs/design.md §3.1; GP2Y0A21YK datasheet timing chart, T1).
 pub const DATASHEET_PERIOD_MEAN_MS: f64 = 38.3;
-/// Spread of the measuring period, ±9.6 ms (SPEC §3.1; GP2Y0A21YK datasheet timing chart).
+/// Spread of the measuring period, ±9.6 ms (docs/design.md §3.1; GP2Y0A21YK datasheet timing chart).
 pub const DATASHEET_PERIOD_SPREAD_MS: f64 = 9.6;
 /// Cycle-to-cycle jitter of each refresh instant, ±0.4 ms (≈ 1 % of the period): an
 /// assumption; the datasheet gives only the unit-to-unit spread of the period.
 pub const DEFAULT_PERIOD_JITTER_MS: f64 = 0.4;
-/// Read noise, Gaussian σ = 15 mV (SPEC §3.1).
+/// Read noise, Gaussian σ = 15 mV (docs/design.md §3.1).
 pub const NOISE_SIGMA_VOLTS: f64 = 0.015;
-/// Probability that one A/D sample lands in an output spike, 0.1 (SPEC §3.1: ~0.1 ms spikes
+/// Probability that one A/D sample lands in an output spike, 0.1 (docs/design.md §3.1: ~0.1 ms spikes
 /// every ~1 ms).
 pub const SPIKE_PROBABILITY: f64 = 0.1;
-/// Smallest spike height, +150 mV (SPEC §3.1).
+/// Smallest spike height, +150 mV (docs/design.md §3.1).
 pub const SPIKE_MIN_VOLTS: f64 = 0.150;
-/// Largest spike height, +200 mV (SPEC §3.1).
+/// Largest spike height, +200 mV (docs/design.md §3.1).
 pub const SPIKE_MAX_VOLTS: f64 = 0.200;
 /// The sensor's supply, Vcc = 5 V on the robot (datasheet: 4.5–5.5 V); its output stays within
 /// 0 V … Vcc, so held values and reads are clamped to that range.

@@ -1,5 +1,5 @@
 //! What the robot's H8/3052F sees of the world: its four IR distance sensors and four bumpers,
-//! through the A/D converter and port 2 (SPEC §3.1–3.4).
+//! through the A/D converter and port 2 (docs/design.md §3.1–3.4).
 //!
 //! The emulated MCU (crate `emu`) drives this crate: at each A/D conversion it asks a sensor
 //! for "the voltage on the pin at this instant" ([`IrSensor::sample`]), giving the MCU time in
@@ -29,7 +29,7 @@
 //! **Nominal curve** ([`nominal_volts`], module [`curve`]): `V(d) = 28.48 / (d + 3.0) + 0.059` V
 //! for d ≥ 8 cm (d in cm), continuing its 1/d fall beyond the datasheet's 80 cm. Below 8 cm the
 //! output folds back along a straight line to 0.75 V at contact ([`FOLDBACK_CONTACT_VOLTS`],
-//! the middle of SPEC's 0.5–1 V). *Reading of a SPEC inconsistency:* SPEC §3.1 says "peak ≈
+//! the middle of the design's 0.5–1 V). *Reading of a design inconsistency:* docs/design.md §3.1 says "peak ≈
 //! 3.2 V at 8 cm" but its own formula gives V(8 cm) = 2.648 V (3.2 V is the formula's value at
 //! 6 cm). The formula is kept as the authority for d ≥ 8 cm, so the modelled peak is
 //! **2.648 V at 8 cm**, continuous with the fold-back line. With it, the reading at 5 cm
@@ -63,7 +63,7 @@
 //! measuring before the emulation began.
 //!
 //! **Read noise**, per A/D sample: Gaussian σ = 15 mV, plus with probability 0.1 a spike uniform
-//! in +150…200 mV. SPEC's spikes are ~0.1 ms wide every ~1 ms; a 5–11 µs conversion lands in
+//! in +150…200 mV. the design's spikes are ~0.1 ms wide every ~1 ms; a 5–11 µs conversion lands in
 //! one with probability ≈ 0.1. They are modelled as independent per read, which is right
 //! unless one sensor is read twice within 0.1 ms or in lock-step with its LED pulses (the
 //! firmware reads each sensor once per step). The sum is clamped to 0 V … 5 V.
@@ -78,19 +78,19 @@
 //! ([`IrParams::validate`] lists them), NaN/negative distances and time going backwards
 //! return a [`SensorError`] naming the value and the valid range.
 //!
-//! # A/D conversion (module [`adc`], SPEC §3.2)
+//! # A/D conversion (module [`adc`], docs/design.md §3.2)
 //! Ideal 10-bit converter at Vref = 5.0 V: code k from `k · 5/1024` V upward (the H8 manual's
 //! ideal conversion characteristic), clamped to 0..=1023, exact at every boundary; ADDRn =
 //! code << 6 (left-justified); the firmware's byte `c = code >> 2`, 19.53 mV per step.
 //!
-//! # Distance units (module [`du`], SPEC §3.3)
+//! # Distance units (module [`du`], docs/design.md §3.3)
 //! [`DU_TABLE`] maps c to du (1 du = 80/255 cm), computed at compile time by inverting the
 //! nominal far branch at each code's bin centre `(c + 0.5) · 5/256` V, rounded, clamped to
 //! 0..=255; codes above the peak extrapolate the formula (down to 9 du at code 255), codes at
 //! or below V(80 cm) read 255. Exact to ±0.5 du on codes 71–134 ([`STEEP_CODES`], 8.05–18.45 cm),
 //! where one code spans at most 1 du.
 //!
-//! # Bumpers (module [`bumpers`], SPEC §3.4)
+//! # Bumpers (module [`bumpers`], docs/design.md §3.4)
 //! Front, rear, left, right on P2.0–P2.3, active low with pull-ups; the collision counter
 //! counts released→pressed edges.
 #![forbid(unsafe_code)]

@@ -2,13 +2,13 @@
 
 use crate::error::WorldError;
 
-/// Length of the paper's corridor (environment 1): 3.0 m (SPEC §5).
+/// Length of the paper's corridor (environment 1): 3.0 m (docs/design.md §5).
 pub const CORRIDOR_LENGTH_M: f64 = 3.0;
-/// The corridor is the robot width plus 4 cm wide (SPEC §5).
+/// The corridor is the robot width plus 4 cm wide (docs/design.md §5).
 pub const CORRIDOR_EXTRA_WIDTH_M: f64 = 0.04;
-/// Side of the paper's square arena (environment 2): 1.8 m (SPEC §5).
+/// Side of the paper's square arena (environment 2): 1.8 m (docs/design.md §5).
 pub const SQUARE_SIDE_M: f64 = 1.8;
-/// Robots in the paper's runs: 3 (SPEC §5); the scaled arena keeps 3 robots per 1.8 m × 1.8 m.
+/// Robots in the paper's runs: 3 (docs/design.md §5); the scaled arena keeps 3 robots per 1.8 m × 1.8 m.
 pub const PAPER_ROBOTS: usize = 3;
 /// Largest accepted arena side: 10 km (our limit).
 pub const MAX_ARENA_SIDE_M: f64 = 10_000.0;
@@ -73,7 +73,7 @@ impl Arena {
         })
     }
 
-    /// The paper's corridor for the SPEC body (180 mm wide): 3.0 m × 0.22 m.
+    /// The paper's corridor for the design body (180 mm wide): 3.0 m × 0.22 m.
     pub fn paper_corridor() -> Arena {
         Arena {
             kind: ArenaKind::Corridor,

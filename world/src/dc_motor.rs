@@ -2,7 +2,7 @@
 //! load.
 //!
 //! The robot is a commercial toy with two DC gear motors (paper §2); the world moves it like a
-//! Tamiya 203:1 gearbox with 56 mm wheels (SPEC §3.5), and every Tamiya twin-motor and double
+//! Tamiya 203:1 gearbox with 56 mm wheels (docs/design.md §3.5), and every Tamiya twin-motor and double
 //! gearbox of that class is built around the Mabuchi FA-130, so the motor is an FA-130. Its
 //! published figures give the permanent-magnet DC motor's two constants:
 //! - armature resistance R = nominal voltage / stall current;
@@ -59,9 +59,9 @@ pub const FA130_NO_LOAD_CURRENT_A: f64 = 0.20;
 /// current").
 pub const FA130_STALL_CURRENT_A: f64 = 2.20;
 /// Gear ratio of the Tamiya twin-motor gearbox in its slow setting, 203.7:1 (Tamiya 70097
-/// instructions; SPEC §3.5's "203:1").
+/// instructions; docs/design.md §3.5's "203:1").
 pub const GEAR_RATIO: f64 = 203.7;
-/// Wheel diameter, 56 mm (SPEC §3.5: Tamiya 56 mm wheels).
+/// Wheel diameter, 56 mm (docs/design.md §3.5: Tamiya 56 mm wheels).
 pub const WHEEL_DIAMETER_M: f64 = 0.056;
 /// Wheel radius, 28 mm: half of [`WHEEL_DIAMETER_M`].
 pub const WHEEL_RADIUS_M: f64 = WHEEL_DIAMETER_M / 2.0;

@@ -30,9 +30,9 @@
 //!   sides. The corridor (paper env. 1) is 3.0 m along x and body width + 4 cm (0.22 m) across;
 //!   the square arena (env. 2) is 1.8 m; [`Arena::scaled_square`] keeps the paper's density
 //!   (side = 1.8 m · sqrt(n/3)).
-//! - **Bodies** are oriented rectangles 230 mm along the heading × 180 mm across (SPEC §1),
+//! - **Bodies** are oriented rectangles 230 mm along the heading × 180 mm across (docs/design.md §1),
 //!   centred on the midpoint of the wheel axle (the robot turns about its body centre).
-//! - **Motors** (SPEC §3.5): commanded wheel speed = duty × top speed (0.15 m/s) × motor gain
+//! - **Motors** (docs/design.md §3.5): commanded wheel speed = duty × top speed (0.15 m/s) × motor gain
 //!   (uniform in 1 ± 5 %, drawn once per robot and wheel from the seed, one stream per robot)
 //!   × sign (forward +, reverse −). The wheel speed follows it with a first-order lag, τ = 60 ms
 //!   (valid 20–100 ms), integrated exactly (`exp(−dt/τ)`), so any sub-step is stable.
@@ -53,7 +53,7 @@
 //!   so there is no floating-point accumulation of time and no sliver of a sub-step. Robots are
 //!   processed in index order. [`World::advance`] takes seconds, rounded to states (for tests).
 //! - **Bodies are rigid and pushed by their wheels**, not placed: a robot has mass 0.5 kg
-//!   (SPEC §1) and the inertia of a uniform box; each of its two drive wheels grips the floor
+//!   (docs/design.md §1) and the inertia of a uniform box; each of its two drive wheels grips the floor
 //!   and makes the body's velocity at the wheel equal the wheel's rim speed along it and zero
 //!   across it, with a force of at most `μ_floor · m·g/2` (default μ 0.6, about 1.5 N per
 //!   wheel); past that it slips, and a slipping wheel's friction points against the slip of its
@@ -91,7 +91,7 @@
 //!   which nothing overlaps (a time of impact, never a jump back). **After every sub-step no
 //!   body overlaps a wall or another body** (tests check it over thousands of crowded
 //!   sub-steps). There is no reset anywhere.
-//! - **Bumpers** (SPEC §3.4): a switch is pressed in a sub-step when the contacts on its face
+//! - **Bumpers** (docs/design.md §3.4): a switch is pressed in a sub-step when the contacts on its face
 //!   carried at least `bumper_force_n` (default 0.1 N) between them over the sub-step: the
 //!   solver's normal impulses plus the position corrections' pushes, a push of λ (kg·m) counting
 //!   as the impulse λ / h. A contact's face is the one its normal points at in the body frame (the
@@ -104,7 +104,7 @@
 //!   released at its operating force: a robot rubbing lightly along a wall, its turning corner
 //!   corrected out of a sub-micrometre overlap in every second sub-step, read pressed, released,
 //!   pressed… and counted a collision every 40 ms; `tests/bumper_rub.rs`.)
-//! - **Sensors** (SPEC §3.1): by default four, at the middle of the front, rear, left and right
+//! - **Sensors** (docs/design.md §3.1): by default four, at the middle of the front, rear, left and right
 //!   sides, facing out (indices [`FRONT`], [`REAR`], [`LEFT`], [`RIGHT`]); mounts, rays per
 //!   sensor (a cone) and range are parameters. [`World::sense`] casts from the mount against
 //!   the walls and every other robot's body and returns the distance to the nearest hit in mm,

@@ -2,7 +2,7 @@
 
 use crate::error::WorldError;
 
-/// The H-bridge mode of one motor, from its two input pins (TA7291P truth table, SPEC §3.5).
+/// The H-bridge mode of one motor, from its two input pins (TA7291P truth table, docs/design.md §3.5).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Direction {
     /// IN1 = H, IN2 = L: drive forward.
@@ -91,10 +91,10 @@ impl WheelCommand {
     }
 }
 
-/// Speed ratio of the slow wheel in the turning behaviours: 0.3 (SPEC §3.5).
+/// Speed ratio of the slow wheel in the turning behaviours: 0.3 (docs/design.md §3.5).
 pub const TURN_SLOW_WHEEL_RATIO: f64 = 0.3;
 
-/// The paper's four primitive behaviours (SPEC §3.5) as wheel commands at full duty.
+/// The paper's four primitive behaviours (docs/design.md §3.5) as wheel commands at full duty.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Behaviour {
     /// (+v, +v).

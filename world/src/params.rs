@@ -2,27 +2,27 @@
 
 use crate::error::WorldError;
 
-/// Body length along the heading: 230 mm (SPEC §1, paper §4: robots of 230 × 180 × 130 mm).
+/// Body length along the heading: 230 mm (docs/design.md §1, paper §4: robots of 230 × 180 × 130 mm).
 pub const BODY_LENGTH_M: f64 = 0.230;
-/// Body width across the heading: 180 mm (SPEC §1, paper §4).
+/// Body width across the heading: 180 mm (docs/design.md §1, paper §4).
 pub const BODY_WIDTH_M: f64 = 0.180;
-/// Default top wheel speed at 100 % duty: 0.15 m/s (SPEC §3.5; Tamiya 203:1 gearbox with 56 mm
+/// Default top wheel speed at 100 % duty: 0.15 m/s (docs/design.md §3.5; Tamiya 203:1 gearbox with 56 mm
 /// wheels gives 0.14–0.18 m/s).
 pub const TOP_SPEED_M_PER_S: f64 = 0.15;
 /// Largest accepted top speed: 1 m/s (our limit, so a body cannot cross another in one
 /// [`MAX_SUBSTEP_LIMIT_S`] sub-step; the real robot does about 0.15 m/s).
 pub const MAX_TOP_SPEED_M_PER_S: f64 = 1.0;
-/// Default motor time constant of the first-order wheel-speed lag: 60 ms (SPEC §3.5).
+/// Default motor time constant of the first-order wheel-speed lag: 60 ms (docs/design.md §3.5).
 pub const MOTOR_TIME_CONSTANT_S: f64 = 0.060;
-/// Shortest valid motor time constant: 20 ms (SPEC §3.5, range 20–100 ms).
+/// Shortest valid motor time constant: 20 ms (docs/design.md §3.5, range 20–100 ms).
 pub const MOTOR_TIME_CONSTANT_MIN_S: f64 = 0.020;
-/// Longest valid motor time constant: 100 ms (SPEC §3.5, range 20–100 ms).
+/// Longest valid motor time constant: 100 ms (docs/design.md §3.5, range 20–100 ms).
 pub const MOTOR_TIME_CONSTANT_MAX_S: f64 = 0.100;
 /// Shortest accepted braking or coasting time constant: 5 ms (our limit).
 pub const STOP_TIME_CONSTANT_MIN_S: f64 = 0.005;
 /// Longest accepted braking or coasting time constant: 1 s (our limit).
 pub const STOP_TIME_CONSTANT_MAX_S: f64 = 1.0;
-/// Per-robot, per-wheel motor gain spread: ±5 % (SPEC §3.5).
+/// Per-robot, per-wheel motor gain spread: ±5 % (docs/design.md §3.5).
 pub const MOTOR_GAIN_SPREAD: f64 = 0.05;
 /// Default wheel track (distance between the wheel contact lines): 160 mm. Our choice: the
 /// paper gives no figure; two 56 mm Tamiya wheels about 20 mm wide sit inside the 180 mm body.
@@ -37,7 +37,7 @@ pub const MAX_SUBSTEP_LIMIT_S: f64 = 0.100;
 /// Largest time one `advance` call may cover: one hour (our limit, so a call always ends).
 pub const MAX_ADVANCE_S: f64 = 3600.0;
 /// Default sensor maximum range: 1.5 m (brief; the GP2Y0A21 is specified to 80 cm, beyond which
-/// its curve keeps falling as 1/d, SPEC §3.1, so "farther than 1.5 m" reads as far).
+/// its curve keeps falling as 1/d, docs/design.md §3.1, so "farther than 1.5 m" reads as far).
 pub const SENSOR_MAX_RANGE_M: f64 = 1.5;
 /// Default placement clearance between bodies, and between bodies and walls: 50 mm (our choice).
 pub const PLACEMENT_CLEARANCE_M: f64 = 0.050;
@@ -52,7 +52,7 @@ pub const SOLVER_ITERATIONS: u32 = 12;
 pub const POSITION_ITERATIONS: u32 = 16;
 /// Standard gravity, m/s² (for the wheels' normal force).
 pub const GRAVITY_M_PER_S2: f64 = 9.806_65;
-/// Robot mass: 0.5 kg (SPEC §1, paper §2: without batteries, the only figure the paper gives).
+/// Robot mass: 0.5 kg (docs/design.md §1, paper §2: without batteries, the only figure the paper gives).
 pub const MASS_KG: f64 = 0.5;
 /// Default tyre–floor friction coefficient: 0.6 (our choice: rubber on a hard floor is
 /// 0.5–0.8). The traction of a blocked robot, μ·m·g ≈ 2.9 N, is far below what the 203:1
@@ -72,7 +72,7 @@ pub const BUMPER_FORCE_N: f64 = 0.1;
 /// D2F-01 at 0.74 N / 0.05 N (Omron D2F datasheet, "Operating Characteristics"). We keep the
 /// data sheet's release force with our lower operating force.
 pub const BUMPER_RELEASE_FORCE_N: f64 = 0.02;
-/// Default clock that counts the world's time: φ = 25 MHz, one state = 40 ns (SPEC §4.1): the
+/// Default clock that counts the world's time: φ = 25 MHz, one state = 40 ns (docs/design.md §4.1): the
 /// world advances in whole MCU states, the clock the robots' MCUs count.
 pub const CLOCK_HZ: u64 = 25_000_000;
 /// Most rays a sensor cone may use (our limit).
@@ -93,7 +93,7 @@ pub struct SensorMount {
 }
 
 impl SensorMount {
-    /// The four default mounts (SPEC §3.1): middle of the front, rear, left and right sides,
+    /// The four default mounts (docs/design.md §3.1): middle of the front, rear, left and right sides,
     /// facing out, in that order (sensor indices 0, 1, 2, 3).
     pub fn default_mounts(body_length_m: f64, body_width_m: f64) -> Vec<SensorMount> {
         let hl = 0.5 * body_length_m;
@@ -123,7 +123,7 @@ impl SensorMount {
     }
 }
 
-/// All parameters of the physical world. [`WorldParams::default`] gives the SPEC values.
+/// All parameters of the physical world. [`WorldParams::default`] gives the design values.
 #[derive(Debug, Clone, PartialEq)]
 pub struct WorldParams {
     /// Body length along the heading, metres.

@@ -1,5 +1,5 @@
 //! Firmware images on the robot board: loading an image with its symbol table, writing the
-//! configuration block (SPEC §8) into the flash at load, reading back what the firmware made of
+//! configuration block (docs/design.md §8) into the flash at load, reading back what the firmware made of
 //! it, and running the image on the core.
 
 use std::path::Path;
@@ -12,7 +12,7 @@ use crate::chip::trace::{CodeNames, PhaseRecorder};
 use crate::core::cpu::{Cpu, CpuError, Event, StackFault, StackGuard, StackGuardMode, StackRoom};
 use crate::core::srec::{self, SrecError, SrecImage};
 
-/// Where the configuration block sits in the flash (SPEC §8: "say H'000400, after the
+/// Where the configuration block sits in the flash (docs/design.md §8: "say H'000400, after the
 /// vectors").
 pub const CONFIG_BLOCK_ADDR: u32 = 0x400;
 /// Bytes of the block.
@@ -54,7 +54,7 @@ pub struct ConfigBlock {
 }
 
 impl ConfigBlock {
-    /// The firmware's compiled defaults: the arena (SPEC §5) at φ = 25 MHz.
+    /// The firmware's compiled defaults: the arena (docs/design.md §5) at φ = 25 MHz.
     pub const ARENA: ConfigBlock = ConfigBlock {
         outputs: 4,
         history: 1,
@@ -485,7 +485,7 @@ pub fn halted(cpu: &Cpu) -> RunError {
 
 /// Longest a robot's firmware may go without beginning a step (starting the A/D converter) or
 /// without going back to sleep after one before the emulator calls it stuck: 10 s of MCU time,
-/// a watchdog's view (SPEC §3.5's steps come every 0.45–0.60 s).
+/// a watchdog's view (docs/design.md §3.5's steps come every 0.45–0.60 s).
 pub const WATCHDOG_S: f64 = 10.0;
 
 /// Why a robot's firmware cannot go on.

@@ -1,4 +1,4 @@
-//! States per function, attributed by PC through the symbol table (SPEC §8).
+//! States per function, attributed by PC through the symbol table (docs/design.md §8).
 //!
 //! The profiler follows the firmware's calls: a JSR or BSR enters the function at its target,
 //! RTS leaves it; an interrupt (or TRAPA) enters its handler, RTE leaves it; a JMP to the start

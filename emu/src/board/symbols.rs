@@ -1,4 +1,4 @@
-//! The symbol table of a firmware image: the output of `h8300-hms-nm -n` (SPEC §8), committed
+//! The symbol table of a firmware image: the output of `h8300-hms-nm -n` (docs/design.md §8), committed
 //! beside the image as `robot.sym`.
 //!
 //! Each line is `ADDRESS KIND NAME` (address in hex, kind one letter as nm prints it: `T`/`t`

@@ -1,4 +1,4 @@
-//! How the robot's parts are wired to the H8/3052F (SPEC §3.2–3.6).
+//! How the robot's parts are wired to the H8/3052F (docs/design.md §3.2–3.6).
 //!
 //! | part | pin | register bit |
 //! |---|---|---|
@@ -15,7 +15,7 @@
 //! port pins as long as ITU3 and ITU4 leave their outputs off (TIOR IOx = 000, not in PWM or
 //! complementary mode — the reset state) and the TPC is not enabled on them (NDERB = 0, the
 //! reset state), which holds for the robot's firmware: it uses ITU0–2 only. The H-bridges are
-//! Toshiba TA7291P-class (SPEC §3.5): IN1/IN2 = H/L forward, L/H reverse, H/H brake, L/L
+//! Toshiba TA7291P-class (docs/design.md §3.5): IN1/IN2 = H/L forward, L/H reverse, H/H brake, L/L
 //! coast; the PWM drives the bridge's reference/enable input.
 //!
 //! Which port bit each TIOCA output shares, and the I²C lines of the EEPROM bus the chip model
@@ -74,7 +74,7 @@ pub const ITU_MOTOR_LEFT: usize = 1;
 pub const ITU_MOTOR_RIGHT: usize = 2;
 /// ITU channel of the system tick (ITU0, compare match A).
 pub const ITU_TICK: usize = 0;
-/// Interrupt vector of the system tick: ITU0 IMIA0 (SPEC §4.1: 24).
+/// Interrupt vector of the system tick: ITU0 IMIA0 (docs/design.md §4.1: 24).
 pub const VECTOR_TICK: u8 = 24;
 
 /// Port-B bit of the left H-bridge's IN1 (PB0).
@@ -114,7 +114,7 @@ impl Bridge {
     }
 }
 
-/// What a TA7291P-class H-bridge does with its two logic inputs (SPEC §3.5).
+/// What a TA7291P-class H-bridge does with its two logic inputs (docs/design.md §3.5).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Bridge {
     /// IN1 = H, IN2 = L: forward.

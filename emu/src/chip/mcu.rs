@@ -37,7 +37,7 @@
 //! asked about and not later than the MCU clock.
 //!
 //! # I²C on port 4
-//! The chip model carries the robot's EEPROM bus (two 24LC256 at 0x50 and 0x51, SPEC §3.6) on
+//! The chip model carries the robot's EEPROM bus (two 24LC256 at 0x50 and 0x51, docs/design.md §3.6) on
 //! P4.7 (SDA) and P4.6 (SCL), as the ports module describes ([`crate::chip::periph::ports`]),
 //! so that the chips' own events (the end of a write cycle) are synchronised with the chip's
 //! clock; they are applied lazily by the bus.
@@ -63,7 +63,7 @@ use crate::core::memmap::{
 };
 use crate::core::srec::SrecImage;
 
-/// The clock φ of the AKI-H8/3052F board: 25 MHz, 1 state = 40 ns (SPEC §4.1).
+/// The clock φ of the AKI-H8/3052F board: 25 MHz, 1 state = 40 ns (docs/design.md §4.1).
 pub const DEFAULT_CLOCK_HZ: u32 = 25_000_000;
 /// Lowest φ accepted: 2 MHz (H8/3052F hardware manual, electrical characteristics: operating
 /// frequency 2–25 MHz).

@@ -3,7 +3,7 @@
 //! [`run_image`] parses a `.mot` image, loads it into a [`Machine`] — the same [`Mcu`] the
 //! robot's controller runs on (flash, RAM, SCI1 as console, ITU, A/D, ports, interrupt
 //! controller, EEPROMs on port 4) with a [`NullBoard`](crate::chip::mcu::NullBoard) outside it — resets the CPU through vector 0 and runs it until the program halts
-//! (SLEEP with CCR.I = 1 and no NMI pending; exit status = low byte of R0, SPEC §7), the state
+//! (SLEEP with CCR.I = 1 and no NMI pending; exit status = low byte of R0, docs/design.md §7), the state
 //! budget runs out, or the core stops on an error (undefined opcode, fetch outside ROM/RAM).
 //! Bytes the program transmits on SCI1 go to the console writer as they leave TDR; the
 //! optional trace writer gets one line per instruction: address, disassembly (objdump's form)
@@ -28,7 +28,7 @@ use crate::core::cpu::disasm::format_instr;
 use crate::core::cpu::{Cpu, CpuError, Event, StackFault, StackGuard, StackRoom};
 use crate::core::srec::{self, SrecError};
 
-/// The system clock φ of the AKI-H8/3052F board: 25 MHz, 1 state = 40 ns (SPEC §4.1).
+/// The system clock φ of the AKI-H8/3052F board: 25 MHz, 1 state = 40 ns (docs/design.md §4.1).
 pub const PHI_HZ: u64 = 25_000_000;
 
 /// Options of a run.
@@ -42,7 +42,7 @@ pub struct RunOptions {
 /// How a run ended.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Outcome {
-    /// SLEEP with CCR.I = 1 and no NMI pending (SPEC §7).
+    /// SLEEP with CCR.I = 1 and no NMI pending (docs/design.md §7).
     Halted {
         /// The low byte of R0.
         exit_status: u8,

@@ -29,7 +29,7 @@ pub enum CpuSignal {
 /// - the clock advances by the access's states *before* the access takes effect, so a device
 ///   sees a read or write at the instant the bus cycle ends;
 /// - a read from an unmapped address returns 0xFF (a floating bus reads high) and costs an
-///   8-bit 3-state cycle; the H8/300H core refuses to *fetch* from there (SPEC §7).
+///   8-bit 3-state cycle; the H8/300H core refuses to *fetch* from there (docs/design.md §7).
 pub trait Bus {
     /// The current time in states since reset.
     fn now(&self) -> u64;

@@ -1,4 +1,4 @@
-//! The H8/3052F memory map in advanced mode (SPEC §4.1) and the access states of each area.
+//! The H8/3052F memory map in advanced mode (docs/design.md §4.1) and the access states of each area.
 //!
 //! Every bus access is charged by the area it touches: the H8/300H manual's rule
 //! `states = I·S_I + J·S_J + K·S_K + L·S_L + M·S_M + N·S_N` multiplies each access count by
@@ -10,33 +10,33 @@ pub const ADDRESS_MASK: u32 = 0x00FF_FFFF;
 
 /// First address of the exception vector table (reset = vector 0, 4 bytes per vector).
 pub const VECTORS_START: u32 = 0x00_0000;
-/// Number of vectors of the H8/3052F (SPEC §4.1: 61 × 4 bytes, H'000000–H'0000F3).
+/// Number of vectors of the H8/3052F (docs/design.md §4.1: 61 × 4 bytes, H'000000–H'0000F3).
 pub const VECTOR_COUNT: u32 = 61;
 
-/// First byte of the 512 KB on-chip flash (SPEC §4.1).
+/// First byte of the 512 KB on-chip flash (docs/design.md §4.1).
 pub const ROM_START: u32 = 0x00_0000;
-/// Last byte of the on-chip flash (SPEC §4.1).
+/// Last byte of the on-chip flash (docs/design.md §4.1).
 pub const ROM_END: u32 = 0x07_FFFF;
 /// Size of the on-chip flash in bytes.
 pub const ROM_BYTES: u32 = ROM_END - ROM_START + 1;
 
-/// First byte of the 8 KB on-chip RAM (SPEC §4.1).
+/// First byte of the 8 KB on-chip RAM (docs/design.md §4.1).
 pub const RAM_START: u32 = 0xFF_DF10;
-/// Last byte of the on-chip RAM (SPEC §4.1).
+/// Last byte of the on-chip RAM (docs/design.md §4.1).
 pub const RAM_END: u32 = 0xFF_FF0F;
 /// Size of the on-chip RAM in bytes (8 192).
 pub const RAM_BYTES: u32 = RAM_END - RAM_START + 1;
 
-/// First byte of the on-chip I/O registers (SPEC §4.1).
+/// First byte of the on-chip I/O registers (docs/design.md §4.1).
 pub const IO_START: u32 = 0xFF_FF1C;
-/// Last byte of the on-chip I/O registers (SPEC §4.1).
+/// Last byte of the on-chip I/O registers (docs/design.md §4.1).
 pub const IO_END: u32 = 0xFF_FFFF;
 
-/// States of one access to on-chip flash: 2, over a 16-bit bus (SPEC §4.1).
+/// States of one access to on-chip flash: 2, over a 16-bit bus (docs/design.md §4.1).
 pub const ROM_ACCESS_STATES: u32 = 2;
-/// States of one access to on-chip RAM: 2, over a 16-bit bus (SPEC §4.1).
+/// States of one access to on-chip RAM: 2, over a 16-bit bus (docs/design.md §4.1).
 pub const RAM_ACCESS_STATES: u32 = 2;
-/// States of one access to on-chip I/O: 3, over an 8-bit bus. SPEC §4.1 marks this figure as an
+/// States of one access to on-chip I/O: 3, over an 8-bit bus. docs/design.md §4.1 marks this figure as an
 /// assumption not confirmed from the manual; it is kept in this one constant on purpose.
 pub const IO_ACCESS_STATES: u32 = 3;
 
@@ -105,7 +105,7 @@ impl Area {
         }
     }
 
-    /// Whether instructions may be fetched from this area (SPEC §7: only ROM and RAM).
+    /// Whether instructions may be fetched from this area (docs/design.md §7: only ROM and RAM).
     #[must_use]
     pub const fn executable(self) -> bool {
         matches!(self, Area::Rom | Area::Ram)

@@ -1,4 +1,4 @@
-//! Motorola S-record images (`.mot`, as flashed onto real H8/3052F boards; SPEC §7).
+//! Motorola S-record images (`.mot`, as flashed onto real H8/3052F boards; docs/design.md §7).
 //!
 //! Record types: S0 header, S1/S2/S3 data with 16/24/32-bit addresses, S5/S6 record counts
 //! (checked against the number of data records), S7/S8/S9 start address with 32/24/16 bits.

@@ -6,7 +6,7 @@
 #ifdef __H8300H__
 
 /* SCI1 registers (H8/3052F hardware manual, section 13 "Serial Communication
- * Interface"; addresses as in SPEC 4.1: SCI1 at H'FFFFB8-H'FFFFBD). */
+ * Interface"; addresses as in docs/design.md §4.1: SCI1 at H'FFFFB8-H'FFFFBD). */
 #define SCI1_SMR (*(volatile u8 *)0xFFFFB8) /* serial mode register */
 #define SCI1_BRR (*(volatile u8 *)0xFFFFB9) /* bit rate register */
 #define SCI1_SCR (*(volatile u8 *)0xFFFFBA) /* serial control register */

@@ -1,7 +1,7 @@
 ; crt0.S - start-up code for the differential test programs on the emulated
 ; H8/3052F (H8/300H, advanced mode, 24-bit addresses).
 ;
-; Layout and conventions (SPEC 4.1 and 7):
+; Layout and conventions (docs/design.md §4.1 and 7):
 ;   - The exception vector table sits at H'000000: 61 vectors of 4 bytes
 ;     (H'000000-H'0000F3). Vector 0 (reset) holds _start. Every other vector
 ;     points at its own 6-byte stub that loads 0x80 + vector number into R0L

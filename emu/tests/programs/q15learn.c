@@ -1,5 +1,5 @@
 /*
- * q15learn.c - the fixed-point learner step of SPEC 2.3-2.4 on a toy world.
+ * q15learn.c - the fixed-point learner step of docs/design.md §2.3-2.4 on a toy world.
  *
  * N = 13 Q7 inputs (4 proximities - 128, the same 4 from the previous step,
  * the 4 previous outputs >> 8, sat_i8(E(t-1) >> 3)), M = 4 outputs with Q15
@@ -21,8 +21,8 @@
 #define N_IN 13
 #define N_OUT 4
 #define K_PROX 4
-#define ETA_Q15 3277 /* 0.1 in Q15 (SPEC 2.1) */
-#define THRESHOLD_DU 10 /* T (SPEC 2.1) */
+#define ETA_Q15 3277 /* 0.1 in Q15 (docs/design.md §2.1) */
+#define THRESHOLD_DU 10 /* T (docs/design.md §2.1) */
 #define STEPS 160
 
 static i16 weights[N_OUT][N_IN];
@@ -190,7 +190,7 @@ int main(void)
     u32 wins[N_OUT] = { 0u, 0u, 0u, 0u };
 
     con_init();
-    con_puts("q15learn: Q15 forward pass and update (SPEC 2.3-2.4), 13 inputs, 4 outputs\n");
+    con_puts("q15learn: Q15 forward pass and update (docs/design.md §2.3-2.4), 13 inputs, 4 outputs\n");
 
     rng_seed(0x51A4F00Du);
     for (j = 0; j < N_OUT; j++) {

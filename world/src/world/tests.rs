@@ -13,7 +13,7 @@ const HY: f64 = 0.5 * BODY_WIDTH_M;
 const V: f64 = 0.15;
 const TAU: f64 = 0.060;
 
-/// SPEC parameters with no motor-gain spread, so wheel speeds are exactly duty × top speed.
+/// Default parameters with no motor-gain spread, so wheel speeds are exactly duty × top speed.
 fn exact_params() -> WorldParams {
     WorldParams {
         motor_gain_spread: 0.0,

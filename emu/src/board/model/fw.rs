@@ -2,7 +2,7 @@
 //!
 //! The controller is a program running on the H8/3052F, written in Rust instead of H8 code. It
 //! reaches the hardware only through [`crate::core::bus::Bus`] register reads and writes, each
-//! charged by the area it touches (3 states per byte of on-chip I/O, SPEC §4.1); the instruction
+//! charged by the area it touches (3 states per byte of on-chip I/O, docs/design.md §4.1); the instruction
 //! fetches of the instructions that make those accesses are charged as ROM fetch cycles (2 states
 //! per word); register-only code is charged from its instruction sequence ([`nn_q15::cost::Insn`]);
 //! the learner's arithmetic is charged from `nn_q15`'s H8 meter. Between charges the controller
@@ -17,7 +17,7 @@ use super::regs::{IMA, ITU0, P4DDR, P4DR, SCL_BIT, SDA_BIT, TSR, VECTOR_IMIA0};
 use crate::core::cpu::timing::{N_INTERRUPT_INTERNAL, N_PRIORITY_DECISION_INTERNAL};
 use crate::core::memmap::{RAM_ACCESS_STATES, ROM_ACCESS_STATES};
 
-/// States of one instruction-fetch cycle from the on-chip flash (SPEC §4.1: 2 states, 16-bit).
+/// States of one instruction-fetch cycle from the on-chip flash (docs/design.md §4.1: 2 states, 16-bit).
 pub const FETCH_STATES: u32 = ROM_ACCESS_STATES;
 
 /// Interrupt entry for an on-chip source, as the H8/300H core charges it (H8/3052F hardware
@@ -31,12 +31,12 @@ pub const INTERRUPT_ENTRY_STATES: u32 = N_PRIORITY_DECISION_INTERNAL
     + FETCH_STATES
     + N_INTERRUPT_INTERNAL;
 
-/// States of RTE (SPEC §4.2).
+/// States of RTE (docs/design.md §4.2).
 pub const RTE_STATES: u32 = 10;
-/// States of SLEEP (SPEC §4.2).
+/// States of SLEEP (docs/design.md §4.2).
 pub const SLEEP_STATES: u32 = 2;
 
-/// Sum of the states of an instruction sequence (on-chip operands, SPEC §4.2).
+/// Sum of the states of an instruction sequence (on-chip operands, docs/design.md §4.2).
 #[must_use]
 pub const fn states_of(insns: &[Insn]) -> u32 {
     let mut total = 0;
@@ -178,7 +178,7 @@ impl<'a, B: ModelBus> Fw<'a, B> {
     }
 }
 
-/// Port 4 as the I²C pins (SPEC §3.6): a line is pulled low by setting its DDR bit (DR bits 7
+/// Port 4 as the I²C pins (docs/design.md §3.6): a line is pulled low by setting its DDR bit (DR bits 7
 /// and 6 stay 0) and released by clearing it; the DDR is write-only, so the firmware keeps a
 /// shadow in a register and writes it whole. A pin operation is `BSET/BCLR #n,R2L ;
 /// MOV.B R2L,@P4DDR:8` (2 + 2 + 3 = 7 states, the edge at the end of the write); reading SDA is

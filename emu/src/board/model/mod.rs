@@ -1,14 +1,14 @@
 //! The robot controller: the program the H8/3052F runs, written in Rust, running on the
 //! emulated MCU through its registers.
 //!
-//! # What it does (SPEC §3.5)
+//! # What it does (docs/design.md §3.5)
 //! At boot it sets up the ports, the ITU (ITU0 as a 10 ms tick interrupt, ITU1 and ITU2 as the
 //! motors' PWM) and the I²C lines, then restores the newest valid record from the two EEPROMs
 //! or, if there is none, draws fresh weights with a seeded xorshift32 (uniform in ±0.5). Then it
 //! sleeps; every tick interrupt counts a tick, and every `step_period_s / 10 ms` ticks it runs a
 //! step:
 //! 1. **A/D**: a scan of AN0–AN3 (134 states per conversion, CKS = 1), polling ADF, then the
-//!    four 8-bit codes through the du table (SPEC §3.3) into the proximities p;
+//!    four 8-bit codes through the du table (docs/design.md §3.3) into the proximities p;
 //! 2. **learner**: D and E(t−1), the update, the input vector and the forward pass
 //!    (`nn_q15`, charged from its H8 meter, phases `input`, `update`, `forward`);
 //! 3. **motors**: the winner's row of the behaviour table into GRB1 and GRB2 (PWM duty) and the
@@ -87,7 +87,7 @@ pub const PWM_PERIOD_COUNTS: u16 = 1250;
 pub const PWM_FULL_GRB: u16 = PWM_PERIOD_COUNTS;
 /// Lowest φ the H8/3052F runs at (hardware manual, electrical characteristics: 2 MHz).
 pub const CLOCK_MIN_HZ: u32 = 2_000_000;
-/// Highest φ of the H8/3052F (hardware manual: 25 MHz; the AKI board's crystal, SPEC §4.1).
+/// Highest φ of the H8/3052F (hardware manual: 25 MHz; the AKI board's crystal, docs/design.md §4.1).
 pub const CLOCK_MAX_HZ: u32 = 25_000_000;
 /// Longest step period accepted (10 minutes).
 pub const MAX_STEP_PERIOD_S: f64 = 600.0;
@@ -149,7 +149,7 @@ const MAIN_TICK_TEST: [Insn; 4] = [Insn::MovLAbs24, Insn::Reg, Insn::Reg, Insn::
 /// its 84 states (three MULXU.W), MOV.W E0,R0, EXTU.L (4).
 pub const RANDOM_WALK_DRAW_STATES: u64 = 10 + 210 + 14 + 10 + 84 + 4;
 
-/// The default wiring of the four IR sensors (front, rear, left, right): AN0–AN3 (SPEC §3.2).
+/// The default wiring of the four IR sensors (front, rear, left, right): AN0–AN3 (docs/design.md §3.2).
 pub const DEFAULT_SENSOR_CHANNELS: [u8; 4] = crate::board::wiring::AN_IR;
 
 /// How the controller is set up.
@@ -764,7 +764,7 @@ impl Controller {
     }
 
     /// [`Self::step`], but the motors run `forced` instead of the network's choice when it is
-    /// given (the random-walk control of SPEC §5: the learner still runs and costs what it
+    /// given (the random-walk control of docs/design.md §5: the learner still runs and costs what it
     /// costs, only its choice is not obeyed).
     ///
     /// # Errors
@@ -1066,7 +1066,7 @@ impl Mark {
     }
 }
 
-/// GRB1, GRB2 and the port-B direction bits for a behaviour (SPEC §3.5: forward (v, v),
+/// GRB1, GRB2 and the port-B direction bits for a behaviour (docs/design.md §3.5: forward (v, v),
 /// backward (−v, −v), turn-left-forward (0.3 v, v), turn-right-forward (v, 0.3 v)).
 #[must_use]
 pub fn motor_row(b: Behaviour) -> (u16, u16, u8) {

@@ -1,4 +1,4 @@
-//! The 10-bit A/D converter of the H8/3052F at register level (SPEC §3.2; H8/3052F hardware
+//! The 10-bit A/D converter of the H8/3052F at register level (docs/design.md §3.2; H8/3052F hardware
 //! manual, section 15 "A/D Converter").
 //!
 //! # Registers
@@ -16,7 +16,7 @@
 //! # Timing (manual: "Input Sampling and A/D Conversion Time", Table "A/D conversion time")
 //! A conversion starts when ADST is written 1 (at the end of that bus cycle). The first
 //! conversion takes t_CONV = [`CONV_STATES_CKS0`] = 266 states with CKS = 0 and
-//! [`CONV_STATES_CKS1`] = 134 with CKS = 1 (the table's maxima, SPEC §3.2): the start delay
+//! [`CONV_STATES_CKS1`] = 134 with CKS = 1 (the table's maxima, docs/design.md §3.2): the start delay
 //! t_D (10–17 / 6–9 states, used at its maximum 17 / 9), then the input sampling time t_SPL
 //! (63 / 31 states), then the successive approximation. The sample-and-hold keeps the input
 //! at the **end of the sampling window**, so the analog input is sampled at
@@ -50,7 +50,7 @@ use sensors::adc10_code;
 use super::Peripheral;
 use crate::chip::mcu::Board;
 
-/// Address of ADDRA (high byte; low byte at +1) (SPEC §3.2: H'FFFFE0).
+/// Address of ADDRA (high byte; low byte at +1) (docs/design.md §3.2: H'FFFFE0).
 pub const ADDRA: u32 = 0xFF_FFE0;
 /// Address of ADDRB.
 pub const ADDRB: u32 = 0xFF_FFE2;
@@ -58,7 +58,7 @@ pub const ADDRB: u32 = 0xFF_FFE2;
 pub const ADDRC: u32 = 0xFF_FFE4;
 /// Address of ADDRD (low byte at H'FFFFE7).
 pub const ADDRD: u32 = 0xFF_FFE6;
-/// Address of ADCSR, A/D control/status register (SPEC §3.2: H'FFFFE8).
+/// Address of ADCSR, A/D control/status register (docs/design.md §3.2: H'FFFFE8).
 pub const ADCSR: u32 = 0xFF_FFE8;
 /// Address of ADCR, A/D control register (H'FFFFE9).
 pub const ADCR: u32 = 0xFF_FFE9;
@@ -80,13 +80,13 @@ pub const ADCR_TRGE: u8 = 0x80;
 /// ADCR bits 6–0 are reserved and read 1 (reset value H'7F).
 pub const ADCR_RESERVED: u8 = 0x7F;
 
-/// A/D interrupt ADI vector (SPEC §4.1: 60).
+/// A/D interrupt ADI vector (docs/design.md §4.1: 60).
 pub const VECTOR_ADI: u8 = 60;
 
-/// Total conversion time with CKS = 0, in states (SPEC §3.2; manual Table "A/D conversion
+/// Total conversion time with CKS = 0, in states (docs/design.md §3.2; manual Table "A/D conversion
 /// time", t_CONV max).
 pub const CONV_STATES_CKS0: u64 = 266;
-/// Total conversion time with CKS = 1, in states (SPEC §3.2; t_CONV max).
+/// Total conversion time with CKS = 1, in states (docs/design.md §3.2; t_CONV max).
 pub const CONV_STATES_CKS1: u64 = 134;
 /// A/D conversion start delay t_D with CKS = 0, at its maximum (manual: 10–17 states).
 pub const START_DELAY_STATES_CKS0: u64 = 17;

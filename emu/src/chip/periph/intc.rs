@@ -23,7 +23,7 @@
 use super::Peripheral;
 use crate::chip::mcu::Board;
 
-/// Address of SYSCR, the system control register (SPEC §4.1: H'FFFFF2).
+/// Address of SYSCR, the system control register (docs/design.md §4.1: H'FFFFF2).
 pub const SYSCR: u32 = 0xFF_FFF2;
 /// Reset value of SYSCR in this model: H'0B (UE = 1, RAME = 1, STS = 000, SSBY = 0).
 pub const SYSCR_RESET: u8 = 0x0B;

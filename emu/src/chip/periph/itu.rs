@@ -27,7 +27,7 @@
 //! - **PWM mode** (TMDR.PWMn = 1): TIOCAn is set to 1 at compare match A and cleared to 0 at
 //!   compare match B; when both happen at once (GRA = GRB) the output does not change. With
 //!   the counter cleared by GRA (CCLR = 01) the period is GRA + 1 counts and the high time
-//!   GRB + 1 counts (SPEC §3.5); GRB > GRA gives 100 % (B never matches), as the manual's
+//!   GRB + 1 counts (docs/design.md §3.5); GRB > GRA gives 100 % (B never matches), as the manual's
 //!   0 %/100 % duty examples say. Cleared by GRB instead, the high time is GRB − GRA counts.
 //!   See [`Itu::pwm`] for the steady-state waveform.
 //! - Output compare outside PWM mode on TIOCA (IOA = 001 → 0, 010 → 1, 011 → toggle) is
@@ -51,7 +51,7 @@
 use super::Peripheral;
 use crate::chip::mcu::Board;
 
-/// Address of TSTR, timer start register (SPEC §4.1: H'FFFF60).
+/// Address of TSTR, timer start register (docs/design.md §4.1: H'FFFF60).
 pub const TSTR: u32 = 0xFF_FF60;
 /// Address of TSNC, timer synchro register.
 pub const TSNC: u32 = 0xFF_FF61;
@@ -68,7 +68,7 @@ pub const ITU_FIRST: u32 = TSTR;
 /// Last ITU register address (BRB4 low byte).
 pub const ITU_LAST: u32 = 0xFF_FF9F;
 
-/// Base address of each channel's registers (SPEC §4.1: ITU0 H'FFFF64, ITU1 H'FFFF6E, ITU2
+/// Base address of each channel's registers (docs/design.md §4.1: ITU0 H'FFFF64, ITU1 H'FFFF6E, ITU2
 /// H'FFFF78, ITU3 H'FFFF82, ITU4 H'FFFF92).
 pub const CHANNEL_BASE: [u32; 5] = [0xFF_FF64, 0xFF_FF6E, 0xFF_FF78, 0xFF_FF82, 0xFF_FF92];
 
@@ -123,7 +123,7 @@ pub const CCLR_GRA: u8 = 1;
 pub const CCLR_GRB: u8 = 2;
 
 /// States of a word access to TCNT/GRA/GRB/BRA/BRB: one 3-state cycle on the ITU's internal
-/// 16-bit bus (manual, ITU register descriptions; the 3 states are SPEC §4.1's on-chip I/O
+/// 16-bit bus (manual, ITU register descriptions; the 3 states are docs/design.md §4.1's on-chip I/O
 /// figure, [`crate::core::memmap::IO_ACCESS_STATES`]).
 pub const ITU_WORD_ACCESS_STATES: u32 = crate::core::memmap::IO_ACCESS_STATES;
 

@@ -7,7 +7,7 @@
 //!
 //! - **DDRs are write-only.** The manual: a DDR cannot be read; a read returns 1 in every bit.
 //!   So reading PnDDR returns [`DDR_READ_VALUE`] (H'FF) whatever was written — firmware keeps a
-//!   shadow copy (SPEC §3.6).
+//!   shadow copy (docs/design.md §3.6).
 //! - **DR reads** return the DR latch for output bits (DDR = 1) and the pin level for input
 //!   bits (DDR = 0).
 //! - **Pull-ups** (P2PCR, P4PCR): an input pin with its PCR bit set is pulled high by the
@@ -32,17 +32,17 @@ use super::Peripheral;
 use super::itu::Itu;
 use crate::chip::mcu::Board;
 
-/// Address of P2DDR, port 2 data direction register (write-only; SPEC §4.1: H'FFFFC1).
+/// Address of P2DDR, port 2 data direction register (write-only; docs/design.md §4.1: H'FFFFC1).
 pub const P2DDR: u32 = 0xFF_FFC1;
-/// Address of P2DR, port 2 data register (SPEC §4.1: H'FFFFC3).
+/// Address of P2DR, port 2 data register (docs/design.md §4.1: H'FFFFC3).
 pub const P2DR: u32 = 0xFF_FFC3;
 /// Address of P2PCR, port 2 input pull-up control register (H'FFFFD8).
 pub const P2PCR: u32 = 0xFF_FFD8;
-/// Address of P4DDR, port 4 data direction register (write-only; SPEC §4.1: H'FFFFC5).
+/// Address of P4DDR, port 4 data direction register (write-only; docs/design.md §4.1: H'FFFFC5).
 pub const P4DDR: u32 = 0xFF_FFC5;
-/// Address of P4DR, port 4 data register (SPEC §4.1: H'FFFFC7).
+/// Address of P4DR, port 4 data register (docs/design.md §4.1: H'FFFFC7).
 pub const P4DR: u32 = 0xFF_FFC7;
-/// Address of P4PCR, port 4 input pull-up control register (SPEC §4.1: H'FFFFDA).
+/// Address of P4PCR, port 4 input pull-up control register (docs/design.md §4.1: H'FFFFDA).
 pub const P4PCR: u32 = 0xFF_FFDA;
 /// Address of PADDR, port A data direction register (write-only; H8/3052F manual appendix B:
 /// H'FFFFD1).
@@ -65,11 +65,11 @@ pub const PB_TIOCA3: u8 = 0x01;
 /// Port-B bit of TIOCA4 (PB2).
 pub const PB_TIOCA4: u8 = 0x04;
 
-/// Port-4 bit of the EEPROM bus's data line SDA (P4.7, SPEC §3.6). The H8/3052F has no I²C
+/// Port-4 bit of the EEPROM bus's data line SDA (P4.7, docs/design.md §3.6). The H8/3052F has no I²C
 /// module: the chip model carries the robot's I²C bus on these two pins, bit-banged by
 /// firmware through P4DDR (see [`crate::chip::mcu`]).
 pub const P4_SDA: u8 = 0x80;
-/// Port-4 bit of the EEPROM bus's clock line SCL (P4.6, SPEC §3.6).
+/// Port-4 bit of the EEPROM bus's clock line SCL (P4.6, docs/design.md §3.6).
 pub const P4_SCL: u8 = 0x40;
 
 /// What a read of a write-only DDR returns: every bit 1 (H8/3052F manual, port sections: "DDR
@@ -126,7 +126,7 @@ impl Port {
     }
 
     /// Pins that drive a low level (output bits whose latch is 0): what pulls an open-drain
-    /// line low when DDR is set with DR = 0 (SPEC §3.6).
+    /// line low when DDR is set with DR = 0 (docs/design.md §3.6).
     #[inline]
     #[must_use]
     pub const fn driven_low(&self) -> u8 {

@@ -1,8 +1,8 @@
 //! SCI1, the serial communication interface channel 1 of the H8/3052F, at register level
 //! (H8/3052F hardware manual, section 13 "Serial Communication Interface"), transmit side.
 //!
-//! Registers at H'FFFFB8–H'FFFFBD (SPEC §4.1): SMR, BRR, SCR, TDR, SSR, RDR. The transmitter
-//! behaves as on the chip (SPEC §7): with SCR.TE = 1, a program writes TDR and clears SSR.TDRE
+//! Registers at H'FFFFB8–H'FFFFBD (docs/design.md §4.1): SMR, BRR, SCR, TDR, SSR, RDR. The transmitter
+//! behaves as on the chip (docs/design.md §7): with SCR.TE = 1, a program writes TDR and clears SSR.TDRE
 //! (by writing 0 after reading it as 1); the byte moves to the transmit shift register as soon
 //! as that is free, at which moment TDRE is set again and the byte goes to the console sink;
 //! TEND is set when the shift register has sent its last bit and TDR is empty. A frame takes
@@ -20,7 +20,7 @@
 use super::Peripheral;
 use crate::chip::mcu::Board;
 
-/// Address of SMR (serial mode register) of SCI1 (SPEC §4.1).
+/// Address of SMR (serial mode register) of SCI1 (docs/design.md §4.1).
 pub const SCI1_SMR: u32 = 0xFF_FFB8;
 /// Address of BRR (bit rate register) of SCI1.
 pub const SCI1_BRR: u32 = 0xFF_FFB9;
@@ -37,7 +37,7 @@ pub const SCI1_RDR: u32 = 0xFF_FFBD;
 pub const VECTOR_ERI1: u8 = 56;
 /// SCI1 RXI (receive data full) vector.
 pub const VECTOR_RXI1: u8 = 57;
-/// SCI1 TXI (transmit data empty) vector (SPEC §4.1: 58).
+/// SCI1 TXI (transmit data empty) vector (docs/design.md §4.1: 58).
 pub const VECTOR_TXI1: u8 = 58;
 /// SCI1 TEI (transmit end) vector.
 pub const VECTOR_TEI1: u8 = 59;

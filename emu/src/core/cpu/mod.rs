@@ -116,11 +116,11 @@ pub const CCR_V: u8 = 0x02;
 /// CCR bit 0: carry.
 pub const CCR_C: u8 = 0x01;
 
-/// Vector number of the reset exception (SPEC §4.1).
+/// Vector number of the reset exception (docs/design.md §4.1).
 pub const VECTOR_RESET: u8 = 0;
 /// Vector number of NMI (H8/3052F hardware manual, Table 5-3).
 pub const VECTOR_NMI: u8 = 7;
-/// First TRAPA vector (TRAPA #0 = 8 ... #3 = 11; SPEC §4.1).
+/// First TRAPA vector (TRAPA #0 = 8 ... #3 = 11; docs/design.md §4.1).
 pub const VECTOR_TRAPA0: u8 = 8;
 /// Vector number of IRQ0 (H8/3052F hardware manual, Table 5-3; IRQ0–IRQ5 = 12–17).
 pub const VECTOR_IRQ0: u8 = 12;
@@ -140,7 +140,7 @@ pub enum CpuError {
         /// The bytes read, as `xx xx ...`.
         bytes: String,
     },
-    /// An instruction fetch went outside ROM and RAM (SPEC §7).
+    /// An instruction fetch went outside ROM and RAM (docs/design.md §7).
     #[error(
         "instruction fetch outside ROM and RAM at H'{addr:06X} (instruction at PC H'{pc:06X}, area {area:?}); code may run only from ROM H'000000-H'07FFFF or RAM H'FFDF10-H'FFFF0F"
     )]
@@ -174,7 +174,7 @@ pub enum Event {
     Executed,
     /// An interrupt was accepted (exception handling ran; no instruction).
     Interrupt(u8),
-    /// SLEEP ran with CCR.I = 1 and no NMI pending: the program has halted (SPEC §7). Further
+    /// SLEEP ran with CCR.I = 1 and no NMI pending: the program has halted (docs/design.md §7). Further
     /// steps do nothing and report this again.
     Halted,
     /// The CPU is in sleep mode and the deadline passed with no interrupt to wake it.
@@ -476,7 +476,7 @@ impl Cpu {
         self.fast_path
     }
 
-    /// Whether SLEEP has halted the program (SPEC §7).
+    /// Whether SLEEP has halted the program (docs/design.md §7).
     #[must_use]
     pub fn halted(&self) -> bool {
         self.state == RunState::Halted

@@ -10,7 +10,7 @@
 //! more than the instruction's length: the prefetch of the branch target), charged by the core as
 //! a word fetch at the target.
 //!
-//! With on-chip operands (S = 2 for every access, S_N = 1) the totals are those of SPEC §4.2;
+//! With on-chip operands (S = 2 for every access, S_N = 1) the totals are those of docs/design.md §4.2;
 //! `tests/timing.rs` checks them one by one.
 
 /// Internal states (N) of MOV and LDC/STC with `@ERs+` or `@-ERd` (programming manual, Table A:
