@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Sweeps on a real Slurm (issue 15): starts a single-node Slurm on this machine from Debian's
+# Sweeps on a real Slurm: starts a single-node Slurm on this machine from Debian's
 # slurm-wlm and munge (munged, slurmctld and slurmd as root, every address 127.0.0.1, no cgroups:
 # ProctrackType=proctrack/linuxproc, TaskPlugin=task/none), plans a 2 x 2 x 3-seed sweep of
 # short arena runs, submits its sweep.sbatch with the real sbatch (a job array of 6 tasks of 2
