@@ -435,9 +435,10 @@ proptest! {
 
     /// Against the exact ratio 2^15·y/m (before the shift that fits m into 16 bits), O is off by
     /// less than 5 LSB: the shift drops up to one unit of m' ≥ 2^14 from y and from m (each
-    /// worth < 2 LSB) and the division truncates (< 1 LSB). docs/design.md §2.5 asks for 1 LSB of "the
-    /// real quotient"; against the exact ratio the spec's own algorithm cannot give that (the
-    /// worst case seen is about 3.8 LSB), so this test pins the bound the algorithm does give.
+    /// worth < 2 LSB) and the division truncates (< 1 LSB). Against the
+    /// shifted operands the division sees, O is within 1 LSB (the test above); against the exact
+    /// ratio the algorithm cannot give that (the worst case seen is about 3.8 LSB), so this test
+    /// pins the bound it does give (docs/design.md §2.5 states both).
     #[test]
     fn output_within_5_lsb_of_exact_ratio(c in case()) {
         let shape = Shape::new(c.n, c.m).unwrap();

@@ -2,8 +2,8 @@
 //!
 //! Far branch (d ≥ 8 cm, d in cm): `V(d) = 28.48 / (d + 3.0) + 0.059` V, the design's fit to the
 //! datasheet curve. It is the authority for d ≥ 8 cm, so the modelled peak is
-//! `V(8 cm) = 2.648 V` (the design's "≈ 3.2 V at 8 cm" is the formula's value at 6 cm; see the crate
-//! docs). Beyond 80 cm the same 1/d fall continues (0.402 V at 80 cm, 0.087 V at 10 m).
+//! `V(8 cm) = 2.648 V` (the often-quoted "≈ 3.2 V" peak is the formula's value at 6 cm; see the
+//! crate docs). Beyond 80 cm the same 1/d fall continues (0.402 V at 80 cm, 0.087 V at 10 m).
 //!
 //! Fold-back branch (d < 8 cm): a straight line from [`FOLDBACK_CONTACT_VOLTS`] at contact up
 //! to `V(8 cm)`, continuous with the far branch. Every voltage of the fold-back branch below
@@ -99,7 +99,7 @@ mod tests {
     fn key_points_of_the_curve() {
         assert!((v(80.0) - 2.6481).abs() < 1e-4, "peak {}", v(80.0));
         assert_eq!(v(80.0), PEAK_VOLTS);
-        // the design's "3.2 V" is the formula's value at 6 cm.
+        // the often-quoted "3.2 V" peak is the formula's value at 6 cm.
         assert!((far_branch_volts_at_cm(6.0) - 3.2234).abs() < 1e-4);
         assert!((v(100.0) - 2.2498).abs() < 1e-4);
         assert!((v(800.0) - 0.4021).abs() < 1e-4);

