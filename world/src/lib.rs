@@ -140,6 +140,7 @@
 #![deny(missing_docs)]
 
 pub mod arena;
+mod body;
 mod contact;
 pub mod dc_motor;
 pub mod error;
@@ -147,14 +148,17 @@ pub mod geometry;
 mod grid;
 pub mod motor;
 pub mod params;
-mod solver;
+mod pipeline;
+mod placement;
 mod world;
 
 pub use arena::{Arena, ArenaKind, Segment};
 pub use error::WorldError;
 pub use motor::{Behaviour, Direction, WheelCommand};
 pub use params::{SensorMount, WorldParams};
+pub use pipeline::broad_phase::BROAD_PHASE_MARGIN_M;
+pub use pipeline::solver::CONTACT_SKIN_M;
 pub use world::{
-    BROAD_PHASE_MARGIN_M, CONTACT_SKIN_M, FRONT, LEFT, MAX_ROBOTS, Pose, REAR, RIGHT, SolverStats,
-    SubstepPlan, World, coefficient_of_variation,
+    FRONT, LEFT, MAX_ROBOTS, Pose, REAR, RIGHT, SolverStats, SubstepPlan, World,
+    coefficient_of_variation,
 };

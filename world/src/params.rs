@@ -1,5 +1,6 @@
 //! Physical parameters of the robots and the simulation, with their sources and valid ranges.
 
+use crate::body::BodyConst;
 use crate::error::WorldError;
 
 /// Body length along the heading: 230 mm (docs/design.md §1, paper §4: robots of 230 × 180 × 130 mm).
@@ -444,13 +445,15 @@ impl WorldParams {
             .wheel_forces(d_along_m_per_s, d_omega_rad_per_s, 1.0 / h_s)
     }
 
-    fn body(&self) -> crate::solver::BodyConst {
-        crate::solver::BodyConst::new(
+    /// What every robot shares, from these parameters: size, mass, inertia, wheel geometry,
+    /// traction (`μ_floor · m·g/2` per drive wheel) and friction.
+    pub(crate) fn body(&self) -> BodyConst {
+        BodyConst::new(
             self.mass_kg,
             self.body_length_m,
             self.body_width_m,
             self.wheel_track_m,
-            self.mu_floor,
+            self.mu_floor * self.mass_kg * GRAVITY_M_PER_S2 * 0.5,
             self.mu_robot,
             self.mu_wall,
         )
