@@ -157,3 +157,128 @@ pub(crate) fn place_open(
     }
     Ok(poses)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::arena::ArenaKind;
+    use crate::params::PLACEMENT_CLEARANCE_M;
+
+    /// The placement the world makes for `arena`'s kind.
+    fn place(
+        arena: &Arena,
+        params: &WorldParams,
+        n: usize,
+        seed: u64,
+    ) -> Result<Vec<BodyPose>, WorldError> {
+        match arena.kind() {
+            ArenaKind::Corridor => place_corridor(arena, params, n, seed),
+            ArenaKind::Open => place_open(arena, params, n, seed),
+        }
+    }
+
+    /// Every body keeps `clr` from the walls (in the corridor: along it, and inside it across)
+    /// and from every other body.
+    fn assert_clearance(arena: &Arena, params: &WorldParams, poses: &[BodyPose], clr: f64) {
+        let (hx, hy) = (0.5 * params.body_length_m, 0.5 * params.body_width_m);
+        let (w, h) = (arena.width_m(), arena.height_m());
+        for (i, b) in poses.iter().enumerate() {
+            let (ex, ey) = b.obb(hx, hy).aabb_half_extents();
+            assert!(b.x - ex >= clr - 1e-12 && b.x + ex <= w - clr + 1e-12);
+            if arena.kind() == ArenaKind::Open {
+                assert!(b.y - ey >= clr - 1e-12 && b.y + ey <= h - clr + 1e-12);
+            } else {
+                assert!(!b.crosses_walls(hx, hy, w, h));
+            }
+            for (j, c) in poses.iter().enumerate().skip(i + 1) {
+                assert!(
+                    obb_overlap(&b.obb(hx, hy), &c.obb(hx, hy), -clr + 1e-12).is_none(),
+                    "{i} {j}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn placement_is_non_overlapping_and_deterministic() {
+        let params = WorldParams::default();
+        for (arena, n) in [
+            (Arena::square(), 3),
+            (Arena::square(), 15),
+            (Arena::scaled_square(300).unwrap(), 300),
+            (Arena::paper_corridor(), 3),
+            (Arena::paper_corridor(), 8),
+        ] {
+            let a = place(&arena, &params, n, 5).unwrap();
+            let b = place(&arena, &params, n, 5).unwrap();
+            let c = place(&arena, &params, n, 6).unwrap();
+            assert_eq!(a, b);
+            assert_ne!(a, c);
+            assert_eq!(a.len(), n);
+            assert_clearance(&arena, &params, &a, PLACEMENT_CLEARANCE_M);
+            if arena.kind() == ArenaKind::Corridor {
+                for p in &a {
+                    assert_eq!(p.y, 0.11);
+                    assert!(p.s == 0.0 && p.c.abs() == 1.0);
+                }
+            }
+        }
+        // Headings in the corridor are both ways across seeds.
+        let mut dirs = std::collections::BTreeSet::new();
+        for seed in 0..20 {
+            for p in place(&Arena::paper_corridor(), &params, 3, seed).unwrap() {
+                dirs.insert(p.c as i64);
+            }
+        }
+        assert_eq!(dirs.len(), 2);
+    }
+
+    #[test]
+    fn crowded_placement_is_an_error_that_says_how_many_fit() {
+        let params = WorldParams::default();
+        // Corridor: 3.0 m holds floor((3.0 − 0.05) / 0.28) = 10 robots at 5 cm.
+        assert!(place(&Arena::paper_corridor(), &params, 10, 1).is_ok());
+        let e = place(&Arena::paper_corridor(), &params, 11, 1).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                WorldError::TooManyRobots {
+                    requested: 11,
+                    max_fit: 10,
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        assert!(e.to_string().contains("at most 10 fit"), "{e}");
+        // Square: the area bound is (1.75)² / (0.28 · 0.23) = 47.
+        let e = place(&Arena::square(), &params, 48, 1).unwrap_err();
+        assert!(
+            matches!(e, WorldError::TooManyRobots { max_fit: 47, .. }),
+            "{e}"
+        );
+        // Below the bound but beyond what random placement reaches: bounded attempts, then an
+        // error.
+        let e = place(&Arena::square(), &params, 46, 1).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                WorldError::PlacementFailed {
+                    requested: 46,
+                    attempts: 56_000,
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        assert!(e.to_string().contains("after 56000 random attempts"), "{e}");
+        // A body wider than the corridor.
+        let wide = WorldParams {
+            body_width_m: 0.25,
+            ..WorldParams::default()
+        };
+        assert!(place(&Arena::paper_corridor(), &wide, 1, 1).is_err());
+        // Zero robots: nothing placed.
+        assert!(place(&Arena::square(), &params, 0, 1).unwrap().is_empty());
+    }
+}

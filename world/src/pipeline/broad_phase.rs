@@ -182,3 +182,94 @@ impl CandidateCtx<'_> {
         }
     }
 }
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+    use crate::body::BodyConst;
+    use crate::geometry::obb_overlap;
+    use crate::params::WorldParams;
+    use crate::pipeline::narrow_phase::speculative_m;
+    use core::f64::consts::PI;
+    use proptest::prelude::*;
+
+    /// A broad phase built over arbitrary (possibly overlapping) poses, given as fractions
+    /// (x, y) of a `side` × 0.7·`side` arena and a heading, with the margins of `params`.
+    pub(crate) fn scene(
+        params: &WorldParams,
+        side: f64,
+        xs: &[(f64, f64, f64)],
+    ) -> (Vec<BodyPose>, BodyConst, BroadPhase) {
+        let body = params.body();
+        let (w, h) = (side, side * 0.7);
+        let pose: Vec<BodyPose> = xs
+            .iter()
+            .map(|&(fx, fy, th)| {
+                let (s, c) = th.sin_cos();
+                BodyPose {
+                    x: fx * w,
+                    y: fy * h,
+                    c,
+                    s,
+                }
+            })
+            .collect();
+        let states = (params.max_substep_s * params.clock_hz as f64).round();
+        let spec_max = speculative_m(params, body.radius_m, states / params.clock_hz as f64);
+        let mut broad = BroadPhase::new(w, h, body.radius_m, spec_max, pose.len());
+        broad.rebuild(&pose, body.radius_m, w, h, false);
+        (pose, body, broad)
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(200))]
+
+        /// Overlapping pairs found through the grid equal brute force, and every robot that
+        /// reaches past a wall is a wall candidate.
+        #[test]
+        fn broad_phase_equals_brute_force(
+            side in 1.0f64..8.0,
+            xs in proptest::collection::vec((0.0f64..1.0, 0.0f64..1.0, -PI..PI), 1..80),
+        ) {
+            let n = xs.len();
+            let (pose, body, broad) = scene(&WorldParams::default(), side, &xs);
+            let obb = |i: usize| body.obb(pose[i]);
+            let mut via_grid = std::collections::BTreeSet::new();
+            for &[i, j] in &broad.candidates().pairs {
+                if obb_overlap(&obb(i as usize), &obb(j as usize), 0.0).is_some() {
+                    via_grid.insert((i as usize, j as usize));
+                }
+            }
+            let mut brute = std::collections::BTreeSet::new();
+            for (i, b) in pose.iter().enumerate() {
+                for j in i + 1..n {
+                    if obb_overlap(&obb(i), &obb(j), 0.0).is_some() {
+                        brute.insert((i, j));
+                    }
+                }
+                if b.crosses_walls(body.hx, body.hy, side, side * 0.7) {
+                    prop_assert!(broad.candidates().walls.contains(&(i as u32)));
+                }
+            }
+            prop_assert_eq!(via_grid, brute);
+        }
+    }
+
+    /// The parallel rebuild, chunk by chunk, gives the serial one's candidates in the same
+    /// order.
+    #[test]
+    fn parallel_rebuild_equals_serial() {
+        let xs: Vec<(f64, f64, f64)> = (0..3 * PAR_CHUNK + 7)
+            .map(|k| {
+                let f = k as f64;
+                ((f * 0.618_034).fract(), (f * 0.414_214).fract(), f)
+            })
+            .collect();
+        let (pose, body, serial) = scene(&WorldParams::default(), 12.0, &xs);
+        let mut parallel = serial.clone();
+        parallel.rebuild(&pose, body.radius_m, 12.0, 8.4, true);
+        assert!(!serial.candidates().pairs.is_empty());
+        assert_eq!(serial.candidates().pairs, parallel.candidates().pairs);
+        assert_eq!(serial.candidates().walls, parallel.candidates().walls);
+    }
+}

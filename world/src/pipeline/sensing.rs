@@ -230,3 +230,65 @@ impl RayScene<'_> {
         hit.then_some(t_max)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::pipeline::broad_phase::tests::scene;
+    use core::f64::consts::PI;
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(200))]
+
+        /// Every ray cast through the grid equals a brute-force cast against all walls and
+        /// robots.
+        #[test]
+        fn rays_equal_brute_force(
+            side in 1.0f64..8.0,
+            xs in proptest::collection::vec((0.0f64..1.0, 0.0f64..1.0, -PI..PI), 1..80),
+        ) {
+            let params = WorldParams {
+                rays_per_sensor: 3,
+                cone_half_angle_rad: 0.05,
+                ..WorldParams::default()
+            };
+            let (pose, body, broad) = scene(&params, side, &xs);
+            let (w, h) = (side, side * 0.7);
+            let rays = RayScene {
+                pose: &pose,
+                body: &body,
+                grid: broad.grid(),
+                drift_limit_m: broad.drift_limit_m(),
+                w,
+                h,
+                range: params.sensor_max_range_m,
+            };
+            let mounts = MountRays::all(&params);
+            for robot in 0..pose.len() {
+                for m in &mounts {
+                    let b = pose[robot];
+                    let ox = b.x + b.c * m.x - b.s * m.y;
+                    let oy = b.y + b.s * m.x + b.c * m.y;
+                    let mut brute: Option<f64> = None;
+                    for &(dc, ds) in &m.dirs {
+                        let dx = b.c * dc - b.s * ds;
+                        let dy = b.s * dc + b.c * ds;
+                        let mut t = ray_walls(ox, oy, dx, dy, w, h);
+                        for (j, &q) in pose.iter().enumerate() {
+                            if j != robot
+                                && let Some(tj) = ray_obb(ox, oy, dx, dy, &body.obb(q), f64::INFINITY)
+                            {
+                                t = t.min(tj);
+                            }
+                        }
+                        if t <= params.sensor_max_range_m && brute.is_none_or(|bt| t < bt) {
+                            brute = Some(t);
+                        }
+                    }
+                    prop_assert_eq!(rays.sense(robot, m), brute.map(|t| t * 1000.0));
+                }
+            }
+        }
+    }
+}

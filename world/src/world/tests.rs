@@ -1,6 +1,7 @@
-//! Unit and property tests of the world: kinematics, motors, collisions, bumpers, rays, broad
-//! phase against brute force, placement, determinism, errors, and a `parry2d` cross-check of
-//! the narrow phase.
+//! Tests of the whole world through its step: kinematics, motors, collisions, bumpers, rays
+//! after motion, poses given by the caller, determinism and thread counts, errors. The stages'
+//! own tests stand in their files (the broad phase and the rays against brute force,
+//! placement; the geometry against `parry2d`).
 
 use super::*;
 use crate::geometry::{ray_obb, ray_walls};
@@ -892,7 +893,7 @@ fn a_cone_sees_what_the_axis_ray_misses() {
     assert!(near < 500.0, "{near}");
 }
 
-// ----- broad phase against brute force --------------------------------------------------------
+// ----- rays against brute force after motion ----------------------------------------------------
 
 /// The nearest hit by brute force over every wall and robot.
 fn brute_sense(w: &World, robot: usize, sensor: usize) -> Option<f64> {
@@ -944,7 +945,15 @@ proptest! {
     }
 }
 
-// ----- poses given by the caller ----------------------------------------------------------------
+// ----- placement and poses given by the caller ----------------------------------------------------
+
+/// A world of no robots is a world, and advances.
+#[test]
+fn an_empty_world_advances() {
+    let mut w = World::new(Arena::square(), WorldParams::default(), 0, 1).unwrap();
+    assert_eq!(w.robot_count(), 0);
+    w.advance(0.01).unwrap();
+}
 
 #[test]
 fn from_poses_rejects_overlaps_and_bodies_outside() {
