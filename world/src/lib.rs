@@ -99,11 +99,10 @@
 //!   robot resting against a wall without pushing does not hold its switch. A pressed switch
 //!   releases only when its face carries less than `bumper_release_force_n` (default 0.02 N: a
 //!   snap-action micro-switch's release force, far below its operating force; Omron D2F data
-//!   sheet). A press is a force, so it does not depend on the sub-step's length. (Until issue
-//!   12's last stop any correction pressed the switch whatever its size, and a pressed switch
-//!   released at its operating force: a robot rubbing lightly along a wall, its turning corner
-//!   corrected out of a sub-micrometre overlap in every second sub-step, read pressed, released,
-//!   pressed… and counted a collision every 40 ms; `tests/bumper_rub.rs`.)
+//!   sheet). A press is a force, so it does not depend on the sub-step's length. Without the
+//!   threshold and the hysteresis, a robot rubbing lightly along a wall, its turning corner
+//!   corrected out of a sub-micrometre overlap in every second sub-step, would read pressed,
+//!   released, pressed… and count a collision every 40 ms (`tests/bumper_rub.rs`).
 //! - **Sensors** (docs/design.md §3.1): by default four, at the middle of the front, rear, left and right
 //!   sides, facing out (indices [`FRONT`], [`REAR`], [`LEFT`], [`RIGHT`]); mounts, rays per
 //!   sensor (a cone) and range are parameters. [`World::sense`] casts from the mount against
