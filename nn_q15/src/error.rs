@@ -4,6 +4,8 @@
 
 use core::fmt;
 
+use crate::limits::{MAX_BEHAVIOURS, MAX_HISTORY, MAX_INPUTS, MAX_OUTPUTS, MIN_OUTPUTS};
+
 /// A network shape or a slice that does not fit it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ShapeError {
@@ -47,19 +49,17 @@ impl fmt::Display for ShapeError {
             ShapeError::Inputs { got } => write!(
                 f,
                 "{got} inputs is outside the no-overflow bound: valid is 1 to {}",
-                crate::net::MAX_INPUTS
+                MAX_INPUTS
             ),
             ShapeError::Outputs { got } => write!(
                 f,
                 "{got} outputs: valid is {} to {}",
-                crate::net::MIN_OUTPUTS,
-                crate::net::MAX_OUTPUTS
+                MIN_OUTPUTS, MAX_OUTPUTS
             ),
             ShapeError::Behaviours { got } => write!(
                 f,
                 "{got} outputs: a learner that drives the robot has one per enabled behaviour, {} to {}",
-                crate::net::MIN_OUTPUTS,
-                crate::learner::MAX_BEHAVIOURS
+                MIN_OUTPUTS, MAX_BEHAVIOURS
             ),
             ShapeError::Length {
                 what,
@@ -134,7 +134,7 @@ impl fmt::Display for ConfigError {
             ConfigError::History { got } => write!(
                 f,
                 "history depth {got} is out of range: valid is 0 to {}",
-                crate::input::MAX_HISTORY
+                MAX_HISTORY
             ),
             ConfigError::Inputs { layout, network } => write!(
                 f,

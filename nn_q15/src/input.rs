@@ -11,11 +11,10 @@
 //! place (one 32-bit move per block on the H8) before writing the new readings.
 
 use crate::error::ConfigError;
+use crate::limits::MAX_HISTORY;
 
 /// Number of proximity sensors K (front, rear, left, right: docs/design.md §1).
 pub const SENSORS: usize = 4;
-/// Deepest history the layout allows (docs/design.md §2.2: 0 … 8).
-pub const MAX_HISTORY: usize = 8;
 
 /// How the input vector is made up: history depth and bias.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

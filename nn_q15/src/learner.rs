@@ -11,9 +11,8 @@ use crate::cost::{Meter, Op, Phase};
 use crate::error::{ConfigError, ShapeError};
 use crate::format::{Q7, Q15, evaluation_to_q7, output_to_q7, proximity_to_q7};
 use crate::input::{InputLayout, SENSORS};
-use crate::net::{
-    ForwardOut, MAX_INPUTS, Network, Params, Shape, UpdateKind, forward_core, update_core,
-};
+use crate::limits::{MAX_BEHAVIOURS, MAX_INPUTS};
+use crate::net::{ForwardOut, Network, Params, Shape, UpdateKind, forward_core, update_core};
 
 /// The four primitive behaviours (docs/design.md §2.3 step 4).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -385,11 +384,6 @@ impl<const N: usize, const M: usize> Learner<N, M> {
         }
     }
 }
-
-/// Most behaviours a robot's learner drives: the four primitive behaviours (docs/design.md §2.2). The
-/// learner core takes up to [`crate::MAX_OUTPUTS`] outputs; [`Learner`] and [`DynLearner`] map each
-/// output to a behaviour, so they take at most four.
-pub const MAX_BEHAVIOURS: usize = 4;
 
 /// Capacity of a [`DynLearner`]'s weight storage: the largest network, 256 × 4.
 pub const MAX_WEIGHTS: usize = MAX_INPUTS * MAX_BEHAVIOURS;

@@ -32,17 +32,15 @@ pub mod error;
 pub mod format;
 pub mod input;
 pub mod learner;
+pub mod limits;
 pub mod net;
 
 pub use cost::{H8Meter, Meter, NoopMeter, Op, Phase};
 pub use error::{ConfigError, ParamError, ShapeError};
 pub use format::{Q7, Q15, Q22};
-pub use input::{InputLayout, MAX_HISTORY, SENSORS};
+pub use input::{InputLayout, SENSORS};
 pub use learner::{
-    Behaviour, DynLearner, Learner, MAX_BEHAVIOURS, MAX_WEIGHTS, RamItem, StepOut, ram_bytes,
-    ram_items,
+    Behaviour, DynLearner, Learner, MAX_WEIGHTS, RamItem, StepOut, ram_bytes, ram_items,
 };
-pub use net::{
-    ForwardOut, MAX_INPUTS, MAX_OUTPUTS, MIN_OUTPUTS, Network, Params, Shape, UpdateKind,
-    forward_slice, update_slice,
-};
+pub use limits::{MAX_BEHAVIOURS, MAX_HISTORY, MAX_INPUTS, MAX_OUTPUTS, MIN_OUTPUTS};
+pub use net::{ForwardOut, Network, Params, Shape, UpdateKind, forward_slice, update_slice};

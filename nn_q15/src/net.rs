@@ -7,16 +7,8 @@
 use crate::cost::{Meter, Op, Phase};
 use crate::error::{ParamError, ShapeError};
 use crate::format::{Q7, Q15, Q22, round_half_away_shr7, sat16};
+use crate::limits::{MAX_INPUTS, MAX_OUTPUTS, MIN_OUTPUTS};
 
-/// Most inputs a network may have: with |w·x| ≤ 2^15 · 2^7 = 2^22 per product, 256 products sum
-/// to at most 2^30, inside an `i32` (docs/design.md §2.1: "no overflow for N ≤ 256").
-pub const MAX_INPUTS: usize = 256;
-/// Fewest outputs (the corridor's forward and backward, docs/design.md §2.2).
-pub const MIN_OUTPUTS: usize = 2;
-/// Most outputs of the learner core (forward pass, update, replay): 8. A robot enables 2 or 4
-/// behaviours ([`crate::MAX_BEHAVIOURS`]); wider shapes are for what-if studies and for the
-/// calibration of the cost model against the firmware, whose routines take up to 8.
-pub const MAX_OUTPUTS: usize = 8;
 /// 1.0 in Q22: a weighted sum at or above it switches the forward pass to Eq. 2's division by
 /// the largest sum (docs/design.md §2.3 step 3).
 pub const ONE_Q22: i32 = 1 << 22;

@@ -1,4 +1,4 @@
-//! The contact model against `rapier2d` on the same scenes (issue 12): n robots (3, 100, 1 000,
+//! The contact model against `rapier2d` on the same scenes: n robots (3, 100, 1 000,
 //! 10 000) in the square arena scaled to the paper's density, every robot drawing a random
 //! behaviour every 0.45 s, 0.45 s steps cut into 23 sub-steps of 19.6 ms. Both engines get the
 //! same bodies (0.5 kg boxes 230 × 180 mm), the same wheels (a first-order lag of 60 ms to the

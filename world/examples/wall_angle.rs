@@ -1,4 +1,4 @@
-//! One differential-drive robot driving into a wall at an angle (issue 12): does it square up
+//! One differential-drive robot driving into a wall at an angle: does it square up
 //! to the wall and stay, or slide along it? Three models of the same robot (0.5 kg box
 //! 230 × 180 mm, wheels 160 mm apart on the axle through the centre, μ_floor 0.6, μ_wall 0.3,
 //! a 60 ms motor lag, no motor-gain spread):

@@ -407,4 +407,160 @@ mod tests {
         assert_eq!(side_of(0.2, -0.5), 3);
         assert_eq!(side_of(0.5, 0.5), 0);
     }
+
+    /// A cross-check against `parry2d` of the overlap, distance and ray tests on boxes of the
+    /// robot's size (230 × 180 mm).
+    mod parry_check {
+        use super::*;
+        use proptest::prelude::*;
+
+        const HX: f64 = 0.115;
+        const HY: f64 = 0.090;
+        use parry2d::math::{Pose as PPose, Vector};
+        use parry2d::query::{Ray, RayCast, contact, distance};
+        use parry2d::shape::Cuboid;
+
+        fn ppose(b: &Obb) -> PPose {
+            PPose::new(Vector::new(b.x as f32, b.y as f32), b.s.atan2(b.c) as f32)
+        }
+
+        proptest! {
+            #![proptest_config(ProptestConfig::with_cases(5000))]
+
+            /// Same contact / no contact as parry2d (away from touching, where f32 cannot decide),
+            /// and the same depth and normal within f32 precision.
+            #[test]
+            fn obb_contact_agrees_with_parry(
+                bx in -0.4f64..0.4, by in -0.4f64..0.4, ta in -PI..PI, tb in -PI..PI,
+            ) {
+                let a = Obb::new(0.0, 0.0, ta, HX, HY);
+                let b = Obb::new(bx, by, tb, HX, HY);
+                let cub = Cuboid::new(Vector::new(HX as f32, HY as f32));
+                let pc = contact(&ppose(&a), &cub, &ppose(&b), &cub, 0.0).unwrap();
+                let ours = obb_overlap(&a, &b, 0.0);
+                match (ours, pc) {
+                    (Some(o), Some(c)) if c.dist < 0.0 => {
+                        prop_assert!((o.depth_m + f64::from(c.dist)).abs() < 1e-5, "{o:?} {c:?}");
+                        if o.depth_m > 1e-4 {
+                            let (px, py) = (f64::from(c.normal1.x), f64::from(c.normal1.y));
+                            let dot = o.nx * px + o.ny * py;
+                            // Where two axes give the same depth, either normal is right: parry's
+                            // must then give (within f32) the same overlap along its own axis.
+                            let along = |bx: &Obb| bx.hx * (px * bx.c + py * bx.s).abs()
+                                + bx.hy * (-px * bx.s + py * bx.c).abs();
+                            let overlap_on_parry_axis =
+                                along(&a) + along(&b) - ((b.x - a.x) * px + (b.y - a.y) * py).abs();
+                            prop_assert!(
+                                dot > 0.999 || (overlap_on_parry_axis - o.depth_m).abs() < 1e-5,
+                                "{o:?} {c:?}"
+                            );
+                        }
+                    }
+                    (None, None) => {}
+                    (None, Some(c)) if c.dist >= 0.0 => {}
+                    (o, c) => {
+                        // Only allowed within f32 reach of touching.
+                        let d = o.map_or(0.0, |o| o.depth_m);
+                        let pd = c.map_or(0.0, |c| f64::from(c.dist));
+                        prop_assert!(d.abs() < 1e-5 && pd.abs() < 1e-5, "ours {o:?} parry {c:?}");
+                    }
+                }
+            }
+
+                    /// The distance between outlines equals parry2d's within f32 precision.
+            #[test]
+            fn obb_distance_agrees_with_parry(
+                bx in -0.8f64..0.8, by in -0.8f64..0.8, ta in -PI..PI, tb in -PI..PI,
+            ) {
+                let a = Obb::new(0.0, 0.0, ta, HX, HY);
+                let b = Obb::new(bx, by, tb, HX, HY);
+                let cub = Cuboid::new(Vector::new(HX as f32, HY as f32));
+                let theirs = f64::from(distance(&ppose(&a), &cub, &ppose(&b), &cub).unwrap().distance);
+                let ours = obb_distance(&a, &b);
+                prop_assert!((ours - theirs).abs() < 2e-6, "ours {ours} parry {theirs}");
+            }
+
+            /// Ray distances equal an independent f64 reference (intersection with the four edge
+            /// segments) within 1e-12 m, and parry2d's within 1e-6 m; parry2d computes in f32, so
+            /// for rays meeting a face at a grazing angle α its error grows as 1/sin α and the
+            /// tolerance is 1e-6 m / max(sin α, 0.01); hit/miss may differ only for rays passing
+            /// within f32 reach of a corner.
+            #[test]
+            fn ray_distance_agrees_with_reference_and_parry(
+                ox in -2.0f64..2.0, oy in -2.0f64..2.0, th in -PI..PI, aim in -0.3f64..0.3, tb in -PI..PI,
+            ) {
+                let b = Obb::new(0.0, 0.0, tb, HX, HY);
+                // Aim roughly at the box so that most rays hit.
+                let base = (-oy).atan2(-ox);
+                let dir = if th.abs() < 1.0 { base + aim } else { th };
+                let (dy, dx) = dir.sin_cos();
+                let ours = ray_obb(ox, oy, dx, dy, &b, 10.0);
+
+                // f64 reference: the nearest crossing of the four edges (0 from inside).
+                let lo = (ox * b.c + oy * b.s, -ox * b.s + oy * b.c);
+                let inside = lo.0.abs() < HX && lo.1.abs() < HY;
+                let mut reference: Option<f64> = if inside { Some(0.0) } else { None };
+                if !inside {
+                    let c = b.corners();
+                    for k in 0..4 {
+                        let (p, q) = (c[k], c[(k + 1) % 4]);
+                        let (ex, ey) = (q.0 - p.0, q.1 - p.1);
+                        let den = dx * ey - dy * ex;
+                        if den.abs() < 1e-15 {
+                            continue;
+                        }
+                        let (wx, wy) = (p.0 - ox, p.1 - oy);
+                        let t = (wx * ey - wy * ex) / den;
+                        let u = (wx * dy - wy * dx) / den;
+                        if t >= 0.0 && (0.0..=1.0).contains(&u) && reference.is_none_or(|r| t < r) {
+                            reference = Some(t);
+                        }
+                    }
+                }
+                match (ours, reference) {
+                    (Some(a), Some(r)) => prop_assert!((a - r).abs() < 1e-12, "ours {a} reference {r}"),
+                    (None, None) => {}
+                    (o, r) => {
+                        let t = o.or(r).unwrap();
+                        let (hx, hy) = (ox + dx * t, oy + dy * t);
+                        let lx = (hx * b.c + hy * b.s).abs();
+                        let ly = (-hx * b.s + hy * b.c).abs();
+                        prop_assert!((lx - HX).abs() < 1e-12 && (ly - HY).abs() < 1e-12, "ours {o:?} reference {r:?}");
+                    }
+                }
+
+                let cub = Cuboid::new(Vector::new(HX as f32, HY as f32));
+                let ray = Ray::new(Vector::new(ox as f32, oy as f32), Vector::new(dx as f32, dy as f32));
+                let theirs = cub.cast_ray(&ppose(&b), &ray, 10.0, true).map(f64::from);
+                match (ours, theirs) {
+                    (Some(a), Some(p)) => {
+                        // Grazing angle at our hit: the direction's component along the face normal.
+                        let (hx, hy) = (ox + dx * a, oy + dy * a);
+                        let lx = hx * b.c + hy * b.s;
+                        let ly = -hx * b.s + hy * b.c;
+                        let ldx = dx * b.c + dy * b.s;
+                        let ldy = -dx * b.s + dy * b.c;
+                        let sin_graze = if a == 0.0 {
+                            1.0
+                        } else if (lx.abs() - HX).abs() < (ly.abs() - HY).abs() {
+                            ldx.abs()
+                        } else {
+                            ldy.abs()
+                        };
+                        let tol = 1e-6 / sin_graze.max(0.01);
+                        prop_assert!((a - p).abs() < tol, "ours {a} parry {p} (sin graze {sin_graze})");
+                    }
+                    (None, None) => {}
+                    (o, p) => {
+                        // A corner graze: the ray passes within f32 reach of the box outline.
+                        let t = o.or(p).unwrap();
+                        let (hx, hy) = (ox + dx * t, oy + dy * t);
+                        let lx = (hx * b.c + hy * b.s).abs();
+                        let ly = (-hx * b.s + hy * b.c).abs();
+                        prop_assert!((lx - HX).abs() < 1e-5 && (ly - HY).abs() < 1e-5, "ours {o:?} parry {p:?}");
+                    }
+                }
+            }
+        }
+    }
 }

@@ -99,11 +99,10 @@
 //!   robot resting against a wall without pushing does not hold its switch. A pressed switch
 //!   releases only when its face carries less than `bumper_release_force_n` (default 0.02 N: a
 //!   snap-action micro-switch's release force, far below its operating force; Omron D2F data
-//!   sheet). A press is a force, so it does not depend on the sub-step's length. (Until issue
-//!   12's last stop any correction pressed the switch whatever its size, and a pressed switch
-//!   released at its operating force: a robot rubbing lightly along a wall, its turning corner
-//!   corrected out of a sub-micrometre overlap in every second sub-step, read pressed, released,
-//!   pressed… and counted a collision every 40 ms; `tests/bumper_rub.rs`.)
+//!   sheet). A press is a force, so it does not depend on the sub-step's length. Without the
+//!   threshold and the hysteresis, a robot rubbing lightly along a wall, its turning corner
+//!   corrected out of a sub-micrometre overlap in every second sub-step, would read pressed,
+//!   released, pressed… and count a collision every 40 ms (`tests/bumper_rub.rs`).
 //! - **Sensors** (docs/design.md §3.1): by default four, at the middle of the front, rear, left and right
 //!   sides, facing out (indices [`FRONT`], [`REAR`], [`LEFT`], [`RIGHT`]); mounts, rays per
 //!   sensor (a cone) and range are parameters. [`World::sense`] casts from the mount against
@@ -140,6 +139,7 @@
 #![deny(missing_docs)]
 
 pub mod arena;
+mod body;
 mod contact;
 pub mod dc_motor;
 pub mod error;
@@ -147,14 +147,17 @@ pub mod geometry;
 mod grid;
 pub mod motor;
 pub mod params;
-mod solver;
+mod pipeline;
+mod placement;
 mod world;
 
 pub use arena::{Arena, ArenaKind, Segment};
 pub use error::WorldError;
 pub use motor::{Behaviour, Direction, WheelCommand};
 pub use params::{SensorMount, WorldParams};
+pub use pipeline::broad_phase::BROAD_PHASE_MARGIN_M;
+pub use pipeline::solver::CONTACT_SKIN_M;
 pub use world::{
-    BROAD_PHASE_MARGIN_M, CONTACT_SKIN_M, FRONT, LEFT, MAX_ROBOTS, Pose, REAR, RIGHT, SolverStats,
-    SubstepPlan, World, coefficient_of_variation,
+    FRONT, LEFT, MAX_ROBOTS, Pose, REAR, RIGHT, SolverStats, SubstepPlan, World,
+    coefficient_of_variation,
 };

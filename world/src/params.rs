@@ -1,5 +1,6 @@
 //! Physical parameters of the robots and the simulation, with their sources and valid ranges.
 
+use crate::body::BodyConst;
 use crate::error::WorldError;
 
 /// Body length along the heading: 230 mm (docs/design.md §1, paper §4: robots of 230 × 180 × 130 mm).
@@ -241,6 +242,14 @@ fn check_time_constant(
 impl WorldParams {
     /// Checks every parameter; the error names the first bad one and its valid range.
     pub fn validate(&self) -> Result<(), WorldError> {
+        self.check_body_and_drive()?;
+        self.check_sensors()?;
+        self.check_placement_and_contacts()?;
+        self.check_clock()
+    }
+
+    /// The body's size, the motors, the wheels and the sub-step.
+    fn check_body_and_drive(&self) -> Result<(), WorldError> {
         check_range(
             "body_length_m",
             self.body_length_m,
@@ -303,6 +312,11 @@ impl WorldParams {
             MAX_SUBSTEP_LIMIT_S,
             "a time in 0.00001..=0.1 s",
         )?;
+        Ok(())
+    }
+
+    /// The sensor mounts (on or inside the body), their rays, cone and range.
+    fn check_sensors(&self) -> Result<(), WorldError> {
         let hl = 0.5 * self.body_length_m;
         let hw = 0.5 * self.body_width_m;
         for m in &self.sensor_mounts {
@@ -350,6 +364,11 @@ impl WorldParams {
             100.0,
             "a distance in 0.001..=100 m",
         )?;
+        Ok(())
+    }
+
+    /// The placement clearance, the solver, the masses, frictions and bumper forces.
+    fn check_placement_and_contacts(&self) -> Result<(), WorldError> {
         check_range(
             "placement_clearance_m",
             self.placement_clearance_m,
@@ -405,6 +424,11 @@ impl WorldParams {
             self.bumper_force_n,
             "a force in 0..=bumper_force_n",
         )?;
+        Ok(())
+    }
+
+    /// The clock, and that the sub-step is at least one of its states.
+    fn check_clock(&self) -> Result<(), WorldError> {
         if self.clock_hz < 1_000 || self.clock_hz > 1_000_000_000 {
             return Err(WorldError::Parameter {
                 name: "clock_hz",
@@ -444,13 +468,15 @@ impl WorldParams {
             .wheel_forces(d_along_m_per_s, d_omega_rad_per_s, 1.0 / h_s)
     }
 
-    fn body(&self) -> crate::solver::BodyConst {
-        crate::solver::BodyConst::new(
+    /// What every robot shares, from these parameters: size, mass, inertia, wheel geometry,
+    /// traction (`μ_floor · m·g/2` per drive wheel) and friction.
+    pub(crate) fn body(&self) -> BodyConst {
+        BodyConst::new(
             self.mass_kg,
             self.body_length_m,
             self.body_width_m,
             self.wheel_track_m,
-            self.mu_floor,
+            self.mu_floor * self.mass_kg * GRAVITY_M_PER_S2 * 0.5,
             self.mu_robot,
             self.mu_wall,
         )

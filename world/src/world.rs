@@ -1,39 +1,25 @@
-//! The world: robots' bodies, motors, kinematics, collisions, bumpers and sensor rays.
+//! The world: the robots' state and the sub-step that runs the pipeline's stages over it in
+//! order (see [`crate::pipeline`]'s module documentation for the stages).
 
-use rand::{RngExt, SeedableRng};
-use rand_pcg::Pcg64;
 use rayon::prelude::*;
 use seeding::Purpose;
 
 use crate::arena::{Arena, ArenaKind};
-use crate::contact::{Manifold, box_box, box_walls};
+use crate::body::{BodyConst, BodyPose};
 use crate::error::WorldError;
-use crate::geometry::{
-    Obb, arc_step, arc_step_twist, obb_distance, obb_overlap, ray_obb, ray_walls, side_of,
-};
-use crate::grid::Grid;
+use crate::geometry::{Obb, arc_step_twist, obb_distance, obb_overlap};
 use crate::motor::{Direction, LagCoefficients, MODE_BRAKE, MODE_COAST, MODE_DRIVE, WheelCommand};
 use crate::params::{MAX_ADVANCE_S, WorldParams};
-use crate::solver::{BodyConst, Contact, IslandBody, WALL, solve_island};
+use crate::pipeline::broad_phase::BroadPhase;
+use crate::pipeline::corrections::{Corrections, Scene};
+use crate::pipeline::drive::{Drive, Motion};
+use crate::pipeline::islands::Islands;
+use crate::pipeline::narrow_phase::{NarrowPhase, Probe, speculative_m};
+use crate::pipeline::par::PAR_CHUNK;
+use crate::pipeline::sensing::{Bumpers, MountRays, RayScene};
+use crate::pipeline::warm_start::WarmStart;
+use crate::placement::{place_corridor, place_open, stream_rng, unit};
 
-/// Overlaps are corrected to this gap (10 nm), so that corrected bodies do not touch even
-/// after rounding, and far below anything a sensor or a metric resolves.
-pub const CONTACT_SKIN_M: f64 = 1e-8;
-/// The gap a position correction opens (10 µm): more than the skin, so that a correction that
-/// pushes a body a little into a neighbour (a chain of contacts) still leaves the neighbour's
-/// pair clear, and a chain clears in a few sweeps instead of converging on the skin forever.
-/// Far below anything a sensor (3 mm per du) or a metric resolves.
-const CORRECTION_GAP_M: f64 = 1e-5;
-/// Smallest broad-phase margin (a Verlet skin): pairs of bodies whose bounding circles are
-/// closer than the margin, and bodies closer than it to a wall, are contact candidates; the
-/// grid and the candidate lists are kept until some robot has moved half the margin less the
-/// speculative contact distance since they were built (our choice: 200 mm, about 60 sub-steps
-/// of 10 ms at 0.15 m/s; larger when fast robots and long sub-steps need it).
-pub const BROAD_PHASE_MARGIN_M: f64 = 0.2;
-/// Robots per chunk in the parallel phases (fixed, so results never depend on thread count).
-const PAR_CHUNK: usize = 512;
-/// Solved robots from which [`World::advance_states_par`] solves islands in parallel.
-const PAR_ISLAND_ROBOTS: usize = 64;
 /// Most robots a world may hold (indices are stored as `u32`).
 pub const MAX_ROBOTS: usize = 50_000_000;
 
@@ -56,80 +42,6 @@ pub struct Pose {
     /// Heading, radians.
     pub heading_rad: f64,
 }
-
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub(crate) struct BodyPose {
-    pub(crate) x: f64,
-    pub(crate) y: f64,
-    pub(crate) c: f64,
-    pub(crate) s: f64,
-}
-
-impl BodyPose {
-    /// The body's box, half extents `hx` along the heading and `hy` across.
-    #[inline]
-    fn obb(self, hx: f64, hy: f64) -> Obb {
-        Obb {
-            x: self.x,
-            y: self.y,
-            c: self.c,
-            s: self.s,
-            hx,
-            hy,
-        }
-    }
-
-    /// Whether the body's box reaches past a wall of the `w` × `h` arena.
-    #[inline]
-    fn crosses_walls(self, hx: f64, hy: f64, w: f64, h: f64) -> bool {
-        let (ex, ey) = self.obb(hx, hy).aabb_half_extents();
-        self.x - ex < 0.0 || self.x + ex > w || self.y - ey < 0.0 || self.y + ey > h
-    }
-}
-
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-struct Motion {
-    /// Wheel speeds now, m/s (left, right).
-    speed: [f64; 2],
-    /// Commanded wheel speeds, m/s (duty × top speed × gain × sign).
-    target: [f64; 2],
-    /// Which lag applies: drive, brake or coast.
-    mode: [u8; 2],
-}
-
-/// A sensor's mount point and ray directions in the body frame.
-#[derive(Debug, Clone, PartialEq)]
-struct MountRays {
-    x: f64,
-    y: f64,
-    dirs: Vec<(f64, f64)>,
-}
-
-#[derive(Debug, Clone, Default)]
-struct Candidates {
-    pairs: Vec<[u32; 2]>,
-    walls: Vec<u32>,
-}
-
-/// A solved contact's identity, point count and (normal, friction) impulses per point.
-type WarmStart = ((u32, u32, u8), u8, [[f64; 2]; 2]);
-
-/// In a binding contact this sub-step (or in contact with such a robot): solved, not moved
-/// freely.
-const ACTIVE: u8 = 1;
-/// The share of the previous sub-step's impulses a solve starts from: all of them, so that a
-/// steady push converges in a sweep or two. (A wheel that is braked or coasting starts from
-/// nothing instead: a braked robot held against a wall is statically indeterminate, and a full
-/// warm start would keep a push that nothing sustains any more.)
-const WARM_START: f64 = 1.0;
-/// Listed in `World::active`.
-const LISTED: u8 = 2;
-/// In some contact (binding or not): checked for overlap after the move.
-const CHECK: u8 = 4;
-/// A contact binds when the robots' own wheels would bring a point to within this of touching
-/// (0.1 mm: the linear estimate misses the chord of a turning corner's arc by at most about
-/// R·(ω·h)²/2 ≈ 13 µm at 20 ms).
-const BIND_MARGIN_M: f64 = 1e-4;
 
 /// What the contact solver did, counted over the world's life (for evaluation: these are
 /// not used by the simulation).
@@ -219,10 +131,8 @@ pub struct World {
     arena: Arena,
     params: WorldParams,
     seed: u64,
-    hx: f64,
-    hy: f64,
-    /// Bounding-circle radius of a body, metres.
-    radius_m: f64,
+    /// What every body shares: size, mass, inertia, wheels, friction.
+    body: BodyConst,
     gains: Vec<[f64; 2]>,
     pose: Vec<BodyPose>,
     motion: Vec<Motion>,
@@ -238,62 +148,12 @@ pub struct World {
     /// Longitudinal force each drive wheel transmitted to the body over the latest sub-step
     /// (left, right), N, along the heading (see [`World::wheel_forces`]).
     wheel_force: Vec<[f64; 2]>,
-    bumpers: Vec<u8>,
-    /// Normal impulse each bumper face took in the current sub-step, from the solver's
-    /// contacts and the position corrections (front, rear, left, right), N·s.
-    face_impulse: Vec<[f64; 4]>,
-    /// The robots with some face impulse in the current sub-step.
-    pushed: Vec<u32>,
-    /// The bumpers as the previous sub-step left them (a pressed switch releases at a lower
-    /// force than it operates).
-    held: Vec<u8>,
-    grid: Grid,
-    cand: Candidates,
-    /// Broad-phase margin in use, metres.
-    margin_m: f64,
-    /// Drift from the filed position that triggers a rebuild, metres.
-    drift_limit_m: f64,
-    /// The sub-step's contacts, walls first, then pairs, in candidate order.
-    contacts: Vec<Contact>,
-    chunk_contacts: Vec<Vec<Contact>>,
-    /// The robots solved this sub-step, in index order.
-    active: Vec<u32>,
-    /// Union-find parents of the active robots (scratch, by robot).
-    uf: Vec<u32>,
-    /// Island number of a union-find root (scratch, by robot; `u32::MAX` when unset).
-    root_island: Vec<u32>,
-    /// Per active robot (in `active`'s order, which `build_islands` makes island by island),
-    /// what the solver needs.
-    island_bodies: Vec<IslandBody>,
-    /// Per island, its range in `active`/`island_bodies` and in `contacts`.
-    islands: Vec<(core::ops::Range<usize>, core::ops::Range<usize>)>,
-    /// Island of each active robot (scratch, in `active`'s order before the sort).
-    isl_of: Vec<u32>,
-    /// First place of each island in `active` (scratch; one more entry than islands).
-    isl_start: Vec<usize>,
-    /// Next free place of each island (scratch).
-    isl_fill: Vec<usize>,
-    /// `active` being sorted into islands (scratch).
-    active_scratch: Vec<u32>,
-    /// `contacts` being sorted into islands (scratch).
-    contact_scratch: Vec<Contact>,
-    /// The solved contacts' impulses of the previous sub-step, sorted by contact identity
-    /// (the warm start of the next solve).
-    warm: Vec<WarmStart>,
-    /// Per robot, the sub-step in which it was last solved (its wheel impulses warm-start the
-    /// next solve only if that was the previous sub-step).
-    solved_at: Vec<u64>,
-    /// The robots in some contact this sub-step (solved or not), in index order.
-    checked: Vec<u32>,
-    /// Overlaps found by the latest check.
-    overlaps: Candidates,
-    /// Correction epoch: one per sweep, counted over the whole run.
-    epoch: u64,
-    /// Per robot, the epoch in which it last moved in the contact phases.
-    last_move: Vec<u64>,
-    chunk_cands: Vec<Candidates>,
-    flags: Vec<u8>,
-    body: BodyConst,
+    bumpers: Bumpers,
+    broad: BroadPhase,
+    narrow: NarrowPhase,
+    islands: Islands,
+    warm: WarmStart,
+    corrections: Corrections,
     /// Lag coefficients for the two sub-step lengths of the latest plan (length in states).
     lag_cache: [(u64, LagCoefficients); 2],
     mounts: Vec<MountRays>,
@@ -301,17 +161,6 @@ pub struct World {
     elapsed_states: u64,
     substeps: u64,
     stats: SolverStats,
-}
-
-/// The generator for one purpose and one index (robot index, or 0 for world-wide purposes):
-/// the project's one derivation, `seeding::derive(seed, index, purpose)`.
-fn stream_rng(seed: u64, purpose: Purpose, index: u64) -> Pcg64 {
-    Pcg64::seed_from_u64(seeding::derive(seed, index, purpose))
-}
-
-/// A uniform draw in [0, 1).
-fn unit(rng: &mut Pcg64) -> f64 {
-    rng.random::<f64>()
 }
 
 impl World {
@@ -375,9 +224,7 @@ impl World {
         seed: u64,
     ) -> Result<World, WorldError> {
         let n = poses.len();
-        let hx = 0.5 * params.body_length_m;
-        let hy = 0.5 * params.body_width_m;
-        let radius_m = hx.hypot(hy);
+        let body = params.body();
         let spread = params.motor_gain_spread;
         let gains = (0..n)
             .map(|i| {
@@ -388,67 +235,26 @@ impl World {
             })
             .collect();
         let max_substep_states = (params.max_substep_s * params.clock_hz as f64).round() as u64;
-        // The speculative distance of the longest sub-step (see `speculative_m`) must fit in
-        // the margin with room for drift.
-        let vmax = params.top_speed_m_per_s * (1.0 + params.motor_gain_spread);
-        let spec_max = 2.5
-            * vmax
-            * (1.0 + 2.0 * radius_m / params.wheel_track_m)
-            * (max_substep_states as f64 / params.clock_hz as f64);
-        let margin_m = BROAD_PHASE_MARGIN_M.max(4.0 * spec_max);
-        let drift_limit_m = 0.5 * (margin_m - spec_max);
-        let grid = Grid::new(
+        let max_h = max_substep_states as f64 / params.clock_hz as f64;
+        // The speculative distance of the longest sub-step must fit in the broad phase's
+        // margin with room for drift.
+        let broad = BroadPhase::new(
             arena.width_m(),
             arena.height_m(),
-            2.0 * radius_m + margin_m,
+            body.radius_m,
+            speculative_m(&params, body.radius_m, max_h),
             n,
         );
-        let mounts = params
-            .sensor_mounts
-            .iter()
-            .map(|m| {
-                let k = params.rays_per_sensor;
-                let dirs = (0..k)
-                    .map(|r| {
-                        let off = if k == 1 {
-                            0.0
-                        } else {
-                            params.cone_half_angle_rad
-                                * (2.0 * f64::from(r) / f64::from(k - 1) - 1.0)
-                        };
-                        let (s, c) = (m.angle_rad + off).sin_cos();
-                        (c, s)
-                    })
-                    .collect();
-                MountRays {
-                    x: m.x_m,
-                    y: m.y_m,
-                    dirs,
-                }
-            })
-            .collect();
         let lag = LagCoefficients::new(
-            max_substep_states as f64 / params.clock_hz as f64,
+            max_h,
             params.motor_time_constant_s,
             params.brake_time_constant_s,
             params.coast_time_constant_s,
         );
-        let body = BodyConst::new(
-            params.mass_kg,
-            params.body_length_m,
-            params.body_width_m,
-            params.wheel_track_m,
-            params.mu_floor,
-            params.mu_robot,
-            params.mu_wall,
-        );
-        let n_chunks = n.div_ceil(PAR_CHUNK);
         let mut w = World {
             arena,
             seed,
-            hx,
-            hy,
-            radius_m,
+            body,
             gains,
             motion: vec![
                 Motion {
@@ -464,37 +270,14 @@ impl World {
             wheel_imp: vec![[0.0; 4]; n],
             wheel_force: vec![[0.0; 2]; n],
             pose: poses,
-            bumpers: vec![0; n],
-            face_impulse: vec![[0.0; 4]; n],
-            pushed: Vec::new(),
-            held: vec![0; n],
-            grid,
-            cand: Candidates::default(),
-            margin_m,
-            drift_limit_m,
-            contacts: Vec::new(),
-            chunk_contacts: Vec::new(),
-            active: Vec::new(),
-            warm: Vec::new(),
-            uf: vec![0; n],
-            root_island: vec![u32::MAX; n],
-            island_bodies: Vec::new(),
-            islands: Vec::new(),
-            isl_of: Vec::new(),
-            isl_start: Vec::new(),
-            isl_fill: Vec::new(),
-            active_scratch: Vec::new(),
-            contact_scratch: Vec::new(),
-            solved_at: vec![u64::MAX; n],
-            checked: Vec::new(),
-            overlaps: Candidates::default(),
-            epoch: 1,
-            last_move: vec![0; n],
-            chunk_cands: vec![Candidates::default(); n_chunks],
-            flags: vec![0; n],
-            body,
+            bumpers: Bumpers::new(n),
+            broad,
+            narrow: NarrowPhase::new(n),
+            islands: Islands::new(n),
+            warm: WarmStart::new(n),
+            corrections: Corrections::new(n),
             lag_cache: [(max_substep_states, lag), (0, lag)],
-            mounts,
+            mounts: MountRays::all(&params),
             params,
             max_substep_states,
             elapsed_states: 0,
@@ -544,7 +327,7 @@ impl World {
 
     /// Side of the broad-phase grid cells, metres (diagnostic).
     pub fn grid_cell_m(&self) -> f64 {
-        self.grid.cell_m()
+        self.broad.grid().cell_m()
     }
 
     /// Internal sub-steps taken so far.
@@ -562,7 +345,6 @@ impl World {
             })
         }
     }
-
     /// A robot's pose (heading in (−π, π]).
     pub fn pose(&self, robot: usize) -> Result<Pose, WorldError> {
         self.check_robot(robot)?;
@@ -615,8 +397,7 @@ impl World {
     /// pressed (index with [`FRONT`], [`REAR`], [`LEFT`], [`RIGHT`]).
     pub fn bumpers(&self, robot: usize) -> Result<[bool; 4], WorldError> {
         self.check_robot(robot)?;
-        let b = self.bumpers[robot];
-        Ok([b & 1 != 0, b & 2 != 0, b & 4 != 0, b & 8 != 0])
+        Ok(self.bumpers.of(robot))
     }
 
     /// A robot's body outline for plotting: front-left, rear-left, rear-right, front-right
@@ -628,7 +409,7 @@ impl World {
 
     #[inline]
     fn obb(&self, i: usize) -> Obb {
-        self.pose[i].obb(self.hx, self.hy)
+        self.body.obb(self.pose[i])
     }
 
     // ----- commands ----------------------------------------------------------------------------
@@ -775,14 +556,9 @@ impl World {
         l
     }
 
-    /// The largest distance two bodies' points can close in a sub-step of `h` seconds under
-    /// their own wheels (each point of a body moves at most `v_max·(1 + 2R/track)`), with a
-    /// margin of 25 % for pushes: contacts nearer than this are handed to the solver.
-    fn speculative_m(&self, h: f64) -> f64 {
-        let vmax = self.params.top_speed_m_per_s * (1.0 + self.params.motor_gain_spread);
-        2.5 * vmax * (1.0 + 2.0 * self.radius_m / self.params.wheel_track_m) * h
-    }
-
+    /// One sub-step of `len` clock states: the pipeline's stages in order (see
+    /// [`crate::pipeline`]); with `parallel`, the per-robot stages and the islands on rayon's
+    /// pool, with the same result.
     fn substep(&mut self, len: u64, parallel: bool) {
         let h = len as f64 / self.params.clock_hz as f64;
         let drive = Drive {
@@ -793,6 +569,59 @@ impl World {
             body: self.body,
         };
         // 1. Motors: the wheel speeds over the sub-step.
+        self.run_motors(&drive, parallel);
+        self.bumpers.begin_substep();
+        // 2. Contacts at the start of the sub-step, gaps up to the speculative distance.
+        let spec = speculative_m(&self.params, self.body.radius_m, h);
+        let probe = Probe::new(
+            &self.pose,
+            &self.body,
+            self.arena.width_m(),
+            self.arena.height_m(),
+            spec,
+        );
+        self.narrow.find(
+            &probe,
+            self.broad.candidates(),
+            &self.wmean,
+            drive.inv_track,
+            h,
+            parallel,
+        );
+        // 3. Robots touching nothing follow their wheels exactly; the others are solved.
+        self.move_free(&drive, parallel);
+        if !self.narrow.active.is_empty() {
+            self.solve(h, parallel);
+        }
+        self.warm.keep(&self.narrow.contacts);
+        if !self.narrow.checked.is_empty() {
+            // 4. What the linearised solve left of an overlap is corrected.
+            self.correct(h);
+            // 5. A bumper is pressed when the contacts on its face carried force: the solver's
+            // impulses and the corrections' pushes (as impulses) summed over the sub-step.
+            // A switch operates at `bumper_force_n` and, once pressed, releases only below
+            // `bumper_release_force_n` (a snap-action switch's hysteresis).
+            self.bumpers
+                .push_contacts(&self.narrow.contacts, &self.pose);
+            self.bumpers.press(
+                self.params.bumper_force_n * h,
+                self.params.bumper_release_force_n * h,
+            );
+            self.stats.active_robot_substeps += self.narrow.active.len() as u64;
+            self.stats.contacts += self.narrow.contacts.len() as u64;
+            self.narrow.clear_flags();
+        }
+        // 6. The broad phase is rebuilt once some robot has drifted too far.
+        if self.broad.is_stale(&self.pose) {
+            self.rebuild_broad_phase(parallel);
+        }
+        self.elapsed_states += len;
+        self.substeps += 1;
+        self.stats.substeps += 1;
+    }
+
+    /// The motors of every robot, in chunks on rayon's pool with `parallel`.
+    fn run_motors(&mut self, drive: &Drive, parallel: bool) {
         if parallel && self.pose.len() > PAR_CHUNK {
             self.motion
                 .par_chunks_mut(PAR_CHUNK)
@@ -808,13 +637,12 @@ impl World {
                 &self.pose,
             );
         }
-        core::mem::swap(&mut self.bumpers, &mut self.held);
-        self.bumpers.fill(0);
-        // 2. Contacts at the start of the sub-step, gaps up to the speculative distance.
-        let spec = self.speculative_m(h);
-        self.find_contacts(spec, h, parallel);
-        // 3. Robots touching nothing follow their wheels exactly; the others are solved.
-        let flags = &self.flags;
+    }
+
+    /// The robots that touch nothing follow their wheels, in chunks on rayon's pool with
+    /// `parallel`.
+    fn move_free(&mut self, drive: &Drive, parallel: bool) {
+        let flags = &self.narrow.flags;
         if parallel && self.pose.len() > PAR_CHUNK {
             self.pose
                 .par_chunks_mut(PAR_CHUNK)
@@ -832,699 +660,98 @@ impl World {
                 flags,
             );
         }
-        if !self.active.is_empty() {
-            // Warm start from the previous sub-step's impulses of the same contacts and wheels.
-            let motion = &self.motion;
-            let driven = |i: u32| {
-                i != WALL
-                    && motion[i as usize]
-                        .mode
-                        .iter()
-                        .zip(motion[i as usize].target)
-                        .any(|(&m, t)| m == MODE_DRIVE && t != 0.0)
-            };
-            for ct in self.contacts.iter_mut() {
-                // A contact between robots whose motors do not drive starts from nothing (a
-                // braked robot against a wall is statically indeterminate, see WARM_START).
-                if !driven(ct.a) && !driven(ct.b) {
-                    continue;
-                }
-                if let Ok(k) = self.warm.binary_search_by(|w| w.0.cmp(&ct.id()))
-                    && self.warm[k].1 == ct.count
-                {
-                    for (p, [ln, lt]) in ct.pts.iter_mut().zip(self.warm[k].2) {
-                        p.ln = WARM_START * ln;
-                        p.lt = WARM_START * lt;
-                    }
-                }
-            }
-            for &i in &self.active {
-                let i = i as usize;
-                if self.solved_at[i] == self.substeps.wrapping_sub(1) {
-                    for (w, x) in self.wheel_imp[i].iter_mut().enumerate() {
-                        let driven = self.motion[i].mode[w / 2] == MODE_DRIVE
-                            && self.motion[i].target[w / 2] != 0.0;
-                        *x *= if driven { WARM_START } else { 0.0 };
-                    }
-                } else {
-                    self.wheel_imp[i] = [0.0; 4];
-                }
-                self.solved_at[i] = self.substeps;
-            }
-            self.build_islands();
-            let (body, iterations) = (&self.body, self.params.solver_iterations);
-            if parallel && self.active.len() > PAR_ISLAND_ROBOTS && self.islands.len() > 1 {
-                // Islands share nothing: each is solved on whichever thread, with the same
-                // result as in order.
-                let mut jobs = Vec::with_capacity(self.islands.len());
-                let (mut bodies, mut contacts) =
-                    (&mut self.island_bodies[..], &mut self.contacts[..]);
-                for (b, c) in &self.islands {
-                    let (bi, rest) = core::mem::take(&mut bodies).split_at_mut(b.len());
-                    bodies = rest;
-                    let (ci, rest) = core::mem::take(&mut contacts).split_at_mut(c.len());
-                    contacts = rest;
-                    jobs.push((bi, ci));
-                }
-                self.stats.solver_sweeps += jobs
-                    .par_iter_mut()
-                    .with_min_len(16)
-                    .map(|(b, c)| u64::from(solve_island(b, c, body, h, iterations)))
-                    .sum::<u64>();
-            } else {
-                for (b, c) in &self.islands {
-                    self.stats.solver_sweeps += u64::from(solve_island(
-                        &mut self.island_bodies[b.clone()],
-                        &mut self.contacts[c.clone()],
-                        body,
-                        h,
-                        iterations,
-                    ));
-                }
-            }
-            let inv_h = 1.0 / h;
-            for (k, &i) in self.active.iter().enumerate() {
-                let b = &self.island_bodies[k];
-                self.vel[i as usize] = b.vel;
-                self.wheel_imp[i as usize] = b.wheel_imp;
-                // The wheels' rolling impulses over the sub-step, as mean forces.
-                self.wheel_force[i as usize] = [b.wheel_imp[0] * inv_h, b.wheel_imp[2] * inv_h];
-            }
-            for k in 0..self.active.len() {
-                let i = self.active[k] as usize;
-                let p = &mut self.pose[i];
-                let v = &mut self.vel[i];
-                let along = v[0] * p.c + v[1] * p.s;
-                let across = -v[0] * p.s + v[1] * p.c;
-                let (dx, dy, c, s) = arc_step_twist(p.c, p.s, along, across, v[2], h);
-                p.x += dx;
-                p.y += dy;
-                p.c = c;
-                p.s = s;
-                v[0] = along * c - across * s;
-                v[1] = along * s + across * c;
-            }
+    }
+
+    /// The solved robots of a sub-step of `h` seconds: warm-started from the previous
+    /// sub-step's impulses of the same contacts and wheels, split into islands and solved;
+    /// they then move by the exact motion of their solved velocities.
+    fn solve(&mut self, h: f64, parallel: bool) {
+        self.warm.apply(
+            &mut self.narrow.contacts,
+            &self.narrow.active,
+            &self.motion,
+            &mut self.wheel_imp,
+            self.substeps,
+        );
+        self.islands.build(
+            &mut self.narrow.active,
+            &mut self.narrow.contacts,
+            &self.pose,
+            &self.vel,
+            &self.wmean,
+            &self.wheel_imp,
+        );
+        self.stats.solver_sweeps += self.islands.solve(
+            &mut self.narrow.contacts,
+            &self.body,
+            h,
+            self.params.solver_iterations,
+            parallel,
+        );
+        let inv_h = 1.0 / h;
+        for (k, &i) in self.narrow.active.iter().enumerate() {
+            let b = &self.islands.bodies[k];
+            self.vel[i as usize] = b.vel;
+            self.wheel_imp[i as usize] = b.wheel_imp;
+            // The wheels' rolling impulses over the sub-step, as mean forces.
+            self.wheel_force[i as usize] = [b.wheel_imp[0] * inv_h, b.wheel_imp[2] * inv_h];
         }
-        self.warm.clear();
-        self.warm.extend(self.contacts.iter().map(|ct| {
-            (
-                ct.id(),
-                ct.count,
-                [[ct.pts[0].ln, ct.pts[0].lt], [ct.pts[1].ln, ct.pts[1].lt]],
-            )
-        }));
-        self.warm.sort_unstable_by_key(|w| w.0);
-        if !self.checked.is_empty() {
-            // 4. What the linearised solve left of an overlap is corrected.
-            self.clear_overlaps(h);
-            // 5. A bumper is pressed when the contacts on its face carried force: the solver's
-            // impulses and the corrections' pushes (as impulses) summed over the sub-step.
-            for k in 0..self.contacts.len() {
-                let ct = self.contacts[k];
-                let j = ct.normal_impulse();
-                self.push_face(ct.a as usize, ct.nx, ct.ny, j);
-                if ct.b != WALL {
-                    self.push_face(ct.b as usize, -ct.nx, -ct.ny, j);
-                }
-            }
-            // A switch operates at `bumper_force_n` and, once pressed, releases only below
-            // `bumper_release_force_n` (a snap-action switch's hysteresis).
-            let operate = self.params.bumper_force_n * h;
-            let release = self.params.bumper_release_force_n * h;
-            for &i in &self.pushed {
-                let i = i as usize;
-                let held = self.held[i];
-                for (side, j) in self.face_impulse[i].iter_mut().enumerate() {
-                    let threshold = if held & (1 << side) != 0 {
-                        release
-                    } else {
-                        operate
-                    };
-                    if *j > threshold {
-                        self.bumpers[i] |= 1 << side;
-                    }
-                    *j = 0.0;
-                }
-            }
-            self.pushed.clear();
-            self.stats.active_robot_substeps += self.active.len() as u64;
-            self.stats.contacts += self.contacts.len() as u64;
-            for &i in &self.checked {
-                self.flags[i as usize] = 0;
-            }
+        for &i in &self.narrow.active {
+            let i = i as usize;
+            let p = &mut self.pose[i];
+            let v = &mut self.vel[i];
+            let along = v[0] * p.c + v[1] * p.s;
+            let across = -v[0] * p.s + v[1] * p.c;
+            let (dx, dy, c, s) = arc_step_twist(p.c, p.s, along, across, v[2], h);
+            p.x += dx;
+            p.y += dy;
+            p.c = c;
+            p.s = s;
+            v[0] = along * c - across * s;
+            v[1] = along * s + across * c;
         }
-        // 6. The broad phase is rebuilt once some robot has drifted too far.
-        let lim2 = self.drift_limit_m * self.drift_limit_m;
-        let stale = self
-            .pose
-            .iter()
-            .zip(&self.grid.build_xy)
-            .any(|(b, [x0, y0])| (b.x - x0) * (b.x - x0) + (b.y - y0) * (b.y - y0) > lim2);
-        if stale {
-            self.rebuild_broad_phase(parallel);
-        }
-        self.elapsed_states += len;
-        self.substeps += 1;
-        self.stats.substeps += 1;
+    }
+
+    /// The position corrections of a sub-step of `h` seconds, counted in the statistics.
+    fn correct(&mut self, h: f64) {
+        let mut scene = Scene {
+            pose: &mut self.pose,
+            prev: &self.prev,
+            vel: &mut self.vel,
+            bumpers: &mut self.bumpers,
+            cand: self.broad.candidates(),
+            body: &self.body,
+            w: self.arena.width_m(),
+            h: self.arena.height_m(),
+        };
+        let done = self.corrections.clear_overlaps(
+            &mut scene,
+            &self.narrow.checked,
+            self.params.position_iterations,
+            h,
+        );
+        self.stats.overlap_substeps += u64::from(done.overlapped);
+        self.stats.position_sweeps += done.sweeps;
+        self.stats.stopped_robot_substeps += done.stopped;
     }
 
     // ----- collisions ----------------------------------------------------------------------------
 
     /// Rebuilds the grid and the candidate lists from the current positions.
     fn rebuild_broad_phase(&mut self, parallel: bool) {
-        let pose = &self.pose;
-        self.grid.build(pose.iter().map(|b| (b.x, b.y)));
-        let reach = 2.0 * self.radius_m + self.margin_m;
-        let ctx = CandidateCtx {
-            pose,
-            grid: &self.grid,
-            reach2: reach * reach,
-            wall_reach: self.radius_m + self.margin_m,
-            w: self.arena.width_m(),
-            h: self.arena.height_m(),
-        };
-        self.cand.pairs.clear();
-        self.cand.walls.clear();
-        if parallel && pose.len() > PAR_CHUNK {
-            let n_chunks = pose.len().div_ceil(PAR_CHUNK);
-            if self.chunk_cands.len() < n_chunks {
-                self.chunk_cands.resize_with(n_chunks, Candidates::default);
-            }
-            self.chunk_cands[..n_chunks]
-                .par_iter_mut()
-                .enumerate()
-                .for_each(|(k, out)| {
-                    out.pairs.clear();
-                    out.walls.clear();
-                    let lo = k * PAR_CHUNK;
-                    let hi = (lo + PAR_CHUNK).min(ctx.pose.len());
-                    ctx.find(lo, hi, out);
-                });
-            for c in &self.chunk_cands[..n_chunks] {
-                self.cand.pairs.extend_from_slice(&c.pairs);
-                self.cand.walls.extend_from_slice(&c.walls);
-            }
-        } else {
-            ctx.find(0, pose.len(), &mut self.cand);
-        }
-    }
-
-    /// The contacts of the sub-step: every candidate wall or pair whose manifold has a point
-    /// within `spec` metres, in the candidates' order (walls first, then pairs); marks the
-    /// robots in them active and lists those in index order.
-    fn find_contacts(&mut self, spec: f64, h: f64, parallel: bool) {
-        let probe = Probe {
-            pose: &self.pose,
-            hx: self.hx,
-            hy: self.hy,
-            reach2: (2.0 * self.radius_m + spec) * (2.0 * self.radius_m + spec),
-            w: self.arena.width_m(),
-            h: self.arena.height_m(),
-            spec,
-            body: &self.body,
-        };
-        self.contacts.clear();
-        let n_pairs = self.cand.pairs.len();
-        let n_walls = self.cand.walls.len();
-        if parallel && n_pairs + n_walls > PAR_CHUNK {
-            let chunks = n_pairs.max(n_walls).div_ceil(PAR_CHUNK);
-            if self.chunk_contacts.len() < 2 * chunks {
-                self.chunk_contacts.resize_with(2 * chunks, Vec::new);
-            }
-            let cand = &self.cand;
-            self.chunk_contacts[..2 * chunks]
-                .par_iter_mut()
-                .enumerate()
-                .for_each(|(k, out)| {
-                    out.clear();
-                    let lo = (k / 2) * PAR_CHUNK;
-                    if k % 2 == 0 {
-                        probe.walls(
-                            &cand.walls[lo.min(n_walls)..(lo + PAR_CHUNK).min(n_walls)],
-                            out,
-                        );
-                    } else {
-                        probe.pairs(
-                            &cand.pairs[lo.min(n_pairs)..(lo + PAR_CHUNK).min(n_pairs)],
-                            out,
-                        );
-                    }
-                });
-            for c in self.chunk_contacts[..2 * chunks].iter().step_by(2) {
-                self.contacts.extend_from_slice(c);
-            }
-            for c in self.chunk_contacts[1..2 * chunks].iter().step_by(2) {
-                self.contacts.extend_from_slice(c);
-            }
-        } else {
-            probe.walls(&self.cand.walls, &mut self.contacts);
-            probe.pairs(&self.cand.pairs, &mut self.contacts);
-        }
-        // Which contacts bind: those that the robots' own wheels would close (to within
-        // BIND_MARGIN_M, which covers the chord of a turning corner's arc). A robot in a binding
-        // contact is solved, and so, in turn, is every robot in a contact with a solved one
-        // (its motion is no longer its wheels'); the rest follow their wheels exactly, and
-        // their contacts are checked for overlap after the move.
-        self.active.clear();
-        self.checked.clear();
-        let inv_track = 1.0 / self.params.wheel_track_m;
-        let twist = |i: usize| -> [f64; 3] {
-            let w = self.wmean[i];
-            let v = 0.5 * (w[0] + w[1]);
-            let p = self.pose[i];
-            [v * p.c, v * p.s, (w[1] - w[0]) * inv_track]
-        };
-        for ct in &self.contacts {
-            let a = ct.a as usize;
-            let wall = ct.b == WALL;
-            let ua = twist(a);
-            let ub = if wall { [0.0; 3] } else { twist(ct.b as usize) };
-            let (ca, cb) = (
-                self.pose[a],
-                if wall {
-                    self.pose[a]
-                } else {
-                    self.pose[ct.b as usize]
-                },
-            );
-            let binds = ct.pts[..usize::from(ct.count)].iter().any(|p| {
-                let _ = (ca, cb);
-                let rvx = (ub[0] - ub[2] * p.rb[1]) - (ua[0] - ua[2] * p.ra[1]);
-                let rvy = (ub[1] + ub[2] * p.rb[0]) - (ua[1] + ua[2] * p.ra[0]);
-                p.sep + (rvx * ct.nx + rvy * ct.ny) * h < BIND_MARGIN_M
-            });
-            for i in [ct.a, ct.b] {
-                if i != WALL && self.flags[i as usize] & CHECK == 0 {
-                    self.flags[i as usize] |= CHECK;
-                    self.checked.push(i);
-                }
-            }
-            if binds {
-                for i in [ct.a, ct.b] {
-                    if i != WALL {
-                        self.flags[i as usize] |= ACTIVE;
-                    }
-                }
-            }
-        }
-        loop {
-            let mut grew = false;
-            for ct in &self.contacts {
-                if ct.b == WALL {
-                    continue;
-                }
-                let (fa, fb) = (self.flags[ct.a as usize], self.flags[ct.b as usize]);
-                if (fa ^ fb) & ACTIVE != 0 {
-                    self.flags[ct.a as usize] |= ACTIVE;
-                    self.flags[ct.b as usize] |= ACTIVE;
-                    grew = true;
-                }
-            }
-            if !grew {
-                break;
-            }
-        }
-        let flags = &self.flags;
-        self.contacts
-            .retain(|ct| flags[ct.a as usize] & ACTIVE != 0);
-        for ct in &self.contacts {
-            for i in [ct.a, ct.b] {
-                if i != WALL && self.flags[i as usize] & LISTED == 0 {
-                    self.flags[i as usize] |= LISTED;
-                    self.active.push(i);
-                }
-            }
-        }
-        self.active.sort_unstable();
-        self.checked.sort_unstable();
-    }
-
-    /// Splits the solved robots into islands (connected by robot–robot contacts), numbered in
-    /// order of their lowest robot: `active` is reordered island by island (index order within
-    /// each), `contacts` likewise (their order kept within each island), every contact gets
-    /// its robots' places in the island, and `island_bodies` the solver's view of each robot.
-    fn build_islands(&mut self) {
-        fn find(uf: &mut [u32], mut i: u32) -> u32 {
-            while uf[i as usize] != i {
-                let p = uf[uf[i as usize] as usize];
-                uf[i as usize] = p;
-                i = p;
-            }
-            i
-        }
-        for &i in &self.active {
-            self.uf[i as usize] = i;
-        }
-        for ct in &self.contacts {
-            if ct.b != WALL {
-                let (ra, rb) = (find(&mut self.uf, ct.a), find(&mut self.uf, ct.b));
-                if ra != rb {
-                    // The lower root wins, so the result does not depend on contact order.
-                    let (lo, hi) = (ra.min(rb), ra.max(rb));
-                    self.uf[hi as usize] = lo;
-                }
-            }
-        }
-        // Island numbers in order of each island's lowest robot (`active` is in index order).
-        let mut count = 0u32;
-        self.isl_of.clear();
-        for k in 0..self.active.len() {
-            let r = find(&mut self.uf, self.active[k]) as usize;
-            if self.root_island[r] == u32::MAX {
-                self.root_island[r] = count;
-                count += 1;
-            }
-            self.isl_of.push(self.root_island[r]);
-        }
-        for &i in &self.active {
-            let r = find(&mut self.uf, i) as usize;
-            self.root_island[r] = u32::MAX;
-        }
-        // Members island by island, index order within each (a stable counting sort).
-        let islands = count as usize;
-        self.isl_start.clear();
-        self.isl_start.resize(islands + 1, 0);
-        for &k in &self.isl_of {
-            self.isl_start[k as usize + 1] += 1;
-        }
-        for k in 0..islands {
-            self.isl_start[k + 1] += self.isl_start[k];
-        }
-        self.isl_fill.clear();
-        self.isl_fill.extend_from_slice(&self.isl_start[..islands]);
-        self.active_scratch.clear();
-        self.active_scratch.resize(self.active.len(), 0);
-        for (k, &i) in self.active.iter().enumerate() {
-            let isl = self.isl_of[k] as usize;
-            self.active_scratch[self.isl_fill[isl]] = i;
-            self.isl_fill[isl] += 1;
-        }
-        core::mem::swap(&mut self.active, &mut self.active_scratch);
-        // Each robot's island and place in it, through the `uf` scratch (no longer needed).
-        self.islands.clear();
-        for isl in 0..islands {
-            let range = self.isl_start[isl]..self.isl_start[isl + 1];
-            for (local, &i) in self.active[range.clone()].iter().enumerate() {
-                self.uf[i as usize] = local as u32;
-                self.root_island[i as usize] = isl as u32;
-            }
-            self.islands.push((range, 0..0));
-        }
-        // Contacts island by island, their order kept within each (a stable counting sort).
-        self.isl_fill.clear();
-        self.isl_fill.resize(islands + 1, 0);
-        for ct in &self.contacts {
-            self.isl_fill[self.root_island[ct.a as usize] as usize + 1] += 1;
-        }
-        for k in 0..islands {
-            self.isl_fill[k + 1] += self.isl_fill[k];
-        }
-        for (isl, range) in self.islands.iter_mut().enumerate() {
-            range.1 = self.isl_fill[isl]..self.isl_fill[isl + 1];
-        }
-        self.contact_scratch.clear();
-        self.contact_scratch
-            .resize(self.contacts.len(), Contact::default());
-        for ct in &self.contacts {
-            let isl = self.root_island[ct.a as usize] as usize;
-            let mut c = *ct;
-            c.la = self.uf[ct.a as usize];
-            c.lb = if ct.b == WALL {
-                WALL
-            } else {
-                self.uf[ct.b as usize]
-            };
-            self.contact_scratch[self.isl_fill[isl]] = c;
-            self.isl_fill[isl] += 1;
-        }
-        core::mem::swap(&mut self.contacts, &mut self.contact_scratch);
-        for &i in &self.active {
-            self.root_island[i as usize] = u32::MAX;
-        }
-        self.island_bodies.clear();
-        for &i in &self.active {
-            let i = i as usize;
-            self.island_bodies.push(IslandBody {
-                c: self.pose[i].c,
-                s: self.pose[i].s,
-                vel: self.vel[i],
-                wheel_speed: self.wmean[i],
-                wheel_imp: self.wheel_imp[i],
-            });
-        }
-    }
-
-    /// Removes the overlaps the velocity solve left (a rotation is linearised in it; a cluster
-    /// may not have converged): position sweeps over the overlapping pairs and walls, each
-    /// pushing the bodies apart along the contact normal with rotation, weighted by mass and
-    /// inertia, to [`CONTACT_SKIN_M`]; after every sweep the candidates of the robots it moved
-    /// are tested again. What is still overlapping after `position_iterations` sweeps stops
-    /// early: its robots move only the largest fraction (1/2, 1/4, …, 0) of this sub-step's
-    /// motion at which nothing overlaps (a time of impact: no body jumps anywhere, it is only
-    /// kept from going on), and so do robots whose motion ends in those robots.
-    fn clear_overlaps(&mut self, h: f64) {
-        self.epoch += 1;
-        let mut since = self.epoch;
-        for k in 0..self.checked.len() {
-            let i = self.checked[k] as usize;
-            self.last_move[i] = self.epoch;
-        }
-        let mut first = true;
-        for _ in 0..self.params.position_iterations {
-            self.collect_overlaps(since);
-            if self.overlaps.pairs.is_empty() && self.overlaps.walls.is_empty() {
-                return;
-            }
-            if first {
-                self.stats.overlap_substeps += 1;
-                first = false;
-            }
-            self.stats.position_sweeps += 1;
-            self.epoch += 1;
-            since = self.epoch;
-            let list = core::mem::take(&mut self.overlaps);
-            for &i in &list.walls {
-                self.correct_wall(i as usize, h);
-            }
-            for &[i, j] in &list.pairs {
-                self.correct_pair(i as usize, j as usize, h);
-            }
-            self.overlaps = list;
-        }
-        self.collect_overlaps(since);
-        if !self.overlaps.pairs.is_empty() || !self.overlaps.walls.is_empty() {
-            self.stop_early();
-        }
-    }
-
-    /// The candidates with a robot moved at or after epoch `since` that overlap now, into
-    /// `overlaps`.
-    fn collect_overlaps(&mut self, since: u64) {
-        self.overlaps.pairs.clear();
-        self.overlaps.walls.clear();
-        let moved = &self.last_move;
-        let (w, h) = (self.arena.width_m(), self.arena.height_m());
-        for &i in &self.cand.walls {
-            if moved[i as usize] >= since
-                && self.pose[i as usize].crosses_walls(self.hx, self.hy, w, h)
-            {
-                self.overlaps.walls.push(i);
-            }
-        }
-        let reach2 = 4.0 * self.radius_m * self.radius_m;
-        for &[i, j] in &self.cand.pairs {
-            if moved[i as usize] < since && moved[j as usize] < since {
-                continue;
-            }
-            let (a, b) = (self.pose[i as usize], self.pose[j as usize]);
-            if (b.x - a.x) * (b.x - a.x) + (b.y - a.y) * (b.y - a.y) >= reach2 {
-                continue;
-            }
-            if obb_overlap(&self.obb(i as usize), &self.obb(j as usize), 0.0).is_some() {
-                self.overlaps.pairs.push([i, j]);
-            }
-        }
-    }
-
-    /// Moves and turns robot `i` by a position impulse (px, py) applied at lever arm r.
-    #[inline]
-    fn nudge(&mut self, i: usize, px: f64, py: f64, r: [f64; 2]) {
-        let b = &mut self.pose[i];
-        b.x += px * self.body.inv_m;
-        b.y += py * self.body.inv_m;
-        let dtheta = (r[0] * py - r[1] * px) * self.body.inv_i;
-        if dtheta != 0.0 {
-            let (sn, cs) = dtheta.sin_cos();
-            let (c, s) = (b.c * cs - b.s * sn, b.s * cs + b.c * sn);
-            let k = 1.5 - 0.5 * (c * c + s * s);
-            b.c = c * k;
-            b.s = s * k;
-        }
-        self.last_move[i] = self.epoch;
-    }
-
-    /// One position correction of robot `i` against the walls: per wall in contact, the
-    /// deepest point is pushed out to the skin, then the manifold is taken again (a corner
-    /// pushed out turns the body, which moves the other corner). A push of `λ` (kg·m) in a
-    /// sub-step of `h` seconds is the impulse λ / h on the bumper face it acts on.
-    fn correct_wall(&mut self, i: usize, h: f64) {
-        let skin = CORRECTION_GAP_M;
-        for _ in 0..4 {
-            let mut deepest: Option<(Manifold, usize)> = None;
-            box_walls(
-                &self.obb(i),
-                self.arena.width_m(),
-                self.arena.height_m(),
-                skin,
-                |m| {
-                    for k in 0..m.count {
-                        if deepest.is_none_or(|(d, dk)| m.points[k].sep < d.points[dk].sep) {
-                            deepest = Some((m, k));
-                        }
-                    }
-                },
-            );
-            let Some((m, k)) = deepest else {
-                return;
-            };
-            let p = m.points[k];
-            let c = p.sep - skin;
-            if c >= 0.0 {
-                return;
-            }
-            let b = self.pose[i];
-            let r = [p.x - b.x, p.y - b.y];
-            let rn = r[0] * m.ny - r[1] * m.nx;
-            let kn = self.body.inv_m + self.body.inv_i * rn * rn;
-            // The wall does not give way: the body takes the whole push, into the arena.
-            let lambda = -c / kn;
-            self.push_face(i, m.nx, m.ny, lambda / h);
-            self.nudge(i, -lambda * m.nx, -lambda * m.ny, r);
-        }
-    }
-
-    /// One position correction of the pair (i, j): the deepest point of their manifold is
-    /// pushed apart to the skin, shared by mass and inertia, then the manifold is taken again
-    /// for the other point. The push is an impulse on both robots' faces, as in
-    /// [`World::correct_wall`].
-    fn correct_pair(&mut self, i: usize, j: usize, h: f64) {
-        let skin = CORRECTION_GAP_M;
-        for _ in 0..2 {
-            let Some(m) = box_box(&self.obb(i), &self.obb(j), skin) else {
-                return;
-            };
-            let k = if m.count == 2 && m.points[1].sep < m.points[0].sep {
-                1
-            } else {
-                0
-            };
-            let p = m.points[k];
-            let c = p.sep - skin;
-            if c >= 0.0 {
-                return;
-            }
-            let (a, b) = (self.pose[i], self.pose[j]);
-            let ra = [p.x - a.x, p.y - a.y];
-            let rb = [p.x - b.x, p.y - b.y];
-            let rna = ra[0] * m.ny - ra[1] * m.nx;
-            let rnb = rb[0] * m.ny - rb[1] * m.nx;
-            let kn = 2.0 * self.body.inv_m + self.body.inv_i * (rna * rna + rnb * rnb);
-            let lambda = -c / kn;
-            self.push_face(i, m.nx, m.ny, lambda / h);
-            self.push_face(j, -m.nx, -m.ny, lambda / h);
-            self.nudge(i, -lambda * m.nx, -lambda * m.ny, ra);
-            self.nudge(j, lambda * m.nx, lambda * m.ny, rb);
-        }
-    }
-
-    /// The last resort when position sweeps leave an overlap: the robots involved (and, in
-    /// turn, any robot whose end pose overlaps their stopped poses) move only a fraction of
-    /// this sub-step's motion, the largest of 1, 1/2, …, 1/1024, 0 at which nothing they touch
-    /// overlaps. Their start poses were free of overlaps, so this ends.
-    fn stop_early(&mut self) {
-        let mut group: Vec<u32> = Vec::new();
-        let mut ends: Vec<BodyPose> = Vec::new();
-        let add = |i: u32, group: &mut Vec<u32>, ends: &mut Vec<BodyPose>, pose: &[BodyPose]| {
-            if !group.contains(&i) {
-                group.push(i);
-                ends.push(pose[i as usize]);
-            }
-        };
-        for &i in &self.overlaps.walls {
-            add(i, &mut group, &mut ends, &self.pose);
-        }
-        for &[i, j] in &self.overlaps.pairs {
-            add(i, &mut group, &mut ends, &self.pose);
-            add(j, &mut group, &mut ends, &self.pose);
-        }
-        loop {
-            let mut fraction = 1.0;
-            let mut clear = false;
-            for _ in 0..=11 {
-                fraction = if fraction > 1.0 / 1024.0 {
-                    fraction * 0.5
-                } else {
-                    0.0
-                };
-                self.epoch += 1;
-                for (k, &i) in group.iter().enumerate() {
-                    let i = i as usize;
-                    self.pose[i] = interpolate(self.prev[i], ends[k], fraction);
-                    self.last_move[i] = self.epoch;
-                }
-                self.collect_overlaps(self.epoch);
-                if self.overlaps.pairs.is_empty() && self.overlaps.walls.is_empty() {
-                    clear = true;
-                    break;
-                }
-                if fraction == 0.0 {
-                    break;
-                }
-            }
-            if clear {
-                break;
-            }
-            // At fraction 0 the group is where it started, free of overlaps among itself: what
-            // still overlaps is a robot outside the group ending in it, which joins the group.
-            let before = group.len();
-            for &i in &self.overlaps.walls {
-                add(i, &mut group, &mut ends, &self.pose);
-            }
-            for k in 0..self.overlaps.pairs.len() {
-                let [i, j] = self.overlaps.pairs[k];
-                add(i, &mut group, &mut ends, &self.pose);
-                add(j, &mut group, &mut ends, &self.pose);
-            }
-            if group.len() == before {
-                break;
-            }
-        }
-        for &i in &group {
-            self.vel[i as usize] = [0.0; 3];
-        }
-        self.stats.stopped_robot_substeps += group.len() as u64;
-    }
-
-    /// Adds a normal impulse (N·s, > 0 to count) to the bumper face of robot `i` that faces
-    /// the world direction (fx, fy).
-    #[inline]
-    fn push_face(&mut self, i: usize, fx: f64, fy: f64, impulse: f64) {
-        if impulse <= 0.0 {
-            return;
-        }
-        let b = self.pose[i];
-        let side = side_of(fx * b.c + fy * b.s, -fx * b.s + fy * b.c);
-        let f = &mut self.face_impulse[i];
-        if f.iter().all(|&x| x == 0.0) {
-            self.pushed.push(i as u32);
-        }
-        f[side] += impulse;
+        self.broad.rebuild(
+            &self.pose,
+            self.body.radius_m,
+            self.arena.width_m(),
+            self.arena.height_m(),
+            parallel,
+        );
     }
 
     fn wall_penetration(&self, i: usize) -> bool {
         self.pose[i].crosses_walls(
-            self.hx,
-            self.hy,
+            self.body.hx,
+            self.body.hy,
             self.arena.width_m(),
             self.arena.height_m(),
         )
@@ -1534,7 +761,7 @@ impl World {
     /// broad-phase candidates.
     fn first_overlap(&self) -> Option<(usize, usize, f64)> {
         let mut best: Option<(usize, usize, f64)> = None;
-        for &[i, j] in &self.cand.pairs {
+        for &[i, j] in &self.broad.candidates().pairs {
             let (i, j) = (i as usize, j as usize);
             if let Some(o) = obb_overlap(&self.obb(i), &self.obb(j), 0.0)
                 && best.is_none_or(|(a, b, _)| (i, j) < (a, b))
@@ -1550,7 +777,7 @@ impl World {
     /// the simulation.
     pub fn deepest_overlap_m(&self) -> f64 {
         let mut deepest: f64 = 0.0;
-        for &[i, j] in &self.cand.pairs {
+        for &[i, j] in &self.broad.candidates().pairs {
             if let Some(o) = obb_overlap(&self.obb(i as usize), &self.obb(j as usize), 0.0) {
                 deepest = deepest.max(o.depth_m);
             }
@@ -1579,67 +806,20 @@ impl World {
                 count: self.mounts.len(),
             });
         };
-        let b = self.pose[robot];
-        let ox = b.x + b.c * m.x - b.s * m.y;
-        let oy = b.y + b.s * m.x + b.c * m.y;
-        let mut best: Option<f64> = None;
-        for &(dc, ds) in &m.dirs {
-            let dx = b.c * dc - b.s * ds;
-            let dy = b.s * dc + b.c * ds;
-            if let Some(t) = self.cast(robot, ox, oy, dx, dy)
-                && best.is_none_or(|bt| t < bt)
-            {
-                best = Some(t);
-            }
-        }
-        Ok(best.map(|t| t * 1000.0))
+        Ok(self.rays().sense(robot, m))
     }
 
-    /// Casts one ray (unit direction) and returns the nearest hit in metres within range.
-    fn cast(&self, own: usize, ox: f64, oy: f64, dx: f64, dy: f64) -> Option<f64> {
-        let range = self.params.sensor_max_range_m;
-        let t_wall = ray_walls(ox, oy, dx, dy, self.arena.width_m(), self.arena.height_m());
-        let (mut t_max, mut hit) = if t_wall <= range {
-            (t_wall, true)
-        } else {
-            (range, false)
-        };
-        // Cells whose robots (filed by their centre at the last build, which may have moved
-        // up to half the margin since) can reach the segment.
-        let pad = self.radius_m + self.drift_limit_m;
-        let (ex, ey) = (ox + dx * t_max, oy + dy * t_max);
-        let c0 = self.grid.col(ox.min(ex) - pad);
-        let c1 = self.grid.col(ox.max(ex) + pad);
-        let r0 = self.grid.row(oy.min(ey) - pad);
-        let r1 = self.grid.row(oy.max(ey) + pad);
-        let r = self.radius_m;
-        for row in r0..=r1 {
-            for col in c0..=c1 {
-                for &j in self.grid.cell(col, row) {
-                    let j = j as usize;
-                    if j == own {
-                        continue;
-                    }
-                    let b = self.pose[j];
-                    let (rx, ry) = (b.x - ox, b.y - oy);
-                    let tc = rx * dx + ry * dy;
-                    if tc < -r || tc > t_max + r {
-                        continue;
-                    }
-                    let perp2 = rx * rx + ry * ry - tc * tc;
-                    if perp2 > r * r {
-                        continue;
-                    }
-                    if let Some(t) = ray_obb(ox, oy, dx, dy, &self.obb(j), t_max)
-                        && (t < t_max || !hit)
-                    {
-                        t_max = t;
-                        hit = true;
-                    }
-                }
-            }
+    /// What the sensors' rays are cast against now.
+    fn rays(&self) -> RayScene<'_> {
+        RayScene {
+            pose: &self.pose,
+            body: &self.body,
+            grid: self.broad.grid(),
+            drift_limit_m: self.broad.drift_limit_m(),
+            w: self.arena.width_m(),
+            h: self.arena.height_m(),
+            range: self.params.sensor_max_range_m,
         }
-        hit.then_some(t_max)
     }
 
     // ----- corridor metric -----------------------------------------------------------------------
@@ -1722,327 +902,6 @@ fn outside(robot: usize, p: &Pose, arena: &Arena) -> WorldError {
         width_m: arena.width_m(),
         height_m: arena.height_m(),
     }
-}
-
-/// What the motor and free-motion phases need for one sub-step.
-#[derive(Clone, Copy)]
-struct Drive {
-    lag: LagCoefficients,
-    inv_track: f64,
-    h: f64,
-    /// 1 / h.
-    inv_h: f64,
-    /// The bodies' mass, inertia, wheel geometry and traction (for the free robots' wheel
-    /// forces).
-    body: BodyConst,
-}
-
-/// The wheel-speed difference below which a wheel is taken to have reached its target speed:
-/// 1e-12 m/s, a picometre per second, far below anything the model resolves.
-const SPEED_SNAP_M_S: f64 = 1e-12;
-
-impl Drive {
-    /// Motors for a slice of robots: wheel speeds follow their targets with the exact
-    /// first-order lag; `wmean` gets each wheel's mean speed over the sub-step (the exact
-    /// integral of the lag) and `prev` the pose at its start.
-    fn motors(
-        &self,
-        motion: &mut [Motion],
-        wmean: &mut [[f64; 2]],
-        prev: &mut [BodyPose],
-        pose: &[BodyPose],
-    ) {
-        for (((m, mean), pr), p) in motion.iter_mut().zip(wmean).zip(prev).zip(pose) {
-            *pr = *p;
-            for (w, mean_w) in mean.iter_mut().enumerate() {
-                let l = self.lag.by_mode[usize::from(m.mode[w]).min(2)];
-                let mut diff = m.speed[w] - m.target[w];
-                // A speed within SPEED_SNAP_M_S of its target has arrived: without the snap, a
-                // wheel decaying to a zero target keeps shrinking through subnormal floats,
-                // which cost x86 cores about a hundred cycles per operation.
-                if diff.abs() < SPEED_SNAP_M_S {
-                    diff = 0.0;
-                }
-                *mean_w = m.target[w] + diff * l.mean_factor;
-                m.speed[w] = m.target[w] + diff * l.decay;
-            }
-        }
-    }
-
-    /// Robots touching nothing (no `ACTIVE` flag) follow their wheels: the exact arc of the
-    /// sub-step's mean wheel speeds (exact heading change and, for straight motion, exact
-    /// distance); their velocity becomes the wheels' twist, and their wheel forces those that
-    /// changed the velocity they had along their heading (see [`World::wheel_forces`]).
-    fn free(
-        &self,
-        pose: &mut [BodyPose],
-        vel: &mut [[f64; 3]],
-        force: &mut [[f64; 2]],
-        wmean: &[[f64; 2]],
-        flags: &[u8],
-    ) {
-        for ((((p, v), fw), w), &f) in pose.iter_mut().zip(vel).zip(force).zip(wmean).zip(flags) {
-            if f & ACTIVE != 0 {
-                continue;
-            }
-            let along = 0.5 * (w[0] + w[1]);
-            let omega = (w[1] - w[0]) * self.inv_track;
-            let along0 = v[0] * p.c + v[1] * p.s;
-            *fw = self
-                .body
-                .wheel_forces(along - along0, omega - v[2], self.inv_h);
-            let (dx, dy, c, s) = arc_step(p.c, p.s, along, omega, self.h);
-            p.x += dx;
-            p.y += dy;
-            p.c = c;
-            p.s = s;
-            *v = [along * c, along * s, omega];
-        }
-    }
-}
-
-/// What the contact search reads.
-struct Probe<'a> {
-    pose: &'a [BodyPose],
-    hx: f64,
-    hy: f64,
-    /// Squared distance between centres beyond which bodies cannot come within `spec`.
-    reach2: f64,
-    w: f64,
-    h: f64,
-    spec: f64,
-    body: &'a BodyConst,
-}
-
-impl Probe<'_> {
-    /// Appends the wall contacts of the robots `walls`, in order.
-    fn walls(&self, walls: &[u32], out: &mut Vec<Contact>) {
-        for &i in walls {
-            let b = self.pose[i as usize];
-            let (ex, ey) = b.obb(self.hx, self.hy).aabb_half_extents();
-            let near = b.x - ex <= self.spec
-                || b.x + ex >= self.w - self.spec
-                || b.y - ey <= self.spec
-                || b.y + ey >= self.h - self.spec;
-            if !near {
-                continue;
-            }
-            box_walls(&b.obb(self.hx, self.hy), self.w, self.h, self.spec, |m| {
-                out.push(Contact::new(i, WALL, &m, (b.x, b.y), (0.0, 0.0), self.body));
-            });
-        }
-    }
-
-    /// Appends the contacts of the candidate pairs, in order.
-    fn pairs(&self, pairs: &[[u32; 2]], out: &mut Vec<Contact>) {
-        for &[i, j] in pairs {
-            let (a, b) = (self.pose[i as usize], self.pose[j as usize]);
-            let (dx, dy) = (b.x - a.x, b.y - a.y);
-            if dx * dx + dy * dy >= self.reach2 {
-                continue;
-            }
-            if let Some(m) = box_box(
-                &a.obb(self.hx, self.hy),
-                &b.obb(self.hx, self.hy),
-                self.spec,
-            ) {
-                out.push(Contact::new(i, j, &m, (a.x, a.y), (b.x, b.y), self.body));
-            }
-        }
-    }
-}
-
-/// The pose a fraction `f` of the way from `a` to `b` (position linearly, heading by the
-/// shorter rotation).
-fn interpolate(a: BodyPose, b: BodyPose, f: f64) -> BodyPose {
-    let dtheta = (a.c * b.s - a.s * b.c).atan2(a.c * b.c + a.s * b.s);
-    let (sn, cs) = (f * dtheta).sin_cos();
-    BodyPose {
-        x: a.x + f * (b.x - a.x),
-        y: a.y + f * (b.y - a.y),
-        c: a.c * cs - a.s * sn,
-        s: a.s * cs + a.c * sn,
-    }
-}
-
-/// What the candidate search reads.
-struct CandidateCtx<'a> {
-    pose: &'a [BodyPose],
-    grid: &'a Grid,
-    reach2: f64,
-    /// A robot whose centre is nearer a wall than this is a wall candidate.
-    wall_reach: f64,
-    w: f64,
-    h: f64,
-}
-
-impl CandidateCtx<'_> {
-    /// Candidates for robots `lo..hi`: those whose bounding circle is within the margin of a
-    /// wall, and pairs (i, j > i) whose centres are within two bounding radii plus the margin.
-    fn find(&self, lo: usize, hi: usize, out: &mut Candidates) {
-        let nx = self.grid.nx();
-        let ny = self.grid.ny();
-        for i in lo..hi {
-            let b = self.pose[i];
-            // By the bounding circle, so that turning cannot bring a body to a wall unseen.
-            let e = self.wall_reach;
-            if b.x - e < 0.0 || b.x + e > self.w || b.y - e < 0.0 || b.y + e > self.h {
-                out.walls.push(i as u32);
-            }
-            let (cx, cy) = self.grid.cell_of(i);
-            let (c0, c1) = (cx.saturating_sub(1), (cx + 1).min(nx - 1));
-            let (r0, r1) = (cy.saturating_sub(1), (cy + 1).min(ny - 1));
-            for row in r0..=r1 {
-                for col in c0..=c1 {
-                    for &j in self.grid.cell(col, row) {
-                        if (j as usize) <= i {
-                            continue;
-                        }
-                        let q = self.pose[j as usize];
-                        let (dx, dy) = (q.x - b.x, q.y - b.y);
-                        if dx * dx + dy * dy < self.reach2 {
-                            out.pairs.push([i as u32, j]);
-                        }
-                    }
-                }
-            }
-        }
-    }
-}
-
-/// Corridor placement: bodies on the centre line facing +x or −x at random, separated by the
-/// clearance plus a uniformly random share of the free length (uniform spacings).
-fn place_corridor(
-    arena: &Arena,
-    params: &WorldParams,
-    n: usize,
-    seed: u64,
-) -> Result<Vec<BodyPose>, WorldError> {
-    let len = params.body_length_m;
-    let clr = params.placement_clearance_m;
-    let (w, h) = (arena.width_m(), arena.height_m());
-    if params.body_width_m > h {
-        return Err(WorldError::Parameter {
-            name: "body_width_m",
-            value: params.body_width_m,
-            valid: "a body no wider than the corridor",
-        });
-    }
-    let free = w - n as f64 * len - (n as f64 + 1.0) * clr;
-    if free < 0.0 {
-        let max_fit = ((w - clr) / (len + clr)).floor().max(0.0) as usize;
-        return Err(WorldError::TooManyRobots {
-            requested: n,
-            max_fit,
-            arena: arena.describe(),
-            clearance_m: clr,
-        });
-    }
-    let mut rng = stream_rng(seed, Purpose::Placement, 0);
-    let mut cuts: Vec<f64> = (0..n).map(|_| unit(&mut rng) * free).collect();
-    cuts.sort_by(f64::total_cmp);
-    let mut poses = Vec::with_capacity(n);
-    let mut edge = 0.0; // right edge of the previous body (or the wall)
-    let mut last_cut = 0.0;
-    for &cut in &cuts {
-        let gap = clr + (cut - last_cut);
-        last_cut = cut;
-        let x = edge + gap + 0.5 * len;
-        edge = x + 0.5 * len;
-        let backward = unit(&mut rng) < 0.5;
-        let (c, s) = if backward { (-1.0, 0.0) } else { (1.0, 0.0) };
-        poses.push(BodyPose {
-            x,
-            y: 0.5 * h,
-            c,
-            s,
-        });
-    }
-    Ok(poses)
-}
-
-/// Open-arena placement: rejection sampling of uniform headings and positions with the
-/// clearance to walls and bodies; a bounded number of attempts.
-fn place_open(
-    arena: &Arena,
-    params: &WorldParams,
-    n: usize,
-    seed: u64,
-) -> Result<Vec<BodyPose>, WorldError> {
-    let (w, h) = (arena.width_m(), arena.height_m());
-    let (hx, hy) = (0.5 * params.body_length_m, 0.5 * params.body_width_m);
-    let clr = params.placement_clearance_m;
-    // Bodies inflated by half the clearance are disjoint and lie inside the arena shrunk by
-    // half the clearance on each side: an upper bound on how many fit.
-    let usable = ((w - clr).max(0.0)) * ((h - clr).max(0.0));
-    let cell_area = (params.body_length_m + clr) * (params.body_width_m + clr);
-    let max_fit = (usable / cell_area).floor() as usize;
-    if n > max_fit {
-        return Err(WorldError::TooManyRobots {
-            requested: n,
-            max_fit,
-            arena: arena.describe(),
-            clearance_m: clr,
-        });
-    }
-    let reach = 2.0 * hx.hypot(hy) + clr;
-    let mut grid_cells: Vec<Vec<u32>>;
-    let cell_m = reach.max((w * h / (n.max(1) as f64)).sqrt());
-    let nx = ((w / cell_m).ceil() as usize).max(1);
-    let ny = ((h / cell_m).ceil() as usize).max(1);
-    grid_cells = vec![Vec::new(); nx * ny];
-    let cell_ix = |x: f64, y: f64| -> (usize, usize) {
-        let cx = ((x / cell_m).floor().max(0.0) as usize).min(nx - 1);
-        let cy = ((y / cell_m).floor().max(0.0) as usize).min(ny - 1);
-        (cx, cy)
-    };
-    let max_attempts: u64 = 1000 * n as u64 + 10_000;
-    let mut attempts: u64 = 0;
-    let mut rng = stream_rng(seed, Purpose::Placement, 0);
-    let mut poses: Vec<BodyPose> = Vec::with_capacity(n);
-    while poses.len() < n {
-        if attempts >= max_attempts {
-            return Err(WorldError::PlacementFailed {
-                placed: poses.len(),
-                requested: n,
-                attempts,
-                max_fit,
-                arena: arena.describe(),
-                clearance_m: clr,
-            });
-        }
-        attempts += 1;
-        let theta = core::f64::consts::PI * (2.0 * unit(&mut rng) - 1.0);
-        let (s, c) = theta.sin_cos();
-        let ex = hx * c.abs() + hy * s.abs() + clr;
-        let ey = hx * s.abs() + hy * c.abs() + clr;
-        let ux = unit(&mut rng);
-        let uy = unit(&mut rng);
-        if 2.0 * ex > w || 2.0 * ey > h {
-            continue;
-        }
-        let x = ex + ux * (w - 2.0 * ex);
-        let y = ey + uy * (h - 2.0 * ey);
-        let a = Obb { x, y, c, s, hx, hy };
-        let (cx, cy) = cell_ix(x, y);
-        let mut free = true;
-        'scan: for row in cy.saturating_sub(1)..=(cy + 1).min(ny - 1) {
-            for col in cx.saturating_sub(1)..=(cx + 1).min(nx - 1) {
-                for &j in &grid_cells[row * nx + col] {
-                    let b = poses[j as usize].obb(hx, hy);
-                    if obb_overlap(&a, &b, -clr).is_some() {
-                        free = false;
-                        break 'scan;
-                    }
-                }
-            }
-        }
-        if free {
-            grid_cells[cy * nx + cx].push(poses.len() as u32);
-            poses.push(BodyPose { x, y, c, s });
-        }
-    }
-    Ok(poses)
 }
 
 #[cfg(test)]

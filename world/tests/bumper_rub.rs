@@ -1,4 +1,4 @@
-//! A robot rubbing along a wall (issue 12): its motors differ a little, so it keeps turning
+//! A robot rubbing along a wall: its motors differ a little, so it keeps turning
 //! into the wall and slides along it with a light, steady push. The switch on that face must
 //! read one steady state, not chatter: the 10^6-step soak found such a robot pressed in every
 //! second sub-step (the position correction of the turning corner's micro-overlap pressed the

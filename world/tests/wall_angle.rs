@@ -1,4 +1,4 @@
-//! A differential-drive robot driving into a wall at an angle (issue 12). With both wheels
+//! A differential-drive robot driving into a wall at an angle. With both wheels
 //! slipping (the wall blocks them) each wheel pushes with μ_floor·m·g/2 along the heading and
 //! the pair has no moment about the axle's centre, so only the wall's force turns the body: at
 //! the leading front corner, inside its friction cone. The corner sticks, and the robot pivots

@@ -1,12 +1,15 @@
-//! Unit and property tests of the world: kinematics, motors, collisions, bumpers, rays, broad
-//! phase against brute force, placement, determinism, errors, and a `parry2d` cross-check of
-//! the narrow phase.
+//! Tests of the whole world through its step: kinematics, motors, collisions, bumpers, rays
+//! after motion, poses given by the caller, determinism and thread counts, errors. The stages'
+//! own tests stand in their files (the broad phase and the rays against brute force,
+//! placement; the geometry against `parry2d`).
 
 use super::*;
+use crate::geometry::{ray_obb, ray_walls};
 use crate::motor::Behaviour;
 use crate::params::{BODY_LENGTH_M, BODY_WIDTH_M, SensorMount};
 use core::f64::consts::{FRAC_PI_2, PI};
 use proptest::prelude::*;
+use rand_pcg::Pcg64;
 
 const HX: f64 = 0.5 * BODY_LENGTH_M;
 const HY: f64 = 0.5 * BODY_WIDTH_M;
@@ -890,7 +893,7 @@ fn a_cone_sees_what_the_axis_ray_misses() {
     assert!(near < 500.0, "{near}");
 }
 
-// ----- broad phase against brute force --------------------------------------------------------
+// ----- rays against brute force after motion ----------------------------------------------------
 
 /// The nearest hit by brute force over every wall and robot.
 fn brute_sense(w: &World, robot: usize, sensor: usize) -> Option<f64> {
@@ -918,71 +921,8 @@ fn brute_sense(w: &World, robot: usize, sensor: usize) -> Option<f64> {
     best.map(|t| t * 1000.0)
 }
 
-fn random_scene(n: usize, side: f64, xs: &[(f64, f64, f64)]) -> World {
-    let arena = Arena::rectangle(side, side * 0.7).unwrap();
-    let params = WorldParams {
-        rays_per_sensor: 3,
-        cone_half_angle_rad: 0.05,
-        ..WorldParams::default()
-    };
-    let mut w = World::from_poses(arena, params, &[], 1).unwrap();
-    // Install arbitrary (possibly overlapping) poses directly, as a broad-phase test scene.
-    let body: Vec<BodyPose> = xs[..n]
-        .iter()
-        .map(|&(fx, fy, th)| body_pose(&pose(fx * side, fy * side * 0.7, th)))
-        .collect();
-    w.grid = Grid::new(side, side * 0.7, 2.0 * w.radius_m + w.margin_m, n);
-    w.pose = body.clone();
-    w.prev = body;
-    w.motion = vec![Motion::default(); n];
-    w.vel = vec![[0.0; 3]; n];
-    w.wmean = vec![[0.0; 2]; n];
-    w.wheel_imp = vec![[0.0; 4]; n];
-    w.bumpers = vec![0; n];
-    w.flags = vec![0; n];
-    w.last_move = vec![0; n];
-    w.gains = vec![[1.0; 2]; n];
-    w.chunk_cands = vec![Candidates::default(); n.div_ceil(PAR_CHUNK)];
-    w.rebuild_broad_phase(false);
-    w
-}
-
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(200))]
-
-    /// Overlapping pairs and wall penetrations found through the grid equal brute force, and
-    /// every ray equals a brute-force cast against all walls and robots.
-    #[test]
-    fn broad_phase_equals_brute_force(
-        side in 1.0f64..8.0,
-        xs in proptest::collection::vec((0.0f64..1.0, 0.0f64..1.0, -PI..PI), 1..80),
-    ) {
-        let n = xs.len();
-        let w = random_scene(n, side, &xs);
-        let mut via_grid = std::collections::BTreeSet::new();
-        for &[i, j] in &w.cand.pairs {
-            if obb_overlap(&w.obb(i as usize), &w.obb(j as usize), 0.0).is_some() {
-                via_grid.insert((i as usize, j as usize));
-            }
-        }
-        let mut brute = std::collections::BTreeSet::new();
-        for i in 0..n {
-            for j in i + 1..n {
-                if obb_overlap(&w.obb(i), &w.obb(j), 0.0).is_some() {
-                    brute.insert((i, j));
-                }
-            }
-            if w.wall_penetration(i) {
-                prop_assert!(w.cand.walls.contains(&(i as u32)));
-            }
-        }
-        prop_assert_eq!(via_grid, brute);
-        for r in 0..n {
-            for s in 0..4 {
-                prop_assert_eq!(w.sense(r, s).unwrap(), brute_sense(&w, r, s));
-            }
-        }
-    }
 
     /// After real motion (the grid is a sub-step old and robots moved since), rays still equal
     /// brute force.
@@ -1005,111 +945,13 @@ proptest! {
     }
 }
 
-// ----- placement ------------------------------------------------------------------------------
+// ----- placement and poses given by the caller ----------------------------------------------------
 
-fn assert_clearance(w: &World, clr: f64) {
-    for i in 0..w.robot_count() {
-        let (ex, ey) = w.obb(i).aabb_half_extents();
-        let b = w.pose[i];
-        if w.arena.kind() == ArenaKind::Open {
-            assert!(b.x - ex >= clr - 1e-12 && b.x + ex <= w.arena.width_m() - clr + 1e-12);
-            assert!(b.y - ey >= clr - 1e-12 && b.y + ey <= w.arena.height_m() - clr + 1e-12);
-        } else {
-            assert!(b.x - ex >= clr - 1e-12 && b.x + ex <= w.arena.width_m() - clr + 1e-12);
-            assert!(!w.wall_penetration(i));
-        }
-        for j in i + 1..w.robot_count() {
-            assert!(
-                obb_overlap(&w.obb(i), &w.obb(j), -clr + 1e-12).is_none(),
-                "{i} {j}"
-            );
-        }
-    }
-}
-
+/// A world of no robots is a world, and advances.
 #[test]
-fn placement_is_non_overlapping_and_deterministic() {
-    for (arena, n) in [
-        (Arena::square(), 3),
-        (Arena::square(), 15),
-        (Arena::scaled_square(300).unwrap(), 300),
-        (Arena::paper_corridor(), 3),
-        (Arena::paper_corridor(), 8),
-    ] {
-        let a = World::new(arena, WorldParams::default(), n, 5).unwrap();
-        let b = World::new(arena, WorldParams::default(), n, 5).unwrap();
-        let c = World::new(arena, WorldParams::default(), n, 6).unwrap();
-        assert_eq!(a.pose, b.pose);
-        assert_ne!(a.pose, c.pose);
-        assert_eq!(a.robot_count(), n);
-        assert_clearance(&a, PLACEMENT_CLEARANCE);
-        if arena.kind() == ArenaKind::Corridor {
-            for p in &a.pose {
-                assert_eq!(p.y, 0.11);
-                assert!(p.s == 0.0 && p.c.abs() == 1.0);
-            }
-        }
-    }
-    // Headings in the corridor are both ways across seeds.
-    let mut dirs = std::collections::BTreeSet::new();
-    for seed in 0..20 {
-        let w = World::new(Arena::paper_corridor(), WorldParams::default(), 3, seed).unwrap();
-        for p in &w.pose {
-            dirs.insert(p.c as i64);
-        }
-    }
-    assert_eq!(dirs.len(), 2);
-}
-
-const PLACEMENT_CLEARANCE: f64 = crate::params::PLACEMENT_CLEARANCE_M;
-
-#[test]
-fn crowded_placement_is_an_error_that_says_how_many_fit() {
-    // Corridor: 3.0 m holds floor((3.0 − 0.05) / 0.28) = 10 robots at 5 cm.
-    assert!(World::new(Arena::paper_corridor(), WorldParams::default(), 10, 1).is_ok());
-    let e = World::new(Arena::paper_corridor(), WorldParams::default(), 11, 1).unwrap_err();
-    assert!(
-        matches!(
-            e,
-            WorldError::TooManyRobots {
-                requested: 11,
-                max_fit: 10,
-                ..
-            }
-        ),
-        "{e}"
-    );
-    assert!(e.to_string().contains("at most 10 fit"), "{e}");
-    // Square: the area bound is (1.75)² / (0.28 · 0.23) = 47.
-    let e = World::new(Arena::square(), WorldParams::default(), 48, 1).unwrap_err();
-    assert!(
-        matches!(e, WorldError::TooManyRobots { max_fit: 47, .. }),
-        "{e}"
-    );
-    // Below the bound but beyond what random placement reaches: bounded attempts, then an error.
-    let e = World::new(Arena::square(), WorldParams::default(), 46, 1).unwrap_err();
-    assert!(
-        matches!(
-            e,
-            WorldError::PlacementFailed {
-                requested: 46,
-                attempts: 56_000,
-                ..
-            }
-        ),
-        "{e}"
-    );
-    assert!(e.to_string().contains("after 56000 random attempts"), "{e}");
-    // A body wider than the corridor.
-    let params = WorldParams {
-        body_width_m: 0.25,
-        ..WorldParams::default()
-    };
-    assert!(World::new(Arena::paper_corridor(), params, 1, 1).is_err());
-    // Zero robots is an empty world.
-    let w = World::new(Arena::square(), WorldParams::default(), 0, 1).unwrap();
+fn an_empty_world_advances() {
+    let mut w = World::new(Arena::square(), WorldParams::default(), 0, 1).unwrap();
     assert_eq!(w.robot_count(), 0);
-    let mut w = w;
     w.advance(0.01).unwrap();
 }
 
@@ -1172,7 +1014,7 @@ fn state_bits(w: &World) -> Vec<u64> {
         v.extend([b.x, b.y, b.c, b.s].map(f64::to_bits));
         v.extend(w.motion[i].speed.map(f64::to_bits));
         v.extend(w.wheel_force[i].map(f64::to_bits));
-        v.push(u64::from(w.bumpers[i]));
+        v.push(u64::from(w.bumpers.bits(i)));
     }
     v
 }
@@ -1226,7 +1068,7 @@ fn thread_count_does_not_change_the_result() {
     drive_run(&mut seq, 300, 9, false);
     let reference = state_bits(&seq);
     assert!(
-        seq.bumpers.iter().any(|&b| b != 0),
+        (0..seq.robot_count()).any(|i| seq.bumpers.bits(i) != 0),
         "some contacts happened"
     );
     for threads in [1, 2, 3, 4] {
@@ -1400,158 +1242,6 @@ fn corners_outline_the_body() {
             (a.0 - b.0).abs() < 1e-12 && (a.1 - b.1).abs() < 1e-12,
             "{a:?} {b:?}"
         );
-    }
-}
-
-// ----- parry2d cross-check of the narrow phase ----------------------------------------------------
-
-mod parry_check {
-    use super::*;
-    use parry2d::math::{Pose as PPose, Vector};
-    use parry2d::query::{Ray, RayCast, contact, distance};
-    use parry2d::shape::Cuboid;
-
-    fn ppose(b: &Obb) -> PPose {
-        PPose::new(Vector::new(b.x as f32, b.y as f32), b.s.atan2(b.c) as f32)
-    }
-
-    proptest! {
-        #![proptest_config(ProptestConfig::with_cases(5000))]
-
-        /// Same contact / no contact as parry2d (away from touching, where f32 cannot decide),
-        /// and the same depth and normal within f32 precision.
-        #[test]
-        fn obb_contact_agrees_with_parry(
-            bx in -0.4f64..0.4, by in -0.4f64..0.4, ta in -PI..PI, tb in -PI..PI,
-        ) {
-            let a = Obb::new(0.0, 0.0, ta, HX, HY);
-            let b = Obb::new(bx, by, tb, HX, HY);
-            let cub = Cuboid::new(Vector::new(HX as f32, HY as f32));
-            let pc = contact(&ppose(&a), &cub, &ppose(&b), &cub, 0.0).unwrap();
-            let ours = obb_overlap(&a, &b, 0.0);
-            match (ours, pc) {
-                (Some(o), Some(c)) if c.dist < 0.0 => {
-                    prop_assert!((o.depth_m + f64::from(c.dist)).abs() < 1e-5, "{o:?} {c:?}");
-                    if o.depth_m > 1e-4 {
-                        let (px, py) = (f64::from(c.normal1.x), f64::from(c.normal1.y));
-                        let dot = o.nx * px + o.ny * py;
-                        // Where two axes give the same depth, either normal is right: parry's
-                        // must then give (within f32) the same overlap along its own axis.
-                        let along = |bx: &Obb| bx.hx * (px * bx.c + py * bx.s).abs()
-                            + bx.hy * (-px * bx.s + py * bx.c).abs();
-                        let overlap_on_parry_axis =
-                            along(&a) + along(&b) - ((b.x - a.x) * px + (b.y - a.y) * py).abs();
-                        prop_assert!(
-                            dot > 0.999 || (overlap_on_parry_axis - o.depth_m).abs() < 1e-5,
-                            "{o:?} {c:?}"
-                        );
-                    }
-                }
-                (None, None) => {}
-                (None, Some(c)) if c.dist >= 0.0 => {}
-                (o, c) => {
-                    // Only allowed within f32 reach of touching.
-                    let d = o.map_or(0.0, |o| o.depth_m);
-                    let pd = c.map_or(0.0, |c| f64::from(c.dist));
-                    prop_assert!(d.abs() < 1e-5 && pd.abs() < 1e-5, "ours {o:?} parry {c:?}");
-                }
-            }
-        }
-
-                /// The distance between outlines equals parry2d's within f32 precision.
-        #[test]
-        fn obb_distance_agrees_with_parry(
-            bx in -0.8f64..0.8, by in -0.8f64..0.8, ta in -PI..PI, tb in -PI..PI,
-        ) {
-            let a = Obb::new(0.0, 0.0, ta, HX, HY);
-            let b = Obb::new(bx, by, tb, HX, HY);
-            let cub = Cuboid::new(Vector::new(HX as f32, HY as f32));
-            let theirs = f64::from(distance(&ppose(&a), &cub, &ppose(&b), &cub).unwrap().distance);
-            let ours = obb_distance(&a, &b);
-            prop_assert!((ours - theirs).abs() < 2e-6, "ours {ours} parry {theirs}");
-        }
-
-        /// Ray distances equal an independent f64 reference (intersection with the four edge
-        /// segments) within 1e-12 m, and parry2d's within 1e-6 m; parry2d computes in f32, so
-        /// for rays meeting a face at a grazing angle α its error grows as 1/sin α and the
-        /// tolerance is 1e-6 m / max(sin α, 0.01); hit/miss may differ only for rays passing
-        /// within f32 reach of a corner.
-        #[test]
-        fn ray_distance_agrees_with_reference_and_parry(
-            ox in -2.0f64..2.0, oy in -2.0f64..2.0, th in -PI..PI, aim in -0.3f64..0.3, tb in -PI..PI,
-        ) {
-            let b = Obb::new(0.0, 0.0, tb, HX, HY);
-            // Aim roughly at the box so that most rays hit.
-            let base = (-oy).atan2(-ox);
-            let dir = if th.abs() < 1.0 { base + aim } else { th };
-            let (dy, dx) = dir.sin_cos();
-            let ours = ray_obb(ox, oy, dx, dy, &b, 10.0);
-
-            // f64 reference: the nearest crossing of the four edges (0 from inside).
-            let lo = (ox * b.c + oy * b.s, -ox * b.s + oy * b.c);
-            let inside = lo.0.abs() < HX && lo.1.abs() < HY;
-            let mut reference: Option<f64> = if inside { Some(0.0) } else { None };
-            if !inside {
-                let c = b.corners();
-                for k in 0..4 {
-                    let (p, q) = (c[k], c[(k + 1) % 4]);
-                    let (ex, ey) = (q.0 - p.0, q.1 - p.1);
-                    let den = dx * ey - dy * ex;
-                    if den.abs() < 1e-15 {
-                        continue;
-                    }
-                    let (wx, wy) = (p.0 - ox, p.1 - oy);
-                    let t = (wx * ey - wy * ex) / den;
-                    let u = (wx * dy - wy * dx) / den;
-                    if t >= 0.0 && (0.0..=1.0).contains(&u) && reference.is_none_or(|r| t < r) {
-                        reference = Some(t);
-                    }
-                }
-            }
-            match (ours, reference) {
-                (Some(a), Some(r)) => prop_assert!((a - r).abs() < 1e-12, "ours {a} reference {r}"),
-                (None, None) => {}
-                (o, r) => {
-                    let t = o.or(r).unwrap();
-                    let (hx, hy) = (ox + dx * t, oy + dy * t);
-                    let lx = (hx * b.c + hy * b.s).abs();
-                    let ly = (-hx * b.s + hy * b.c).abs();
-                    prop_assert!((lx - HX).abs() < 1e-12 && (ly - HY).abs() < 1e-12, "ours {o:?} reference {r:?}");
-                }
-            }
-
-            let cub = Cuboid::new(Vector::new(HX as f32, HY as f32));
-            let ray = Ray::new(Vector::new(ox as f32, oy as f32), Vector::new(dx as f32, dy as f32));
-            let theirs = cub.cast_ray(&ppose(&b), &ray, 10.0, true).map(f64::from);
-            match (ours, theirs) {
-                (Some(a), Some(p)) => {
-                    // Grazing angle at our hit: the direction's component along the face normal.
-                    let (hx, hy) = (ox + dx * a, oy + dy * a);
-                    let lx = hx * b.c + hy * b.s;
-                    let ly = -hx * b.s + hy * b.c;
-                    let ldx = dx * b.c + dy * b.s;
-                    let ldy = -dx * b.s + dy * b.c;
-                    let sin_graze = if a == 0.0 {
-                        1.0
-                    } else if (lx.abs() - HX).abs() < (ly.abs() - HY).abs() {
-                        ldx.abs()
-                    } else {
-                        ldy.abs()
-                    };
-                    let tol = 1e-6 / sin_graze.max(0.01);
-                    prop_assert!((a - p).abs() < tol, "ours {a} parry {p} (sin graze {sin_graze})");
-                }
-                (None, None) => {}
-                (o, p) => {
-                    // A corner graze: the ray passes within f32 reach of the box outline.
-                    let t = o.or(p).unwrap();
-                    let (hx, hy) = (ox + dx * t, oy + dy * t);
-                    let lx = (hx * b.c + hy * b.s).abs();
-                    let ly = (-hx * b.s + hy * b.c).abs();
-                    prop_assert!((lx - HX).abs() < 1e-5 && (ly - HY).abs() < 1e-5, "ours {o:?} parry {p:?}");
-                }
-            }
-        }
     }
 }
 

@@ -1,5 +1,5 @@
 //! A reference model of one robot driving into the wall x = `wall_x` (used by the
-//! `wall_angle` test and example; issue 12): plain Coulomb friction integrated explicitly in
+//! `wall_angle` test and example): plain Coulomb friction integrated explicitly in
 //! 10 µs steps, independent of the world crate's solver.
 //!
 //! Each drive wheel takes a force of μ_floor·m·g/2 against the slip velocity of its contact

@@ -16,7 +16,12 @@
 //! `sep < 0` (an overlap, left by the linearisation of a rotation) is pushed apart by `−sep`
 //! within the sub-step.
 
+use crate::body::BodyConst;
 use crate::contact::Manifold;
+
+/// The gap the solver closes a contact to, and pushes an overlap apart to (10 nm), so that
+/// bodies do not touch even after rounding; far below anything a sensor or a metric resolves.
+pub const CONTACT_SKIN_M: f64 = 1e-8;
 
 /// A robot–robot or robot–wall contact and the solver's state for its points.
 #[derive(Debug, Clone, Copy, Default)]
@@ -134,78 +139,6 @@ fn cross(r: [f64; 2], x: f64, y: f64) -> f64 {
     r[0] * y - r[1] * x
 }
 
-/// What every robot shares: mass, inertia, wheel geometry and the friction coefficients.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct BodyConst {
-    /// 1 / mass, 1/kg.
-    pub inv_m: f64,
-    /// 1 / moment of inertia about the centre, 1/(kg·m²).
-    pub inv_i: f64,
-    /// Half the wheel track, metres (left wheel at +, right at −, on the body's y axis).
-    pub half_track: f64,
-    /// Largest friction force one drive wheel can take from the floor, N.
-    pub wheel_force_n: f64,
-    /// Coulomb coefficient between two bodies.
-    pub mu_robot: f64,
-    /// Coulomb coefficient between a body and a wall.
-    pub mu_wall: f64,
-    /// Effective mass of a wheel's rolling row, kg.
-    pub wheel_mass_long: f64,
-    /// Effective mass of a wheel's sideways row, kg.
-    pub wheel_mass_lat: f64,
-    /// Mass, kg.
-    pub mass: f64,
-    /// Moment of inertia over half the wheel track, kg·m.
-    pub inertia_per_half_track: f64,
-}
-
-impl BodyConst {
-    /// From the body's mass, size, wheel track and the friction coefficients.
-    pub(crate) fn new(
-        mass_kg: f64,
-        length_m: f64,
-        width_m: f64,
-        track_m: f64,
-        mu_floor: f64,
-        mu_robot: f64,
-        mu_wall: f64,
-    ) -> BodyConst {
-        let inertia = mass_kg * (length_m * length_m + width_m * width_m) / 12.0;
-        let half_track = 0.5 * track_m;
-        let inv_m = 1.0 / mass_kg;
-        let inv_i = 1.0 / inertia;
-        BodyConst {
-            inv_m,
-            inv_i,
-            half_track,
-            wheel_force_n: mu_floor * mass_kg * crate::params::GRAVITY_M_PER_S2 * 0.5,
-            mu_robot,
-            mu_wall,
-            wheel_mass_long: 1.0 / (inv_m + inv_i * half_track * half_track),
-            wheel_mass_lat: mass_kg,
-            mass: mass_kg,
-            inertia_per_half_track: inertia / half_track,
-        }
-    }
-}
-
-impl BodyConst {
-    /// The longitudinal forces (left, right), N, the floor gives the two drive wheels of a body
-    /// whose speed along its heading changes by `d_along` (m/s) and whose turn rate changes by
-    /// `d_omega` (rad/s) in a sub-step of `1 / inv_h` seconds: from m·a = F_l + F_r and
-    /// I·α = (F_r − F_l)·half_track, each at most the wheel's traction.
-    #[inline]
-    pub(crate) fn wheel_forces(&self, d_along: f64, d_omega: f64, inv_h: f64) -> [f64; 2] {
-        let sum = self.mass * d_along * inv_h;
-        let diff = self.inertia_per_half_track * d_omega * inv_h;
-        let cap = self.wheel_force_n;
-        [
-            (0.5 * (sum - diff)).clamp(-cap, cap),
-            (0.5 * (sum + diff)).clamp(-cap, cap),
-        ]
-    }
-}
-
 /// One robot of an island as the solver sees it: heading at the start of the sub-step, its
 /// world-frame velocity (vx, vy, ω; the momentum in, the solution out), its wheels' rim speeds
 /// over the sub-step (left, right) and their accumulated impulses (left along, left across,
@@ -315,7 +248,7 @@ pub(crate) fn solve_island(
                 let vn = rvx * nx + rvy * ny;
                 // Allowed approach: close the gap down to the skin (sep > 0), or open an overlap
                 // to it (sep < 0).
-                let target = -(p.sep - crate::world::CONTACT_SKIN_M) * inv_h;
+                let target = -(p.sep - CONTACT_SKIN_M) * inv_h;
                 let new = (p.ln + p.mass_n * (target - vn)).max(0.0);
                 let d = new - p.ln;
                 p.ln = new;

@@ -1,0 +1,237 @@
+//! The islands: the solved robots split into groups joined by robot–robot contacts (found by
+//! union–find), each solved on its own, in order or on rayon's pool.
+
+use core::ops::Range;
+
+use rayon::prelude::*;
+
+use crate::body::{BodyConst, BodyPose};
+use crate::pipeline::par::PAR_ISLAND_ROBOTS;
+use crate::pipeline::solver::{Contact, IslandBody, WALL, solve_island};
+
+/// The islands of the latest sub-step and the scratch that sorts robots and contacts into
+/// them.
+#[derive(Debug, Clone)]
+pub(crate) struct Islands {
+    /// Union-find parents of the active robots (scratch, by robot).
+    uf: Vec<u32>,
+    /// Island number of a union-find root (scratch, by robot; `u32::MAX` when unset).
+    root_island: Vec<u32>,
+    /// Per active robot (in the order [`Islands::build`] gives `active`), what the solver
+    /// needs.
+    pub(crate) bodies: Vec<IslandBody>,
+    /// Per island, its range in `active`/`bodies` and in `contacts`.
+    ranges: Vec<(Range<usize>, Range<usize>)>,
+    /// Island of each active robot (scratch, in `active`'s order before the sort).
+    isl_of: Vec<u32>,
+    /// First place of each island in `active` (scratch; one more entry than islands).
+    isl_start: Vec<usize>,
+    /// Next free place of each island (scratch).
+    isl_fill: Vec<usize>,
+    /// `active` being sorted into islands (scratch).
+    active_scratch: Vec<u32>,
+    /// `contacts` being sorted into islands (scratch).
+    contact_scratch: Vec<Contact>,
+}
+
+/// Union–find root of `i`, halving the path on the way.
+fn find(uf: &mut [u32], mut i: u32) -> u32 {
+    while uf[i as usize] != i {
+        let p = uf[uf[i as usize] as usize];
+        uf[i as usize] = p;
+        i = p;
+    }
+    i
+}
+
+impl Islands {
+    /// No islands yet, for `n` robots.
+    pub(crate) fn new(n: usize) -> Islands {
+        Islands {
+            uf: vec![0; n],
+            root_island: vec![u32::MAX; n],
+            bodies: Vec::new(),
+            ranges: Vec::new(),
+            isl_of: Vec::new(),
+            isl_start: Vec::new(),
+            isl_fill: Vec::new(),
+            active_scratch: Vec::new(),
+            contact_scratch: Vec::new(),
+        }
+    }
+
+    /// Splits the solved robots `active` (in index order) into islands (connected by
+    /// robot–robot contacts), numbered in order of their lowest robot: `active` is reordered
+    /// island by island (index order within each), `contacts` likewise (their order kept
+    /// within each island), every contact gets its robots' places in the island, and
+    /// `bodies` the solver's view of each robot (from `pose`, `vel`, `wmean`, `wheel_imp`).
+    pub(crate) fn build(
+        &mut self,
+        active: &mut Vec<u32>,
+        contacts: &mut Vec<Contact>,
+        pose: &[BodyPose],
+        vel: &[[f64; 3]],
+        wmean: &[[f64; 2]],
+        wheel_imp: &[[f64; 4]],
+    ) {
+        let islands = self.number(active, contacts);
+        self.sort_robots(active, islands);
+        self.sort_contacts(contacts, islands);
+        for &i in active.iter() {
+            self.root_island[i as usize] = u32::MAX;
+        }
+        self.bodies.clear();
+        for &i in active.iter() {
+            let i = i as usize;
+            self.bodies.push(IslandBody {
+                c: pose[i].c,
+                s: pose[i].s,
+                vel: vel[i],
+                wheel_speed: wmean[i],
+                wheel_imp: wheel_imp[i],
+            });
+        }
+    }
+
+    /// Joins the robots of each robot–robot contact and numbers the islands in order of each
+    /// island's lowest robot (`active` is in index order) into `isl_of`; returns how many.
+    fn number(&mut self, active: &[u32], contacts: &[Contact]) -> usize {
+        for &i in active {
+            self.uf[i as usize] = i;
+        }
+        for ct in contacts {
+            if ct.b != WALL {
+                let (ra, rb) = (find(&mut self.uf, ct.a), find(&mut self.uf, ct.b));
+                if ra != rb {
+                    // The lower root wins, so the result does not depend on contact order.
+                    let (lo, hi) = (ra.min(rb), ra.max(rb));
+                    self.uf[hi as usize] = lo;
+                }
+            }
+        }
+        let mut count = 0u32;
+        self.isl_of.clear();
+        for &i in active {
+            let r = find(&mut self.uf, i) as usize;
+            if self.root_island[r] == u32::MAX {
+                self.root_island[r] = count;
+                count += 1;
+            }
+            self.isl_of.push(self.root_island[r]);
+        }
+        for &i in active {
+            let r = find(&mut self.uf, i) as usize;
+            self.root_island[r] = u32::MAX;
+        }
+        count as usize
+    }
+
+    /// Reorders `active` island by island, index order within each (a stable counting sort),
+    /// and records each robot's island and place in it (through the `uf` scratch, no longer
+    /// needed for the roots).
+    fn sort_robots(&mut self, active: &mut Vec<u32>, islands: usize) {
+        self.isl_start.clear();
+        self.isl_start.resize(islands + 1, 0);
+        for &k in &self.isl_of {
+            self.isl_start[k as usize + 1] += 1;
+        }
+        for k in 0..islands {
+            self.isl_start[k + 1] += self.isl_start[k];
+        }
+        self.isl_fill.clear();
+        self.isl_fill.extend_from_slice(&self.isl_start[..islands]);
+        self.active_scratch.clear();
+        self.active_scratch.resize(active.len(), 0);
+        for (k, &i) in active.iter().enumerate() {
+            let isl = self.isl_of[k] as usize;
+            self.active_scratch[self.isl_fill[isl]] = i;
+            self.isl_fill[isl] += 1;
+        }
+        core::mem::swap(active, &mut self.active_scratch);
+        self.ranges.clear();
+        for isl in 0..islands {
+            let range = self.isl_start[isl]..self.isl_start[isl + 1];
+            for (local, &i) in active[range.clone()].iter().enumerate() {
+                self.uf[i as usize] = local as u32;
+                self.root_island[i as usize] = isl as u32;
+            }
+            self.ranges.push((range, 0..0));
+        }
+    }
+
+    /// Reorders `contacts` island by island, their order kept within each (a stable counting
+    /// sort), and gives each its robots' places in the island.
+    fn sort_contacts(&mut self, contacts: &mut Vec<Contact>, islands: usize) {
+        self.isl_fill.clear();
+        self.isl_fill.resize(islands + 1, 0);
+        for ct in contacts.iter() {
+            self.isl_fill[self.root_island[ct.a as usize] as usize + 1] += 1;
+        }
+        for k in 0..islands {
+            self.isl_fill[k + 1] += self.isl_fill[k];
+        }
+        for (isl, range) in self.ranges.iter_mut().enumerate() {
+            range.1 = self.isl_fill[isl]..self.isl_fill[isl + 1];
+        }
+        self.contact_scratch.clear();
+        self.contact_scratch
+            .resize(contacts.len(), Contact::default());
+        for ct in contacts.iter() {
+            let isl = self.root_island[ct.a as usize] as usize;
+            let mut c = *ct;
+            c.la = self.uf[ct.a as usize];
+            c.lb = if ct.b == WALL {
+                WALL
+            } else {
+                self.uf[ct.b as usize]
+            };
+            self.contact_scratch[self.isl_fill[isl]] = c;
+            self.isl_fill[isl] += 1;
+        }
+        core::mem::swap(contacts, &mut self.contact_scratch);
+    }
+
+    /// Solves every island (its `bodies` and its share of `contacts`, as [`Islands::build`]
+    /// sorted them) over a sub-step of `h` seconds with at most `iterations` sweeps each;
+    /// with `parallel` and enough robots, islands on rayon's pool (each island's solve is the
+    /// same on any thread). Returns the sweeps run, summed over the islands.
+    pub(crate) fn solve(
+        &mut self,
+        contacts: &mut [Contact],
+        body: &BodyConst,
+        h: f64,
+        iterations: u32,
+        parallel: bool,
+    ) -> u64 {
+        let mut sweeps = 0;
+        if parallel && self.bodies.len() > PAR_ISLAND_ROBOTS && self.ranges.len() > 1 {
+            // Islands share nothing: each is solved on whichever thread, with the same
+            // result as in order.
+            let mut jobs = Vec::with_capacity(self.ranges.len());
+            let (mut bodies, mut contacts) = (&mut self.bodies[..], contacts);
+            for (b, c) in &self.ranges {
+                let (bi, rest) = core::mem::take(&mut bodies).split_at_mut(b.len());
+                bodies = rest;
+                let (ci, rest) = core::mem::take(&mut contacts).split_at_mut(c.len());
+                contacts = rest;
+                jobs.push((bi, ci));
+            }
+            sweeps += jobs
+                .par_iter_mut()
+                .with_min_len(16)
+                .map(|(b, c)| u64::from(solve_island(b, c, body, h, iterations)))
+                .sum::<u64>();
+        } else {
+            for (b, c) in &self.ranges {
+                sweeps += u64::from(solve_island(
+                    &mut self.bodies[b.clone()],
+                    &mut contacts[c.clone()],
+                    body,
+                    h,
+                    iterations,
+                ));
+            }
+        }
+        sweeps
+    }
+}
