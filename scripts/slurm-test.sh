@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Sweeps on a real Slurm (issue 15): starts a single-node Slurm on this machine from Debian's
+# Sweeps on a real Slurm: starts a single-node Slurm on this machine from Debian's
 # slurm-wlm and munge (munged, slurmctld and slurmd as root, every address 127.0.0.1, no cgroups:
 # ProctrackType=proctrack/linuxproc, TaskPlugin=task/none), plans a 2 x 2 x 3-seed sweep of
 # short arena runs, submits its sweep.sbatch with the real sbatch (a job array of 6 tasks of 2
@@ -13,8 +13,8 @@
 #      the other ten, removes the leftover, and merges to the same table.
 #
 #   scripts/slurm-test.sh             (as root; H8SWARM_BIN=path picks the binary, default:
-#                                      cargo build --profile test --bin h8swarm: the build the tests
-#                                      use, at opt-level 2; KEEP=1 keeps the Slurm folder)
+#                                      cargo build --release --bin h8swarm: the build the tests
+#                                      use; KEEP=1 keeps the Slurm folder)
 #
 # Needs: apt-get install slurm-wlm munge. About 30 s on a 2-core machine with that build
 # (the points are short: 0.7 s each); CI runs it after the tests (.ci/run). The daemons are
@@ -33,8 +33,8 @@ done
 if [ -n "${H8SWARM_BIN:-}" ]; then
     bin=$(realpath "$H8SWARM_BIN")
 else
-    cargo build --locked --quiet --profile test --bin h8swarm
-    bin=$(realpath "${CARGO_TARGET_DIR:-target}")/debug/h8swarm
+    cargo build --locked --quiet --release --bin h8swarm
+    bin=$(realpath "${CARGO_TARGET_DIR:-target}")/release/h8swarm
 fi
 [ -x "$bin" ] || fail "no h8swarm binary at $bin"
 
