@@ -127,7 +127,7 @@ done
 [ "$(sinfo -h -n h8node -o %t)" = idle ] || fail "node h8node is not idle: $(sinfo -h -n h8node -o '%t %E')"
 
 cat >"$state/sweep.toml" <<'EOF'
-# The issue's test sweep: 2 x 2 x 3 seeds of short arena runs.
+# The test sweep: 2 x 2 x 3 seeds of short arena runs.
 name = "slurm-test"
 base = "arena"
 seeds = [1, 2, 3]

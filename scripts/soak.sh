@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Soak test (issue 13; not in CI): 10 robots x STEPS steps (default 10^6) in the arena, learning
+# Soak test (not in CI): 10 robots x STEPS steps (default 10^6) in the arena, learning
 # condition only (scenarios/arena-learning-only.toml; SCENARIO=... for another), with the
 # firmware and with the model, each run twice (1 and 2 threads); the four runs go at once.
 # Checks that every run ends with status 0, that its resident memory stays flat (sampled every
