@@ -2,7 +2,7 @@
 //! (`scenarios/arena-learning-only.toml`), one repeat, from placing the robots and booting their
 //! MCUs to the metrics, summary, figures and fit verdict written to a folder. Fresh swarms only:
 //! a run this short never reaches the crowded, contact-heavy state an ageing swarm of learning
-//! robots gets into (see the README's speed figures for the whole 2 000-step command).
+//! robots gets into (see docs/performance.md for the whole 2 000-step command).
 //!
 //! Cases: 100 robots x 200 steps and 1 000 robots x 50 steps on one thread, 10 000 robots x
 //! 5 steps on two. Throughput is in robot-steps; a step is 0.45 s of robot time, so the

@@ -1,9 +1,9 @@
-//! What the bumpers read inside a step (issue 12): runs a scenario's learning condition with
+//! What the bumpers read inside a step: runs a scenario's learning condition with
 //! model robots to step STEP, then replays the next STEPS steps' world sub-step by sub-step on
 //! a copy of it (the commands the robots set, which do not change within a step) and prints,
 //! per robot, its pose and wheel speeds at the step's start and its four switches (front,
 //! rear, left, right; 1 = pressed) after every sub-step. It found the light rub along a wall
-//! that read pressed and released in alternate sub-steps (README, "Fuzzing and soaking").
+//! that read pressed and released in alternate sub-steps (docs/testing.md, "The soak").
 //!
 //!     cargo run --release --example chatter_probe FILE.toml ROBOTS SEED STEP [STEPS]
 //!

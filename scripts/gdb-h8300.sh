@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # gdb-h8300.sh - build GDB for h8300-elf from Debian's gdb-source package into
-# target/gdb-h8300/ and run a scripted session against h8swarm's GDB stub (README: "The GDB
-# stub"). Debian's gdb-multiarch has no H8/300 support, hence the build. Not part of CI.
+# target/gdb-h8300/ and run a scripted session against h8swarm's GDB stub (docs/debugging.md:
+# "A GDB for the H8/300"). Debian's gdb-multiarch has no H8/300 support, hence the build. Not part of CI.
 #
 # Usage:
 #   scripts/gdb-h8300.sh            build GDB unless built, then run the session

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # gtkwave-shot.sh - a GTKWave screenshot of one robot firmware step with an EEPROM save, for
-# the README (docs/gtkwave-step.png), made under Xvfb. Not part of CI.
+# docs/debugging.md (docs/gtkwave-step.png), made under Xvfb. Not part of CI.
 #
 #   scripts/gtkwave-shot.sh [OUT.png]
 #

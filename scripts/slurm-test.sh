@@ -13,8 +13,8 @@
 #      the other ten, removes the leftover, and merges to the same table.
 #
 #   scripts/slurm-test.sh             (as root; H8SWARM_BIN=path picks the binary, default:
-#                                      cargo build --profile test --bin h8swarm: the build the tests
-#                                      use, at opt-level 2; KEEP=1 keeps the Slurm folder)
+#                                      cargo build --release --bin h8swarm: the build the tests
+#                                      use; KEEP=1 keeps the Slurm folder)
 #
 # Needs: apt-get install slurm-wlm munge. About 30 s on a 2-core machine with that build
 # (the points are short: 0.7 s each); CI runs it after the tests (.ci/run). The daemons are
@@ -33,8 +33,8 @@ done
 if [ -n "${H8SWARM_BIN:-}" ]; then
     bin=$(realpath "$H8SWARM_BIN")
 else
-    cargo build --locked --quiet --profile test --bin h8swarm
-    bin=$(realpath "${CARGO_TARGET_DIR:-target}")/debug/h8swarm
+    cargo build --locked --quiet --release --bin h8swarm
+    bin=$(realpath "${CARGO_TARGET_DIR:-target}")/release/h8swarm
 fi
 [ -x "$bin" ] || fail "no h8swarm binary at $bin"
 
@@ -127,7 +127,7 @@ done
 [ "$(sinfo -h -n h8node -o %t)" = idle ] || fail "node h8node is not idle: $(sinfo -h -n h8node -o '%t %E')"
 
 cat >"$state/sweep.toml" <<'EOF'
-# The issue's test sweep: 2 x 2 x 3 seeds of short arena runs.
+# The test sweep: 2 x 2 x 3 seeds of short arena runs.
 name = "slurm-test"
 base = "arena"
 seeds = [1, 2, 3]

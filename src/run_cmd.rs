@@ -1357,11 +1357,19 @@ fn report(t: &mut String, s: &Scenario, a: &Analysis) {
             r.robots,
         );
     }
-    let _ = writeln!(
-        t,
-        "(windows of {} steps; first -> last window, mean over repeats; [95 % interval: expanded percentile bootstrap over repeats])",
-        s.window
-    );
+    if s.repeats < 2 {
+        let _ = writeln!(
+            t,
+            "(windows of {} steps; first -> last window; one repeat, so no intervals)",
+            s.window
+        );
+    } else {
+        let _ = writeln!(
+            t,
+            "(windows of {} steps; first -> last window, mean over repeats; [95 % interval: expanded percentile bootstrap over repeats])",
+            s.window
+        );
+    }
     for p in &a.pairings {
         let _ = writeln!(
             t,

@@ -303,6 +303,12 @@ impl Claim {
         let (ea, eb) = (Estimate::of_defined(a, seed), Estimate::of_defined(b, seed));
         let r = Paired::of(a, b);
         let n = r.defined();
+        // "k of n repeats go" / "1 of 1 repeat goes".
+        let (of_n, go) = if n == 1 {
+            ("of 1 repeat".to_string(), "goes")
+        } else {
+            (format!("of {n} repeats"), "go")
+        };
         let (outcome, mut verdict) = if n == 0 {
             (
                 Outcome::Undecided,
@@ -311,17 +317,13 @@ impl Claim {
         } else if r.p < SIGNIFICANCE {
             (
                 Outcome::Holds,
-                format!(
-                    "holds: {} of {n} repeats, sign test p = {}",
-                    r.for_,
-                    fmt_p(r.p)
-                ),
+                format!("holds: {} {of_n}, sign test p = {}", r.for_, fmt_p(r.p)),
             )
         } else if r.p_opposite < SIGNIFICANCE {
             (
                 Outcome::Fails,
                 format!(
-                    "fails: the opposite, {} of {n} repeats, sign test p = {}",
+                    "fails: the opposite, {} {of_n}, sign test p = {}",
                     r.against,
                     fmt_p(r.p_opposite)
                 ),
@@ -330,7 +332,7 @@ impl Claim {
             (
                 Outcome::Unsure,
                 format!(
-                    "unsure: {} of {n} repeats go this way, {} the other (sign test p = {})",
+                    "unsure: {} {of_n} {go} this way, {} the other (sign test p = {})",
                     r.for_,
                     r.against,
                     fmt_p(r.p)
@@ -348,7 +350,7 @@ impl Claim {
             (
                 Outcome::Fails,
                 format!(
-                    "fails: {} of {n} repeats go the other way, {} this way (sign test p = {})",
+                    "fails: {} {of_n} {go} the other way, {} this way (sign test p = {})",
                     r.against,
                     r.for_,
                     fmt_p(r.p_opposite)

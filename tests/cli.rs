@@ -356,6 +356,35 @@ fn run_writes_identical_metrics_for_any_thread_count() {
     }
 }
 
+/// A run of one repeat says "1 repeat" and gives no interval legend, since it has no intervals.
+#[test]
+fn one_repeat_is_worded_as_one_and_promises_no_intervals() {
+    let dir = temp_dir("one-repeat");
+    let out = h8swarm(
+        &[
+            "run",
+            "arena",
+            "--steps",
+            "60",
+            "--repeats",
+            "1",
+            "--out",
+            dir.to_str().expect("utf-8 path"),
+        ],
+        None,
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(!stdout.contains("1 repeats"), "{stdout}");
+    assert!(!stdout.contains("95 % interval"), "{stdout}");
+    assert!(stdout.contains("one repeat, so no intervals"), "{stdout}");
+}
+
 #[test]
 fn run_reports_bad_scenarios_and_folders_clearly() {
     let dir = temp_dir("bad");

@@ -7,7 +7,7 @@
 //! 0.1 to 0.5 s, so that their 2 000 would take many minutes in CI; a soak sets their
 //! counts too. The library families go through the entry points the binary runs; the
 //! argument vectors, signals and limits run the real binary in a folder of its own. Every
-//! case must end without a panic or an abort, with an exit status the README promises, a
+//! case must end without a panic or an abort, with an exit status docs/limits-and-failures.md promises, a
 //! one-line error first when it fails, and no file written outside the folder it ran in.
 
 use std::cell::{Cell, RefCell};

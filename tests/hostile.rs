@@ -1,7 +1,7 @@
 //! Hostile input through the real binary: what a user's files, folders, signals and limits can
 //! do to `h8swarm`, and what it promises in return (docs/limits-and-failures.md): it never
 //! deletes a user's files, an output folder is replaced whole or not at all, a failure is one
-//! line on standard error with the exit status the README gives, and nothing a file or an
+//! line on standard error with the exit status docs/limits-and-failures.md gives, and nothing a file or an
 //! argument holds reaches the terminal as a control sequence.
 
 use std::path::{Path, PathBuf};

@@ -6,8 +6,9 @@
 //! forward pass, so a bug there cannot hide a broken guarantee; `forward_matches_i64_reference`
 //! checks the forward pass bit for bit against the same reference.
 //!
-//! The test profile keeps overflow checks on (the workspace sets `[profile.test]
-//! overflow-checks = true`); `overflow_checks_are_on` proves it for this build.
+//! Overflow checks are on for the learner and these tests in every build (the workspace sets
+//! `overflow-checks = true` for `nn_q15` and `proptests` in the release profile, and for the
+//! whole test profile); `overflow_checks_are_on` proves it for this build.
 
 use nn_q15::{NoopMeter, Params, Q7, Q15, Shape, UpdateKind, forward_slice, update_slice};
 use proptest::prelude::*;

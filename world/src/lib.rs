@@ -82,7 +82,7 @@
 //!   balance), slide along walls and each other when friction allows, and turn under an
 //!   off-centre contact (a robot driving into a wall less than atan(width/length) + atan(μ_wall)
 //!   = 54.7° off its normal turns square to it and stays, wheels slipping, as a differential-drive
-//!   robot does; at a flatter angle it turns along the wall and slides; the README derives it and
+//!   robot does; at a flatter angle it turns along the wall and slides; docs/physics.md derives it and
 //!   `tests/wall_angle.rs` checks it against a plain-Coulomb reference). Poses follow the exact motion of the
 //!   solved velocities. What the linearised solve leaves of an overlap (a turning corner) is
 //!   removed by position sweeps that push along the contact normal with rotation, weighted by

@@ -4,8 +4,7 @@
 //! the leading front corner, inside its friction cone. The corner sticks, and the robot pivots
 //! square to the wall, while the line from the corner to the centre lies inside the cone, i.e.
 //! while θ < atan(half width / half length) + atan(μ_wall) (54.7° by default); past that the
-//! corner slides and the wall's force turns the robot parallel to the wall (README, "Contacts
-//! and the wall").
+//! corner slides and the wall's force turns the robot parallel to the wall (docs/physics.md).
 
 mod coulomb_reference;
 
