@@ -13,7 +13,8 @@ use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use emu::board::model::{Controller, ControllerConfig};
-use emu::chip::mcu::{Board, Mcu, McuConfig};
+use emu::chip::mcu::{Mcu, McuConfig};
+use emu::chip::pins::Board;
 use emu::core::bus::Bus;
 
 struct Wave;

@@ -8,7 +8,7 @@
 //!    S-record loader for `.mot` images). It knows no chip.
 //! 2. [`chip`] — the H8/3052F: [`chip::periph`] (A/D, ITU, ports, interrupt controller, SCI1,
 //!    each synchronised lazily to the clock), [`chip::mcu`] (the chip as one bus: memories,
-//!    peripherals, the EEPROM bus on port 4, the [`chip::mcu::Board`] outside it),
+//!    peripherals, the EEPROM bus on port 4, the [`chip::pins::Board`] outside it),
 //!    [`chip::machine`] (the MCU with nothing connected, for `h8swarm emu`), [`chip::run`]
 //!    (running an image to its halt, with console, trace and statistics) and [`chip::power`]
 //!    (what the chip draws from its supply, by state). It knows the core and no robot.

@@ -2,8 +2,9 @@
 //! docs/design.md §4.2, saves and their restore, a power cut in the middle of a save, determinism.
 
 use emu::board::model::{Controller, ControllerConfig, ModelBus, StepReport};
-use emu::chip::mcu::{Board, Mcu, McuConfig};
-use emu::core::bus::Bus;
+use emu::chip::mcu::{Mcu, McuConfig};
+use emu::chip::pins::Board;
+use emu::core::bus::{Bus, FastPathHints};
 use nn_q15::Q15;
 
 /// A board whose four sensors read voltages that change with time (so the learner sees
@@ -196,6 +197,7 @@ impl Bus for CutAt<'_> {
 }
 
 /// No emulation shortcuts through the wrapper: the model runs it register by register.
+impl FastPathHints for CutAt<'_> {}
 impl ModelBus for CutAt<'_> {}
 
 #[test]

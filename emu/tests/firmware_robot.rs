@@ -6,7 +6,8 @@ use emu::board::firmware::{
     CONFIG_BLOCK_ADDR, ConfigBlock, ConfigStatus, FLAG_RANDOM_WALK, Firmware, run_until,
 };
 use emu::board::wiring::{Bridge, motor_pins};
-use emu::chip::mcu::{Board, Mcu, McuConfig, NullBoard};
+use emu::chip::mcu::{Mcu, McuConfig};
+use emu::chip::pins::{Board, NullBoard};
 use emu::core::bus::Bus;
 use emu::core::cpu::Cpu;
 

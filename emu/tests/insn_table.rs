@@ -2,7 +2,8 @@
 //! table ([`nn_q15::cost::Insn`]) is run on the H8/300H core from on-chip flash with on-chip RAM
 //! operands, and the states the core counts must be the table's.
 
-use emu::chip::mcu::{Mcu, McuConfig, NullBoard};
+use emu::chip::mcu::{Mcu, McuConfig};
+use emu::chip::pins::NullBoard;
 use emu::core::bus::Bus;
 use emu::core::cpu::Cpu;
 use nn_q15::cost::Insn;

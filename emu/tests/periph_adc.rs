@@ -2,13 +2,14 @@
 //! that state, the input sampled at the sampling instant (a board whose voltage changes with
 //! time), scan order and repetition, ADI, the ADF clearing rule and the ADDR byte order.
 
-use emu::chip::mcu::{Board, Mcu, McuConfig};
+use emu::chip::mcu::{Mcu, McuConfig};
 use emu::chip::periph::adc::{
     ADCR, ADCSR, ADCSR_ADF, ADCSR_ADIE, ADCSR_ADST, ADCSR_CKS, ADCSR_SCAN, ADDRA, ADDRB, ADDRC,
     ADDRD, CONV_STATES_CKS0, CONV_STATES_CKS1, SAMPLE_OFFSET_CKS0, SAMPLE_OFFSET_CKS1,
     SCAN_CONV_STATES_CKS0, VECTOR_ADI,
 };
 use emu::chip::periph::intc::{IPRA, IPRA_ITU0, IPRB, IPRB_AD};
+use emu::chip::pins::Board;
 use emu::core::bus::Bus;
 use emu::core::memmap::IO_ACCESS_STATES;
 use sensors::adc10_code;

@@ -7,7 +7,8 @@ use std::sync::Arc;
 
 use crate::board::symbols::{SymbolError, SymbolTable};
 use crate::chip::gdb::{DebugAction, Debugger};
-use crate::chip::mcu::{Board, LoadError, Mcu};
+use crate::chip::mcu::{LoadError, Mcu};
+use crate::chip::pins::Board;
 use crate::chip::trace::{CodeNames, PhaseRecorder};
 use crate::core::cpu::{Cpu, CpuError, Event, StackFault, StackGuard, StackGuardMode, StackRoom};
 use crate::core::srec::{self, SrecError, SrecImage};

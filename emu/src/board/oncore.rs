@@ -15,7 +15,8 @@
 
 use crate::board::firmware::{Firmware, FirmwareError};
 use crate::board::profile::{PhaseDef, Profiler};
-use crate::chip::mcu::{Mcu, McuConfig, McuError, NullBoard};
+use crate::chip::mcu::{Mcu, McuConfig, McuError};
+use crate::chip::pins::NullBoard;
 use crate::core::bus::Bus;
 use crate::core::cpu::{CCR_I, Cpu, CpuError, Event};
 

@@ -12,7 +12,7 @@
 use std::collections::HashMap;
 
 use crate::board::symbols::SymbolTable;
-use crate::core::bus::Bus;
+use crate::core::bus::FastPathHints;
 use crate::core::cpu::decode::Instr;
 use crate::core::cpu::{Cpu, CpuError, Event};
 
@@ -202,7 +202,7 @@ impl Profiler {
     ///
     /// # Errors
     /// The core's error, with the CPU left at the failing instruction.
-    pub fn run<B: Bus>(
+    pub fn run<B: FastPathHints>(
         &mut self,
         cpu: &mut Cpu,
         bus: &mut B,
@@ -222,7 +222,7 @@ impl Profiler {
     ///
     /// # Errors
     /// The core's error, with the CPU left at the failing instruction.
-    pub fn run_one<B: Bus>(
+    pub fn run_one<B: FastPathHints>(
         &mut self,
         cpu: &mut Cpu,
         bus: &mut B,

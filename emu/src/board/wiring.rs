@@ -23,8 +23,9 @@
 //! what the robot connects to them and reads the motor pins as H-bridge inputs
 //! ([`motor_pins`]).
 
-use crate::chip::mcu::{Board, Mcu};
+use crate::chip::mcu::Mcu;
 use crate::chip::periph::ports::{PA_TIOCA1, PA_TIOCA2};
+use crate::chip::pins::Board;
 
 /// A/D channel of the front IR sensor: AN0 (result in ADDRA).
 pub const AN_IR_FRONT: u8 = 0;

@@ -64,8 +64,9 @@ use gdbstub::target::ext::breakpoints::{
 use gdbstub::target::ext::monitor_cmd::{ConsoleOutput, MonitorCmd, MonitorCmdOps};
 use gdbstub::target::{Target, TargetError, TargetResult};
 
-use crate::chip::mcu::{Board, Mcu};
-use crate::core::bus::{Bus, CpuSignal};
+use crate::chip::mcu::Mcu;
+use crate::chip::pins::Board;
+use crate::core::bus::{Bus, CpuSignal, FastPathHints};
 use crate::core::cpu::{Cpu, CpuError, Event};
 use crate::core::memmap::{ADDRESS_MASK, Area};
 
@@ -1307,13 +1308,13 @@ fn monitor<B: Board>(cmd: &str, cpu: &Cpu, mcu: &Mcu<B>) -> String {
 }
 
 /// A bus that notes data accesses touching a watchpoint (the program's side of watchpoints).
-struct WatchBus<'a, B: Bus> {
+struct WatchBus<'a, B: FastPathHints> {
     bus: &'a mut B,
     watches: &'a [Watchpoint],
     hit: Option<(WatchKind, u32)>,
 }
 
-impl<B: Bus> WatchBus<'_, B> {
+impl<B: FastPathHints> WatchBus<'_, B> {
     #[inline]
     fn note(&mut self, addr: u32, len: u32, write: bool) {
         if self.hit.is_some() {
@@ -1334,7 +1335,7 @@ impl<B: Bus> WatchBus<'_, B> {
     }
 }
 
-impl<B: Bus> Bus for WatchBus<'_, B> {
+impl<B: FastPathHints> Bus for WatchBus<'_, B> {
     fn now(&self) -> u64 {
         self.bus.now()
     }
@@ -1366,6 +1367,9 @@ impl<B: Bus> Bus for WatchBus<'_, B> {
     fn cpu_signal(&mut self, signal: CpuSignal) {
         self.bus.cpu_signal(signal);
     }
+}
+
+impl<B: FastPathHints> FastPathHints for WatchBus<'_, B> {
     fn code_generation(&self) -> Option<u64> {
         self.bus.code_generation()
     }

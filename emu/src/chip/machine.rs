@@ -8,8 +8,9 @@
 use std::ops::{Deref, DerefMut};
 
 pub use crate::chip::mcu::LoadError;
-use crate::chip::mcu::{Mcu, McuConfig, NullBoard};
-use crate::core::bus::Bus;
+use crate::chip::mcu::{Mcu, McuConfig};
+use crate::chip::pins::NullBoard;
+use crate::core::bus::{Bus, FastPathHints};
 use crate::core::srec::SrecImage;
 
 /// The MCU with nothing connected outside it, at φ = 25 MHz.
@@ -128,7 +129,9 @@ impl Bus for Machine {
     fn cpu_signal(&mut self, signal: crate::core::bus::CpuSignal) {
         self.0.cpu_signal(signal);
     }
+}
 
+impl FastPathHints for Machine {
     #[inline]
     fn code_generation(&self) -> Option<u64> {
         self.0.code_generation()

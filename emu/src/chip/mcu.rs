@@ -56,8 +56,9 @@ use crate::chip::periph::intc::Intc;
 use crate::chip::periph::itu::{self, Itu, PwmWave};
 use crate::chip::periph::ports::{PortPins, Ports};
 use crate::chip::periph::sci::Sci;
+use crate::chip::pins::Board;
 use crate::chip::trace::{Accepted, ChipView, PinTrace, Tracer};
-use crate::core::bus::{Bus, CpuSignal, fresh_code_generation};
+use crate::core::bus::{Bus, CpuSignal, FastPathHints, fresh_code_generation};
 use crate::core::memmap::{
     ADDRESS_MASK, Area, IO_ACCESS_STATES, RAM_BYTES, RAM_START, ROM_BYTES, ROM_END,
 };
@@ -74,31 +75,6 @@ pub const MAX_CLOCK_HZ: u32 = 25_000_000;
 /// Index masks of the flash and RAM arrays (both sizes are powers of two).
 const ROM_INDEX_MASK: usize = ROM_BYTES as usize - 1;
 const RAM_INDEX_MASK: usize = RAM_BYTES as usize - 1;
-
-/// The robot outside the chip, as the MCU's input pins see it.
-pub trait Board {
-    /// Volts on analog input ANn at `now_states` (called at each conversion's sampling instant).
-    fn analog_volts(&mut self, channel: u8, now_states: u64) -> f64;
-    /// Levels of the port-2 input pins (bit n = P2.n) at `now_states`: 0 where something pulls
-    /// the pin low (a pressed bumper), 1 where nothing does — such a pin reads high only with
-    /// its on-chip pull-up enabled (P2PCR), as `sensors::port2_pins` assumes.
-    fn port2_pins(&mut self, now_states: u64) -> u8;
-}
-
-/// A board with nothing connected: every analog input at 0 V, every port-2 pin released
-/// (high with its pull-up). What `h8swarm emu` runs machine code with.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct NullBoard;
-
-impl Board for NullBoard {
-    fn analog_volts(&mut self, _channel: u8, _now_states: u64) -> f64 {
-        0.0
-    }
-
-    fn port2_pins(&mut self, _now_states: u64) -> u8 {
-        0xFF
-    }
-}
 
 /// How to build an [`Mcu`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -970,6 +946,36 @@ impl<B: Board> Bus for Mcu<B> {
         }
     }
 
+    /// Tells a pin trace under way (SLEEP, and the accepted interrupts); otherwise nothing.
+    #[inline]
+    fn cpu_signal(&mut self, signal: CpuSignal) {
+        if self.tracer.is_some() {
+            self.trace_cpu_signal(signal);
+        }
+    }
+
+    fn sleep_until_irq(&mut self, deadline: u64) -> bool {
+        if self.pending_irq().is_some() {
+            return true;
+        }
+        match self.next_irq_time() {
+            Some(t) if t <= deadline => {
+                self.now = self.now.max(t);
+                self.sync();
+                self.pending_irq().is_some()
+            }
+            _ => {
+                if deadline != u64::MAX {
+                    self.now = self.now.max(deadline);
+                    self.sync();
+                }
+                false
+            }
+        }
+    }
+}
+
+impl<B: Board> FastPathHints for Mcu<B> {
     /// Fetching from flash or RAM touches no device, and the token changes at every write to
     /// the flash ([`Mcu::load_image`], [`Mcu::poke`]).
     #[inline]
@@ -1047,40 +1053,13 @@ impl<B: Board> Bus for Mcu<B> {
         self.invalidate_irq();
         true
     }
-
-    /// Tells a pin trace under way (SLEEP, and the accepted interrupts); otherwise nothing.
-    #[inline]
-    fn cpu_signal(&mut self, signal: CpuSignal) {
-        if self.tracer.is_some() {
-            self.trace_cpu_signal(signal);
-        }
-    }
-
-    fn sleep_until_irq(&mut self, deadline: u64) -> bool {
-        if self.pending_irq().is_some() {
-            return true;
-        }
-        match self.next_irq_time() {
-            Some(t) if t <= deadline => {
-                self.now = self.now.max(t);
-                self.sync();
-                self.pending_irq().is_some()
-            }
-            _ => {
-                if deadline != u64::MAX {
-                    self.now = self.now.max(deadline);
-                    self.sync();
-                }
-                false
-            }
-        }
-    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::chip::periph::adc;
+    use crate::chip::pins::NullBoard;
 
     fn mcu() -> Mcu<NullBoard> {
         Mcu::new(McuConfig::default(), NullBoard).unwrap()

@@ -3,7 +3,7 @@
 //! the [`machine::Machine`] with nothing connected, [`run`], which runs an image on it, and
 //! [`trace`], the pin traces the MCU records on request, written as VCD files by [`vcd`], and [`gdb`], a GDB remote stub.
 //!
-//! The chip knows the core and nothing above it: the robot outside is a [`mcu::Board`] that
+//! The chip knows the core and nothing above it: the robot outside is a [`pins::Board`] that
 //! answers for the input pins, and what the output pins drive is read by the board layer
 //! (`emu::board::wiring`).
 
@@ -11,6 +11,7 @@ pub mod gdb;
 pub mod machine;
 pub mod mcu;
 pub mod periph;
+pub mod pins;
 pub mod power;
 pub mod run;
 pub mod trace;

@@ -2,7 +2,7 @@
 //!
 //! [`run_image`] parses a `.mot` image, loads it into a [`Machine`] — the same [`Mcu`] the
 //! robot's controller runs on (flash, RAM, SCI1 as console, ITU, A/D, ports, interrupt
-//! controller, EEPROMs on port 4) with a [`NullBoard`](crate::chip::mcu::NullBoard) outside it — resets the CPU through vector 0 and runs it until the program halts
+//! controller, EEPROMs on port 4) with a [`NullBoard`](crate::chip::pins::NullBoard) outside it — resets the CPU through vector 0 and runs it until the program halts
 //! (SLEEP with CCR.I = 1 and no NMI pending; exit status = low byte of R0, docs/design.md §7), the state
 //! budget runs out, or the core stops on an error (undefined opcode, fetch outside ROM/RAM).
 //! Bytes the program transmits on SCI1 go to the console writer as they leave TDR; the
@@ -21,7 +21,8 @@ use std::io::Write;
 
 use crate::chip::gdb::DebugAction;
 use crate::chip::machine::{LoadError, Machine};
-use crate::chip::mcu::{Board, Mcu};
+use crate::chip::mcu::Mcu;
+use crate::chip::pins::Board;
 use crate::chip::trace::{CodeNames, PhaseRecorder, phase_name};
 use crate::core::bus::Bus;
 use crate::core::cpu::disasm::format_instr;
@@ -191,7 +192,7 @@ pub fn run_machine(
     run_mcu(cpu, machine.mcu_mut(), options, console, trace)
 }
 
-/// [`run_machine`] on any [`Mcu`], whatever board is outside it (a [`NullBoard`](crate::chip::mcu::NullBoard) for
+/// [`run_machine`] on any [`Mcu`], whatever board is outside it (a [`NullBoard`](crate::chip::pins::NullBoard) for
 /// `h8swarm emu`, the robot for machine-code controllers). `emulated_seconds` uses the MCU's φ.
 ///
 /// # Errors

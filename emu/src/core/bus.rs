@@ -56,7 +56,17 @@ pub trait Bus {
     fn cpu_signal(&mut self, signal: CpuSignal) {
         let _ = signal;
     }
+}
 
+/// What a bus may promise about itself so that the core can skip work without changing a
+/// single state or access: the extension of [`Bus`] for the CPU's fast path (decoded ROM
+/// instructions charged without their fetches), its loop fast-forwarding and its idle-cycle
+/// fast-forwarding ([`crate::core::cpu`]).
+///
+/// Every method has a conservative default that promises nothing, so implementing the trait
+/// with an empty body (or wrapping a bus in [`NoHints`]) gives a CPU that fetches every
+/// instruction word through [`Bus::read16`] and skips nothing.
+pub trait FastPathHints: Bus {
     /// A token for the flash contents, which lets the CPU decode ROM instructions once and
     /// charge their fetches without reading them ([`crate::core::cpu`]'s fast path).
     ///
@@ -95,7 +105,7 @@ pub trait Bus {
     /// For the core's idle-cycle fast-forwarding ([`crate::core::cpu::Cpu::run_idle`]): a
     /// description of the devices' state now, relative to now. The promise: if two
     /// descriptions taken `P` states apart are equal, and in between the program's only device
-    /// accesses are to addresses [`Bus::idle_io`] accepts, then the devices repeat with period
+    /// accesses are to addresses [`FastPathHints::idle_io`] accepts, then the devices repeat with period
     /// `P` as long as the program repeats the same accesses at the same offsets (same reads,
     /// same interrupt requests at the same instants). `None` (the default): no promise.
     fn idle_signature(&mut self) -> Option<Vec<u64>> {
@@ -103,13 +113,13 @@ pub trait Bus {
     }
 
     /// Whether accesses to the device register at `addr` are covered by
-    /// [`Bus::idle_signature`]'s promise. The default: none is.
+    /// [`FastPathHints::idle_signature`]'s promise. The default: none is.
     fn idle_io(&self, addr: u32) -> bool {
         let _ = addr;
         false
     }
 
-    /// Moves the clock `states` ahead (a whole number of the periods [`Bus::idle_signature`]
+    /// Moves the clock `states` ahead (a whole number of the periods [`FastPathHints::idle_signature`]
     /// found) with the devices where repeating their period would bring them, and stores the
     /// longwords `ram` (address, value) without bus cycles: the state a program repeating its
     /// idle cycle reaches. Returns whether it did; the default does nothing and says no.
@@ -119,11 +129,56 @@ pub trait Bus {
     }
 }
 
-/// The source of [`Bus::code_generation`] tokens: one process-wide counter, so a token is
+/// A [`Bus`] with no fast-path promises: every [`FastPathHints`] method at its default. For a
+/// bus that implements only [`Bus`] (a flat memory, a probe), to run the CPU on it.
+#[derive(Debug)]
+pub struct NoHints<'b, B: Bus>(pub &'b mut B);
+
+impl<B: Bus> Bus for NoHints<'_, B> {
+    #[inline]
+    fn now(&self) -> u64 {
+        self.0.now()
+    }
+    #[inline]
+    fn read8(&mut self, addr: u32) -> u8 {
+        self.0.read8(addr)
+    }
+    #[inline]
+    fn read16(&mut self, addr: u32) -> u16 {
+        self.0.read16(addr)
+    }
+    #[inline]
+    fn write8(&mut self, addr: u32, value: u8) {
+        self.0.write8(addr, value);
+    }
+    #[inline]
+    fn write16(&mut self, addr: u32, value: u16) {
+        self.0.write16(addr, value);
+    }
+    #[inline]
+    fn internal(&mut self, states: u32) {
+        self.0.internal(states);
+    }
+    #[inline]
+    fn pending_irq(&self) -> Option<u8> {
+        self.0.pending_irq()
+    }
+    fn sleep_until_irq(&mut self, deadline: u64) -> bool {
+        self.0.sleep_until_irq(deadline)
+    }
+    #[inline]
+    fn cpu_signal(&mut self, signal: CpuSignal) {
+        self.0.cpu_signal(signal);
+    }
+}
+
+impl<B: Bus> FastPathHints for NoHints<'_, B> {}
+
+/// The source of [`FastPathHints::code_generation`] tokens: one process-wide counter, so a token is
 /// never reused, whichever bus draws it.
 static NEXT_CODE_GENERATION: AtomicU64 = AtomicU64::new(1);
 
-/// A token no bus has shown before (for [`Bus::code_generation`]): draw one whenever the flash
+/// A token no bus has shown before (for [`FastPathHints::code_generation`]): draw one whenever the flash
 /// may have changed.
 #[must_use]
 pub fn fresh_code_generation() -> u64 {

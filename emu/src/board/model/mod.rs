@@ -52,19 +52,20 @@ use nn_q15::{
 };
 
 use crate::board::ram::{RamMap, RamOverflow};
-use crate::chip::mcu::{Board, Mcu};
-use crate::core::bus::Bus;
+use crate::chip::mcu::Mcu;
+use crate::chip::pins::Board;
+use crate::core::bus::FastPathHints;
 use fast::SaveTimelines;
 use fw::{FETCH_STATES, Fw, FwPins, SLEEP_STATES};
 use regs::*;
 
 /// What the model asks of the MCU besides the bus: the EEPROM bus for its transaction-level
 /// save ([`ControllerConfig::fast_forward`]), which no program on the chip could reach and
-/// the core's [`Bus`] therefore does not carry (the ADF poll's shortcut uses
-/// [`Bus::reads_stable_until`], as the core's loop fast-forwarding does). Implemented for
+/// the core's [`crate::core::bus::Bus`] therefore does not carry (the ADF poll's shortcut uses
+/// [`FastPathHints::reads_stable_until`], as the core's loop fast-forwarding does). Implemented for
 /// [`Mcu`]; a bus that answers neither (the defaults, as a test's wrapper around an MCU may)
 /// runs the model register by register and I²C pin by pin, with the same results.
-pub trait ModelBus: Bus {
+pub trait ModelBus: FastPathHints {
     /// The EEPROM bus behind port 4, for the fast save that acts on the chips at transaction
     /// level with exactly the pin-level outcome ([`fast`]). `None`: pin-level access only.
     fn eeprom_bus(&mut self) -> Option<&mut eeprom::I2cBus> {

@@ -48,7 +48,7 @@
 use sensors::adc10_code;
 
 use super::Peripheral;
-use crate::chip::mcu::Board;
+use crate::chip::pins::Board;
 
 /// Address of ADDRA (high byte; low byte at +1) (docs/design.md §3.2: H'FFFFE0).
 pub const ADDRA: u32 = 0xFF_FFE0;

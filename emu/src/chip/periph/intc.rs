@@ -21,7 +21,7 @@
 //! the bus controller's BRCR at H'FFFFF3 read 0 and ignore writes.
 
 use super::Peripheral;
-use crate::chip::mcu::Board;
+use crate::chip::pins::Board;
 
 /// Address of SYSCR, the system control register (docs/design.md §4.1: H'FFFFF2).
 pub const SYSCR: u32 = 0xFF_FFF2;

@@ -49,7 +49,7 @@
 //! 65 536 counts). Nothing is stepped per state.
 
 use super::Peripheral;
-use crate::chip::mcu::Board;
+use crate::chip::pins::Board;
 
 /// Address of TSTR, timer start register (docs/design.md §4.1: H'FFFF60).
 pub const TSTR: u32 = 0xFF_FF60;

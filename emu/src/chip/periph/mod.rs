@@ -21,7 +21,7 @@ pub mod itu;
 pub mod ports;
 pub mod sci;
 
-use crate::chip::mcu::Board;
+use crate::chip::pins::Board;
 
 /// One on-chip module as the MCU sees it.
 ///

@@ -30,7 +30,7 @@ use eeprom::I2cBus;
 
 use super::Peripheral;
 use super::itu::Itu;
-use crate::chip::mcu::Board;
+use crate::chip::pins::Board;
 
 /// Address of P2DDR, port 2 data direction register (write-only; docs/design.md §4.1: H'FFFFC1).
 pub const P2DDR: u32 = 0xFF_FFC1;

@@ -18,7 +18,7 @@
 //! lazily from the clock value of each access, so the SCI needs no stepping.
 
 use super::Peripheral;
-use crate::chip::mcu::Board;
+use crate::chip::pins::Board;
 
 /// Address of SMR (serial mode register) of SCI1 (docs/design.md §4.1).
 pub const SCI1_SMR: u32 = 0xFF_FFB8;

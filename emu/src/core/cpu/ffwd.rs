@@ -16,7 +16,7 @@
 //! - **Fixed point** (poll loops, spins): any other back edge is watched for one iteration
 //!   through a recording bus. If that iteration wrote nothing, returned to the loop's head with
 //!   every register and CCR as they were, and every read it made comes with the bus's promise
-//!   that re-reading gives the same and changes nothing ([`Bus::reads_stable_until`]: ROM and
+//!   that re-reading gives the same and changes nothing ([`FastPathHints::reads_stable_until`]: ROM and
 //!   RAM for ever, the A/D converter's registers until its next event), then each further
 //!   iteration repeats it exactly, reads included, and is skipped. Four iterations that fail
 //!   the test (a write, a changed register, a read with no promise, a body of more than
@@ -24,7 +24,7 @@
 //!   for the watching only a few times.
 //!
 //! Either way the skipped iterations end no later than (a) the run's deadline, (b) the
-//! instant until which the bus promises no new interrupt request ([`Bus::irq_stable_until`];
+//! instant until which the bus promises no new interrupt request ([`FastPathHints::irq_stable_until`];
 //! the decision at every skipped boundary is then the one the stepped run would see), and (c)
 //! for a fixed point, the earliest end of its reads' promises. The iterations after that run
 //! normally. A bus that makes no promises (the defaults) gets no fast-forwarding.
@@ -39,7 +39,7 @@ use super::exec::sz;
 use super::fast::{Op, Slot};
 use super::timing as t;
 use super::{Cpu, CpuError, Event, ROM_FETCH_STATES, RunState};
-use crate::core::bus::Bus;
+use crate::core::bus::{Bus, FastPathHints};
 
 /// Most instructions one watched iteration of a poll loop may take.
 pub const MAX_BODY: u32 = 24;
@@ -90,14 +90,14 @@ pub(super) enum Outcome {
 
 /// A bus that notes what one watched iteration does: whether it wrote, and until when its
 /// reads stay the same.
-struct Recorder<'b, B: Bus> {
+struct Recorder<'b, B: FastPathHints> {
     bus: &'b mut B,
     /// The earliest end of the reads' promises (0: a read without one).
     stable_until: u64,
     wrote: bool,
 }
 
-impl<B: Bus> Recorder<'_, B> {
+impl<B: FastPathHints> Recorder<'_, B> {
     #[inline]
     fn note(&mut self, addr: u32) {
         let until = self.bus.reads_stable_until(addr).unwrap_or(0);
@@ -105,7 +105,7 @@ impl<B: Bus> Recorder<'_, B> {
     }
 }
 
-impl<B: Bus> Bus for Recorder<'_, B> {
+impl<B: FastPathHints> Bus for Recorder<'_, B> {
     #[inline]
     fn now(&self) -> u64 {
         self.bus.now()
@@ -147,6 +147,9 @@ impl<B: Bus> Bus for Recorder<'_, B> {
     fn cpu_signal(&mut self, signal: crate::core::bus::CpuSignal) {
         self.bus.cpu_signal(signal);
     }
+}
+
+impl<B: FastPathHints> FastPathHints for Recorder<'_, B> {
     #[inline]
     fn code_generation(&self) -> Option<u64> {
         self.bus.code_generation()
@@ -236,13 +239,13 @@ impl Cpu {
     }
 
     /// Whether the next boundary takes an interrupt (then nothing may be skipped before it).
-    fn interrupt_due<B: Bus>(&self, bus: &B) -> bool {
+    fn interrupt_due<B: FastPathHints>(&self, bus: &B) -> bool {
         !self.irq_inhibit && bus.pending_irq().is_some_and(|v| self.accepts(v))
     }
 
     /// After the back edge in slot `edge` was taken (PC at the loop's head): advances the loop
     /// as far as it exactly can (module docs).
-    pub(super) fn loop_back<B: Bus, F: FnMut(&Cpu, &B) -> bool>(
+    pub(super) fn loop_back<B: FastPathHints, F: FnMut(&Cpu, &B) -> bool>(
         &mut self,
         bus: &mut B,
         edge: usize,
@@ -321,7 +324,7 @@ impl Cpu {
 
     /// A countdown loop at its head: skips all iterations but the last that end by the
     /// deadline and before the interrupt decision may change.
-    fn countdown<B: Bus>(
+    fn countdown<B: FastPathHints>(
         &mut self,
         bus: &mut B,
         edge: usize,
@@ -365,7 +368,7 @@ impl Cpu {
     /// Watches one iteration of the loop closed by slot `edge` (PC at its head) and, if it is a
     /// fixed point, skips the identical iterations after it. Returns what to do next and
     /// whether the watch failed (the loop is no fixed point, or not now for good reasons).
-    fn watch<B: Bus, F: FnMut(&Cpu, &B) -> bool>(
+    fn watch<B: FastPathHints, F: FnMut(&Cpu, &B) -> bool>(
         &mut self,
         bus: &mut B,
         edge: usize,

@@ -12,7 +12,7 @@
 //! everything but values in RAM and registers: the same instructions (and accepted interrupts)
 //! at the same PCs and instants, the same accesses at the same instants, the same CCR before
 //! every instruction, the same values read from and written to ROM and devices, the devices
-//! only those [`Bus::idle_io`] covers, and the bus's [`Bus::idle_signature`] equal at s_A and
+//! only those [`FastPathHints::idle_io`] covers, and the bus's [`FastPathHints::idle_signature`] equal at s_A and
 //! s_B (the devices then repeat with period P = s_B − s_A as long as the program does). Then
 //! every value of cycle j (A = 0, B = 1) is shown to be `v_A + j·(v_B − v_A)` (mod 2^32), by
 //! induction over the cycle's instructions:
@@ -31,14 +31,14 @@
 //!
 //! Then cycles 2..=J repeat A and B with the same branches, interrupts, device accesses and
 //! timing, and `n` of them are advanced at once: registers and the changing longwords to their
-//! values after cycle 1 + n, the devices and the clock by [`Bus::idle_shift`] (n·P states),
+//! values after cycle 1 + n, the devices and the clock by [`FastPathHints::idle_shift`] (n·P states),
 //! the instruction count by n times the cycle's. The cycle after them runs as usual (the one
 //! where the counter reaches its threshold and the loop ends is never skipped). A cycle that
 //! fails the proof counts as a failure of its sleep PC; four mark that PC as no idle loop.
 
 use super::decode::{AluOp, BitNum, BitTarget, Instr, Operand, Size};
 use super::{Cpu, CpuError, Event, RunState};
-use crate::core::bus::{Bus, CpuSignal};
+use crate::core::bus::{Bus, CpuSignal, FastPathHints};
 use crate::core::memmap::{ADDRESS_MASK, Area};
 
 /// Most steps (instructions and accepted interrupts) one recorded idle cycle may take.
@@ -105,14 +105,14 @@ struct Cycle {
 }
 
 /// A bus that logs every data access of a recorded cycle.
-struct Log<'b, B: Bus> {
+struct Log<'b, B: FastPathHints> {
     bus: &'b mut B,
     wake: u64,
     step: u32,
     accesses: Vec<Access>,
 }
 
-impl<B: Bus> Log<'_, B> {
+impl<B: FastPathHints> Log<'_, B> {
     #[inline]
     fn note(&mut self, addr: u32, wide: bool, write: bool, value: u16) {
         let at = self.bus.now() - self.wake;
@@ -127,7 +127,7 @@ impl<B: Bus> Log<'_, B> {
     }
 }
 
-impl<B: Bus> Bus for Log<'_, B> {
+impl<B: FastPathHints> Bus for Log<'_, B> {
     fn now(&self) -> u64 {
         self.bus.now()
     }
@@ -161,6 +161,9 @@ impl<B: Bus> Bus for Log<'_, B> {
     fn cpu_signal(&mut self, signal: CpuSignal) {
         self.bus.cpu_signal(signal);
     }
+}
+
+impl<B: FastPathHints> FastPathHints for Log<'_, B> {
     fn code_generation(&self) -> Option<u64> {
         self.bus.code_generation()
     }
@@ -316,12 +319,12 @@ impl Cpu {
     /// prove that the cycles after them repeat (module docs), advances as many of those as
     /// were proven and end by `deadline`, to the state stepping reaches. `stop` is asked after
     /// every instruction run (not inside the advanced cycles, which touch only the devices
-    /// [`Bus::idle_io`] covers). Does nothing unless loop fast-forwarding is on
+    /// [`FastPathHints::idle_io`] covers). Does nothing unless loop fast-forwarding is on
     /// ([`Cpu::set_fast_forward`]), the CPU is asleep and the bus makes the promises.
     ///
     /// # Errors
     /// As [`Cpu::step`].
-    pub fn run_idle<B: Bus, F: FnMut(&Cpu, &B) -> bool>(
+    pub fn run_idle<B: FastPathHints, F: FnMut(&Cpu, &B) -> bool>(
         &mut self,
         bus: &mut B,
         deadline: u64,
@@ -396,7 +399,7 @@ impl Cpu {
     }
 
     /// Runs one idle cycle from sleep back to sleep, logging it.
-    fn record_cycle<B: Bus, F: FnMut(&Cpu, &B) -> bool>(
+    fn record_cycle<B: FastPathHints, F: FnMut(&Cpu, &B) -> bool>(
         &mut self,
         bus: &mut B,
         deadline: u64,
@@ -466,7 +469,7 @@ impl Cpu {
     }
 
     /// Checks that cycles A and B prove the next ones (module docs); the CPU is at B's end.
-    fn prove<B: Bus>(&self, bus: &B, a: &Cycle, b: &Cycle) -> Result<Plan, NoProof> {
+    fn prove<B: FastPathHints>(&self, bus: &B, a: &Cycle, b: &Cycle) -> Result<Plan, NoProof> {
         use NoProof::{Fails, Misaligned, NotNow};
         let (Some(sa), Some(sb)) = (&a.signature, &b.signature) else {
             return Err(NotNow);

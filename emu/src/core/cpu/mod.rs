@@ -16,7 +16,7 @@
 //!   indexed by address, but their fetch cycles still go through the bus), and the decoded
 //!   [`decode::Instr`] is executed by one generic executor.
 //! - The fast path ([`Cpu::step`], unless [`Cpu::set_fast_path`] turned it off) runs when the
-//!   bus shows a [`Bus::code_generation`] token, i.e. promises that fetching from ROM or RAM
+//!   bus shows a [`FastPathHints::code_generation`] token, i.e. promises that fetching from ROM or RAM
 //!   has no effect but the clock: each ROM instruction is decoded once into a handler of its
 //!   own form (`fast`: register moves and ALU operations by size and source, loads and stores
 //!   by size, branches with their target, condition mask and prefetch states precomputed,
@@ -33,9 +33,9 @@
 //!   [`Cpu::set_fast_forward`] turns it off): a delay loop (INC/DEC/ADD/SUB #imm on one
 //!   register and a BNE back) is advanced to its last iteration in closed form, and a loop
 //!   whose watched iteration wrote nothing, came back to its head with every register and CCR
-//!   unchanged and read only what the bus promises stays the same ([`Bus::reads_stable_until`]:
+//!   unchanged and read only what the bus promises stays the same ([`FastPathHints::reads_stable_until`]:
 //!   ROM, RAM, the A/D converter until its next event) is skipped to where something can change:
-//!   the deadline, the next possible interrupt request ([`Bus::irq_stable_until`]), the end of
+//!   the deadline, the next possible interrupt request ([`FastPathHints::irq_stable_until`]), the end of
 //!   its reads' promises. The skipped iterations' states and instructions are counted
 //!   ([`Cpu::skipped_instructions`]); registers, flags, clock and memory are what stepping
 //!   reaches at the same instruction boundary. [`Cpu::step`] never skips.
@@ -95,7 +95,7 @@ pub mod timing;
 pub use idle::{IdleRun, MAX_CYCLE};
 pub use stack::{StackAccess, StackFault, StackGuard, StackGuardMode, StackRoom};
 
-use crate::core::bus::{Bus, CpuSignal};
+use crate::core::bus::{Bus, CpuSignal, FastPathHints};
 use crate::core::memmap::Area;
 use decode::{DecodeError, Decoded, Instr, WordSource, decode};
 
@@ -214,7 +214,7 @@ pub struct Cpu {
     cache: Vec<Decoded>,
     /// The fast path's handlers of the same instructions, same index; grows on demand.
     fast: Vec<fast::Slot>,
-    /// The bus's [`Bus::code_generation`] token the caches were filled under (0: none; the
+    /// The bus's [`FastPathHints::code_generation`] token the caches were filled under (0: none; the
     /// tokens of [`crate::core::bus::fresh_code_generation`] start at 1).
     code_generation: u64,
     /// Whether [`Cpu::step`] may take the fast path.
@@ -488,7 +488,7 @@ impl Cpu {
         self.state == RunState::Sleeping
     }
 
-    /// Forgets every predecoded instruction. A bus that shows a [`Bus::code_generation`]
+    /// Forgets every predecoded instruction. A bus that shows a [`FastPathHints::code_generation`]
     /// token has the caches emptied whenever its flash changes; with another bus, call this
     /// after replacing the ROM image.
     pub fn flush_decode_cache(&mut self) {
@@ -502,7 +502,7 @@ impl Cpu {
 
     /// Empties the caches if the bus's flash token changed since they were filled.
     #[inline]
-    fn check_code_generation<B: Bus>(&mut self, bus: &B) -> Option<u64> {
+    fn check_code_generation<B: FastPathHints>(&mut self, bus: &B) -> Option<u64> {
         let token = bus.code_generation();
         if let Some(t) = token
             && t != self.code_generation
@@ -597,13 +597,17 @@ impl Cpu {
     /// mode) waits for an interrupt until the clock reaches `deadline`.
     ///
     /// Takes the fast path (see the module docs) when it is on and the bus shows a
-    /// [`Bus::code_generation`] token; otherwise this is [`Cpu::step_reference`].
+    /// [`FastPathHints::code_generation`] token; otherwise this is [`Cpu::step_reference`].
     ///
     /// # Errors
     /// [`CpuError`] on an undefined opcode, a fetch outside ROM/RAM or an unsupported
     /// instruction; the CPU state is left as it was before the instruction (PC at it).
     #[inline]
-    pub fn step<B: Bus>(&mut self, bus: &mut B, deadline: u64) -> Result<Event, CpuError> {
+    pub fn step<B: FastPathHints>(
+        &mut self,
+        bus: &mut B,
+        deadline: u64,
+    ) -> Result<Event, CpuError> {
         if self.fast_ready(bus) {
             return self.step_fast(bus);
         }
@@ -613,7 +617,7 @@ impl Cpu {
     /// Whether the fast path may run this step: on, running, and the caches filled under the
     /// bus's present token.
     #[inline(always)]
-    fn fast_ready<B: Bus>(&self, bus: &B) -> bool {
+    fn fast_ready<B: FastPathHints>(&self, bus: &B) -> bool {
         self.fast_path
             && self.state == RunState::Running
             && bus.code_generation() == Some(self.code_generation)
@@ -622,7 +626,11 @@ impl Cpu {
     /// A step when [`Cpu::fast_ready`] says no: a new token (the caches are emptied and the
     /// fast path runs), or the reference path.
     #[inline(never)]
-    fn step_not_ready<B: Bus>(&mut self, bus: &mut B, deadline: u64) -> Result<Event, CpuError> {
+    fn step_not_ready<B: FastPathHints>(
+        &mut self,
+        bus: &mut B,
+        deadline: u64,
+    ) -> Result<Event, CpuError> {
         if self.fast_path
             && self.state == RunState::Running
             && self.check_code_generation(bus).is_some()
@@ -641,7 +649,7 @@ impl Cpu {
     ///
     /// # Errors
     /// As [`Cpu::step`].
-    pub fn run<B: Bus>(&mut self, bus: &mut B, deadline: u64) -> Result<Event, CpuError> {
+    pub fn run<B: FastPathHints>(&mut self, bus: &mut B, deadline: u64) -> Result<Event, CpuError> {
         self.run_until(bus, deadline, |_, _| false)
     }
 
@@ -662,7 +670,7 @@ impl Cpu {
     ///
     /// # Errors
     /// As [`Cpu::step`].
-    pub fn run_until<B: Bus, F: FnMut(&Cpu, &B) -> bool>(
+    pub fn run_until<B: FastPathHints, F: FnMut(&Cpu, &B) -> bool>(
         &mut self,
         bus: &mut B,
         deadline: u64,
@@ -787,7 +795,7 @@ impl Cpu {
     ///
     /// # Errors
     /// As [`Cpu::step`].
-    pub fn step_reference<B: Bus>(
+    pub fn step_reference<B: FastPathHints>(
         &mut self,
         bus: &mut B,
         deadline: u64,
