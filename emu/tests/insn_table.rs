@@ -1,4 +1,4 @@
-//! One source of state counts (issue 10 item 6): every instruction form of `nn_q15`'s cost
+//! One source of state counts: every instruction form of `nn_q15`'s cost
 //! table ([`nn_q15::cost::Insn`]) is run on the H8/300H core from on-chip flash with on-chip RAM
 //! operands, and the states the core counts must be the table's.
 
