@@ -21,7 +21,7 @@ use std::io::Write;
 
 use crate::gdb::DebugAction;
 use crate::machine::{LoadError, Machine};
-use crate::mcu::Mcu;
+use crate::mcu::{DEFAULT_CLOCK_HZ, Mcu};
 use crate::pins::Board;
 use crate::trace::{CodeNames, PhaseRecorder, phase_name};
 use h8300h::bus::Bus;
@@ -29,8 +29,8 @@ use h8300h::cpu::disasm::format_instr;
 use h8300h::cpu::{Cpu, CpuError, Event, StackFault, StackGuard, StackRoom};
 use h8300h::srec::{self, SrecError};
 
-/// The system clock φ of the AKI-H8/3052F board: 25 MHz, 1 state = 40 ns (docs/design.md §4.1).
-pub const PHI_HZ: u64 = 25_000_000;
+/// The clock φ the runner counts seconds in: the board's, [`DEFAULT_CLOCK_HZ`].
+pub const PHI_HZ: u64 = DEFAULT_CLOCK_HZ as u64;
 
 /// Options of a run.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

@@ -86,10 +86,10 @@ pub const PWM_PERIOD_COUNTS: u16 = 1250;
 /// GRB for 100 % duty: above GRA (= [`PWM_PERIOD_COUNTS`] − 1), so its compare match never
 /// comes and the output stays high (the H8/3052 hardware manual's PWM-mode 100 % setting).
 pub const PWM_FULL_GRB: u16 = PWM_PERIOD_COUNTS;
-/// Lowest φ the H8/3052F runs at (hardware manual, electrical characteristics: 2 MHz).
-pub const CLOCK_MIN_HZ: u32 = 2_000_000;
-/// Highest φ of the H8/3052F (hardware manual: 25 MHz; the AKI board's crystal, docs/design.md §4.1).
-pub const CLOCK_MAX_HZ: u32 = 25_000_000;
+/// Lowest φ the H8/3052F runs at (the chip's [`h8_3052f::mcu::MIN_CLOCK_HZ`]).
+pub const CLOCK_MIN_HZ: u32 = h8_3052f::mcu::MIN_CLOCK_HZ;
+/// Highest φ of the H8/3052F (the chip's [`h8_3052f::mcu::MAX_CLOCK_HZ`]).
+pub const CLOCK_MAX_HZ: u32 = h8_3052f::mcu::MAX_CLOCK_HZ;
 /// Longest step period accepted (10 minutes).
 pub const MAX_STEP_PERIOD_S: f64 = 600.0;
 /// Amplitude of the fresh random weights: uniform in ±0.5 (±16384 in Q15).
@@ -187,7 +187,7 @@ impl ControllerConfig {
     #[must_use]
     pub fn arena(weight_seed: u64) -> Self {
         Self {
-            clock_hz: CLOCK_MAX_HZ,
+            clock_hz: h8_3052f::mcu::DEFAULT_CLOCK_HZ,
             behaviours: 4,
             layout: InputLayout::DEFAULT,
             params: Params::ARENA,

@@ -624,9 +624,55 @@ const ALU_RR_BYTE: [Option<AluOp>; 16] = [
     None,
 ];
 
+/// Decodes one instruction: the first word's first byte picks the opcode group, each group
+/// decoded by a function of its own.
 fn decode_inner<S: WordSource>(r: &mut Reader<'_, S>) -> Result<Instr, Stop> {
     let w0 = r.word()?;
     let [op, b1] = w0.to_be_bytes();
+    use Instr as I;
+    use Operand as O;
+    let instr = match op {
+        0x00..=0x07 => decode_control(r, op, b1)?,
+        0x08 | 0x09 | 0x0c..=0x0e | 0x14..=0x16 | 0x18 | 0x19 | 0x1c..=0x1e | 0x64..=0x66 => {
+            decode_register_alu(op, b1)?
+        }
+        0x0a | 0x0b | 0x0f | 0x1a | 0x1b | 0x1f => decode_add_sub_pairs(op, b1)?,
+        0x10..=0x13 | 0x17 => decode_shift_unary(op, b1)?,
+        0x20..=0x2f => I::Mov {
+            size: Size::Byte,
+            src: O::Abs8(b1),
+            dst: O::Reg(op & 0xf),
+        },
+        0x30..=0x3f => I::Mov {
+            size: Size::Byte,
+            src: O::Reg(op & 0xf),
+            dst: O::Abs8(b1),
+        },
+        0x40..=0x4f => I::Bcc {
+            cond: op & 0xf,
+            disp: i16::from(b1 as i8),
+            long: false,
+        },
+        0x50..=0x5f => decode_branch_muldiv(r, op, b1)?,
+        0x60..=0x63 | 0x67..=0x7f => decode_bit_mov(r, op, b1)?,
+        0x80..=0x8f => alu_imm8(AluOp::Add, op, b1),
+        0x90..=0x9f => alu_imm8(AluOp::Addx, op, b1),
+        0xa0..=0xaf => alu_imm8(AluOp::Cmp, op, b1),
+        0xb0..=0xbf => alu_imm8(AluOp::Subx, op, b1),
+        0xc0..=0xcf => alu_imm8(AluOp::Or, op, b1),
+        0xd0..=0xdf => alu_imm8(AluOp::Xor, op, b1),
+        0xe0..=0xef => alu_imm8(AluOp::And, op, b1),
+        0xf0..=0xff => I::Mov {
+            size: Size::Byte,
+            src: O::Imm(u32::from(b1)),
+            dst: O::Reg(op & 0xf),
+        },
+    };
+    Ok(instr)
+}
+
+/// Decodes the control group H'00-H'07: NOP, the H'01 prefix, STC/LDC, ORC/XORC/ANDC.
+fn decode_control<S: WordSource>(r: &mut Reader<'_, S>, op: u8, b1: u8) -> Result<Instr, Stop> {
     let (bh, bl) = (hi4(b1), lo4(b1));
     use Instr as I;
     use Operand as O;
@@ -648,6 +694,18 @@ fn decode_inner<S: WordSource>(r: &mut Reader<'_, S>) -> Result<Instr, Stop> {
         0x05 => I::Xorc(b1),
         0x06 => I::Andc(b1),
         0x07 => I::Ldc(O::Imm(u32::from(b1))),
+        _ => return Err(Stop::Undefined),
+    };
+    Ok(instr)
+}
+
+/// Decodes the ALU operations and MOVs between registers (byte and word ADD, ADDX, SUB,
+/// SUBX, CMP, AND, OR, XOR; MOV.B and MOV.W).
+fn decode_register_alu(op: u8, b1: u8) -> Result<Instr, Stop> {
+    let (bh, bl) = (hi4(b1), lo4(b1));
+    use Instr as I;
+    use Operand as O;
+    let instr = match op {
         0x08 | 0x0e => I::Alu {
             op: ALU_RR_BYTE[usize::from(op & 0xf)].ok_or(Stop::Undefined)?,
             size: Size::Byte,
@@ -667,6 +725,42 @@ fn decode_inner<S: WordSource>(r: &mut Reader<'_, S>) -> Result<Instr, Stop> {
             src: O::Reg(bh),
             rd: bl,
         },
+        0x0c => I::Mov {
+            size: Size::Byte,
+            src: O::Reg(bh),
+            dst: O::Reg(bl),
+        },
+        0x0d => I::Mov {
+            size: Size::Word,
+            src: O::Reg(bh),
+            dst: O::Reg(bl),
+        },
+        0x14 | 0x15 | 0x16 | 0x18 | 0x1c | 0x1e => I::Alu {
+            op: match op {
+                0x14 => AluOp::Or,
+                0x15 => AluOp::Xor,
+                0x16 => AluOp::And,
+                0x18 => AluOp::Sub,
+                0x1c => AluOp::Cmp,
+                _ => AluOp::Subx,
+            },
+            size: Size::Byte,
+            src: O::Reg(bh),
+            rd: bl,
+        },
+        _ => return Err(Stop::Undefined),
+    };
+    Ok(instr)
+}
+
+/// Decodes the opcodes that come in pairs, H'0x adding and H'1x subtracting: INC/DEC
+/// (and longword ADD/SUB), ADDS/SUBS (and INC/DEC word and long), DAA/DAS (and longword MOV
+/// and CMP).
+fn decode_add_sub_pairs(op: u8, b1: u8) -> Result<Instr, Stop> {
+    let (bh, bl) = (hi4(b1), lo4(b1));
+    use Instr as I;
+    use Operand as O;
+    let instr = match op {
         0x0a | 0x1a => {
             if bh == 0 {
                 if op == 0x0a {
@@ -724,16 +818,6 @@ fn decode_inner<S: WordSource>(r: &mut Reader<'_, S>) -> Result<Instr, Stop> {
                 _ => return Err(Stop::Undefined),
             }
         }
-        0x0c => I::Mov {
-            size: Size::Byte,
-            src: O::Reg(bh),
-            dst: O::Reg(bl),
-        },
-        0x0d => I::Mov {
-            size: Size::Word,
-            src: O::Reg(bh),
-            dst: O::Reg(bl),
-        },
         0x0f | 0x1f => {
             if bh == 0 {
                 if op == 0x0f { I::Daa(bl) } else { I::Das(bl) }
@@ -757,6 +841,17 @@ fn decode_inner<S: WordSource>(r: &mut Reader<'_, S>) -> Result<Instr, Stop> {
                 }
             }
         }
+        _ => return Err(Stop::Undefined),
+    };
+    Ok(instr)
+}
+
+/// Decodes shifts and rotates (H'10-H'13) and the one-operand group H'17 (NOT, NEG, EXTU,
+/// EXTS).
+fn decode_shift_unary(op: u8, b1: u8) -> Result<Instr, Stop> {
+    let (bh, bl) = (hi4(b1), lo4(b1));
+    use Instr as I;
+    let instr = match op {
         0x10..=0x13 => {
             // Shifts and rotates: op 10 = shll/shal, 11 = shlr/shar, 12 = rotxl/rotl,
             // 13 = rotxr/rotr; b1 high nibble: 0/1/3 = logical-or-through-carry .b/.w/.l,
@@ -781,19 +876,6 @@ fn decode_inner<S: WordSource>(r: &mut Reader<'_, S>) -> Result<Instr, Stop> {
             };
             I::Unary { op: uop, size, rd }
         }
-        0x14 | 0x15 | 0x16 | 0x18 | 0x1c | 0x1e => I::Alu {
-            op: match op {
-                0x14 => AluOp::Or,
-                0x15 => AluOp::Xor,
-                0x16 => AluOp::And,
-                0x18 => AluOp::Sub,
-                0x1c => AluOp::Cmp,
-                _ => AluOp::Subx,
-            },
-            size: Size::Byte,
-            src: O::Reg(bh),
-            rd: bl,
-        },
         0x17 => {
             let (uop, size) = match bh {
                 0x0 => (UnaryOp::Not, Size::Byte),
@@ -811,21 +893,21 @@ fn decode_inner<S: WordSource>(r: &mut Reader<'_, S>) -> Result<Instr, Stop> {
             let rd = if size == Size::Long { r3(bl)? } else { bl };
             I::Unary { op: uop, size, rd }
         }
-        0x20..=0x2f => I::Mov {
-            size: Size::Byte,
-            src: O::Abs8(b1),
-            dst: O::Reg(op & 0xf),
-        },
-        0x30..=0x3f => I::Mov {
-            size: Size::Byte,
-            src: O::Reg(op & 0xf),
-            dst: O::Abs8(b1),
-        },
-        0x40..=0x4f => I::Bcc {
-            cond: op & 0xf,
-            disp: i16::from(b1 as i8),
-            long: false,
-        },
+        _ => return Err(Stop::Undefined),
+    };
+    Ok(instr)
+}
+
+/// Decodes H'5x: MULXU/DIVXU, RTS/RTE/TRAPA, BSR, the 16-bit-displacement branches, JMP and
+/// JSR.
+fn decode_branch_muldiv<S: WordSource>(
+    r: &mut Reader<'_, S>,
+    op: u8,
+    b1: u8,
+) -> Result<Instr, Stop> {
+    let (bh, bl) = (hi4(b1), lo4(b1));
+    use Instr as I;
+    let instr = match op {
         0x50 | 0x51 => I::MulDiv {
             op: if op == 0x50 {
                 MulDivOp::Mulxu
@@ -893,6 +975,17 @@ fn decode_inner<S: WordSource>(r: &mut Reader<'_, S>) -> Result<Instr, Stop> {
                 long: true,
             }
         }
+        _ => return Err(Stop::Undefined),
+    };
+    Ok(instr)
+}
+
+/// Decodes H'6x-H'7x: bit manipulation, MOV between registers and memory, MOV and ALU
+/// operations with immediates, EEPMOV.
+fn decode_bit_mov<S: WordSource>(r: &mut Reader<'_, S>, op: u8, b1: u8) -> Result<Instr, Stop> {
+    let (bh, bl) = (hi4(b1), lo4(b1));
+    use Instr as I;
+    let instr = match op {
         0x60..=0x63 => I::Bit {
             op: match op {
                 0x60 => BitOp::Bset,
@@ -973,18 +1066,7 @@ fn decode_inner<S: WordSource>(r: &mut Reader<'_, S>) -> Result<Instr, Stop> {
                 target,
             }
         }
-        0x80..=0x8f => alu_imm8(AluOp::Add, op, b1),
-        0x90..=0x9f => alu_imm8(AluOp::Addx, op, b1),
-        0xa0..=0xaf => alu_imm8(AluOp::Cmp, op, b1),
-        0xb0..=0xbf => alu_imm8(AluOp::Subx, op, b1),
-        0xc0..=0xcf => alu_imm8(AluOp::Or, op, b1),
-        0xd0..=0xdf => alu_imm8(AluOp::Xor, op, b1),
-        0xe0..=0xef => alu_imm8(AluOp::And, op, b1),
-        0xf0..=0xff => I::Mov {
-            size: Size::Byte,
-            src: O::Imm(u32::from(b1)),
-            dst: O::Reg(op & 0xf),
-        },
+        _ => return Err(Stop::Undefined),
     };
     Ok(instr)
 }

@@ -487,16 +487,46 @@ impl Cpu {
         {
             return Err(Fails);
         }
-        // Registers at the three boundaries: the same change per cycle.
+        let stride = self.register_stride(a, b)?;
+        let last = self.steps_repeat(a, b)?;
+        accesses_repeat(bus, a, b)?;
+        let ram = ram_strides(&ram_records(a, b))?;
+        if last < 2 {
+            return Err(NotNow);
+        }
+        let instructions = a
+            .steps
+            .iter()
+            .filter(|s| matches!(s.kind, Kind::Instr(_)))
+            .count() as u64;
+        Ok(Plan {
+            period,
+            busy: end - b.wake,
+            instructions,
+            last,
+            stride,
+            ram,
+        })
+    }
+
+    /// The registers at the three boundaries (A's start, B's start, now): the same change per
+    /// cycle, which is returned.
+    fn register_stride(&self, a: &Cycle, b: &Cycle) -> Result<[u32; 8], NoProof> {
         let mut stride = [0u32; 8];
         for (r, s) in stride.iter_mut().enumerate() {
             *s = b.regs[r].wrapping_sub(a.regs[r]);
             if self.er[r].wrapping_sub(b.regs[r]) != *s {
-                return Err(Fails);
+                return Err(NoProof::Fails);
             }
         }
+        Ok(stride)
+    }
+
+    /// The steps of A and B: the same in everything but affine values. Returns the number of
+    /// further cycles for which every affine value keeps its flags ([`span`]'s minimum).
+    fn steps_repeat(&self, a: &Cycle, b: &Cycle) -> Result<u64, NoProof> {
+        use NoProof::Fails;
         let mut last = u64::MAX;
-        // Steps: the same in everything but affine values.
         for (i, (sa, sb)) in a.steps.iter().zip(&b.steps).enumerate() {
             if sa.kind != sb.kind
                 || sa.pc != sb.pc
@@ -523,159 +553,191 @@ impl Cpu {
             let Kind::Instr(instr) = sa.kind else {
                 return Err(Fails);
             };
-            let reg = |r: u8| (sa.regs[usize::from(r & 7)], sb.regs[usize::from(r & 7)]);
-            let out = |r: u8| (aa[usize::from(r & 7)], ab[usize::from(r & 7)]);
-            let mut values: [(u32, u32); 3] = [(1, 1); 3];
-            match instr {
-                Instr::Mov { src, dst, .. } => {
-                    let m = address_regs(src) | address_regs(dst);
-                    for r in 0..8 {
-                        if m & (1 << r) != 0 && sa.regs[r] != sb.regs[r] {
-                            return Err(Fails);
-                        }
-                    }
-                    values[0] = match (src, dst) {
-                        (Operand::Reg(r), _) => reg(r),
-                        (_, Operand::Reg(r)) => out(r),
-                        _ => return Err(Fails),
-                    };
-                }
-                Instr::Alu { op, src, rd, .. } => {
-                    let s = match src {
-                        Operand::Reg(r) => reg(r),
-                        Operand::Imm(v) => (v, v),
-                        _ => return Err(Fails),
-                    };
-                    let d = reg(rd);
-                    values[0] = s;
-                    values[1] = d;
-                    values[2] = if op == AluOp::Cmp {
-                        (d.0.wrapping_sub(s.0), d.1.wrapping_sub(s.1))
-                    } else {
-                        out(rd)
-                    };
-                }
-                Instr::Inc { rd, .. } | Instr::Dec { rd, .. } => {
-                    values[0] = reg(rd);
-                    values[1] = out(rd);
-                }
-                // ADDS/SUBS: no flags, any value.
-                _ => {}
-            }
-            for (va, vb) in values {
+            for (va, vb) in affine_values(instr, sa, sb, &aa, &ab)? {
                 last = last.min(span(va, vb));
             }
         }
-        // Accesses: the same but for RAM values; devices only those the bus covers.
-        for (x, y) in a.accesses.iter().zip(&b.accesses) {
-            if x.addr != y.addr
-                || x.wide != y.wide
-                || x.write != y.write
-                || x.at != y.at
-                || x.step != y.step
-            {
-                return Err(Fails);
-            }
-            match Area::of(x.addr) {
-                Area::Ram => {}
-                Area::Io if !bus.idle_io(x.addr) => return Err(Fails),
-                _ if x.value != y.value => return Err(Fails),
-                _ => {}
-            }
-        }
-        // RAM: longword records (the two words of a 32-bit MOV), changing ones checked.
-        let mut records: Vec<(u32, u32, bool, u32, u32, bool)> = Vec::new(); // addr, len, write, va, vb, long mov
-        let mut k = 0;
-        while k < a.accesses.len() {
-            let (x, y) = (a.accesses[k], b.accesses[k]);
-            let step = a.steps[x.step as usize].kind;
-            let long_mov = affine(step) && matches!(step, Kind::Instr(Instr::Mov { .. }));
-            if long_mov
-                && k + 1 < a.accesses.len()
-                && a.accesses[k + 1].step == x.step
-                && a.accesses[k + 1].addr == x.addr + 2
-                && a.accesses[k + 1].write == x.write
-                && x.wide
-            {
-                let (x2, y2) = (a.accesses[k + 1], b.accesses[k + 1]);
-                records.push((
-                    x.addr,
-                    4,
-                    x.write,
-                    long(x.value, x2.value),
-                    long(y.value, y2.value),
-                    true,
-                ));
-                k += 2;
-            } else {
-                let len = if x.wide { 2 } else { 1 };
-                records.push((
-                    x.addr,
-                    len,
-                    x.write,
-                    u32::from(x.value),
-                    u32::from(y.value),
-                    false,
-                ));
-                k += 1;
-            }
-        }
-        let mut ram = Vec::new();
-        for &(addr, _, _, va, vb, is_long) in &records {
-            if va == vb || Area::of(addr) != Area::Ram {
-                continue;
-            }
-            if !is_long || ram.iter().any(|&(a2, _, _)| a2 == addr) {
-                if !is_long {
+        Ok(last)
+    }
+}
+
+/// The values an affine instruction's flags depend on, in cycle A and in cycle B (`sa`, `sb`:
+/// the step in each; `aa`, `ab`: the registers after it): the source, the destination and the
+/// result; `(1, 1)` where there is none.
+fn affine_values(
+    instr: Instr,
+    sa: &Step,
+    sb: &Step,
+    aa: &[u32; 8],
+    ab: &[u32; 8],
+) -> Result<[(u32, u32); 3], NoProof> {
+    use NoProof::Fails;
+    let reg = |r: u8| (sa.regs[usize::from(r & 7)], sb.regs[usize::from(r & 7)]);
+    let out = |r: u8| (aa[usize::from(r & 7)], ab[usize::from(r & 7)]);
+    let mut values: [(u32, u32); 3] = [(1, 1); 3];
+    match instr {
+        Instr::Mov { src, dst, .. } => {
+            let m = address_regs(src) | address_regs(dst);
+            for r in 0..8 {
+                if m & (1 << r) != 0 && sa.regs[r] != sb.regs[r] {
                     return Err(Fails);
                 }
-                continue;
             }
-            // Every record touching the longword is a whole longword record there.
-            let mut first_read: Option<(u32, u32)> = None;
-            let mut seen_write = false;
-            let mut last_write: Option<(u32, u32)> = None;
-            for &(a2, len2, w2, xa, xb, l2) in &records {
-                if a2 < addr + 4 && addr < a2 + len2 {
-                    if a2 != addr || !l2 {
-                        return Err(Fails);
-                    }
-                    if w2 {
-                        seen_write = true;
-                        last_write = Some((xa, xb));
-                    } else if !seen_write && first_read.is_none() {
-                        first_read = Some((xa, xb));
-                    }
+            values[0] = match (src, dst) {
+                (Operand::Reg(r), _) => reg(r),
+                (_, Operand::Reg(r)) => out(r),
+                _ => return Err(Fails),
+            };
+        }
+        Instr::Alu { op, src, rd, .. } => {
+            let s = match src {
+                Operand::Reg(r) => reg(r),
+                Operand::Imm(v) => (v, v),
+                _ => return Err(Fails),
+            };
+            let d = reg(rd);
+            values[0] = s;
+            values[1] = d;
+            values[2] = if op == AluOp::Cmp {
+                (d.0.wrapping_sub(s.0), d.1.wrapping_sub(s.1))
+            } else {
+                out(rd)
+            };
+        }
+        Instr::Inc { rd, .. } | Instr::Dec { rd, .. } => {
+            values[0] = reg(rd);
+            values[1] = out(rd);
+        }
+        // ADDS/SUBS: no flags, any value.
+        _ => {}
+    }
+    Ok(values)
+}
+
+/// The data accesses of A and B: the same but for RAM values, and to devices only those the
+/// bus covers ([`FastPathHints::idle_io`]).
+fn accesses_repeat<B: FastPathHints>(bus: &B, a: &Cycle, b: &Cycle) -> Result<(), NoProof> {
+    use NoProof::Fails;
+    for (x, y) in a.accesses.iter().zip(&b.accesses) {
+        if x.addr != y.addr
+            || x.wide != y.wide
+            || x.write != y.write
+            || x.at != y.at
+            || x.step != y.step
+        {
+            return Err(Fails);
+        }
+        match Area::of(x.addr) {
+            Area::Ram => {}
+            Area::Io if !bus.idle_io(x.addr) => return Err(Fails),
+            _ if x.value != y.value => return Err(Fails),
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
+/// One data access of the cycle, or the two word accesses of a 32-bit MOV taken together, with
+/// its value in A and in B.
+#[derive(Clone, Copy)]
+struct Record {
+    addr: u32,
+    len: u32,
+    write: bool,
+    va: u32,
+    vb: u32,
+    /// The two words of a longword MOV.
+    long: bool,
+}
+
+/// A's and B's accesses as [`Record`]s: longword MOVs' word pairs joined.
+fn ram_records(a: &Cycle, b: &Cycle) -> Vec<Record> {
+    let mut records = Vec::new();
+    let mut k = 0;
+    while k < a.accesses.len() {
+        let (x, y) = (a.accesses[k], b.accesses[k]);
+        let step = a.steps[x.step as usize].kind;
+        let long_mov = affine(step) && matches!(step, Kind::Instr(Instr::Mov { .. }));
+        if long_mov
+            && k + 1 < a.accesses.len()
+            && a.accesses[k + 1].step == x.step
+            && a.accesses[k + 1].addr == x.addr + 2
+            && a.accesses[k + 1].write == x.write
+            && x.wide
+        {
+            let (x2, y2) = (a.accesses[k + 1], b.accesses[k + 1]);
+            records.push(Record {
+                addr: x.addr,
+                len: 4,
+                write: x.write,
+                va: long(x.value, x2.value),
+                vb: long(y.value, y2.value),
+                long: true,
+            });
+            k += 2;
+        } else {
+            let len = if x.wide { 2 } else { 1 };
+            records.push(Record {
+                addr: x.addr,
+                len,
+                write: x.write,
+                va: u32::from(x.value),
+                vb: u32::from(y.value),
+                long: false,
+            });
+            k += 1;
+        }
+    }
+    records
+}
+
+/// The RAM longwords whose values change from A to B, as (address, value at B's end, change
+/// per cycle): each must be accessed only as a whole longword, written in the cycle, and read
+/// (if at all, before the first write) with the same change. A changing value of any other
+/// access fails.
+fn ram_strides(records: &[Record]) -> Result<Vec<(u32, u32, u32)>, NoProof> {
+    use NoProof::Fails;
+    let mut ram: Vec<(u32, u32, u32)> = Vec::new();
+    for r in records {
+        let addr = r.addr;
+        if r.va == r.vb || Area::of(addr) != Area::Ram {
+            continue;
+        }
+        if !r.long || ram.iter().any(|&(a2, _, _)| a2 == addr) {
+            if !r.long {
+                return Err(Fails);
+            }
+            continue;
+        }
+        // Every record touching the longword is a whole longword record there.
+        let mut first_read: Option<(u32, u32)> = None;
+        let mut seen_write = false;
+        let mut last_write: Option<(u32, u32)> = None;
+        for o in records {
+            if o.addr < addr + 4 && addr < o.addr + o.len {
+                if o.addr != addr || !o.long {
+                    return Err(Fails);
+                }
+                if o.write {
+                    seen_write = true;
+                    last_write = Some((o.va, o.vb));
+                } else if !seen_write && first_read.is_none() {
+                    first_read = Some((o.va, o.vb));
                 }
             }
-            let Some((wa, wb)) = last_write else {
-                return Err(Fails);
-            };
-            let d = wb.wrapping_sub(wa);
-            if let Some((ra, rb)) = first_read
-                && rb.wrapping_sub(ra) != d
-            {
-                return Err(Fails);
-            }
-            ram.push((addr, wb, d));
         }
-        if last < 2 {
-            return Err(NotNow);
+        let Some((wa, wb)) = last_write else {
+            return Err(Fails);
+        };
+        let d = wb.wrapping_sub(wa);
+        if let Some((ra, rb)) = first_read
+            && rb.wrapping_sub(ra) != d
+        {
+            return Err(Fails);
         }
-        let instructions = a
-            .steps
-            .iter()
-            .filter(|s| matches!(s.kind, Kind::Instr(_)))
-            .count() as u64;
-        Ok(Plan {
-            period,
-            busy: end - b.wake,
-            instructions,
-            last,
-            stride,
-            ram,
-        })
+        ram.push((addr, wb, d));
     }
+    Ok(ram)
 }
 
 #[cfg(test)]
