@@ -261,3 +261,20 @@ fn addr_low_byte_comes_from_the_temporary_register() {
     m.write8(ADCR, 0xFF);
     assert_eq!(m.read8(ADCR), 0xFF);
 }
+
+/// The chip's transfer function is the one the sensor model quantises with: the same code at
+/// every transition voltage, one ulp either side of it, and across the range.
+#[test]
+fn the_chips_transfer_function_is_the_sensor_models() {
+    use emu::chip::periph::adc::{addr_register, code10};
+    let mut volts = vec![f64::NAN, -1.0, 0.0, 5.0, 6.0, f64::INFINITY];
+    for k in 0..=1024u32 {
+        let t = f64::from(k) * 5.0 / 1024.0;
+        volts.extend([t, t.next_down(), t.next_up()]);
+    }
+    volts.extend((0..20_000).map(|i| f64::from(i) * 5.5 / 20_000.0 - 0.2));
+    for v in volts {
+        assert_eq!(code10(v), adc10_code(v), "{v}");
+        assert_eq!(addr_register(code10(v)), sensors::addr_register(adc10_code(v)), "{v}");
+    }
+}

@@ -10,7 +10,7 @@ pub trait Board {
     fn analog_volts(&mut self, channel: u8, now_states: u64) -> f64;
     /// Levels of the port-2 input pins (bit n = P2.n) at `now_states`: 0 where something pulls
     /// the pin low (a pressed bumper), 1 where nothing does — such a pin reads high only with
-    /// its on-chip pull-up enabled (P2PCR), as `sensors::port2_pins` assumes.
+    /// its on-chip pull-up enabled (P2PCR), as the robot's bumpers are wired (`robot_board::wiring`).
     fn port2_pins(&mut self, now_states: u64) -> u8;
 }
 

@@ -42,13 +42,59 @@
 //! which conversions ended since, in O(1). The board is asked for the input voltage with the
 //! **sampling instant** of each conversion whose result lands in a register; a conversion
 //! whose result is overwritten before anyone could read it (a channel converted twice between
-//! two accesses in scan mode) is not sampled. Volts become codes with
-//! [`sensors::adc10_code`].
-
-use sensors::adc10_code;
+//! two accesses in scan mode) is not sampled. Volts become codes with [`code10`].
+//!
+//! # Transfer function
+//! The converter is the ideal 10-bit converter of the hardware manual's "A/D conversion
+//! accuracy definitions" figure: the code steps from `k − 1` to `k` exactly at
+//! `k · AVref / 1024`, i.e. `code10(V) = max { k ∈ 0..=1023 : V ≥ k · AVref / 1024 }`, with NaN
+//! and negative volts reading 0 and everything from `1023 · AVref / 1024` up reading 1023. The
+//! result sits left-justified in ADDRn: `ADDRn = code10 << 6` (docs/design.md §3.2).
 
 use super::Peripheral;
 use crate::pins::Board;
+
+/// AVref, the converter's full scale: 5.0 V (the AKI-H8/3052F board ties AVref to Vcc,
+/// docs/design.md §3.2).
+pub const AVREF_VOLTS: f64 = 5.0;
+/// Number of 10-bit codes, 1024.
+const CODES10: u16 = 1024;
+/// Largest 10-bit code, 1023.
+pub const CODE10_MAX: u16 = CODES10 - 1;
+/// One 10-bit step, AVref / 1024 (exact in `f64`).
+const LSB_VOLTS: f64 = AVREF_VOLTS / CODES10 as f64;
+/// Left shift of the 10-bit result in ADDRn (bits 15–6 hold the code, bits 5–0 read 0).
+const ADDR_SHIFT: u32 = 6;
+
+/// The transition voltage into code `k`: `k · AVref / 1024` (exact in `f64`; `k` above 1024
+/// taken as 1024).
+fn threshold_volts(k: u16) -> f64 {
+    f64::from(k.min(CODES10)) * LSB_VOLTS
+}
+
+/// The 10-bit conversion result of `volts` on an analog pin (see the module docs), exact at
+/// every code boundary.
+#[must_use]
+pub fn code10(volts: f64) -> u16 {
+    // NaN and everything below the first transition read 0.
+    if volts.is_nan() || volts < LSB_VOLTS {
+        return 0;
+    }
+    if volts >= threshold_volts(CODE10_MAX) {
+        return CODE10_MAX;
+    }
+    // The step is exact in f64 and division is correctly rounded, so the quotient is never
+    // below the true code k and at most rounds up onto k + 1; the exact threshold check then
+    // steps back once.
+    let k = (volts / LSB_VOLTS) as u16; // in 1..=1023 here
+    if volts < threshold_volts(k) { k - 1 } else { k }
+}
+
+/// The 16-bit contents of ADDRn for a 10-bit result (bits above 10 ignored).
+#[must_use]
+pub fn addr_register(code10: u16) -> u16 {
+    (code10 & CODE10_MAX) << ADDR_SHIFT
+}
 
 /// Address of ADDRA (high byte; low byte at +1) (docs/design.md §3.2: H'FFFFE0).
 pub const ADDRA: u32 = 0xFF_FFE0;
@@ -291,8 +337,8 @@ impl Adc {
         for k in from..completed {
             let ch = run.channel(k);
             let t_sample = run.end(k) - run.timing.sample_to_end;
-            let code = adc10_code(volts(ch, t_sample));
-            self.data[usize::from(ch & 3)] = sensors::addr_register(code);
+            let code = code10(volts(ch, t_sample));
+            self.data[usize::from(ch & 3)] = addr_register(code);
         }
         self.conversions += completed - run.done;
         if run.round_end_from(run.done) < completed {
