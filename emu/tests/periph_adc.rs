@@ -275,6 +275,10 @@ fn the_chips_transfer_function_is_the_sensor_models() {
     volts.extend((0..20_000).map(|i| f64::from(i) * 5.5 / 20_000.0 - 0.2));
     for v in volts {
         assert_eq!(code10(v), adc10_code(v), "{v}");
-        assert_eq!(addr_register(code10(v)), sensors::addr_register(adc10_code(v)), "{v}");
+        assert_eq!(
+            addr_register(code10(v)),
+            sensors::addr_register(adc10_code(v)),
+            "{v}"
+        );
     }
 }

@@ -155,7 +155,7 @@ pub struct Mcu<B: Board> {
     now: u64,
     clock_hz: u32,
     rom: Option<Box<[u8; ROM_BYTES as usize]>>,
-    /// The flash's [`Bus::code_generation`] token: a fresh one at every write to the flash.
+    /// The flash's [`FastPathHints::code_generation`] token: a fresh one at every write to the flash.
     rom_generation: u64,
     ram: Option<Box<[u8; RAM_BYTES as usize]>>,
     sci: Sci,
@@ -1031,7 +1031,7 @@ impl<B: Board> FastPathHints for Mcu<B> {
         Some(out)
     }
 
-    /// The ITU's registers: the only ones [`Bus::idle_signature`] covers.
+    /// The ITU's registers: the only ones [`FastPathHints::idle_signature`] covers.
     fn idle_io(&self, addr: u32) -> bool {
         Module::of(addr & ADDRESS_MASK) == Module::Itu
     }

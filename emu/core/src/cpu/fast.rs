@@ -6,7 +6,7 @@
 //! the same helpers (flags, operands, memory accesses), in the same order. The only change is
 //! how fetches are charged: the instruction's own words as one [`Bus::internal`] lump before
 //! it runs (in `Cpu::step`), and the prefetch at a branch target as [`Bus::internal`] of that
-//! area's word states. Both are what the bus promised with [`Bus::code_generation`]: a fetch
+//! area's word states. Both are what the bus promised with [`crate::bus::FastPathHints::code_generation`]: a fetch
 //! from ROM or RAM has no effect but the clock. Forms without a handler here are
 //! [`Op::Generic`] and run on the reference executor.
 
