@@ -22,7 +22,8 @@
 //!   traction) the current that holds the slipping wheel's friction torque.
 
 use emu::board::wiring::Bridge;
-use emu::chip::mcu::{Board, Mcu};
+use emu::chip::mcu::Mcu;
+use emu::chip::pins::Board;
 use emu::core::bus::Bus;
 use serde::Serialize;
 use world::dc_motor::DcMotor;

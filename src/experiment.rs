@@ -1258,7 +1258,7 @@ mod tests {
     /// them; before, the pins read released whatever the world did).
     #[test]
     fn the_board_shows_the_world_s_bumpers_on_port_2() {
-        use emu::chip::mcu::Board;
+        use emu::chip::pins::Board;
         let mut s = Scenario::arena();
         s.robots = 10;
         s.steps = 300;

@@ -35,7 +35,8 @@ use emu::board::firmware::{
 };
 use emu::board::model::{Controller, ControllerConfig, ControllerError, PhaseStates};
 use emu::board::profile::{PhaseDef, Profiler, UnknownFunction};
-use emu::chip::mcu::{Board, Mcu, McuConfig, McuError};
+use emu::chip::mcu::{Mcu, McuConfig, McuError};
+use emu::chip::pins::Board;
 use emu::core::bus::Bus;
 use emu::core::cpu::{Cpu, CpuError, Event, StackFault, StackGuard};
 use emu::core::memmap::{RAM_BYTES, ROM_BYTES};

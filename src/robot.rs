@@ -15,7 +15,8 @@ use emu::board::firmware::{
 use emu::board::model::{Controller, ControllerConfig};
 use emu::board::wiring::{Bridge, MotorDrive};
 use emu::chip::gdb::Debugger;
-use emu::chip::mcu::{Board, Mcu, McuConfig};
+use emu::chip::mcu::{Mcu, McuConfig};
+use emu::chip::pins::Board;
 use emu::chip::trace::CodeNames;
 use emu::chip::vcd::{VcdInfo, VcdStream};
 use emu::core::bus::Bus;

@@ -929,7 +929,8 @@ fn rsp_reply(s: &mut std::net::TcpStream) -> Option<String> {
 fn raw_gdb_sessions_get_protocol_answers_and_never_hang_the_stub() {
     use emu::board::firmware::Firmware;
     use emu::chip::gdb::GdbListener;
-    use emu::chip::mcu::{Mcu, McuConfig, NullBoard};
+    use emu::chip::mcu::{Mcu, McuConfig};
+    use emu::chip::pins::NullBoard;
     use emu::chip::run::{Probes, RunOptions, run_mcu_probed};
     use std::io::Write;
     let fw = Firmware::robot().unwrap();

@@ -13,14 +13,15 @@ use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use emu::board::model::{Controller, ControllerConfig};
-use emu::chip::mcu::{Board, Mcu, McuConfig};
+use emu::chip::mcu::{DEFAULT_CLOCK_HZ, Mcu, McuConfig};
+use emu::chip::pins::Board;
 use emu::core::bus::Bus;
 
 struct Wave;
 
 impl Board for Wave {
     fn analog_volts(&mut self, channel: u8, now: u64) -> f64 {
-        let t = now as f64 / 25e6;
+        let t = now as f64 / f64::from(DEFAULT_CLOCK_HZ);
         1.4 + 1.1 * (t * (0.7 + 0.3 * f64::from(channel))).sin()
     }
     fn port2_pins(&mut self, _now: u64) -> u8 {

@@ -6,12 +6,13 @@
 //! including the bus cycle's clock advance and the peripheral's lazy catch-up).
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use emu::chip::mcu::{Mcu, McuConfig, NullBoard};
+use emu::chip::mcu::{Mcu, McuConfig};
 use emu::chip::periph::adc::{ADCSR, ADCSR_ADST, ADCSR_SCAN, ADDRA};
 use emu::chip::periph::itu::{
     CHANNEL_BASE, IMFA, OFF_GRA, OFF_GRB, OFF_TCNT, OFF_TCR, OFF_TIER, OFF_TSR, TMDR, TSTR,
 };
 use emu::chip::periph::ports::{P2DR, P2PCR, P4DDR, P4PCR};
+use emu::chip::pins::NullBoard;
 use emu::core::bus::Bus;
 use std::hint::black_box;
 

@@ -14,7 +14,8 @@
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use emu::board::firmware::{ConfigBlock, Firmware, FirmwareController};
 use emu::chip::machine::Machine;
-use emu::chip::mcu::{Mcu, McuConfig, NullBoard};
+use emu::chip::mcu::{Mcu, McuConfig};
+use emu::chip::pins::NullBoard;
 use emu::core::bus::Bus;
 use emu::core::cpu::{Cpu, StackGuard, StackGuardMode, StackRoom};
 use emu::core::srec;

@@ -1,5 +1,7 @@
-//! The emulated H8/3052F and the robot board around it, in three layers; each knows only the
-//! layers below it.
+//! The emulated H8/3052F and the robot board around it, in three layers, each a crate of its
+//! own that knows only the layers below it (Cargo enforces the direction: `h8300h` depends on
+//! neither of the others, `h8_3052f` on `h8300h`, `robot_board` on both). This crate re-exports
+//! them under one name and holds the tests and benchmarks that run across the layers.
 //!
 //! 1. [`core`] — the H8/300H core: [`core::memmap`] (the memory map and the access states of
 //!    each area, docs/design.md §4.1), [`core::bus`] (the clocked [`core::bus::Bus`] every program talks
@@ -8,7 +10,7 @@
 //!    S-record loader for `.mot` images). It knows no chip.
 //! 2. [`chip`] — the H8/3052F: [`chip::periph`] (A/D, ITU, ports, interrupt controller, SCI1,
 //!    each synchronised lazily to the clock), [`chip::mcu`] (the chip as one bus: memories,
-//!    peripherals, the EEPROM bus on port 4, the [`chip::mcu::Board`] outside it),
+//!    peripherals, the EEPROM bus on port 4, the [`chip::pins::Board`] outside it),
 //!    [`chip::machine`] (the MCU with nothing connected, for `h8swarm emu`), [`chip::run`]
 //!    (running an image to its halt, with console, trace and statistics) and [`chip::power`]
 //!    (what the chip draws from its supply, by state). It knows the core and no robot.
@@ -67,6 +69,6 @@
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 
-pub mod board;
-pub mod chip;
-pub mod core;
+pub use h8_3052f as chip;
+pub use h8300h as core;
+pub use robot_board as board;

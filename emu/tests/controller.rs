@@ -2,8 +2,9 @@
 //! docs/design.md §4.2, saves and their restore, a power cut in the middle of a save, determinism.
 
 use emu::board::model::{Controller, ControllerConfig, ModelBus, StepReport};
-use emu::chip::mcu::{Board, Mcu, McuConfig};
-use emu::core::bus::Bus;
+use emu::chip::mcu::{DEFAULT_CLOCK_HZ, Mcu, McuConfig};
+use emu::chip::pins::Board;
+use emu::core::bus::{Bus, FastPathHints};
 use nn_q15::Q15;
 
 /// A board whose four sensors read voltages that change with time (so the learner sees
@@ -12,7 +13,7 @@ struct Wave;
 
 impl Board for Wave {
     fn analog_volts(&mut self, channel: u8, now: u64) -> f64 {
-        let t = now as f64 / 25e6;
+        let t = now as f64 / f64::from(DEFAULT_CLOCK_HZ);
         1.4 + 1.1 * (t * (0.7 + 0.3 * f64::from(channel))).sin()
     }
     fn port2_pins(&mut self, _now: u64) -> u8 {
@@ -23,7 +24,7 @@ impl Board for Wave {
 fn mcu(seed: u64) -> Mcu<Wave> {
     Mcu::new(
         McuConfig {
-            clock_hz: 25_000_000,
+            clock_hz: DEFAULT_CLOCK_HZ,
             eeprom_seed: seed,
         },
         Wave,
@@ -196,6 +197,7 @@ impl Bus for CutAt<'_> {
 }
 
 /// No emulation shortcuts through the wrapper: the model runs it register by register.
+impl FastPathHints for CutAt<'_> {}
 impl ModelBus for CutAt<'_> {}
 
 #[test]
@@ -247,7 +249,8 @@ fn a_power_cut_in_the_middle_of_a_save_leaves_the_last_committed_weights() {
             assert!(bus.cut, "the cut happened at {frac}");
         }
         let now = m.now();
-        m.power_on(now + 25_000_000).expect("power on");
+        m.power_on(now + u64::from(DEFAULT_CLOCK_HZ))
+            .expect("power on");
         let mut rebooted = Controller::new(ControllerConfig::arena(12)).expect("valid");
         let boot = rebooted.boot(&mut m).expect("boots");
         assert_eq!(boot.restored, Some(0), "cut at {frac} of the save");
@@ -407,7 +410,7 @@ fn rewired_sensors_read_the_same() {
     for channels in [[3, 2, 1, 0], [4, 5, 6, 7], [6, 4, 7, 5]] {
         let mut m = Mcu::new(
             McuConfig {
-                clock_hz: 25_000_000,
+                clock_hz: DEFAULT_CLOCK_HZ,
                 eeprom_seed: 2,
             },
             Rewired { channels },

@@ -15,8 +15,9 @@
 
 use emu::board::firmware::{ConfigBlock, Firmware};
 use emu::chip::machine::Machine;
-use emu::chip::mcu::{Board, Mcu, McuConfig, NullBoard};
-use emu::core::bus::Bus;
+use emu::chip::mcu::{Mcu, McuConfig};
+use emu::chip::pins::{Board, NullBoard};
+use emu::core::bus::{Bus, FastPathHints};
 use emu::core::cpu::decode::{Decoded, Instr, decode_bytes};
 use emu::core::cpu::disasm::format_instr;
 use emu::core::cpu::{Cpu, CpuError, Event};
@@ -38,7 +39,7 @@ enum Access {
 }
 
 /// A bus in front of another that logs [`Access`]es and passes the inner bus's promise
-/// ([`Bus::code_generation`]) on: it adds no effect to ROM or RAM reads.
+/// ([`FastPathHints::code_generation`]) on: it adds no effect to ROM or RAM reads.
 struct Logged<'a, M: Bus> {
     bus: &'a mut M,
     log: Vec<Access>,
@@ -85,6 +86,9 @@ impl<M: Bus> Bus for Logged<'_, M> {
         self.log.push(Access::Sleep(deadline, r, self.bus.now()));
         r
     }
+}
+
+impl<M: FastPathHints> FastPathHints for Logged<'_, M> {
     fn code_generation(&self) -> Option<u64> {
         self.bus.code_generation()
     }
@@ -987,7 +991,7 @@ fn halting_code(bytes: &[u8]) -> Vec<u8> {
     v
 }
 
-fn run_to_halt<M: Bus>(cpu: &mut Cpu, m: &mut M) -> ([u32; 8], u64) {
+fn run_to_halt<M: FastPathHints>(cpu: &mut Cpu, m: &mut M) -> ([u32; 8], u64) {
     cpu.set_pc(0x1000);
     cpu.set_ccr(0x80);
     for _ in 0..100 {
@@ -1076,6 +1080,8 @@ fn loading_an_image_empties_the_decode_caches_and_each_mcu_has_its_own_token() {
 /// A bus that shows no token: the CPU fetches every word through it (as a probe needs), on
 /// `step` as on `step_reference`.
 struct NoPromise<'a>(&'a mut Machine, u64);
+
+impl FastPathHints for NoPromise<'_> {}
 
 impl Bus for NoPromise<'_> {
     fn now(&self) -> u64 {

@@ -6,7 +6,8 @@ use emu::board::firmware::{
     CONFIG_BLOCK_ADDR, ConfigBlock, ConfigStatus, FLAG_RANDOM_WALK, Firmware, run_until,
 };
 use emu::board::wiring::{Bridge, motor_pins};
-use emu::chip::mcu::{Board, Mcu, McuConfig, NullBoard};
+use emu::chip::mcu::{DEFAULT_CLOCK_HZ, Mcu, McuConfig};
+use emu::chip::pins::{Board, NullBoard};
 use emu::core::bus::Bus;
 use emu::core::cpu::Cpu;
 
@@ -232,7 +233,7 @@ fn records_are_eeprom_persist_records_and_survive_a_power_cut() {
     // After step 20 the weights were saved; four more steps have changed them since (maybe).
     // Cut the power, power on, reboot: the firmware restores record 3.
     mcu.power_cut().unwrap();
-    let t = mcu.now() + 25_000_000;
+    let t = mcu.now() + u64::from(DEFAULT_CLOCK_HZ);
     mcu.power_on(t).unwrap();
     cpu.reset(&mut mcu);
     run_until(&mut cpu, &mut mcu, t + 2 * TICK_STATES).unwrap();

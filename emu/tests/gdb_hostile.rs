@@ -11,7 +11,8 @@ use std::time::Duration;
 
 use emu::board::firmware::Firmware;
 use emu::chip::gdb::{GdbListener, MAX_PACKET_BYTES};
-use emu::chip::mcu::{Mcu, McuConfig, NullBoard};
+use emu::chip::mcu::{Mcu, McuConfig};
+use emu::chip::pins::NullBoard;
 use emu::chip::run::{Outcome, Probes, RunOptions, RunReport, run_mcu_probed};
 use emu::core::cpu::Cpu;
 

@@ -9,7 +9,8 @@ use std::thread::JoinHandle;
 
 use emu::board::firmware::Firmware;
 use emu::chip::gdb::GdbListener;
-use emu::chip::mcu::{Mcu, McuConfig, NullBoard};
+use emu::chip::mcu::{Mcu, McuConfig};
+use emu::chip::pins::NullBoard;
 use emu::chip::run::{Outcome, Probes, RunOptions, RunReport, run_mcu_probed};
 use emu::core::bus::Bus;
 use emu::core::cpu::Cpu;

@@ -1,8 +1,9 @@
-//! One source of state counts (issue 10 item 6): every instruction form of `nn_q15`'s cost
+//! One source of state counts: every instruction form of `nn_q15`'s cost
 //! table ([`nn_q15::cost::Insn`]) is run on the H8/300H core from on-chip flash with on-chip RAM
 //! operands, and the states the core counts must be the table's.
 
-use emu::chip::mcu::{Mcu, McuConfig, NullBoard};
+use emu::chip::mcu::{Mcu, McuConfig};
+use emu::chip::pins::NullBoard;
 use emu::core::bus::Bus;
 use emu::core::cpu::Cpu;
 use nn_q15::cost::Insn;

@@ -2,13 +2,14 @@
 //! that state, the input sampled at the sampling instant (a board whose voltage changes with
 //! time), scan order and repetition, ADI, the ADF clearing rule and the ADDR byte order.
 
-use emu::chip::mcu::{Board, Mcu, McuConfig};
+use emu::chip::mcu::{Mcu, McuConfig};
 use emu::chip::periph::adc::{
     ADCR, ADCSR, ADCSR_ADF, ADCSR_ADIE, ADCSR_ADST, ADCSR_CKS, ADCSR_SCAN, ADDRA, ADDRB, ADDRC,
     ADDRD, CONV_STATES_CKS0, CONV_STATES_CKS1, SAMPLE_OFFSET_CKS0, SAMPLE_OFFSET_CKS1,
     SCAN_CONV_STATES_CKS0, VECTOR_ADI,
 };
 use emu::chip::periph::intc::{IPRA, IPRA_ITU0, IPRB, IPRB_AD};
+use emu::chip::pins::Board;
 use emu::core::bus::Bus;
 use emu::core::memmap::IO_ACCESS_STATES;
 use sensors::adc10_code;
@@ -259,4 +260,25 @@ fn addr_low_byte_comes_from_the_temporary_register() {
     assert_eq!(m.read8(ADCR), 0x7F);
     m.write8(ADCR, 0xFF);
     assert_eq!(m.read8(ADCR), 0xFF);
+}
+
+/// The chip's transfer function is the one the sensor model quantises with: the same code at
+/// every transition voltage, one ulp either side of it, and across the range.
+#[test]
+fn the_chips_transfer_function_is_the_sensor_models() {
+    use emu::chip::periph::adc::{addr_register, code10};
+    let mut volts = vec![f64::NAN, -1.0, 0.0, 5.0, 6.0, f64::INFINITY];
+    for k in 0..=1024u32 {
+        let t = f64::from(k) * 5.0 / 1024.0;
+        volts.extend([t, t.next_down(), t.next_up()]);
+    }
+    volts.extend((0..20_000).map(|i| f64::from(i) * 5.5 / 20_000.0 - 0.2));
+    for v in volts {
+        assert_eq!(code10(v), adc10_code(v), "{v}");
+        assert_eq!(
+            addr_register(code10(v)),
+            sensors::addr_register(adc10_code(v)),
+            "{v}"
+        );
+    }
 }

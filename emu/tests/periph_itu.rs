@@ -3,12 +3,13 @@
 //! state-by-state reference model.
 
 use emu::board::wiring::{Bridge, ITU_MOTOR_LEFT, ITU_MOTOR_RIGHT, motor_pins};
-use emu::chip::mcu::{Mcu, McuConfig, NullBoard};
+use emu::chip::mcu::{Mcu, McuConfig};
 use emu::chip::periph::itu::{
     self, CHANNEL_BASE, IMFA, IMFB, Itu, OFF_GRA, OFF_GRB, OFF_TCNT, OFF_TCR, OFF_TIER, OFF_TIOR,
     OFF_TSR, OVF, TMDR, TSTR,
 };
 use emu::chip::periph::ports::{PBDDR, PBDR};
+use emu::chip::pins::NullBoard;
 use emu::core::bus::Bus;
 use proptest::prelude::*;
 

@@ -3,11 +3,12 @@
 //! byte acknowledged by a 24LC256).
 
 use emu::board::wiring::{P2_BUMPER_FRONT, P2_BUMPER_LEFT, P2_BUMPERS};
-use emu::chip::mcu::{Board, Mcu, McuConfig, NullBoard};
+use emu::chip::mcu::{Mcu, McuConfig};
 use emu::chip::periph::ports::{
     DDR_READ_VALUE, P2DDR, P2DR, P2PCR, P4_SCL, P4_SDA, P4DDR, P4DR, P4PCR, PADDR, PADR, PBDDR,
     PBDR,
 };
+use emu::chip::pins::{Board, NullBoard};
 use emu::core::bus::Bus;
 use sensors::{Bumper, BumperSet, port2_pins};
 

@@ -5,8 +5,9 @@
 use std::sync::Arc;
 
 use emu::board::firmware::{ConfigBlock, FLAG_RANDOM_WALK, Firmware, FirmwareController};
-use emu::chip::mcu::{Mcu, McuConfig, NullBoard};
+use emu::chip::mcu::{Mcu, McuConfig};
 use emu::chip::periph::itu::PwmWave;
+use emu::chip::pins::NullBoard;
 use emu::chip::run::{Probes, RunOptions, run_mcu_probed};
 use emu::chip::trace::{PhaseRecorder, PinTrace, Signal};
 use emu::chip::vcd::{VcdInfo, write_vcd};

@@ -496,7 +496,8 @@ fn the_differential_programs_run_under_the_guard_untouched() {
 #[test]
 fn the_robot_firmware_s_room_takes_in_its_boot_sized_arrays_and_is_never_left() {
     use emu::board::firmware::{ConfigBlock, Firmware, FirmwareController, peek_be};
-    use emu::chip::mcu::{Mcu, McuConfig, NullBoard};
+    use emu::chip::mcu::{Mcu, McuConfig};
+    use emu::chip::pins::NullBoard;
     let fw = Firmware::robot().unwrap();
     let mut mcu = Mcu::new(McuConfig::default(), NullBoard).unwrap();
     let mut c = FirmwareController::start(&fw, &mut mcu, Some(&ConfigBlock::ARENA)).unwrap();

@@ -1,0 +1,18 @@
+//! The robot board around the chip: [`wiring`] (which robot part sits on which pin, and what
+//! the motor pins mean to the H-bridges), [`ram`] (the on-chip RAM as a budget of placed
+//! items), the robot's firmware ([`firmware`]: images, their [`symbols`], the configuration
+//! block; [`profile`]: states per function from the symbol table; [`oncore`]: the firmware's
+//! learner routines called by symbol), and [`model`], the Rust model of the controller the
+//! robot runs, checked against the firmware.
+//!
+//! The board knows the chip and the core; neither knows it.
+#![forbid(unsafe_code)]
+#![deny(missing_docs)]
+
+pub mod firmware;
+pub mod model;
+pub mod oncore;
+pub mod profile;
+pub mod ram;
+pub mod symbols;
+pub mod wiring;

@@ -1,0 +1,149 @@
+//! The system `h8swarm emu` runs machine code on: the same [`Mcu`] as the robot's controller
+//! (flash, RAM, SCI1 as console, ITU, A/D, ports, interrupt controller, the EEPROMs on port
+//! 4), with a [`NullBoard`] outside it (all analog inputs at 0 V, port-2 pins released).
+//!
+//! [`Machine`] is a thin wrapper that keeps the constructors the core's tests and the runner
+//! use; it dereferences to [`Mcu<NullBoard>`] for everything else.
+
+use std::ops::{Deref, DerefMut};
+
+pub use crate::mcu::LoadError;
+use crate::mcu::{Mcu, McuConfig};
+use crate::pins::NullBoard;
+use h8300h::bus::{Bus, FastPathHints};
+use h8300h::srec::SrecImage;
+
+/// The MCU with nothing connected outside it, at φ = 25 MHz.
+#[derive(Clone, Debug)]
+pub struct Machine(Mcu<NullBoard>);
+
+impl Default for Machine {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Machine {
+    /// A machine with erased flash (H'FF), zeroed RAM, peripherals after reset and the clock
+    /// at 0 (memory is allocated on first use, see [`crate::mcu`]).
+    #[must_use]
+    pub fn new() -> Self {
+        match Mcu::new(McuConfig::default(), NullBoard) {
+            Ok(m) => Machine(m),
+            // The default configuration is valid: φ = 25 MHz and the robot's two chips.
+            Err(e) => unreachable!("default MCU configuration rejected: {e}"),
+        }
+    }
+
+    /// A machine whose flash holds `image`.
+    ///
+    /// # Errors
+    /// [`LoadError`] if the image has data outside the flash or none at all.
+    pub fn with_image(image: &SrecImage) -> Result<Self, LoadError> {
+        let mut m = Self::new();
+        m.load(image)?;
+        Ok(m)
+    }
+
+    /// Programs `image` into the flash (nothing is written if any chunk lies outside it).
+    ///
+    /// # Errors
+    /// [`LoadError`] if the image has data outside the flash or none at all.
+    pub fn load(&mut self, image: &SrecImage) -> Result<(), LoadError> {
+        self.0.load_image(image)
+    }
+
+    /// The MCU inside.
+    #[must_use]
+    pub fn mcu(&self) -> &Mcu<NullBoard> {
+        &self.0
+    }
+
+    /// The MCU inside, mutably.
+    pub fn mcu_mut(&mut self) -> &mut Mcu<NullBoard> {
+        &mut self.0
+    }
+
+    /// The MCU inside, by value.
+    #[must_use]
+    pub fn into_mcu(self) -> Mcu<NullBoard> {
+        self.0
+    }
+}
+
+impl Deref for Machine {
+    type Target = Mcu<NullBoard>;
+
+    fn deref(&self) -> &Self::Target {
+        &self.0
+    }
+}
+
+impl DerefMut for Machine {
+    fn deref_mut(&mut self) -> &mut Self::Target {
+        &mut self.0
+    }
+}
+
+impl Bus for Machine {
+    #[inline]
+    fn now(&self) -> u64 {
+        self.0.now()
+    }
+
+    #[inline]
+    fn read8(&mut self, addr: u32) -> u8 {
+        self.0.read8(addr)
+    }
+
+    #[inline]
+    fn read16(&mut self, addr: u32) -> u16 {
+        self.0.read16(addr)
+    }
+
+    #[inline]
+    fn write8(&mut self, addr: u32, value: u8) {
+        self.0.write8(addr, value);
+    }
+
+    #[inline]
+    fn write16(&mut self, addr: u32, value: u16) {
+        self.0.write16(addr, value);
+    }
+
+    #[inline]
+    fn internal(&mut self, states: u32) {
+        self.0.internal(states);
+    }
+
+    #[inline]
+    fn pending_irq(&self) -> Option<u8> {
+        self.0.pending_irq()
+    }
+
+    fn sleep_until_irq(&mut self, deadline: u64) -> bool {
+        self.0.sleep_until_irq(deadline)
+    }
+
+    #[inline]
+    fn cpu_signal(&mut self, signal: h8300h::bus::CpuSignal) {
+        self.0.cpu_signal(signal);
+    }
+}
+
+impl FastPathHints for Machine {
+    #[inline]
+    fn code_generation(&self) -> Option<u64> {
+        self.0.code_generation()
+    }
+
+    #[inline]
+    fn irq_stable_until(&self) -> u64 {
+        self.0.irq_stable_until()
+    }
+
+    #[inline]
+    fn reads_stable_until(&self, addr: u32) -> Option<u64> {
+        self.0.reads_stable_until(addr)
+    }
+}

@@ -1,0 +1,1142 @@
+//! The H8/3052F as one chip: clock, flash, RAM, the peripherals and the robot's I²C EEPROMs on
+//! port 4, behind the [`Bus`] every program (the Rust controller or machine code on the
+//! H8/300H core) talks through.
+//!
+//! # Memory
+//! A swarm holds thousands of MCUs and the Rust controller never touches ROM or RAM contents,
+//! so memory is allocated only when used:
+//! - the 512 KB flash exists only once an image is loaded ([`Mcu::load_image`]) or poked;
+//!   reads of an empty flash return H'FF (erased flash);
+//! - the 8 KB RAM is allocated on the first write (bus or [`Mcu::poke`]); reads of untouched
+//!   RAM return 0.
+//!
+//! An `Mcu` without image and RAM holds a few hundred bytes plus its two EEPROM chips.
+//!
+//! # Peripherals and time
+//! The clock counts states since reset; every bus access advances it by the states of the
+//! area it touches ([`h8300h::memmap`]) before it takes effect. Word accesses to the ITU's
+//! 16-bit registers take one 3-state cycle ([`itu::ITU_WORD_ACCESS_STATES`]); other I/O word
+//! accesses take two byte cycles, upper byte first.
+//!
+//! Every on-chip module is a [`Peripheral`] that owns one block of I/O addresses: the ITU,
+//! SCI1, the ports, the A/D converter and the interrupt controller (with SYSCR). An I/O
+//! access goes to the module whose block holds the address; the chip asks
+//! every module the same questions for the next event, the interrupt requests and reset.
+//! Modules are synchronised lazily: each keeps the time it was last brought up to date and
+//! catches up, in O(1), when accessed, when the clock is fast-forwarded
+//! ([`Bus::sleep_until_irq`], [`Mcu::advance_to`]) or on [`Mcu::sync`]. The pending interrupt
+//! is cached until the next write to a module that can change it
+//! ([`Peripheral::AFFECTS_IRQ`]), or the next instant a source can raise a request, so
+//! [`Bus::pending_irq`], called by the core before every instruction, is one comparison in
+//! the common case.
+//!
+//! The board (the robot outside the chip, [`Board`]) is asked for analog inputs with each
+//! conversion's sampling instant — at the latest when the MCU is next synchronised (an A/D
+//! access, the end of a sleep, [`Mcu::sync`], [`Mcu::advance_to`]) — and for the port-2 pins
+//! at each P2DR read. A board must answer for any instant not earlier than one it was already
+//! asked about and not later than the MCU clock.
+//!
+//! # I²C on port 4
+//! The chip model carries the robot's EEPROM bus (two 24LC256 at 0x50 and 0x51, docs/design.md §3.6) on
+//! P4.7 (SDA) and P4.6 (SCL), as the ports module describes ([`crate::periph::ports`]),
+//! so that the chips' own events (the end of a write cycle) are synchronised with the chip's
+//! clock; they are applied lazily by the bus.
+//!
+//! # Other registers
+//! Registers of modules not modelled (DMAC, watchdog, SCI0, TPC, ports 1, 3, 5, 6, 7, 8, 9,
+//! the bus controller, the IRQ registers) read 0 and ignore writes.
+
+use std::cell::Cell;
+
+use eeprom::{DeviceConfig, EepromError, I2cBus, PowerCutOutcome};
+
+use crate::periph::Peripheral;
+use crate::periph::adc::{ADCR, ADDRA, Adc};
+use crate::periph::intc::Intc;
+use crate::periph::itu::{self, Itu, PwmWave};
+use crate::periph::ports::{PortPins, Ports};
+use crate::periph::sci::Sci;
+use crate::pins::Board;
+use crate::trace::{Accepted, ChipView, PinTrace, Tracer};
+use h8300h::bus::{Bus, CpuSignal, FastPathHints, fresh_code_generation};
+use h8300h::memmap::{
+    ADDRESS_MASK, Area, IO_ACCESS_STATES, RAM_BYTES, RAM_START, ROM_BYTES, ROM_END,
+};
+use h8300h::srec::SrecImage;
+
+/// Lowest φ accepted: 2 MHz (H8/3052F hardware manual, electrical characteristics: operating
+/// frequency 2–25 MHz).
+pub const MIN_CLOCK_HZ: u32 = 2_000_000;
+/// Highest φ accepted: 25 MHz (same table; also the top of the EEPROM model's clock range).
+pub const MAX_CLOCK_HZ: u32 = 25_000_000;
+/// The clock φ of the AKI-H8/3052F board, the chip's highest: 25 MHz, 1 state = 40 ns
+/// (docs/design.md §4.1). The one definition of the robot's clock; everything else that
+/// needs it refers here.
+pub const DEFAULT_CLOCK_HZ: u32 = MAX_CLOCK_HZ;
+
+/// Index masks of the flash and RAM arrays (both sizes are powers of two).
+const ROM_INDEX_MASK: usize = ROM_BYTES as usize - 1;
+const RAM_INDEX_MASK: usize = RAM_BYTES as usize - 1;
+
+/// How to build an [`Mcu`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct McuConfig {
+    /// The system clock φ in Hz ([`MIN_CLOCK_HZ`]..=[`MAX_CLOCK_HZ`]; default 25 MHz). The MCU
+    /// counts states; φ converts them to seconds and sets the EEPROMs' timing.
+    pub clock_hz: u32,
+    /// Seed of the two EEPROMs' random streams (write-cycle times, power-cut corruption,
+    /// wear).
+    pub eeprom_seed: u64,
+}
+
+impl Default for McuConfig {
+    fn default() -> Self {
+        McuConfig {
+            clock_hz: DEFAULT_CLOCK_HZ,
+            eeprom_seed: 0,
+        }
+    }
+}
+
+/// Why an MCU cannot be built or its EEPROMs cannot be switched.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum McuError {
+    /// φ outside what the chip runs at.
+    #[error(
+        "clock φ = {clock_hz} Hz is outside the H8/3052F's operating range {min}..={max} Hz",
+        min = MIN_CLOCK_HZ,
+        max = MAX_CLOCK_HZ
+    )]
+    InvalidClock {
+        /// The rejected value.
+        clock_hz: u32,
+    },
+    /// The EEPROM bus refused an operation.
+    #[error("EEPROM bus on port 4")]
+    Eeprom(#[from] EepromError),
+}
+
+/// Why an image cannot be loaded into the flash.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum LoadError {
+    /// Data outside the on-chip flash.
+    #[error(
+        "image data at H'{address:06X}..H'{end:06X} lies outside the on-chip flash H'000000-H'{rom_end:06X}; an S-record image may only load flash",
+        end = .address.wrapping_add(*.len as u32).wrapping_sub(1),
+        rom_end = ROM_END
+    )]
+    OutsideFlash {
+        /// First address of the offending chunk.
+        address: u32,
+        /// Its length in bytes.
+        len: usize,
+    },
+    /// No data at all.
+    #[error("the image holds no data records")]
+    Empty,
+}
+
+/// An ITU channel's TIOCA output at one instant ([`Mcu::tioca`]): while the ITU drives the pin
+/// it shares with port A or B, the pin reads `level`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TiocaOutput {
+    /// The ITU drives the pin (PWM mode, or an output-compare setting of IOA).
+    pub drives: bool,
+    /// The output's level now.
+    pub level: bool,
+    /// The steady waveform, while the ITU drives the pin and the channel counts in PWM mode
+    /// with an internal clock.
+    pub wave: Option<PwmWave>,
+}
+
+/// The H8/3052F with its board and the robot's EEPROM bus.
+#[derive(Clone, Debug)]
+pub struct Mcu<B: Board> {
+    now: u64,
+    clock_hz: u32,
+    rom: Option<Box<[u8; ROM_BYTES as usize]>>,
+    /// The flash's [`FastPathHints::code_generation`] token: a fresh one at every write to the flash.
+    rom_generation: u64,
+    ram: Option<Box<[u8; RAM_BYTES as usize]>>,
+    sci: Sci,
+    itu: Itu,
+    adc: Adc,
+    intc: Intc,
+    ports: Ports,
+    i2c: I2cBus,
+    board: B,
+    /// The winning interrupt request as of the last computation.
+    irq_cached: Cell<Option<u8>>,
+    /// The cached request is valid while `now` is below this.
+    irq_valid_until: Cell<u64>,
+    /// The pin trace under way, if one is ([`Mcu::start_trace`]).
+    tracer: Option<Box<Tracer>>,
+}
+
+/// The on-chip module that owns an I/O address: the chip's map of its register blocks, each
+/// block as its module declares it ([`Peripheral::FIRST`]..=[`Peripheral::LAST`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Module {
+    Itu,
+    Sci,
+    Ports,
+    Adc,
+    Intc,
+    /// No module: reads 0, writes are ignored.
+    Unmodelled,
+}
+
+impl Module {
+    /// Every module, in the order the chip synchronises and resets them.
+    const ALL: [Module; 5] = [
+        Module::Itu,
+        Module::Adc,
+        Module::Sci,
+        Module::Ports,
+        Module::Intc,
+    ];
+
+    /// The module whose block holds `a` (an I/O address).
+    #[inline]
+    fn of(a: u32) -> Module {
+        match a {
+            <Itu as Peripheral>::FIRST..=<Itu as Peripheral>::LAST => Module::Itu,
+            <Sci as Peripheral>::FIRST..=<Sci as Peripheral>::LAST => Module::Sci,
+            <Ports as Peripheral>::FIRST..=<Ports as Peripheral>::LAST => Module::Ports,
+            <Adc as Peripheral>::FIRST..=<Adc as Peripheral>::LAST => Module::Adc,
+            <Intc as Peripheral>::FIRST..=<Intc as Peripheral>::LAST => Module::Intc,
+            _ => Module::Unmodelled,
+        }
+    }
+
+    /// Whether a write to the module can change the interrupt decision.
+    #[inline]
+    const fn affects_irq(self) -> bool {
+        match self {
+            Module::Itu => <Itu as Peripheral>::AFFECTS_IRQ,
+            Module::Sci => <Sci as Peripheral>::AFFECTS_IRQ,
+            Module::Ports => <Ports as Peripheral>::AFFECTS_IRQ,
+            Module::Adc => <Adc as Peripheral>::AFFECTS_IRQ,
+            Module::Intc => <Intc as Peripheral>::AFFECTS_IRQ,
+            Module::Unmodelled => false,
+        }
+    }
+}
+
+/// Evaluates `$body` with `$p` bound to module `$m` of the MCU `$mcu` and `$outside` to what
+/// that module sees outside itself (the board's analog inputs for the A/D converter; the
+/// port-2 pins, the EEPROM bus and the ITU for the ports; nothing for the others), or `$none`
+/// for [`Module::Unmodelled`]. The one place that says which field holds which module.
+macro_rules! on_module {
+    ($mcu:ident, $m:expr, |$p:ident, $outside:ident| $body:expr, $none:expr) => {
+        match $m {
+            Module::Itu => {
+                let ($p, $outside) = (&mut $mcu.itu, ());
+                $body
+            }
+            Module::Sci => {
+                let ($p, $outside) = (&mut $mcu.sci, ());
+                $body
+            }
+            Module::Ports => {
+                let $p = &mut $mcu.ports;
+                let $outside = PortPins {
+                    board: &mut $mcu.board,
+                    i2c: &mut $mcu.i2c,
+                    itu: &mut $mcu.itu,
+                };
+                $body
+            }
+            Module::Adc => {
+                let ($p, $outside) = (&mut $mcu.adc, &mut $mcu.board);
+                $body
+            }
+            Module::Intc => {
+                let ($p, $outside) = (&mut $mcu.intc, ());
+                $body
+            }
+            Module::Unmodelled => $none,
+        }
+    };
+}
+
+/// `$body` for each module of `$mcu` in turn, with `$p` bound to it by shared reference (for
+/// the questions that need nothing outside the module), the answers combined left to right
+/// with `$combine`. Unrolled, so that the answers of modules with nothing to say fold away.
+macro_rules! fold_modules {
+    ($mcu:ident, |$p:ident| $body:expr, $combine:expr) => {{
+        let combine = $combine;
+        let all = {
+            let $p = &$mcu.itu;
+            $body
+        };
+        let all = combine(all, {
+            let $p = &$mcu.adc;
+            $body
+        });
+        let all = combine(all, {
+            let $p = &$mcu.sci;
+            $body
+        });
+        let all = combine(all, {
+            let $p = &$mcu.ports;
+            $body
+        });
+        combine(all, {
+            let $p = &$mcu.intc;
+            $body
+        })
+    }};
+}
+
+/// The earlier of two instants, if any.
+#[inline]
+fn earliest(a: Option<u64>, b: Option<u64>) -> Option<u64> {
+    match (a, b) {
+        (Some(x), Some(y)) => Some(x.min(y)),
+        (x, None) => x,
+        (None, y) => y,
+    }
+}
+
+impl<B: Board> Mcu<B> {
+    /// An MCU after reset with `board` outside it and the robot's two 24LC256 (0x50, 0x51) on
+    /// port 4, their streams seeded from `config.eeprom_seed`.
+    ///
+    /// # Errors
+    /// [`McuError::InvalidClock`] if `config.clock_hz` is outside
+    /// [`MIN_CLOCK_HZ`]..=[`MAX_CLOCK_HZ`]; [`McuError::Eeprom`] if the EEPROM model refuses.
+    pub fn new(config: McuConfig, board: B) -> Result<Self, McuError> {
+        if !(MIN_CLOCK_HZ..=MAX_CLOCK_HZ).contains(&config.clock_hz) {
+            return Err(McuError::InvalidClock {
+                clock_hz: config.clock_hz,
+            });
+        }
+        // I2cBus::robot(seed) with the chips counting in this MCU's φ.
+        let chip = DeviceConfig {
+            clock_hz: config.clock_hz,
+            ..DeviceConfig::new(eeprom::CHIP_A, config.eeprom_seed)
+        };
+        let i2c = I2cBus::with_chips(&[eeprom::CHIP_A, eeprom::CHIP_B], &chip)?;
+        Ok(Mcu {
+            now: 0,
+            clock_hz: config.clock_hz,
+            rom: None,
+            rom_generation: fresh_code_generation(),
+            ram: None,
+            sci: Sci::new(),
+            itu: Itu::new(),
+            adc: Adc::new(),
+            intc: Intc::new(),
+            ports: Ports::new(),
+            i2c,
+            board,
+            irq_cached: Cell::new(None),
+            irq_valid_until: Cell::new(0),
+            tracer: None,
+        })
+    }
+
+    /// The board outside the chip.
+    #[must_use]
+    pub fn board(&self) -> &B {
+        &self.board
+    }
+
+    /// The board, mutably (the world updates what the sensors see).
+    pub fn board_mut(&mut self) -> &mut B {
+        &mut self.board
+    }
+
+    /// The I²C bus with the two EEPROMs.
+    #[must_use]
+    pub fn i2c(&self) -> &I2cBus {
+        &self.i2c
+    }
+
+    /// The I²C bus, mutably (back-door loads and reads of the chips). Keep its time calls at
+    /// or after [`Bus::now`].
+    pub fn i2c_mut(&mut self) -> &mut I2cBus {
+        &mut self.i2c
+    }
+
+    /// φ in Hz.
+    #[must_use]
+    pub const fn clock_hz(&self) -> u32 {
+        self.clock_hz
+    }
+
+    /// SCI1 (the console).
+    #[must_use]
+    pub fn sci(&self) -> &Sci {
+        &self.sci
+    }
+
+    /// SCI1, mutably (to collect console output).
+    pub fn sci_mut(&mut self) -> &mut Sci {
+        self.invalidate_irq();
+        &mut self.sci
+    }
+
+    /// The ITU (read-only view; use the bus to program it).
+    #[must_use]
+    pub fn itu(&self) -> &Itu {
+        &self.itu
+    }
+
+    /// The A/D converter (read-only view).
+    #[must_use]
+    pub fn adc(&self) -> &Adc {
+        &self.adc
+    }
+
+    /// The interrupt controller (read-only view).
+    #[must_use]
+    pub fn intc(&self) -> &Intc {
+        &self.intc
+    }
+
+    /// Whether the flash holds an image (or poked bytes).
+    #[must_use]
+    pub fn has_flash(&self) -> bool {
+        self.rom.is_some()
+    }
+
+    /// Whether the RAM has been written since reset or the last power cut.
+    #[must_use]
+    pub fn has_ram(&self) -> bool {
+        self.ram.is_some()
+    }
+
+    /// The flash, for writing (loading an image, poking): every caller may change it, so the
+    /// CPU's decoded copies of it are out of date from here on.
+    fn rom_mut(&mut self) -> &mut [u8; ROM_BYTES as usize] {
+        self.rom_generation = fresh_code_generation();
+        self.rom.get_or_insert_with(new_erased_flash)
+    }
+
+    #[inline]
+    fn ram_mut(&mut self) -> &mut [u8; RAM_BYTES as usize] {
+        self.ram.get_or_insert_with(new_zeroed_ram)
+    }
+
+    /// Programs `image` into the flash (nothing is written if any chunk lies outside it). The
+    /// flash is allocated, erased (H'FF), on the first load.
+    ///
+    /// # Errors
+    /// [`LoadError`] if the image has data outside the flash or none at all.
+    pub fn load_image(&mut self, image: &SrecImage) -> Result<(), LoadError> {
+        if image.data_len() == 0 {
+            return Err(LoadError::Empty);
+        }
+        for c in &image.chunks {
+            let end = u64::from(c.address) + c.data.len() as u64;
+            if end > u64::from(ROM_BYTES) {
+                return Err(LoadError::OutsideFlash {
+                    address: c.address,
+                    len: c.data.len(),
+                });
+            }
+        }
+        let rom = self.rom_mut();
+        for c in &image.chunks {
+            let a = c.address as usize;
+            rom[a..a + c.data.len()].copy_from_slice(&c.data);
+        }
+        Ok(())
+    }
+
+    /// Writes bytes into flash or RAM directly (no bus cycle, no time): test set-up. Bytes at
+    /// addresses outside flash and RAM are ignored.
+    pub fn poke(&mut self, addr: u32, bytes: &[u8]) {
+        for (i, &b) in bytes.iter().enumerate() {
+            let a = addr.wrapping_add(i as u32) & ADDRESS_MASK;
+            match Area::of(a) {
+                Area::Rom => self.rom_mut()[a as usize & ROM_INDEX_MASK] = b,
+                Area::Ram => self.ram_mut()[(a - RAM_START) as usize & RAM_INDEX_MASK] = b,
+                _ => {}
+            }
+        }
+    }
+
+    /// Reads a byte of flash or RAM directly (no bus cycle, no time); other areas read H'FF.
+    #[must_use]
+    pub fn peek(&self, addr: u32) -> u8 {
+        let a = addr & ADDRESS_MASK;
+        match Area::of(a) {
+            Area::Rom => self.rom_byte(a),
+            Area::Ram => self.ram_byte(a),
+            _ => 0xff,
+        }
+    }
+
+    #[inline]
+    fn rom_byte(&self, a: u32) -> u8 {
+        match &self.rom {
+            Some(r) => r[a as usize & ROM_INDEX_MASK],
+            None => 0xff,
+        }
+    }
+
+    #[inline]
+    fn ram_byte(&self, a: u32) -> u8 {
+        match &self.ram {
+            Some(r) => r[(a.wrapping_sub(RAM_START)) as usize & RAM_INDEX_MASK],
+            None => 0,
+        }
+    }
+
+    /// Lets the clock run to `t_states` (if later) without bus cycles, then synchronises every
+    /// peripheral (the board is sampled for conversions that ended).
+    pub fn advance_to(&mut self, t_states: u64) {
+        if t_states > self.now {
+            self.now = t_states;
+        }
+        self.sync();
+    }
+
+    /// Brings every peripheral and the EEPROM bus up to the current clock.
+    pub fn sync(&mut self) {
+        let now = self.now;
+        for m in Module::ALL {
+            on_module!(
+                self,
+                m,
+                |p, outside| Peripheral::sync::<B>(p, now, outside),
+                ()
+            );
+        }
+        // Time never goes back here (max), so the bus cannot refuse.
+        let _ = self.i2c.advance_to(now.max(self.i2c.now()));
+        self.invalidate_irq();
+    }
+
+    /// The earliest state after now at which a peripheral next needs attention (an ITU compare
+    /// match or overflow, an A/D sampling instant or conversion end, an SCI frame end, an
+    /// EEPROM write cycle end), if any.
+    #[must_use]
+    pub fn next_event(&self) -> Option<u64> {
+        let now = self.now;
+        earliest(
+            fold_modules!(self, |p| Peripheral::next_event(p, now), earliest),
+            self.i2c.next_event_states().filter(|&t| t > now),
+        )
+    }
+
+    /// The earliest state after now at which an enabled interrupt request appears.
+    fn next_irq_time(&self) -> Option<u64> {
+        let now = self.now;
+        fold_modules!(self, |p| Peripheral::next_request(p, now), earliest)
+    }
+
+    /// What ITU channel `n`'s TIOCA output does now (channels out of range: neither driving nor
+    /// counting).
+    pub fn tioca(&mut self, n: usize) -> TiocaOutput {
+        let (level, drives) = self.itu.tioca(n, self.now);
+        let wave = if drives && self.itu.running(n) {
+            self.itu.pwm(n, level)
+        } else {
+            None
+        };
+        TiocaOutput {
+            drives,
+            level,
+            wave,
+        }
+    }
+
+    /// Levels of port A's pins now: TIOCA0–2 where the ITU drives them, else the output latch;
+    /// input pins read 0 (port A has no pull-ups and nothing outside drives it here).
+    pub fn port_a_pins(&mut self) -> u8 {
+        self.ports.pa_pins(&mut self.itu, self.now)
+    }
+
+    /// Levels of port B's pins now: TIOCA3/TIOCA4 where the ITU drives them, else the output
+    /// latch; input pins read 0.
+    pub fn port_b_pins(&mut self) -> u8 {
+        self.ports.pb_pins(&mut self.itu, self.now)
+    }
+
+    /// Starts a pin trace now ([`crate::trace`]): from here on every change of the traced
+    /// signals is recorded at its instant, until [`Mcu::finish_trace`]. `cpu_sleeping` says
+    /// whether the CPU is in sleep mode now (the CPU reports later changes itself through
+    /// [`Bus::cpu_signal`]). A trace already under way is discarded.
+    pub fn start_trace(&mut self, cpu_sleeping: bool) {
+        let now = self.now;
+        let tracer = Tracer::start(
+            now,
+            &self.itu,
+            &self.adc,
+            ChipView {
+                ports: &self.ports,
+                i2c: &mut self.i2c,
+            },
+            cpu_sleeping,
+        );
+        self.tracer = Some(Box::new(tracer));
+    }
+
+    /// Whether a pin trace is under way.
+    #[must_use]
+    pub fn tracing(&self) -> bool {
+        self.tracer.is_some()
+    }
+
+    /// The last interrupt accepted during the trace under way, if any.
+    #[must_use]
+    pub fn trace_last_interrupt(&self) -> Option<Accepted> {
+        self.tracer.as_ref().and_then(|t| t.last_accepted())
+    }
+
+    /// The pin trace under way: its first instant and every signal's level then.
+    #[must_use]
+    pub fn trace_beginning(&self) -> Option<(u64, [bool; 12])> {
+        self.tracer.as_ref().map(|t| t.beginning())
+    }
+
+    /// Changes of the pin trace under way recorded and not yet drained.
+    #[must_use]
+    pub fn trace_pending(&self) -> usize {
+        self.tracer.as_ref().map_or(0, |t| t.pending())
+    }
+
+    /// Hands the pin trace's changes up to now to `sink`, a slice of at most `slice` states at
+    /// a time (so a long stretch without a register write, e.g. a sleep with the PWM running,
+    /// is never held whole): for each slice, the changes before its end and that end, below
+    /// which the trace is final. The trace goes on; nothing it records changes.
+    ///
+    /// # Errors
+    /// `sink`'s.
+    pub fn drain_trace(
+        &mut self,
+        slice: u64,
+        sink: &mut dyn FnMut(Vec<crate::trace::PinChange>, u64) -> std::io::Result<()>,
+    ) -> std::io::Result<()> {
+        let now = self.now;
+        loop {
+            let Some(t) = self.tracer.as_mut() else {
+                return Ok(());
+            };
+            // A slice never ends before the EEPROM bus's own clock (its logged changes up to
+            // there are taken whole).
+            let to = t
+                .caught_up()
+                .saturating_add(slice.max(1))
+                .max(self.i2c.now())
+                .min(now);
+            t.catch_up(
+                to,
+                ChipView {
+                    ports: &self.ports,
+                    i2c: &mut self.i2c,
+                },
+            );
+            let changes = t.drain_before(to);
+            sink(changes, to)?;
+            if to >= now {
+                return Ok(());
+            }
+        }
+    }
+
+    /// Ends the pin trace now and returns it (`None` when none was under way).
+    pub fn finish_trace(&mut self) -> Option<PinTrace> {
+        let mut tracer = self.tracer.take()?;
+        let now = self.now;
+        tracer.catch_up(
+            now,
+            ChipView {
+                ports: &self.ports,
+                i2c: &mut self.i2c,
+            },
+        );
+        Some(tracer.finish(now, self.clock_hz, &mut self.i2c))
+    }
+
+    /// A CPU signal for the trace under way.
+    #[cold]
+    fn trace_cpu_signal(&mut self, signal: CpuSignal) {
+        self.trace_before_write();
+        let now = self.now;
+        if let Some(t) = self.tracer.as_mut() {
+            match signal {
+                CpuSignal::Sleep => t.set_sleeping(now, true, &self.ports),
+                CpuSignal::Wake => t.set_sleeping(now, false, &self.ports),
+                CpuSignal::Interrupt(v) => t.accepted(now, v),
+            }
+        }
+    }
+
+    /// Before a write at `now` that may change a traced level: records what happened up to it.
+    #[cold]
+    fn trace_before_write(&mut self) {
+        let now = self.now;
+        if let Some(t) = self.tracer.as_mut() {
+            t.catch_up(
+                now,
+                ChipView {
+                    ports: &self.ports,
+                    i2c: &mut self.i2c,
+                },
+            );
+        }
+    }
+
+    /// After a write at `now` to `module`: records its effect.
+    #[cold]
+    fn trace_after_write(&mut self, module: Module) {
+        let now = self.now;
+        if let Some(t) = self.tracer.as_mut() {
+            t.after_write(
+                now,
+                (module == Module::Itu).then_some(&self.itu),
+                (module == Module::Adc).then_some(&self.adc),
+                ChipView {
+                    ports: &self.ports,
+                    i2c: &mut self.i2c,
+                },
+            );
+        }
+    }
+
+    /// Cuts the robot's power now: the EEPROMs lose power (a write cycle under way is
+    /// corrupted as the `eeprom` crate models it), the RAM loses its contents and every
+    /// peripheral returns to its reset state (ports released). The flash keeps its image. The
+    /// clock keeps running. Returns each chip's outcome (0x50, then 0x51).
+    ///
+    /// # Errors
+    /// [`McuError::Eeprom`] if the bus refuses (it cannot, as time never goes back here).
+    pub fn power_cut(&mut self) -> Result<Vec<PowerCutOutcome>, McuError> {
+        let t = self.now.max(self.i2c.now());
+        let outcomes = self.i2c.power_cut(t)?;
+        self.reset_peripherals();
+        self.ram = None;
+        Ok(outcomes)
+    }
+
+    /// Powers the robot on at `at_states` (the clock jumps there if it is later): the
+    /// EEPROMs power up, the peripherals are in their reset state. The caller resets the CPU
+    /// (or restarts the controller program).
+    ///
+    /// # Errors
+    /// [`McuError::Eeprom`] if the bus refuses (it cannot, as time never goes back here).
+    pub fn power_on(&mut self, at_states: u64) -> Result<(), McuError> {
+        self.now = self.now.max(at_states);
+        let t = self.now.max(self.i2c.now());
+        self.i2c.power_on(t)?;
+        self.reset_peripherals();
+        Ok(())
+    }
+
+    fn reset_peripherals(&mut self) {
+        if self.tracer.is_some() {
+            self.trace_before_write();
+        }
+        for m in Module::ALL {
+            on_module!(self, m, |p, _outside| Peripheral::reset(p), ());
+        }
+        self.invalidate_irq();
+        if self.tracer.is_some() {
+            self.trace_after_write(Module::Itu);
+            self.trace_after_write(Module::Adc);
+        }
+    }
+
+    #[inline]
+    fn invalidate_irq(&self) {
+        self.irq_valid_until.set(0);
+    }
+
+    /// Before a write that changes the interrupt decision: forget the cached decision and
+    /// catch up the ITU channels that can request, so recomputing it is cheap.
+    #[inline]
+    fn before_irq_write(&mut self) {
+        self.invalidate_irq();
+        self.itu.sync_irq_sources(self.now);
+    }
+
+    /// Recomputes the pending interrupt and how long it stays valid.
+    #[cold]
+    fn refresh_irq(&self) -> Option<u8> {
+        let now = self.now;
+        let requests = fold_modules!(self, |p| Peripheral::requests(p, now), |a, b| a | b);
+        let winner = self.intc.choose(requests);
+        let valid_until = match self.next_irq_time() {
+            Some(t) if t > now => t,
+            Some(_) => now, // recompute at every call until something changes
+            None => u64::MAX,
+        };
+        self.irq_cached.set(winner);
+        self.irq_valid_until.set(valid_until);
+        winner
+    }
+
+    #[inline]
+    fn io_read8(&mut self, a: u32) -> u8 {
+        // Reads catch modules up but change no request (flags clear only by writes), so the
+        // cached interrupt decision stays valid.
+        let now = self.now;
+        on_module!(
+            self,
+            Module::of(a),
+            |p, outside| Peripheral::read::<B>(p, a, now, outside),
+            0
+        )
+    }
+
+    #[inline]
+    fn io_write8(&mut self, a: u32, v: u8) {
+        let now = self.now;
+        let module = Module::of(a);
+        if module.affects_irq() {
+            self.before_irq_write();
+        }
+        if self.tracer.is_some() {
+            self.trace_before_write();
+        }
+        on_module!(
+            self,
+            module,
+            |p, outside| Peripheral::write::<B>(p, a, v, now, outside),
+            ()
+        );
+        if self.tracer.is_some() {
+            self.trace_after_write(module);
+        }
+    }
+}
+
+#[cold]
+fn new_erased_flash() -> Box<[u8; ROM_BYTES as usize]> {
+    let v = vec![0xffu8; ROM_BYTES as usize].into_boxed_slice();
+    match v.try_into() {
+        Ok(b) => b,
+        // The length is ROM_BYTES by construction.
+        Err(_) => unreachable!(),
+    }
+}
+
+#[cold]
+fn new_zeroed_ram() -> Box<[u8; RAM_BYTES as usize]> {
+    Box::new([0u8; RAM_BYTES as usize])
+}
+
+impl<B: Board> Bus for Mcu<B> {
+    #[inline]
+    fn now(&self) -> u64 {
+        self.now
+    }
+
+    #[inline]
+    fn read8(&mut self, addr: u32) -> u8 {
+        let a = addr & ADDRESS_MASK;
+        let area = Area::of(a);
+        self.now += u64::from(area.byte_states());
+        match area {
+            Area::Rom => self.rom_byte(a),
+            Area::Ram => self.ram_byte(a),
+            Area::Io => self.io_read8(a),
+            Area::Unmapped => 0xff,
+        }
+    }
+
+    #[inline]
+    fn read16(&mut self, addr: u32) -> u16 {
+        let a = addr & ADDRESS_MASK & !1;
+        match Area::of(a) {
+            Area::Rom => {
+                self.now += u64::from(Area::Rom.word_states());
+                match &self.rom {
+                    Some(r) => {
+                        let i = a as usize & ROM_INDEX_MASK & !1;
+                        u16::from_be_bytes([r[i], r[i | 1]])
+                    }
+                    None => 0xffff,
+                }
+            }
+            Area::Ram => {
+                self.now += u64::from(Area::Ram.word_states());
+                match &self.ram {
+                    Some(r) => {
+                        let i = (a - RAM_START) as usize & RAM_INDEX_MASK & !1;
+                        u16::from_be_bytes([r[i], r[i | 1]])
+                    }
+                    None => 0,
+                }
+            }
+            Area::Io => {
+                if itu::is_word_register(a) {
+                    // One cycle on the ITU's 16-bit internal bus.
+                    self.now += u64::from(itu::ITU_WORD_ACCESS_STATES);
+                    let hi = self.io_read8(a);
+                    let lo = self.io_read8(a + 1);
+                    u16::from_be_bytes([hi, lo])
+                } else {
+                    // Two byte cycles on the 8-bit bus, upper byte first.
+                    self.now += u64::from(IO_ACCESS_STATES);
+                    let hi = self.io_read8(a);
+                    self.now += u64::from(IO_ACCESS_STATES);
+                    let lo = self.io_read8(a + 1);
+                    u16::from_be_bytes([hi, lo])
+                }
+            }
+            Area::Unmapped => {
+                self.now += u64::from(Area::Unmapped.word_states());
+                0xffff
+            }
+        }
+    }
+
+    #[inline]
+    fn write8(&mut self, addr: u32, value: u8) {
+        let a = addr & ADDRESS_MASK;
+        let area = Area::of(a);
+        self.now += u64::from(area.byte_states());
+        match area {
+            Area::Ram => self.ram_mut()[(a - RAM_START) as usize & RAM_INDEX_MASK] = value,
+            Area::Io => self.io_write8(a, value),
+            // Flash is not writable through the bus; nothing answers unmapped addresses.
+            Area::Rom | Area::Unmapped => {}
+        }
+    }
+
+    #[inline]
+    fn write16(&mut self, addr: u32, value: u16) {
+        let a = addr & ADDRESS_MASK & !1;
+        let [hi, lo] = value.to_be_bytes();
+        match Area::of(a) {
+            Area::Ram => {
+                self.now += u64::from(Area::Ram.word_states());
+                let i = (a - RAM_START) as usize & RAM_INDEX_MASK & !1;
+                let r = self.ram_mut();
+                r[i] = hi;
+                r[i | 1] = lo;
+            }
+            Area::Io => {
+                if itu::is_word_register(a) {
+                    self.now += u64::from(itu::ITU_WORD_ACCESS_STATES);
+                    self.before_irq_write();
+                    if self.tracer.is_some() {
+                        self.trace_before_write();
+                    }
+                    self.itu.write16(a, value, self.now);
+                    if self.tracer.is_some() {
+                        self.trace_after_write(Module::Itu);
+                    }
+                } else {
+                    self.now += u64::from(IO_ACCESS_STATES);
+                    self.io_write8(a, hi);
+                    self.now += u64::from(IO_ACCESS_STATES);
+                    self.io_write8(a + 1, lo);
+                }
+            }
+            area @ (Area::Rom | Area::Unmapped) => self.now += u64::from(area.word_states()),
+        }
+    }
+
+    #[inline]
+    fn internal(&mut self, states: u32) {
+        self.now += u64::from(states);
+    }
+
+    #[inline]
+    fn pending_irq(&self) -> Option<u8> {
+        if self.now < self.irq_valid_until.get() {
+            self.irq_cached.get()
+        } else {
+            self.refresh_irq()
+        }
+    }
+
+    /// Tells a pin trace under way (SLEEP, and the accepted interrupts); otherwise nothing.
+    #[inline]
+    fn cpu_signal(&mut self, signal: CpuSignal) {
+        if self.tracer.is_some() {
+            self.trace_cpu_signal(signal);
+        }
+    }
+
+    fn sleep_until_irq(&mut self, deadline: u64) -> bool {
+        if self.pending_irq().is_some() {
+            return true;
+        }
+        match self.next_irq_time() {
+            Some(t) if t <= deadline => {
+                self.now = self.now.max(t);
+                self.sync();
+                self.pending_irq().is_some()
+            }
+            _ => {
+                if deadline != u64::MAX {
+                    self.now = self.now.max(deadline);
+                    self.sync();
+                }
+                false
+            }
+        }
+    }
+}
+
+impl<B: Board> FastPathHints for Mcu<B> {
+    /// Fetching from flash or RAM touches no device, and the token changes at every write to
+    /// the flash ([`Mcu::load_image`], [`Mcu::poke`]).
+    #[inline]
+    fn code_generation(&self) -> Option<u64> {
+        Some(self.rom_generation)
+    }
+
+    /// The cached interrupt decision's end: the next instant a module raises a request
+    /// ([`Mcu::next_event`]'s requesting part); writes to I/O empty the cache.
+    #[inline]
+    fn irq_stable_until(&self) -> u64 {
+        if self.now >= self.irq_valid_until.get() {
+            self.refresh_irq();
+        }
+        self.irq_valid_until.get()
+    }
+
+    /// ROM and RAM change only by writes (no DMA here): for ever. The A/D converter's
+    /// registers change only at its own events (a sample, a conversion's end): until the
+    /// next. Re-reading any of these changes nothing more than the first read did (reading
+    /// ADCSR with ADF = 1 arms the flag's clearing once; reading ADDRnH latches the same low
+    /// byte). Every other register: unknown.
+    fn reads_stable_until(&self, addr: u32) -> Option<u64> {
+        let a = addr & ADDRESS_MASK;
+        match Area::of(a) {
+            Area::Rom | Area::Ram => Some(u64::MAX),
+            Area::Io if (ADDRA..=ADCR).contains(&a) => {
+                Some(self.adc.next_event(self.now).unwrap_or(u64::MAX))
+            }
+            _ => None,
+        }
+    }
+
+    /// The ITU's state relative to now ([`Itu::idle_signature`]), when every other module is
+    /// quiet: the A/D converter, SCI1 and the EEPROMs have nothing under way (no event to
+    /// come), so that without accesses their state stays as it is and they request nothing
+    /// new. `None` while a pin trace is recorded (it must see every cycle) or a module is busy.
+    fn idle_signature(&mut self) -> Option<Vec<u64>> {
+        let now = self.now;
+        if self.tracer.is_some()
+            || self.adc.next_event(now).is_some()
+            || Peripheral::next_event(&self.sci, now).is_some()
+            || Peripheral::next_event(&self.ports, now).is_some()
+            || Peripheral::next_event(&self.intc, now).is_some()
+            || self.i2c.next_event_states().is_some_and(|t| t > now)
+        {
+            return None;
+        }
+        let mut out = Vec::with_capacity(80);
+        self.itu.idle_signature(now, &mut out);
+        Some(out)
+    }
+
+    /// The ITU's registers: the only ones [`FastPathHints::idle_signature`] covers.
+    fn idle_io(&self, addr: u32) -> bool {
+        Module::of(addr & ADDRESS_MASK) == Module::Itu
+    }
+
+    /// The clock and the ITU move `states` ahead; the other modules, quiet, catch up lazily;
+    /// `ram` is stored as by [`Mcu::poke`]. Refused (nothing done) while a pin trace is
+    /// recorded or when an address of `ram` is not in RAM.
+    fn idle_shift(&mut self, states: u64, ram: &[(u32, u32)]) -> bool {
+        if self.tracer.is_some()
+            || ram
+                .iter()
+                .any(|&(a, _)| (0..4).any(|i| Area::of((a + i) & ADDRESS_MASK) != Area::Ram))
+        {
+            return false;
+        }
+        for &(a, v) in ram {
+            self.poke(a, &v.to_be_bytes());
+        }
+        self.now += states;
+        self.itu.shift(states);
+        self.invalidate_irq();
+        true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::periph::adc;
+    use crate::pins::NullBoard;
+
+    fn mcu() -> Mcu<NullBoard> {
+        Mcu::new(McuConfig::default(), NullBoard).unwrap()
+    }
+
+    #[test]
+    fn clock_out_of_range_is_an_error() {
+        for hz in [0, MIN_CLOCK_HZ - 1, MAX_CLOCK_HZ + 1] {
+            let e = Mcu::new(
+                McuConfig {
+                    clock_hz: hz,
+                    eeprom_seed: 1,
+                },
+                NullBoard,
+            )
+            .unwrap_err();
+            assert_eq!(e, McuError::InvalidClock { clock_hz: hz });
+            assert!(e.to_string().contains("2000000..=25000000"), "{e}");
+        }
+        let m = Mcu::new(
+            McuConfig {
+                clock_hz: 16_000_000,
+                eeprom_seed: 1,
+            },
+            NullBoard,
+        )
+        .unwrap();
+        assert_eq!(m.clock_hz(), 16_000_000);
+        assert_eq!(m.i2c().devices()[0].clock().hz(), 16_000_000);
+    }
+
+    #[test]
+    fn memory_is_allocated_lazily() {
+        let mut m = mcu();
+        assert!(!m.has_flash() && !m.has_ram());
+        assert_eq!(m.read16(0x100), 0xFFFF);
+        assert_eq!(m.read8(RAM_START + 10), 0);
+        assert!(!m.has_flash() && !m.has_ram());
+        m.write16(RAM_START + 10, 0x1234);
+        assert!(m.has_ram());
+        assert_eq!(m.read16(RAM_START + 10), 0x1234);
+        // Flash is not writable through the bus.
+        m.write8(0x100, 0);
+        assert!(!m.has_flash());
+        m.poke(0x100, &[1, 2]);
+        assert!(m.has_flash());
+        assert_eq!(m.read16(0x100), 0x0102);
+        assert_eq!(m.peek(0x102), 0xFF);
+    }
+
+    #[test]
+    fn io_words_cost_two_cycles_but_itu_words_one() {
+        let mut m = mcu();
+        let t = m.now();
+        m.read16(adc::ADDRA);
+        assert_eq!(m.now() - t, 6);
+        let t = m.now();
+        m.read16(0xFF_FF68); // TCNT0
+        assert_eq!(m.now() - t, 3);
+        let t = m.now();
+        m.write16(0xFF_FF6A, 0x1234); // GRA0
+        assert_eq!(m.now() - t, 3);
+        assert_eq!(m.read16(0xFF_FF6A), 0x1234);
+        let t = m.now();
+        m.read8(itu::TSTR);
+        assert_eq!(m.now() - t, 3);
+    }
+
+    #[test]
+    fn syscr_and_unmodelled_registers() {
+        use crate::periph::intc::{SYSCR, SYSCR_RESET};
+        let mut m = mcu();
+        assert_eq!(m.read8(SYSCR), SYSCR_RESET);
+        m.write8(SYSCR, 0x09);
+        assert_eq!(m.read8(SYSCR), 0x09);
+        assert_eq!(m.read8(0xFF_FFC0), 0); // P1DDR: not modelled
+    }
+}

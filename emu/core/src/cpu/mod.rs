@@ -1,0 +1,939 @@
+//! The H8/300H CPU core in advanced mode (24-bit addresses, 32-bit ER0–ER7, ER7 = SP).
+//!
+//! Split as in moa: [`mod@decode`] turns instruction words into an [`decode::Instr`], `exec`
+//! carries it out, [`timing`] holds the manual's internal-state counts, and [`disasm`] prints
+//! instructions the way `h8300-hms-objdump -d` does.
+//!
+//! The core is generic over [`Bus`] (static dispatch). Time is right by construction, as in
+//! mooneye-gb: every instruction fetch and data access goes through the bus, which charges the
+//! states of the area it touches, and the internal states N are charged with
+//! [`Bus::internal`]. An instruction therefore costs `I·S_I + J·S_J + K·S_K + L·S_L + M·S_M +
+//! N·S_N` states (programming manual, Appendix A).
+//!
+//! Speed: two paths run the same instructions to the same states.
+//! - The reference path ([`Cpu::step_reference`]) is the plain one: every instruction word is
+//!   fetched through [`Bus::read16`] (ROM instructions are decoded once and kept in a cache
+//!   indexed by address, but their fetch cycles still go through the bus), and the decoded
+//!   [`decode::Instr`] is executed by one generic executor.
+//! - The fast path ([`Cpu::step`], unless [`Cpu::set_fast_path`] turned it off) runs when the
+//!   bus shows a [`FastPathHints::code_generation`] token, i.e. promises that fetching from ROM or RAM
+//!   has no effect but the clock: each ROM instruction is decoded once into a handler of its
+//!   own form (`fast`: register moves and ALU operations by size and source, loads and stores
+//!   by size, branches with their target, condition mask and prefetch states precomputed,
+//!   calls and returns), its fetch cycles are charged as one [`Bus::internal`] lump of
+//!   `words × ROM word states`, and the handler does the operation with the reference path's
+//!   own helpers (flags, operands, memory) and the same bus accesses in the same order. Forms
+//!   without a handler of their own, code in RAM and everything around sleep mode go through
+//!   the reference executor. Interrupts are checked before every instruction on both paths.
+//! - [`Cpu::run`] is [`Cpu::step`] in a loop up to a deadline, with one difference in how, not
+//!   what: it carries PC from one instruction to the next in a local, so that after an
+//!   instruction that can only go on to the next the CPU need not wait for the PC it just
+//!   stored (the store-to-load latency is the fast path's longest chain).
+//! - [`Cpu::run_until`] (and `run`) also fast-forward loops (`ffwd`, on unless
+//!   [`Cpu::set_fast_forward`] turns it off): a delay loop (INC/DEC/ADD/SUB #imm on one
+//!   register and a BNE back) is advanced to its last iteration in closed form, and a loop
+//!   whose watched iteration wrote nothing, came back to its head with every register and CCR
+//!   unchanged and read only what the bus promises stays the same ([`FastPathHints::reads_stable_until`]:
+//!   ROM, RAM, the A/D converter until its next event) is skipped to where something can change:
+//!   the deadline, the next possible interrupt request ([`FastPathHints::irq_stable_until`]), the end of
+//!   its reads' promises. The skipped iterations' states and instructions are counted
+//!   ([`Cpu::skipped_instructions`]); registers, flags, clock and memory are what stepping
+//!   reaches at the same instruction boundary. [`Cpu::step`] never skips.
+//!
+//! The stack guard ([`stack`], [`Cpu::set_stack_guard`]) checks every stack access (pushes,
+//! calls, returns, interrupt entries, loads and stores through ER7) and every instruction that
+//! sets SP against the stack's room, on both paths: the fast path gives loads and stores
+//! through ER7 handlers of their own and leaves the instructions that set SP as a register to
+//! the reference executor, so no other instruction pays for it.
+//!
+//! The decode caches are emptied whenever the bus's token changes (the flash was written:
+//! loading an image, poking), and by [`Cpu::flush_decode_cache`]. Tests run random programs,
+//! the C programs and the robot firmware both ways and compare the complete state after every
+//! instruction.
+//!
+//! DIVXS.B/DIVXS.W flags (programming manual, 2.2.26 (1) and (2)). The condition-code table
+//! says "N: Set to 1 if the quotient is negative; otherwise cleared to 0. Z: Set to 1 if the
+//! divisor is zero; otherwise cleared to 0." (H, V, C unchanged), and the page's notes make N
+//! precise: "The N flag is set to 1 if the dividend and divisor have different signs, and
+//! cleared to 0 if they have the same sign. The N flag may therefore be set to 1 when the
+//! quotient is zero." This core follows the notes for both widths and every operand: N = the
+//! dividend's sign bit XOR the divisor's sign bit (so -1 / 5 and -3 / 100 give quotient 0 with
+//! N = 1, and 0 / -5 gives N = 1), Z = (divisor = 0). GDB's simulator sets N from the
+//! quotient instead (N = 0 for a zero quotient). DIVXU sets N from the
+//! divisor's top bit ("N: Set to 1 if the divisor is negative").
+//!
+//! Choices where the manual leaves the result open (documented behaviour of this core):
+//! - DIVXU/DIVXS by zero or with overflow: the manual says only "Valid results are not assured
+//!   if division by zero is attempted or an overflow occurs". By zero the destination register
+//!   is left unchanged (flags as above: Z = 1; N from the divisor's top bit, i.e. 0, for DIVXU
+//!   and from the signs, i.e. the dividend's sign, for DIVXS); on overflow the low 8/16 bits of
+//!   the quotient and of the remainder are stored, with the flags as above.
+//! - DAA/DAS leave H and V unchanged (the manual: "undetermined").
+//! - STC to memory writes the CCR to both bytes of the word.
+//! - `MOV Rn,@-ERn` with the same register stores the value before the decrement.
+//! - JSR/BSR push the 24-bit return address as a longword whose top byte is 0; interrupts and
+//!   TRAPA push CCR in the top byte (advanced-mode stack frame).
+//! - CCR.UI is treated as a user bit (SYSCR.UE = 1, the reset value): only CCR.I masks
+//!   interrupts, NMI (vector 7) is never masked. Interrupts are not accepted right after LDC,
+//!   ANDC, ORC, XORC (H8/3052F hardware manual, "Instructions that disable interrupts").
+//! - MOVFPE/MOVTPE decode and disassemble but stop the program with
+//!   [`CpuError::Unsupported`]: they need the E clock, which the H8/3052F does not provide.
+//! - Interrupt entry costs the priority decision (1 state internal, 2 external) plus 16 states
+//!   (stack 2 words, vector 2 words, 2 prefetches, 4 internal): H8/3052F hardware manual Table
+//!   5-5 without the "wait for the end of the current instruction", which this core overlaps
+//!   with the instruction (interrupts are taken between instructions).
+
+pub mod decode;
+pub mod disasm;
+mod exec;
+mod fast;
+mod ffwd;
+mod idle;
+pub mod stack;
+pub mod timing;
+
+pub use idle::{IdleRun, MAX_CYCLE};
+pub use stack::{StackAccess, StackFault, StackGuard, StackGuardMode, StackRoom};
+
+use crate::bus::{Bus, CpuSignal, FastPathHints};
+use crate::memmap::Area;
+use decode::{DecodeError, Decoded, Instr, WordSource, decode};
+
+/// CCR bit 7: interrupt mask.
+pub const CCR_I: u8 = 0x80;
+/// CCR bit 6: user bit / interrupt mask (UI).
+pub const CCR_UI: u8 = 0x40;
+/// CCR bit 5: half-carry.
+pub const CCR_H: u8 = 0x20;
+/// CCR bit 4: user bit.
+pub const CCR_U: u8 = 0x10;
+/// CCR bit 3: negative.
+pub const CCR_N: u8 = 0x08;
+/// CCR bit 2: zero.
+pub const CCR_Z: u8 = 0x04;
+/// CCR bit 1: overflow.
+pub const CCR_V: u8 = 0x02;
+/// CCR bit 0: carry.
+pub const CCR_C: u8 = 0x01;
+
+/// Vector number of the reset exception (docs/design.md §4.1).
+pub const VECTOR_RESET: u8 = 0;
+/// Vector number of NMI (H8/3052F hardware manual, Table 5-3).
+pub const VECTOR_NMI: u8 = 7;
+/// First TRAPA vector (TRAPA #0 = 8 ... #3 = 11; docs/design.md §4.1).
+pub const VECTOR_TRAPA0: u8 = 8;
+/// Vector number of IRQ0 (H8/3052F hardware manual, Table 5-3; IRQ0–IRQ5 = 12–17).
+pub const VECTOR_IRQ0: u8 = 12;
+/// Vector number of IRQ5.
+pub const VECTOR_IRQ5: u8 = 17;
+/// Bytes per vector in advanced mode.
+pub const VECTOR_BYTES: u32 = 4;
+
+/// Why the core stopped a program.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum CpuError {
+    /// The bytes at PC are no H8/300H instruction.
+    #[error("undefined opcode at PC H'{pc:06X}: {bytes}")]
+    UndefinedOpcode {
+        /// Address of the instruction.
+        pc: u32,
+        /// The bytes read, as `xx xx ...`.
+        bytes: String,
+    },
+    /// An instruction fetch went outside ROM and RAM (docs/design.md §7).
+    #[error(
+        "instruction fetch outside ROM and RAM at H'{addr:06X} (instruction at PC H'{pc:06X}, area {area:?}); code may run only from ROM H'000000-H'07FFFF or RAM H'FFDF10-H'FFFF0F"
+    )]
+    FetchOutside {
+        /// Address of the instruction.
+        pc: u32,
+        /// The address of the refused fetch.
+        addr: u32,
+        /// The area that address lies in.
+        area: Area,
+    },
+    /// An instruction the H8/3052F cannot execute.
+    #[error("unsupported instruction at PC H'{pc:06X}: {text} ({why})")]
+    Unsupported {
+        /// Address of the instruction.
+        pc: u32,
+        /// The instruction, disassembled.
+        text: String,
+        /// Why it cannot run.
+        why: &'static str,
+    },
+    /// A stack access left the stack's room under a guard that stops ([`stack`]).
+    #[error("{0}")]
+    StackOverflow(Box<StackFault>),
+}
+
+/// What one call of [`Cpu::step`] did.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Event {
+    /// One instruction ran.
+    Executed,
+    /// An interrupt was accepted (exception handling ran; no instruction).
+    Interrupt(u8),
+    /// SLEEP ran with CCR.I = 1 and no NMI pending: the program has halted (docs/design.md §7). Further
+    /// steps do nothing and report this again.
+    Halted,
+    /// The CPU is in sleep mode and the deadline passed with no interrupt to wake it.
+    Asleep,
+}
+
+/// Run state of the CPU.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum RunState {
+    Running,
+    Sleeping,
+    Halted,
+}
+
+/// An empty predecode-cache slot (length 0 marks it).
+const EMPTY_SLOT: Decoded = Decoded {
+    instr: Instr::Nop,
+    words: 0,
+};
+
+/// States of one instruction-word fetch from ROM (what the fast path charges per word).
+const ROM_FETCH_STATES: u32 = Area::Rom.word_states();
+
+/// `Cpu::last_index` when the last instruction is in `last_copy`, not in the cache.
+const LAST_IN_COPY: u32 = u32::MAX;
+
+/// The H8/300H CPU: registers, run state and the decode caches.
+#[derive(Clone, Debug)]
+pub struct Cpu {
+    er: [u32; 8],
+    pc: u32,
+    ccr: u8,
+    state: RunState,
+    /// Set by LDC/ANDC/ORC/XORC: no interrupt is accepted before the next instruction.
+    irq_inhibit: bool,
+    /// Decoded ROM instructions, indexed by address / 2; grows on demand.
+    cache: Vec<Decoded>,
+    /// The fast path's handlers of the same instructions, same index; grows on demand.
+    fast: Vec<fast::Slot>,
+    /// The bus's [`FastPathHints::code_generation`] token the caches were filled under (0: none; the
+    /// tokens of [`crate::bus::fresh_code_generation`] start at 1).
+    code_generation: u64,
+    /// Whether [`Cpu::step`] may take the fast path.
+    fast_path: bool,
+    /// Whether [`Cpu::run_until`] fast-forwards loops ([`ffwd`]).
+    fast_forward: bool,
+    /// What [`ffwd`] knows about each back edge, same index as `fast`.
+    loops: Vec<ffwd::Loop>,
+    /// Instructions fast-forwarded so far.
+    skipped: u64,
+    /// Idle cycles advanced in closed form so far ([`Cpu::run_idle`]).
+    idle_skipped: u64,
+    /// Sleep PCs whose idle cycles failed the proof, with the failures.
+    idle_fails: Vec<(u32, u8)>,
+    instructions: u64,
+    /// Where the instruction executed last is kept (for traces and the profiler): its index
+    /// in `cache` (the fast path), or [`LAST_IN_COPY`] for `last_copy`.
+    last_index: u32,
+    /// The instruction executed last on the reference path.
+    last_copy: Decoded,
+    /// The stack guard's bounds ([`stack::Bounds::OFF`] without a guard).
+    stack_bounds: stack::Bounds,
+    /// The stack guard, if one is set.
+    stack_guard: Option<StackGuard>,
+    /// The first stack fault seen under the guard.
+    stack_fault: Option<Box<StackFault>>,
+}
+
+impl Default for Cpu {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// Fetches instruction words through the bus, refusing areas that are not executable.
+struct BusFetch<'b, B: Bus> {
+    bus: &'b mut B,
+    addr: u32,
+    refused: Option<u32>,
+}
+
+impl<B: Bus> WordSource for BusFetch<'_, B> {
+    #[inline]
+    fn next_word(&mut self) -> Option<u16> {
+        let a = self.addr & crate::memmap::ADDRESS_MASK;
+        if !Area::of(a).executable() {
+            self.refused = Some(a);
+            return None;
+        }
+        self.addr = self.addr.wrapping_add(2);
+        Some(self.bus.read16(a))
+    }
+}
+
+impl Cpu {
+    /// A CPU before reset: registers 0, CCR.I set, PC 0.
+    #[must_use]
+    pub fn new() -> Self {
+        Cpu {
+            er: [0; 8],
+            pc: 0,
+            ccr: CCR_I,
+            state: RunState::Running,
+            irq_inhibit: false,
+            cache: Vec::new(),
+            fast: Vec::new(),
+            code_generation: 0,
+            fast_path: true,
+            fast_forward: true,
+            loops: Vec::new(),
+            skipped: 0,
+            idle_skipped: 0,
+            idle_fails: Vec::new(),
+            instructions: 0,
+            last_index: LAST_IN_COPY,
+            last_copy: EMPTY_SLOT,
+            stack_bounds: stack::Bounds::OFF,
+            stack_guard: None,
+            stack_fault: None,
+        }
+    }
+
+    /// Reset exception: CCR.I = 1, PC = the longword at vector 0 (read through the bus, 2 word
+    /// reads). General registers are cleared (the manual leaves them undefined).
+    pub fn reset<B: Bus>(&mut self, bus: &mut B) {
+        self.er = [0; 8];
+        self.ccr = CCR_I;
+        self.state = RunState::Running;
+        self.irq_inhibit = false;
+        let v = u32::from(VECTOR_RESET) * VECTOR_BYTES;
+        let hi = u32::from(bus.read16(v));
+        let lo = u32::from(bus.read16(v + 2));
+        self.pc = ((hi << 16) | lo) & crate::memmap::ADDRESS_MASK & !1;
+    }
+
+    /// The program counter (24 bits).
+    #[must_use]
+    pub const fn pc(&self) -> u32 {
+        self.pc
+    }
+
+    /// Sets the program counter (masked to 24 bits, bit 0 cleared: instructions are
+    /// word-aligned).
+    pub fn set_pc(&mut self, pc: u32) {
+        self.pc = pc & crate::memmap::ADDRESS_MASK & !1;
+    }
+
+    /// The condition code register.
+    #[must_use]
+    pub const fn ccr(&self) -> u8 {
+        self.ccr
+    }
+
+    /// Sets the condition code register.
+    pub fn set_ccr(&mut self, ccr: u8) {
+        self.ccr = ccr;
+    }
+
+    /// General register ERn (n = 0–7; other values are taken modulo 8).
+    #[must_use]
+    pub const fn er(&self, n: usize) -> u32 {
+        self.er[n & 7]
+    }
+
+    /// Sets general register ERn (n modulo 8).
+    pub fn set_er(&mut self, n: usize, value: u32) {
+        self.er[n & 7] = value;
+    }
+
+    /// All eight general registers.
+    #[must_use]
+    pub const fn regs(&self) -> [u32; 8] {
+        self.er
+    }
+
+    /// Instructions executed since this CPU was created.
+    #[must_use]
+    pub const fn instructions(&self) -> u64 {
+        self.instructions
+    }
+
+    /// The instruction executed last (a NOP of length 0 before the first).
+    #[must_use]
+    pub fn last_executed(&self) -> Decoded {
+        if self.last_index == LAST_IN_COPY {
+            self.last_copy
+        } else {
+            self.cache
+                .get(self.last_index as usize)
+                .copied()
+                .unwrap_or(EMPTY_SLOT)
+        }
+    }
+
+    /// Sets the stack guard (`None`: no guard, the default): from the next instruction on,
+    /// every stack access is checked against the guard's room ([`stack`]). A fault recorded
+    /// before is forgotten.
+    pub fn set_stack_guard(&mut self, guard: Option<StackGuard>) {
+        self.stack_guard = guard;
+        self.stack_bounds = guard.map_or(stack::Bounds::OFF, |g| stack::Bounds::of(g.room));
+        self.stack_fault = None;
+    }
+
+    /// The stack guard, if one is set.
+    #[must_use]
+    pub const fn stack_guard(&self) -> Option<StackGuard> {
+        self.stack_guard
+    }
+
+    /// Raises the low end of the guard's room to `low` (the program has carved memory above
+    /// its data: arrays sized at boot); a lower `low`, or no guard, changes nothing.
+    pub fn raise_stack_low(&mut self, low: u32) {
+        if let Some(g) = self.stack_guard.as_mut()
+            && low > g.room.low
+            && low <= g.room.top
+        {
+            g.room.low = low;
+            self.stack_bounds = stack::Bounds::of(g.room);
+        }
+    }
+
+    /// The first stack access that left the guard's room (under [`StackGuardMode::Warn`]; a
+    /// stopping guard also keeps the fault it stopped at).
+    #[must_use]
+    pub fn stack_fault(&self) -> Option<&StackFault> {
+        self.stack_fault.as_deref()
+    }
+
+    /// Checks a stack access of `bytes` bytes at `addr` by the instruction at `pc` (or the
+    /// interrupt entry before it) against the guard: one add and one compare when it is
+    /// inside.
+    #[inline(always)]
+    fn stack_ok(
+        &mut self,
+        addr: u32,
+        bytes: u32,
+        access: StackAccess,
+        pc: u32,
+    ) -> Result<(), CpuError> {
+        if self.stack_bounds.inside(addr, bytes) {
+            Ok(())
+        } else {
+            self.stack_hit(addr, bytes, access, pc)
+        }
+    }
+
+    /// A stack access left the room: the fault is kept (the first one), and under a stopping
+    /// guard the instruction is undone (PC at it, not counted) and the error returned.
+    #[cold]
+    #[inline(never)]
+    fn stack_hit(
+        &mut self,
+        addr: u32,
+        bytes: u32,
+        access: StackAccess,
+        pc: u32,
+    ) -> Result<(), CpuError> {
+        let Some(guard) = self.stack_guard else {
+            return Ok(());
+        };
+        let instruction = match access {
+            StackAccess::InterruptEntry(_) => String::new(),
+            _ => disasm::format_instr(self.last_executed(), pc).replacen('\t', " ", 1),
+        };
+        let fault = Box::new(StackFault {
+            pc,
+            instruction,
+            sp: self.er[7],
+            addr: addr & crate::memmap::ADDRESS_MASK,
+            bytes,
+            access,
+            room: guard.room,
+            function: None,
+        });
+        if self.stack_fault.is_none() {
+            self.stack_fault = Some(fault.clone());
+        }
+        match guard.mode {
+            StackGuardMode::Warn => Ok(()),
+            StackGuardMode::Stop => {
+                if !matches!(access, StackAccess::InterruptEntry(_)) {
+                    self.pc = pc;
+                    self.instructions -= 1;
+                }
+                Err(CpuError::StackOverflow(fault))
+            }
+        }
+    }
+
+    /// Turns the fast path of [`Cpu::step`] on (the default) or off. Off, `step` is
+    /// [`Cpu::step_reference`]. Both give the same states, bus accesses and results.
+    pub fn set_fast_path(&mut self, on: bool) {
+        self.fast_path = on;
+    }
+
+    /// Whether [`Cpu::step`] may take the fast path.
+    #[must_use]
+    pub const fn fast_path(&self) -> bool {
+        self.fast_path
+    }
+
+    /// Whether SLEEP has halted the program (docs/design.md §7).
+    #[must_use]
+    pub fn halted(&self) -> bool {
+        self.state == RunState::Halted
+    }
+
+    /// Whether the CPU is in sleep mode waiting for an interrupt.
+    #[must_use]
+    pub fn sleeping(&self) -> bool {
+        self.state == RunState::Sleeping
+    }
+
+    /// Forgets every predecoded instruction. A bus that shows a [`FastPathHints::code_generation`]
+    /// token has the caches emptied whenever its flash changes; with another bus, call this
+    /// after replacing the ROM image.
+    pub fn flush_decode_cache(&mut self) {
+        self.last_copy = self.last_executed();
+        self.last_index = LAST_IN_COPY;
+        self.cache.clear();
+        self.fast.clear();
+        self.loops.clear();
+        self.idle_fails.clear();
+    }
+
+    /// Empties the caches if the bus's flash token changed since they were filled.
+    #[inline]
+    fn check_code_generation<B: FastPathHints>(&mut self, bus: &B) -> Option<u64> {
+        let token = bus.code_generation();
+        if let Some(t) = token
+            && t != self.code_generation
+        {
+            self.flush_decode_cache();
+            self.code_generation = t;
+        }
+        token
+    }
+
+    /// Decodes the instruction at `pc` through the bus without executing it, charging its fetch
+    /// states like an execution would. Used by tracing; most callers want [`Cpu::step`].
+    fn fetch_decode<B: Bus>(&mut self, bus: &mut B) -> Result<Decoded, CpuError> {
+        let pc = self.pc;
+        if Area::of(pc) == Area::Rom {
+            let idx = (pc >> 1) as usize;
+            if let Some(d) = self.cache.get(idx)
+                && d.words != 0
+            {
+                let d = *d;
+                // Charge the instruction fetches the cached copy saved us from reading.
+                let mut a = pc;
+                for _ in 0..d.words {
+                    bus.read16(a);
+                    a = a.wrapping_add(2);
+                }
+                return Ok(d);
+            }
+            let d = self.decode_through_bus(bus)?;
+            if Area::of(pc + d.len_bytes() - 1) == Area::Rom {
+                if self.cache.len() <= idx {
+                    self.cache.resize(idx + 1, EMPTY_SLOT);
+                }
+                self.cache[idx] = d;
+            }
+            return Ok(d);
+        }
+        self.decode_through_bus(bus)
+    }
+
+    fn decode_through_bus<B: Bus>(&mut self, bus: &mut B) -> Result<Decoded, CpuError> {
+        let pc = self.pc;
+        let mut src = BusFetch {
+            bus,
+            addr: pc,
+            refused: None,
+        };
+        match decode(&mut src) {
+            Ok(d) => Ok(d),
+            Err(e) => {
+                if let Some(addr) = src.refused {
+                    return Err(CpuError::FetchOutside {
+                        pc,
+                        addr,
+                        area: Area::of(addr),
+                    });
+                }
+                let words = match &e {
+                    DecodeError::Undefined { words } | DecodeError::Truncated { words } => words,
+                };
+                Err(CpuError::UndefinedOpcode {
+                    pc,
+                    bytes: decode::hex_words(words),
+                })
+            }
+        }
+    }
+
+    /// Whether an interrupt with vector `v` gets through the CCR mask.
+    #[inline]
+    fn accepts(&self, v: u8) -> bool {
+        v == VECTOR_NMI || self.ccr & CCR_I == 0
+    }
+
+    /// Before an instruction: ends the one-instruction delay after LDC/ANDC/ORC/XORC, or
+    /// accepts a pending interrupt the mask lets through (its exception handling runs) and
+    /// returns its vector.
+    #[inline(always)]
+    fn take_interrupt<B: Bus>(&mut self, bus: &mut B) -> Result<Option<u8>, CpuError> {
+        if self.irq_inhibit {
+            self.irq_inhibit = false;
+        } else if let Some(v) = bus.pending_irq()
+            && self.accepts(v)
+        {
+            self.interrupt(bus, v)?;
+            return Ok(Some(v));
+        }
+        Ok(None)
+    }
+
+    /// Runs one step: accepts a pending interrupt, or executes one instruction, or (in sleep
+    /// mode) waits for an interrupt until the clock reaches `deadline`.
+    ///
+    /// Takes the fast path (see the module docs) when it is on and the bus shows a
+    /// [`FastPathHints::code_generation`] token; otherwise this is [`Cpu::step_reference`].
+    ///
+    /// # Errors
+    /// [`CpuError`] on an undefined opcode, a fetch outside ROM/RAM or an unsupported
+    /// instruction; the CPU state is left as it was before the instruction (PC at it).
+    #[inline]
+    pub fn step<B: FastPathHints>(
+        &mut self,
+        bus: &mut B,
+        deadline: u64,
+    ) -> Result<Event, CpuError> {
+        if self.fast_ready(bus) {
+            return self.step_fast(bus);
+        }
+        self.step_not_ready(bus, deadline)
+    }
+
+    /// Whether the fast path may run this step: on, running, and the caches filled under the
+    /// bus's present token.
+    #[inline(always)]
+    fn fast_ready<B: FastPathHints>(&self, bus: &B) -> bool {
+        self.fast_path
+            && self.state == RunState::Running
+            && bus.code_generation() == Some(self.code_generation)
+    }
+
+    /// A step when [`Cpu::fast_ready`] says no: a new token (the caches are emptied and the
+    /// fast path runs), or the reference path.
+    #[inline(never)]
+    fn step_not_ready<B: FastPathHints>(
+        &mut self,
+        bus: &mut B,
+        deadline: u64,
+    ) -> Result<Event, CpuError> {
+        if self.fast_path
+            && self.state == RunState::Running
+            && self.check_code_generation(bus).is_some()
+        {
+            return self.step_fast(bus);
+        }
+        self.step_reference(bus, deadline)
+    }
+
+    /// Runs steps until the clock reaches `deadline` or a step reports anything but
+    /// [`Event::Executed`] (an interrupt accepted, the program halted, the CPU asleep past the
+    /// deadline), and returns that step's event, or [`Event::Executed`] once the clock has
+    /// reached `deadline` (at once, running nothing, if it already had).
+    ///
+    /// [`Cpu::run_until`] with no stop condition: see there for what it shares with stepping.
+    ///
+    /// # Errors
+    /// As [`Cpu::step`].
+    pub fn run<B: FastPathHints>(&mut self, bus: &mut B, deadline: u64) -> Result<Event, CpuError> {
+        self.run_until(bus, deadline, |_, _| false)
+    }
+
+    /// [`Cpu::run`] that also returns ([`Event::Executed`]) after any executed instruction
+    /// after which `stop(cpu, bus)` holds (entering sleep mode with `|cpu, _| cpu.sleeping()`,
+    /// an I/O effect with a condition on the bus).
+    ///
+    /// The same as calling [`Cpu::step`] with `deadline` while the clock is below it, the steps
+    /// report [`Event::Executed`] and `stop` does not hold: same states, bus accesses and
+    /// results at the instant it returns. It is faster in two ways. On the fast path PC goes
+    /// from one instruction to the next in a local. And with loop fast-forwarding on
+    /// ([`Cpu::set_fast_forward`], the default) a delay loop or a poll loop whose next
+    /// iterations are known is advanced in closed form to exactly the state stepping would
+    /// reach (the `ffwd` module: which loops, and the bounds: the deadline, the next possible
+    /// interrupt request, the reads' stability). A skipped stretch touches no device and
+    /// changes no run state, and `stop` is not asked inside it: a condition on registers,
+    /// time or instruction counts needs fast-forwarding off.
+    ///
+    /// # Errors
+    /// As [`Cpu::step`].
+    pub fn run_until<B: FastPathHints, F: FnMut(&Cpu, &B) -> bool>(
+        &mut self,
+        bus: &mut B,
+        deadline: u64,
+        mut stop: F,
+    ) -> Result<Event, CpuError> {
+        while bus.now() < deadline {
+            if !self.fast_ready(bus) {
+                let event = self.step_not_ready(bus, deadline)?;
+                if event != Event::Executed {
+                    return Ok(event);
+                }
+                if stop(self, bus) {
+                    return Ok(event);
+                }
+                continue;
+            }
+            // The fast path with PC kept in a local (what `step_fast` does, step after step):
+            // after an instruction that can only go on to the next, the next PC is the slot's,
+            // not a reload of the one just stored.
+            let mut pc = self.pc;
+            loop {
+                if let Some(v) = self.take_interrupt(bus)? {
+                    return Ok(Event::Interrupt(v));
+                }
+                let idx = (pc >> 1) as usize;
+                if let Some(slot) = self.fast.get(idx)
+                    && slot.words != 0
+                {
+                    let (words, next, sequential, back_edge) =
+                        (slot.words, slot.next, slot.sequential, slot.back_edge);
+                    bus.internal(u32::from(words) * ROM_FETCH_STATES);
+                    let event = self.exec_fast(bus, pc, idx, next)?;
+                    if event != Event::Executed {
+                        return Ok(event);
+                    }
+                    if stop(self, bus) {
+                        return Ok(event);
+                    }
+                    if sequential {
+                        pc = next;
+                    } else if self.state == RunState::Running {
+                        pc = self.pc;
+                        if back_edge && pc <= (idx as u32) << 1 && self.fast_forward {
+                            match self.loop_back(bus, idx, deadline, &mut stop)? {
+                                ffwd::Outcome::Continue => {}
+                                ffwd::Outcome::Event(event) => return Ok(event),
+                                ffwd::Outcome::Stop => return Ok(Event::Executed),
+                            }
+                            if self.state != RunState::Running {
+                                break;
+                            }
+                            pc = self.pc;
+                        }
+                    } else {
+                        // Asleep or halted: the outer loop takes the reference path.
+                        break;
+                    }
+                } else {
+                    // Not cached yet: one step the usual way, then from the top.
+                    let event = self.fast_miss(bus, pc, idx)?;
+                    if event != Event::Executed {
+                        return Ok(event);
+                    }
+                    if stop(self, bus) {
+                        return Ok(event);
+                    }
+                    break;
+                }
+                if bus.now() >= deadline || bus.code_generation() != Some(self.code_generation) {
+                    break;
+                }
+            }
+        }
+        Ok(Event::Executed)
+    }
+
+    /// One step on the fast path: the CPU is running, the path is on and the caches match the
+    /// bus's token.
+    #[inline(always)]
+    fn step_fast<B: Bus>(&mut self, bus: &mut B) -> Result<Event, CpuError> {
+        if let Some(v) = self.take_interrupt(bus)? {
+            return Ok(Event::Interrupt(v));
+        }
+        let pc = self.pc;
+        let idx = (pc >> 1) as usize;
+        if let Some(slot) = self.fast.get(idx)
+            && slot.words != 0
+        {
+            // The words of a cached ROM instruction: no device sees their fetch (the bus's
+            // promise), so they cost their states as one lump.
+            let (words, next) = (slot.words, slot.next);
+            bus.internal(u32::from(words) * ROM_FETCH_STATES);
+            return self.exec_fast(bus, pc, idx, next);
+        }
+        self.fast_miss(bus, pc, idx)
+    }
+
+    /// The fast path at an address whose handler is not cached yet: decodes through the bus
+    /// (charging the fetches as the reference path does), caches a ROM instruction's handler
+    /// and runs it; code in RAM (or straddling the end of ROM) runs on the reference executor.
+    #[inline(never)]
+    fn fast_miss<B: Bus>(&mut self, bus: &mut B, pc: u32, idx: usize) -> Result<Event, CpuError> {
+        let d = self.decode_through_bus(bus)?;
+        if Area::of(pc) == Area::Rom && Area::of(pc + d.len_bytes() - 1) == Area::Rom {
+            if self.cache.len() <= idx {
+                self.cache.resize(idx + 1, EMPTY_SLOT);
+            }
+            if self.fast.len() <= idx {
+                self.fast.resize(idx + 1, fast::Slot::EMPTY);
+            }
+            let slot = fast::Slot::new(d, pc);
+            self.cache[idx] = d;
+            self.fast[idx] = slot;
+            return self.exec_fast(bus, pc, idx, slot.next);
+        }
+        self.execute(bus, d)
+    }
+
+    /// One step on the reference path: every instruction word fetched through
+    /// [`Bus::read16`], the generic executor. [`Cpu::step`] with the fast path off, and the
+    /// yardstick the fast path is tested and benchmarked against.
+    ///
+    /// # Errors
+    /// As [`Cpu::step`].
+    pub fn step_reference<B: FastPathHints>(
+        &mut self,
+        bus: &mut B,
+        deadline: u64,
+    ) -> Result<Event, CpuError> {
+        self.check_code_generation(bus);
+        match self.state {
+            RunState::Running => {}
+            RunState::Halted => return Ok(Event::Halted),
+            RunState::Sleeping => {
+                loop {
+                    if let Some(v) = bus.pending_irq()
+                        && self.accepts(v)
+                    {
+                        break;
+                    }
+                    if bus.now() >= deadline || !bus.sleep_until_irq(deadline) {
+                        return Ok(Event::Asleep);
+                    }
+                }
+                self.state = RunState::Running;
+                bus.cpu_signal(CpuSignal::Wake);
+            }
+        }
+        if let Some(v) = self.take_interrupt(bus)? {
+            return Ok(Event::Interrupt(v));
+        }
+        let d = self.fetch_decode(bus)?;
+        self.execute(bus, d)
+    }
+
+    /// Decodes the instruction at PC without side effects on the CPU, reading the words through
+    /// `bus` (which charges them: use it on a scratch bus or accept the states).
+    ///
+    /// # Errors
+    /// As [`Cpu::step`].
+    pub fn peek_decode<B: Bus>(&mut self, bus: &mut B) -> Result<Decoded, CpuError> {
+        self.decode_through_bus(bus)
+    }
+
+    /// Pushes a longword on the stack (ER7 -= 4; two word writes), checked by the stack guard
+    /// first (`access` by the instruction at `pc`).
+    #[inline]
+    fn push32<B: Bus>(
+        &mut self,
+        bus: &mut B,
+        v: u32,
+        access: StackAccess,
+        pc: u32,
+    ) -> Result<(), CpuError> {
+        let sp = self.er[7].wrapping_sub(4);
+        self.stack_ok(sp, 4, access, pc)?;
+        self.er[7] = sp;
+        bus.write16(sp, (v >> 16) as u16);
+        bus.write16(sp.wrapping_add(2), v as u16);
+        Ok(())
+    }
+
+    /// Pops a longword from the stack (two word reads; ER7 += 4), checked by the stack guard
+    /// first.
+    #[inline]
+    fn pop32<B: Bus>(
+        &mut self,
+        bus: &mut B,
+        access: StackAccess,
+        pc: u32,
+    ) -> Result<u32, CpuError> {
+        let sp = self.er[7];
+        self.stack_ok(sp, 4, access, pc)?;
+        let hi = u32::from(bus.read16(sp));
+        let lo = u32::from(bus.read16(sp.wrapping_add(2)));
+        self.er[7] = sp.wrapping_add(4);
+        Ok((hi << 16) | lo)
+    }
+
+    /// Reads the 24-bit address in vector `v` (two word reads: J = 2).
+    #[inline]
+    fn read_vector<B: Bus>(bus: &mut B, v: u8) -> u32 {
+        let a = u32::from(v) * VECTOR_BYTES;
+        let hi = u32::from(bus.read16(a));
+        let lo = u32::from(bus.read16(a + 2));
+        ((hi << 16) | lo) & crate::memmap::ADDRESS_MASK & !1
+    }
+
+    /// Exception handling shared by interrupts and TRAPA: push PC and CCR, set I, load PC from
+    /// the vector.
+    fn enter_exception<B: Bus>(
+        &mut self,
+        bus: &mut B,
+        v: u8,
+        return_pc: u32,
+        access: StackAccess,
+        pc: u32,
+    ) -> Result<(), CpuError> {
+        let frame = (u32::from(self.ccr) << 24) | (return_pc & crate::memmap::ADDRESS_MASK);
+        self.push32(bus, frame, access, pc)?;
+        self.ccr |= CCR_I;
+        self.pc = Self::read_vector(bus, v);
+        Ok(())
+    }
+
+    /// Interrupt exception handling (H8/3052F hardware manual, section 5.4 and Table 5-5).
+    /// The stack guard sees the push before anything happens.
+    fn interrupt<B: Bus>(&mut self, bus: &mut B, v: u8) -> Result<(), CpuError> {
+        let pc = self.pc;
+        self.stack_ok(
+            self.er[7].wrapping_sub(4),
+            4,
+            StackAccess::InterruptEntry(v),
+            pc,
+        )?;
+        bus.cpu_signal(CpuSignal::Interrupt(v));
+        let external = v == VECTOR_NMI || (VECTOR_IRQ0..=VECTOR_IRQ5).contains(&v);
+        bus.internal(if external {
+            timing::N_PRIORITY_DECISION_EXTERNAL
+        } else {
+            timing::N_PRIORITY_DECISION_INTERNAL
+        });
+        let ret = self.pc;
+        // Prefetch after acceptance (at the return address; not executed).
+        Self::fetch_charge(bus, ret);
+        self.enter_exception(bus, v, ret, StackAccess::InterruptEntry(v), pc)?;
+        // Prefetch of the first instruction of the handler.
+        let target = self.pc;
+        Self::fetch_charge(bus, target);
+        bus.internal(timing::N_INTERRUPT_INTERNAL);
+        Ok(())
+    }
+
+    /// Charges one instruction-fetch cycle at `addr` (a branch-target prefetch: the extra I of
+    /// one-word branches). Reads only executable areas, so a bad target has no side effects on
+    /// devices; elsewhere it charges the area's word states as internal time.
+    #[inline]
+    fn fetch_charge<B: Bus>(bus: &mut B, addr: u32) {
+        let area = Area::of(addr);
+        if area.executable() {
+            bus.read16(addr);
+        } else {
+            bus.internal(area.word_states());
+        }
+    }
+}
