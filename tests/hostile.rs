@@ -445,7 +445,7 @@ fn wait_at_most(child: &mut std::process::Child, seconds: u64) -> std::process::
 /// inherits the ignoring, and the tool rightly keeps a signal it was started ignoring ignored,
 /// so such a signal cannot be tested from here (a test run started as a script's background
 /// job ignores SIGINT).
-fn ignored_here(number: u32) -> bool {
+fn ignored_here(number: i32) -> bool {
     let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
     status
         .lines()
