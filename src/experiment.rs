@@ -498,11 +498,11 @@ impl Swarm {
     /// `path` as the step completes.
     ///
     /// # Errors
-    /// The file cannot be created (an [`crate::run_cmd::OutputError`]).
+    /// The file cannot be created (an [`crate::output_error::OutputError`]).
     pub fn set_rows(&mut self, path: &std::path::Path) -> Result<()> {
         let file = std::fs::File::create(path)
             .map_err(anyhow::Error::new)
-            .context(crate::run_cmd::OutputError(format!(
+            .context(crate::output_error::OutputError(format!(
                 "cannot create `{}`",
                 path.display()
             )))?;
@@ -815,7 +815,7 @@ impl Swarm {
                     .write_record(metrics_row(self.condition, self.repeat, k, &last))
                     .map_err(anyhow::Error::new)
                     .with_context(|| {
-                        crate::run_cmd::OutputError(format!(
+                        crate::output_error::OutputError(format!(
                             "cannot write `{}`",
                             rows.path.display()
                         ))
@@ -862,13 +862,9 @@ impl Swarm {
         let end = self.world.elapsed_states() + self.period_states;
         self.close_step(end)?;
         if let Some(mut rows) = self.rows.take() {
-            rows.w
-                .flush()
-                .map_err(anyhow::Error::new)
-                .context(crate::run_cmd::OutputError(format!(
-                    "cannot write `{}`",
-                    rows.path.display()
-                )))?;
+            rows.w.flush().map_err(anyhow::Error::new).context(
+                crate::output_error::OutputError(format!("cannot write `{}`", rows.path.display())),
+            )?;
         }
         let dead = self.dead();
         for t in &mut self.tallies {

@@ -17,6 +17,7 @@ pub mod energy;
 pub mod experiment;
 pub mod fit;
 pub mod fit_cmd;
+pub mod output_error;
 pub mod plot;
 pub mod recording;
 pub mod replay;

@@ -346,9 +346,9 @@ fn sweep(args: &h8swarm::sweep::SweepArgs) -> Result<(), Failure> {
 }
 
 /// An error of `run`: a tool failure when some output could not be written
-/// ([`run_cmd::OutputError`] in its chain), else bad input.
+/// ([`h8swarm::output_error::OutputError`] in its chain), else bad input.
 fn run_failure(e: anyhow::Error) -> Failure {
-    if run_cmd::is_output_error(&e) {
+    if h8swarm::output_error::is_output_error(&e) {
         Failure::Tool(e)
     } else {
         Failure::Input(e)

@@ -178,8 +178,8 @@ pub fn part_paths(stage: &Path, condition: Condition, repeat: u32) -> Vec<PathBu
         .collect()
 }
 
-fn output_error(path: &Path) -> crate::run_cmd::OutputError {
-    crate::run_cmd::OutputError(format!("cannot write `{}`", path.display()))
+fn output_error(path: &Path) -> crate::output_error::OutputError {
+    crate::output_error::OutputError(format!("cannot write `{}`", path.display()))
 }
 
 impl Recorder {

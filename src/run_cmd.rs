@@ -17,6 +17,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::experiment::{RunOptions, RunOutput, build_world, run_one};
+use crate::output_error::OutputError;
 use crate::plot::{
     ArenaFigure, LearningFigure, Panel, Series, SpaceTimeFigure, arena_figure_panels,
     learning_figure, spacetime_figure,
@@ -444,13 +445,6 @@ fn run_counts(s: &Scenario, threads: usize) -> (u64, u64) {
     (runs, runs.min(threads as u64).max(1))
 }
 
-/// Whether `e` is an output that could not be written ([`OutputError`] anywhere in its chain
-/// of contexts): the tool failed (exit status 1), not the input.
-#[must_use]
-pub fn is_output_error(e: &anyhow::Error) -> bool {
-    e.downcast_ref::<OutputError>().is_some()
-}
-
 /// The memory the machine has available now (`MemAvailable` of /proc/meminfo), if known.
 fn available_memory() -> Option<u64> {
     let text = std::fs::read_to_string("/proc/meminfo").ok()?;
@@ -713,19 +707,6 @@ pub fn default_out_name(what: &str) -> String {
         clean
     }
 }
-
-/// An output that cannot be written (the tool failed: exit status 1), as the context of the
-/// error that says why.
-#[derive(Debug)]
-pub struct OutputError(pub String);
-
-impl std::fmt::Display for OutputError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.0)
-    }
-}
-
-impl std::error::Error for OutputError {}
 
 /// A staging folder beside the output folder: `<parent>/.<name>.partial-<pid>`, registered
 /// for removal on SIGINT, SIGTERM and SIGHUP ([`crate::cleanup`]) while it exists.
@@ -1838,18 +1819,6 @@ mod tests {
         };
         let e = check_memory_within(&s, 2, Some(1 << 40), 0, &small_as).unwrap_err();
         assert!(e.to_string().contains("ulimit -v"), "{e}");
-    }
-
-    #[test]
-    fn output_errors_are_found_under_any_context() {
-        let direct = anyhow::Error::new(OutputError("cannot write".into()));
-        assert!(is_output_error(&direct));
-        let wrapped = anyhow::Error::new(std::io::Error::other("disk full"))
-            .context(OutputError("cannot write `metrics.csv`".into()))
-            .context("the run into `out` failed; nothing was written");
-        assert!(is_output_error(&wrapped));
-        let input = anyhow::anyhow!("`steps` = 0 is out of range").context("scenario file");
-        assert!(!is_output_error(&input));
     }
 
     #[test]
