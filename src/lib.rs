@@ -27,3 +27,4 @@ pub mod scenario;
 pub mod seeds;
 pub mod summary;
 pub mod sweep;
+pub mod text;

@@ -17,7 +17,7 @@ use std::io::{self, BufRead, BufReader, BufWriter, Write};
 use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand};
-use h8swarm::sweep::spec::printable;
+use h8swarm::text::printable;
 
 /// Hardware-faithful, fixed-point emulator of the Hartono–Kakita (2008) swarm of H8/3052F robots
 /// that learn obstacle avoidance together.

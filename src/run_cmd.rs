@@ -156,8 +156,8 @@ fn replay_plan(a: &RunArgs, s: &Scenario) -> Result<Option<ReplayPlan>> {
                 let r: u32 = part.trim().parse().map_err(|_| {
                     anyhow::anyhow!(
                         "--replay-repeats `{}`: `{}` is not a repeat: give repeats 0 to {} separated by commas, or `all`",
-                        crate::sweep::spec::one_line(list),
-                        crate::sweep::spec::one_line(part),
+                        crate::text::one_line(list),
+                        crate::text::one_line(part),
                         s.repeats - 1
                     )
                 })?;
@@ -302,7 +302,7 @@ pub fn run(a: &RunArgs) -> Result<String> {
     if let Some(image) = &unconfigured {
         eprintln!(
             "warning: {}: the image has no configuration block, so it runs with its own built-in settings, not the scenario's learner, timing and sensor settings (summary.json says \"image_configured\": false); give its symbol table (IMAGE.sym beside it, or controller.symbols) to configure it",
-            crate::sweep::spec::printable(image)
+            crate::text::printable(image)
         );
     }
     let max_threads = max_threads();

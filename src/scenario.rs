@@ -435,7 +435,7 @@ impl Scenario {
     pub fn from_toml(text: &str) -> Result<Self> {
         // One line: where (line, column, the line's text) and what.
         let file: ScenarioFile = toml::from_str(text)
-            .map_err(|e| anyhow::anyhow!("{}", crate::sweep::spec::toml_error(text, &e)))?;
+            .map_err(|e| anyhow::anyhow!("{}", crate::text::toml_error(text, &e)))?;
         let mut s = Self::builtin(file.base.as_deref().unwrap_or("arena")).context("key `base`")?;
         if let Some(v) = file.name {
             s.name = v;

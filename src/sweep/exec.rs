@@ -298,7 +298,7 @@ pub fn run_task(
     for name in remove_dead_leftovers(&points)? {
         eprintln!(
             "removed points/{}: left by a task that was killed",
-            super::spec::printable(&name)
+            crate::text::printable(&name)
         );
     }
     let share: Vec<&PlanLine> = lines
@@ -339,7 +339,7 @@ pub fn run_task(
             }
         };
         // One line per point as it ends, for Slurm's log (standard output holds the totals).
-        eprintln!("{}", super::spec::printable(&line_text));
+        eprintln!("{}", crate::text::printable(&line_text));
     }
     let _ = writeln!(
         t,

@@ -34,7 +34,7 @@ use super::SweepError;
 use super::exec::{PointState, point_state};
 use super::figures::{ClaimSeries, PointClaim, cell_values, claim_figures, region};
 use super::plan::read_plan;
-use super::spec::printable;
+use crate::text::printable;
 
 /// The statistics of a window in the order the table lists them (others follow, sorted).
 const STAT_ORDER: [&str; 9] = [

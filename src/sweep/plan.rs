@@ -542,7 +542,7 @@ pub fn write_plan(
     })?;
     write_atomic(&dir.join("plan.json"), plan_json.as_bytes())?;
     write_atomic(&dir.join("sweep.sbatch"), script.as_bytes())?;
-    let dir_text = super::spec::printable(&dir.display().to_string());
+    let dir_text = crate::text::printable(&dir.display().to_string());
 
     let mut t = String::new();
     let _ = writeln!(
