@@ -36,7 +36,7 @@ fn swarm(robots: usize, parallel: bool, firmware: bool) -> Swarm {
     s.robots = robots;
     s.steps = LIFE as u32;
     if firmware {
-        s.controller.kind = h8swarm::fit::ControllerKind::Firmware;
+        s.controller.kind = h8swarm::scenario::ControllerKind::Firmware;
     }
     let images = Images::load(&s).expect("the robot firmware");
     let mut swarm =

@@ -8,9 +8,10 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use crate::fit::{
-    Budget, ControllerKind, FirmwareUnderTest, FitConfig, FitReport, fit_weight_seed,
-    largest_fitting, measure, robot_phases,
+    Budget, FirmwareUnderTest, FitConfig, FitReport, fit_weight_seed, largest_fitting, measure,
+    robot_phases,
 };
+use crate::scenario::ControllerKind;
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use emu::board::firmware::Firmware;
@@ -396,8 +397,10 @@ fn render(s: &mut String, name: &str, r: &FitReport) {
         s,
         "measured: {}{}",
         match r.controller {
-            crate::fit::ControllerKind::Firmware => format!("{} on the H8/300H core", r.source),
-            crate::fit::ControllerKind::Model => "the Rust model of the controller".to_string(),
+            crate::scenario::ControllerKind::Firmware =>
+                format!("{} on the H8/300H core", r.source),
+            crate::scenario::ControllerKind::Model =>
+                "the Rust model of the controller".to_string(),
         },
         match &r.compared_with {
             Some(o) => format!("; beside it: {o}"),
@@ -408,8 +411,8 @@ fn render(s: &mut String, name: &str, r: &FitReport) {
         format!(
             " {:>12} {:>7}",
             match r.controller {
-                crate::fit::ControllerKind::Firmware => "model mean",
-                crate::fit::ControllerKind::Model => "fw mean",
+                crate::scenario::ControllerKind::Firmware => "model mean",
+                crate::scenario::ControllerKind::Model => "fw mean",
             },
             "ratio"
         )

@@ -204,7 +204,7 @@ fn probed_robot(option: &str, k: usize, s: &Scenario) -> Result<usize> {
             s.robots - 1
         );
     }
-    if s.controller.kind != crate::fit::ControllerKind::Firmware {
+    if s.controller.kind != crate::scenario::ControllerKind::Firmware {
         bail!(
             "{option} {k}: robot {k} runs the Rust model, which has no firmware to look at (use --controller firmware, or --firmware IMAGE)"
         );
@@ -284,15 +284,15 @@ pub fn run(a: &RunArgs) -> Result<String> {
     let mut s = Scenario::load(what)?;
     if let Some(k) = a.controller {
         s.controller.kind = match k {
-            crate::fit_cmd::ControllerArg::Firmware => crate::fit::ControllerKind::Firmware,
-            crate::fit_cmd::ControllerArg::Model => crate::fit::ControllerKind::Model,
+            crate::fit_cmd::ControllerArg::Firmware => crate::scenario::ControllerKind::Firmware,
+            crate::fit_cmd::ControllerArg::Model => crate::scenario::ControllerKind::Model,
         };
     }
     if let Some(image) = &a.firmware {
         if a.controller == Some(crate::fit_cmd::ControllerArg::Model) {
             bail!("--firmware runs an image on the core: it cannot go with --controller model");
         }
-        s.controller.kind = crate::fit::ControllerKind::Firmware;
+        s.controller.kind = crate::scenario::ControllerKind::Firmware;
         s.controller.image = Some(image.display().to_string());
     }
     let s = s.with_overrides(a.robots, a.steps, a.repeats, a.seed)?;
@@ -423,8 +423,8 @@ pub const BASE_BYTES: u64 = 64 << 20;
 pub fn estimated_memory(s: &Scenario, threads: usize) -> u64 {
     let (runs, at_once) = run_counts(s, threads);
     let per_robot = match s.controller.kind {
-        crate::fit::ControllerKind::Firmware => FIRMWARE_ROBOT_BYTES,
-        crate::fit::ControllerKind::Model => MODEL_ROBOT_BYTES,
+        crate::scenario::ControllerKind::Firmware => FIRMWARE_ROBOT_BYTES,
+        crate::scenario::ControllerKind::Model => MODEL_ROBOT_BYTES,
     };
     BASE_BYTES
         .saturating_add(
@@ -1036,7 +1036,7 @@ fn run_into(
         controller: controller_config(s, crate::fit::fit_weight_seed(s.seed))?,
         steps: 400,
         seed: s.seed,
-        kind: crate::fit::ControllerKind::Firmware,
+        kind: crate::scenario::ControllerKind::Firmware,
         firmware: crate::fit::FirmwareUnderTest::robot()?,
         compare: true,
     })?;
@@ -1209,8 +1209,8 @@ fn write_replay(
         stride: plan.opts.stride,
         step_period_s: s.timing.step_period_s,
         controller: match s.controller.kind {
-            crate::fit::ControllerKind::Firmware => "firmware".into(),
-            crate::fit::ControllerKind::Model => "model".into(),
+            crate::scenario::ControllerKind::Firmware => "firmware".into(),
+            crate::scenario::ControllerKind::Model => "model".into(),
         },
         seed: s.seed,
         weights_shape: [n_in, s.learner.behaviours],

@@ -47,7 +47,7 @@ fn firmware_learner(r: &Robot, n_in: usize, m: usize) -> (Vec<i16>, Vec<i8>, Vec
 
 fn side_by_side(corridor: bool, condition: Condition, steps: u32) -> (u64, i64) {
     let mut s = scenario(corridor);
-    s.controller.kind = h8swarm::fit::ControllerKind::Firmware;
+    s.controller.kind = h8swarm::scenario::ControllerKind::Firmware;
     let images = Images::load(&s).unwrap();
     let mut fw = Robot::new(&s, condition, 0, 0, images.as_ref()).unwrap();
     let mut model = Robot::new(&s, condition, 0, 0, None).unwrap();

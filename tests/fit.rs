@@ -5,7 +5,8 @@
 use std::process::Command;
 
 use emu::board::model::ControllerConfig;
-use h8swarm::fit::{ControllerKind, FirmwareUnderTest, FitConfig, fit_weight_seed, measure};
+use h8swarm::fit::{FirmwareUnderTest, FitConfig, fit_weight_seed, measure};
+use h8swarm::scenario::ControllerKind;
 use nn_q15::InputLayout;
 
 fn config(behaviours: usize, layout: InputLayout, corridor: bool) -> FitConfig {

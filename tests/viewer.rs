@@ -397,7 +397,7 @@ fn the_viewer_shows_the_run_as_recorded() {
         .unwrap()
         .with_overrides(None, Some(60), Some(1), None)
         .unwrap();
-    s.controller.kind = h8swarm::fit::ControllerKind::Firmware;
+    s.controller.kind = h8swarm::scenario::ControllerKind::Firmware;
     check_page(&browser, &fw, &s, 41, "firmware");
 }
 

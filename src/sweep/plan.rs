@@ -30,7 +30,7 @@ use serde::{Deserialize, Serialize};
 
 use super::spec::{Axis, Point, SlurmSpec, Sweep};
 use super::{SweepError, write_atomic};
-use crate::fit::ControllerKind;
+use crate::scenario::ControllerKind;
 
 /// Default points per array task.
 pub const DEFAULT_POINTS_PER_TASK: usize = 1;
