@@ -38,7 +38,6 @@ use world::{Arena, SensorMount, SubstepPlan, World, WorldParams};
 
 use crate::collisions::{ContactMeter, RobotTally, StuckDetector};
 
-use crate::plot::Outline;
 use crate::robot::{Condition, Images, Robot};
 use crate::scenario::{ArenaKind, Scenario};
 use crate::seeds::world_seed;
@@ -100,6 +99,19 @@ pub struct Track {
     /// Corridor only: per tracked robot, (step, position along the corridor in metres) every
     /// [`spacetime_stride`] steps and at the last step, for the space-time figure.
     pub spacetime: Vec<Vec<(f64, f64)>>,
+}
+
+/// A robot's outline at one instant.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Outline {
+    /// Robot number (the index of its path in a figure's paths).
+    pub robot: usize,
+    /// Time of the snapshot in seconds; outlines with equal times share a legend entry.
+    pub time_s: f64,
+    /// Corners of the body in metres, in order around it.
+    pub corners: [(f64, f64); 4],
+    /// Heading as a unit vector (any non-zero length is accepted and normalised).
+    pub heading: (f64, f64),
 }
 
 /// The space-time figure's most samples per robot.

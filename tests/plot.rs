@@ -1,13 +1,13 @@
 //! Tests of the figures module (`src/plot.rs`) through its public API: files written and valid,
 //! output bytes deterministic, bad data and bad paths reported as errors.
 
+use h8swarm::experiment::Outline;
 use h8swarm::plot;
 
 use std::path::{Path, PathBuf};
 
 use plot::{
-    ArenaFigure, LEARNING_SIZE_PX, LearningFigure, Outline, PlotError, Series, arena_figure,
-    learning_figure,
+    ArenaFigure, LEARNING_SIZE_PX, LearningFigure, PlotError, Series, arena_figure, learning_figure,
 };
 
 /// A fresh, empty folder for one test's files.
