@@ -10,6 +10,7 @@
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 
+pub mod battery;
 pub mod cleanup;
 pub mod collisions;
 pub mod cost_report;

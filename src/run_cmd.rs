@@ -271,7 +271,7 @@ struct Summary<'a> {
     /// settings, not the scenario's); absent otherwise.
     #[serde(skip_serializing_if = "Option::is_none")]
     image_configured: Option<bool>,
-    battery: &'a crate::energy::BatteryReport,
+    battery: &'a crate::battery::BatteryReport,
 }
 
 /// Runs the experiment; returns the text to print.
@@ -1417,20 +1417,20 @@ fn fmt_mean(e: &Estimate) -> String {
     }
 }
 
-/// The battery life of each condition ([`crate::energy::BatteryReport`]) for the pack
+/// The battery life of each condition ([`crate::battery::BatteryReport`]) for the pack
 /// `--capacity-mah` gives.
 fn battery_report(
     a: &RunArgs,
     s: &Scenario,
     stats: &[ConditionStats],
     runs: &[RunOutput],
-) -> Result<crate::energy::BatteryReport> {
+) -> Result<crate::battery::BatteryReport> {
     let pack = crate::energy::Pack::paper(crate::fit_cmd::parse_capacity(a.capacity_mah)?);
-    let mut b = crate::energy::BatteryReport::of(stats, pack, s.timing.step_period_s);
+    let mut b = crate::battery::BatteryReport::of(stats, pack, s.timing.step_period_s);
     let robot_seconds = s.robots as f64 * f64::from(s.steps) * s.timing.step_period_s;
     for c in stats {
         let of_c: Vec<&RunOutput> = runs.iter().filter(|r| r.condition == c.condition).collect();
-        b.by_part.push(crate::energy::ConditionParts::of(
+        b.by_part.push(crate::battery::ConditionParts::of(
             c.condition,
             &of_c,
             robot_seconds,
@@ -1441,7 +1441,7 @@ fn battery_report(
 
 /// The battery lines of the summary: each condition's battery life in its first and last
 /// windows, its mean current by part, and what learning costs or saves against the controls.
-fn render_battery(t: &mut String, b: &crate::energy::BatteryReport) {
+fn render_battery(t: &mut String, b: &crate::battery::BatteryReport) {
     let _ = writeln!(t);
     let _ = writeln!(
         t,
