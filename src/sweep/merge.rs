@@ -31,9 +31,9 @@ use std::path::{Path, PathBuf};
 use serde_json::{Map, Value, json};
 
 use super::SweepError;
-use super::exec::{PointState, point_state};
 use super::figures::{ClaimSeries, PointClaim, cell_values, claim_figures, region};
 use super::plan::read_plan;
+use super::points::{PointState, host_name, is_dead_leftover, point_state, read_summary};
 use crate::text::printable;
 
 /// The statistics of a window in the order the table lists them (others follow, sorted).
@@ -289,19 +289,6 @@ pub fn collect(
     Ok((plan, lines, m))
 }
 
-/// A finished point's `summary.json`, or why it cannot be read (an object with its
-/// `conditions` and `claims`).
-pub(crate) fn read_summary(path: &Path) -> Result<Value, String> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| format!("its summary.json cannot be read: {e}"))?;
-    let v: Value =
-        serde_json::from_str(&text).map_err(|e| format!("its summary.json is not JSON: {e}"))?;
-    if !(v["conditions"].is_array() && v["claims"].is_array()) {
-        return Err("its summary.json has no `conditions` and `claims` lists".into());
-    }
-    Ok(v)
-}
-
 /// Leftover temporary folders under `points/` (tasks running now, or killed).
 fn temporaries(points: &Path) -> Vec<String> {
     let mut out: Vec<String> = std::fs::read_dir(points)
@@ -468,9 +455,9 @@ pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepErro
             printable(why)
         );
     }
-    let host = super::exec::host_name();
+    let host = host_name();
     for tmp in temporaries(&dir.join("points")) {
-        let _ = if super::exec::is_dead_leftover(&tmp, &host) {
+        let _ = if is_dead_leftover(&tmp, &host) {
             writeln!(
                 t,
                 "LEFTOVER points/{} (its task was killed; the next `sweep run` removes it)",

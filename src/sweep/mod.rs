@@ -25,6 +25,7 @@ pub mod exec;
 pub mod figures;
 pub mod merge;
 pub mod plan;
+pub mod points;
 pub mod spec;
 
 use std::path::{Path, PathBuf};
