@@ -874,9 +874,10 @@ impl Swarm {
         let end = self.world.elapsed_states() + self.period_states;
         self.close_step(end)?;
         if let Some(mut rows) = self.rows.take() {
-            rows.w.flush().map_err(anyhow::Error::new).context(
-                crate::output_error::OutputError(format!("cannot write `{}`", rows.path.display())),
-            )?;
+            rows.w
+                .flush()
+                .map_err(anyhow::Error::new)
+                .context(crate::output_error::OutputError::cannot_write(&rows.path))?;
         }
         let dead = self.dead();
         for t in &mut self.tallies {

@@ -29,3 +29,4 @@ pub mod seeds;
 pub mod summary;
 pub mod sweep;
 pub mod text;
+pub mod viewer;

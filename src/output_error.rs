@@ -14,6 +14,14 @@ impl std::fmt::Display for OutputError {
 
 impl std::error::Error for OutputError {}
 
+impl OutputError {
+    /// The file at `path` cannot be written.
+    #[must_use]
+    pub fn cannot_write(path: &std::path::Path) -> Self {
+        OutputError(format!("cannot write `{}`", path.display()))
+    }
+}
+
 /// Whether `e` is an output that could not be written ([`OutputError`] anywhere in its chain
 /// of contexts): the tool failed (exit status 1), not the input.
 #[must_use]

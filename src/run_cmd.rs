@@ -1143,7 +1143,8 @@ fn write_replay(
     arena: &world::Arena,
     runs: &[RunOutput],
 ) -> Result<()> {
-    use crate::recording::{CurveHeader, Header, MountHeader, RunHeader, part_paths};
+    use crate::recording::part_paths;
+    use crate::viewer::{CurveHeader, Header, MountHeader, RunHeader};
     let mut headers = Vec::new();
     let mut parts = Vec::new();
     for r in runs {
@@ -1219,7 +1220,7 @@ fn write_replay(
         runs: headers,
         curves,
     };
-    crate::recording::write_viewer(html, &header, &parts)
+    crate::viewer::write_viewer(html, &header, &parts)
 }
 
 /// `n` and the noun, plural when `n` is not 1.
@@ -1544,13 +1545,12 @@ fn write_robots(path: &Path, runs: &[RunOutput]) -> Result<()> {
         w.flush()?;
         Ok(())
     };
-    write().context(OutputError(format!("cannot write `{}`", path.display())))
+    write().context(OutputError::cannot_write(path))
 }
 
 /// Joins the runs' row files (in run order) under the header into `path`, removing them.
 fn write_metrics(path: &Path, parts: &[PathBuf]) -> Result<()> {
-    write_metrics_csv(path, parts)
-        .context(OutputError(format!("cannot write `{}`", path.display())))
+    write_metrics_csv(path, parts).context(OutputError::cannot_write(path))
 }
 
 fn write_metrics_csv(path: &Path, parts: &[PathBuf]) -> Result<()> {
