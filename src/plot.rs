@@ -6,7 +6,7 @@
 //!   band `[lo, hi]`; the learning run is drawn solid over a translucent band, the controls the
 //!   paper lacks (learning off, random walk) dashed.
 //! * [`arena_figure`]: the paper's Fig. 8 — the arena seen from above, in metres at equal aspect
-//!   ratio, with every robot's trajectory and its outline at a few instants ([`Outline`](crate::experiment::Outline)).
+//!   ratio, with every robot's trajectory and its outline at a few instants ([`Outline`](swarm::experiment::Outline)).
 //!
 //! Choices where the spec is silent (docs/design.md §5 names the metrics, not the drawing):
 //! * **Font.** DejaVu Sans 2.37 (`assets/DejaVuSans.ttf`, licence in
@@ -41,7 +41,7 @@ use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use crate::experiment::Outline;
+use swarm::experiment::Outline;
 
 /// Size in pixels of the learning figure (PNG and SVG): two panels side by side, with a
 /// one-row legend under them. Each further legend row (many or long labels) adds

@@ -16,15 +16,15 @@ use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::experiment::{RunOptions, RunOutput, build_world, run_one};
-use crate::output_error::OutputError;
 use crate::plot::{
     ArenaFigure, LearningFigure, Panel, Series, SpaceTimeFigure, arena_figure_panels,
     learning_figure, spacetime_figure,
 };
-use crate::robot::{Condition, controller_config};
-use crate::scenario::Scenario;
-use crate::summary::{Analysis, Claim, ConditionStats, Estimate, Pairing, Quantity, analyse};
+use swarm::experiment::{RunOptions, RunOutput, build_world, run_one};
+use swarm::output_error::OutputError;
+use swarm::robot::{Condition, controller_config};
+use swarm::scenario::Scenario;
+use swarm::summary::{Analysis, Claim, ConditionStats, Estimate, Pairing, Quantity, analyse};
 
 /// Options of `h8swarm run`.
 #[derive(Args, Debug, Default, Clone)]
@@ -134,7 +134,7 @@ impl From<StackGuardArg> for emu::core::cpu::StackGuardMode {
 /// What `--replay` asks for, checked.
 #[derive(Clone, Debug)]
 struct ReplayPlan {
-    opts: crate::recording::RecordOptions,
+    opts: swarm::recording::RecordOptions,
     repeats: Vec<u32>,
     robots: usize,
 }
@@ -156,8 +156,8 @@ fn replay_plan(a: &RunArgs, s: &Scenario) -> Result<Option<ReplayPlan>> {
                 let r: u32 = part.trim().parse().map_err(|_| {
                     anyhow::anyhow!(
                         "--replay-repeats `{}`: `{}` is not a repeat: give repeats 0 to {} separated by commas, or `all`",
-                        crate::text::one_line(list),
-                        crate::text::one_line(part),
+                        swarm::text::one_line(list),
+                        swarm::text::one_line(part),
                         s.repeats - 1
                     )
                 })?;
@@ -185,7 +185,7 @@ fn replay_plan(a: &RunArgs, s: &Scenario) -> Result<Option<ReplayPlan>> {
         );
     }
     Ok(Some(ReplayPlan {
-        opts: crate::recording::RecordOptions::for_steps(s.steps, a.replay_stride),
+        opts: swarm::recording::RecordOptions::for_steps(s.steps, a.replay_stride),
         repeats,
         robots,
     }))
@@ -204,7 +204,7 @@ fn probed_robot(option: &str, k: usize, s: &Scenario) -> Result<usize> {
             s.robots - 1
         );
     }
-    if s.controller.kind != crate::scenario::ControllerKind::Firmware {
+    if s.controller.kind != swarm::scenario::ControllerKind::Firmware {
         bail!(
             "{option} {k}: robot {k} runs the Rust model, which has no firmware to look at (use --controller firmware, or --firmware IMAGE)"
         );
@@ -214,8 +214,8 @@ fn probed_robot(option: &str, k: usize, s: &Scenario) -> Result<usize> {
 
 /// The probes `--vcd` and `--gdb` ask for, checked (a bad value fails before any run); the
 /// GDB stub is listening when this returns.
-fn probes(a: &RunArgs, s: &Scenario) -> Result<crate::experiment::RobotProbes> {
-    let mut p = crate::experiment::RobotProbes::default();
+fn probes(a: &RunArgs, s: &Scenario) -> Result<swarm::experiment::RobotProbes> {
+    let mut p = swarm::experiment::RobotProbes::default();
     if let Some(path) = &a.vcd {
         let robot = probed_robot("--vcd-robot", a.vcd_robot.unwrap_or(0), s)?;
         let from = a.vcd_from.unwrap_or(0);
@@ -237,7 +237,7 @@ fn probes(a: &RunArgs, s: &Scenario) -> Result<crate::experiment::RobotProbes> {
                 "--vcd: cannot create `{}`",
                 path.display()
             )))?;
-        p.vcd = Some(crate::experiment::VcdProbe {
+        p.vcd = Some(swarm::experiment::VcdProbe {
             robot,
             from,
             steps: steps.min(s.steps - from),
@@ -271,7 +271,7 @@ struct Summary<'a> {
     /// settings, not the scenario's); absent otherwise.
     #[serde(skip_serializing_if = "Option::is_none")]
     image_configured: Option<bool>,
-    battery: &'a crate::battery::BatteryReport,
+    battery: &'a swarm::battery::BatteryReport,
 }
 
 /// Runs the experiment; returns the text to print.
@@ -284,25 +284,25 @@ pub fn run(a: &RunArgs) -> Result<String> {
     let mut s = Scenario::load(what)?;
     if let Some(k) = a.controller {
         s.controller.kind = match k {
-            crate::fit_cmd::ControllerArg::Firmware => crate::scenario::ControllerKind::Firmware,
-            crate::fit_cmd::ControllerArg::Model => crate::scenario::ControllerKind::Model,
+            crate::fit_cmd::ControllerArg::Firmware => swarm::scenario::ControllerKind::Firmware,
+            crate::fit_cmd::ControllerArg::Model => swarm::scenario::ControllerKind::Model,
         };
     }
     if let Some(image) = &a.firmware {
         if a.controller == Some(crate::fit_cmd::ControllerArg::Model) {
             bail!("--firmware runs an image on the core: it cannot go with --controller model");
         }
-        s.controller.kind = crate::scenario::ControllerKind::Firmware;
+        s.controller.kind = swarm::scenario::ControllerKind::Firmware;
         s.controller.image = Some(image.display().to_string());
     }
     let s = s.with_overrides(a.robots, a.steps, a.repeats, a.seed)?;
     crate::fit_cmd::parse_capacity(a.capacity_mah)?;
-    let images = crate::robot::Images::load(&s)?;
+    let images = swarm::robot::Images::load(&s)?;
     let unconfigured = unconfigured_image(&s, images.as_ref())?;
     if let Some(image) = &unconfigured {
         eprintln!(
             "warning: {}: the image has no configuration block, so it runs with its own built-in settings, not the scenario's learner, timing and sensor settings (summary.json says \"image_configured\": false); give its symbol table (IMAGE.sym beside it, or controller.symbols) to configure it",
-            crate::text::printable(image)
+            swarm::text::printable(image)
         );
     }
     let max_threads = max_threads();
@@ -388,7 +388,7 @@ pub fn run(a: &RunArgs) -> Result<String> {
 /// An image without a configuration block and a control condition on.
 fn unconfigured_image(
     s: &Scenario,
-    images: Option<&crate::robot::Images>,
+    images: Option<&swarm::robot::Images>,
 ) -> Result<Option<String>> {
     let Some((fw, _)) = images.and_then(|i| i.user.as_ref()) else {
         return Ok(None);
@@ -423,8 +423,8 @@ pub const BASE_BYTES: u64 = 64 << 20;
 pub fn estimated_memory(s: &Scenario, threads: usize) -> u64 {
     let (runs, at_once) = run_counts(s, threads);
     let per_robot = match s.controller.kind {
-        crate::scenario::ControllerKind::Firmware => FIRMWARE_ROBOT_BYTES,
-        crate::scenario::ControllerKind::Model => MODEL_ROBOT_BYTES,
+        swarm::scenario::ControllerKind::Firmware => FIRMWARE_ROBOT_BYTES,
+        swarm::scenario::ControllerKind::Model => MODEL_ROBOT_BYTES,
     };
     BASE_BYTES
         .saturating_add(
@@ -895,9 +895,9 @@ pub const OUTPUT_FILES: [&str; 9] = [
 fn run_into(
     a: &RunArgs,
     s: &Scenario,
-    images: Option<&crate::robot::Images>,
+    images: Option<&swarm::robot::Images>,
     (probes, replay): (
-        &std::sync::Mutex<Option<crate::experiment::RobotProbes>>,
+        &std::sync::Mutex<Option<swarm::experiment::RobotProbes>>,
         Option<&ReplayPlan>,
     ),
     stage: &Stage,
@@ -948,7 +948,7 @@ fn run_into(
     let recorded = |c: Condition, r: u32| -> bool {
         replay.is_some_and(|p| p.repeats.contains(&r)) && kinds.contains(&c)
     };
-    let floor = crate::experiment::arena_of(s)?;
+    let floor = swarm::experiment::arena_of(s)?;
     let runs: Vec<RunOutput> = pool.install(|| {
         jobs.par_iter()
             .map(|&(c, r)| {
@@ -961,10 +961,10 @@ fn run_into(
                 };
                 let replay = match replay.filter(|_| recorded(c, r)) {
                     Some(p) => Some((
-                        crate::recording::Recorder::new(
+                        swarm::recording::Recorder::new(
                             p.opts.clone(),
                             (floor.width_m(), floor.height_m()),
-                            crate::recording::part_paths(&stage.dir, c, r),
+                            swarm::recording::part_paths(&stage.dir, c, r),
                         )?,
                         p.robots,
                     )),
@@ -1000,7 +1000,7 @@ fn run_into(
         s.robots,
         s.steps,
         s.window,
-        crate::seeds::bootstrap_seed(s.seed),
+        swarm::seeds::bootstrap_seed(s.seed),
     );
     let warnings = warnings(s);
     let saves: u64 = runs.iter().map(|r| r.saves).sum();
@@ -1032,12 +1032,12 @@ fn run_into(
         summary_path.display()
     )))?;
 
-    let fit = crate::fit::measure(&crate::fit::FitConfig {
-        controller: controller_config(s, crate::fit::fit_weight_seed(s.seed))?,
+    let fit = swarm::fit::measure(&swarm::fit::FitConfig {
+        controller: controller_config(s, swarm::fit::fit_weight_seed(s.seed))?,
         steps: 400,
         seed: s.seed,
-        kind: crate::scenario::ControllerKind::Firmware,
-        firmware: crate::fit::FirmwareUnderTest::robot()?,
+        kind: swarm::scenario::ControllerKind::Firmware,
+        firmware: swarm::fit::FirmwareUnderTest::robot()?,
         compare: true,
     })?;
     let fit_path = stage.path("fit.json");
@@ -1075,7 +1075,7 @@ fn run_into(
         names.push("replay.html".into());
     }
     if let Some(track) = runs.iter().find_map(|r| r.track.as_ref()) {
-        if s.arena == crate::scenario::ArenaKind::Corridor {
+        if s.arena == swarm::scenario::ArenaKind::Corridor {
             spacetime_figure(&spacetime(s, track), &stage.path("spacetime.png")).map_err(drawn)?;
             names.push("spacetime.png".into());
         } else {
@@ -1143,8 +1143,8 @@ fn write_replay(
     arena: &world::Arena,
     runs: &[RunOutput],
 ) -> Result<()> {
-    use crate::recording::part_paths;
     use crate::viewer::{CurveHeader, Header, MountHeader, RunHeader};
+    use swarm::recording::part_paths;
     let mut headers = Vec::new();
     let mut parts = Vec::new();
     for r in runs {
@@ -1177,18 +1177,18 @@ fn write_replay(
             stuck_percent: find(&fig.stuck, &d.label),
         })
         .collect();
-    let params = crate::experiment::world_params(s);
-    let n_in = crate::robot::controller_config(s, 0)?.n_inputs();
+    let params = swarm::experiment::world_params(s);
+    let n_in = swarm::robot::controller_config(s, 0)?.n_inputs();
     let header = Header {
-        version: crate::recording::VERSION,
+        version: swarm::recording::VERSION,
         name: s.name.clone(),
         arena: match s.arena {
-            crate::scenario::ArenaKind::Corridor => "corridor".into(),
-            crate::scenario::ArenaKind::Square => "square".into(),
+            swarm::scenario::ArenaKind::Corridor => "corridor".into(),
+            swarm::scenario::ArenaKind::Square => "square".into(),
         },
         width_m: arena.width_m(),
         height_m: arena.height_m(),
-        quantum_m: crate::recording::quantum_m(arena.width_m(), arena.height_m()),
+        quantum_m: swarm::recording::quantum_m(arena.width_m(), arena.height_m()),
         walls: arena
             .walls()
             .iter()
@@ -1210,8 +1210,8 @@ fn write_replay(
         stride: plan.opts.stride,
         step_period_s: s.timing.step_period_s,
         controller: match s.controller.kind {
-            crate::scenario::ControllerKind::Firmware => "firmware".into(),
-            crate::scenario::ControllerKind::Model => "model".into(),
+            swarm::scenario::ControllerKind::Firmware => "firmware".into(),
+            swarm::scenario::ControllerKind::Model => "model".into(),
         },
         seed: s.seed,
         weights_shape: [n_in, s.learner.behaviours],
@@ -1355,7 +1355,7 @@ fn report(t: &mut String, s: &Scenario, a: &Analysis) {
             p.both_stuck + p.neither,
             p.both_stuck,
             p.neither,
-            crate::summary::fmt_p(p.p)
+            swarm::summary::fmt_p(p.p)
         );
     }
     let _ = writeln!(t);
@@ -1388,7 +1388,7 @@ fn report(t: &mut String, s: &Scenario, a: &Analysis) {
     let paper: Vec<&Claim> = a.claims.iter().filter(|c| c.paper).collect();
     let held = paper
         .iter()
-        .filter(|c| c.outcome == crate::summary::Outcome::Holds)
+        .filter(|c| c.outcome == swarm::summary::Outcome::Holds)
         .count();
     let _ = writeln!(
         t,
@@ -1418,20 +1418,20 @@ fn fmt_mean(e: &Estimate) -> String {
     }
 }
 
-/// The battery life of each condition ([`crate::battery::BatteryReport`]) for the pack
+/// The battery life of each condition ([`swarm::battery::BatteryReport`]) for the pack
 /// `--capacity-mah` gives.
 fn battery_report(
     a: &RunArgs,
     s: &Scenario,
     stats: &[ConditionStats],
     runs: &[RunOutput],
-) -> Result<crate::battery::BatteryReport> {
-    let pack = crate::energy::Pack::paper(crate::fit_cmd::parse_capacity(a.capacity_mah)?);
-    let mut b = crate::battery::BatteryReport::of(stats, pack, s.timing.step_period_s);
+) -> Result<swarm::battery::BatteryReport> {
+    let pack = swarm::energy::Pack::paper(crate::fit_cmd::parse_capacity(a.capacity_mah)?);
+    let mut b = swarm::battery::BatteryReport::of(stats, pack, s.timing.step_period_s);
     let robot_seconds = s.robots as f64 * f64::from(s.steps) * s.timing.step_period_s;
     for c in stats {
         let of_c: Vec<&RunOutput> = runs.iter().filter(|r| r.condition == c.condition).collect();
-        b.by_part.push(crate::battery::ConditionParts::of(
+        b.by_part.push(swarm::battery::ConditionParts::of(
             c.condition,
             &of_c,
             robot_seconds,
@@ -1442,7 +1442,7 @@ fn battery_report(
 
 /// The battery lines of the summary: each condition's battery life in its first and last
 /// windows, its mean current by part, and what learning costs or saves against the controls.
-fn render_battery(t: &mut String, b: &crate::battery::BatteryReport) {
+fn render_battery(t: &mut String, b: &swarm::battery::BatteryReport) {
     let _ = writeln!(t);
     let _ = writeln!(
         t,
@@ -1555,7 +1555,7 @@ fn write_metrics(path: &Path, parts: &[PathBuf]) -> Result<()> {
 
 fn write_metrics_csv(path: &Path, parts: &[PathBuf]) -> Result<()> {
     let mut w = csv::Writer::from_path(path)?;
-    w.write_record(crate::experiment::METRICS_HEADER)?;
+    w.write_record(swarm::experiment::METRICS_HEADER)?;
     let mut out = w
         .into_inner()
         .map_err(|e| anyhow::anyhow!("{}", e.error()))?;
@@ -1582,7 +1582,7 @@ fn learning(s: &Scenario, runs: &[RunOutput]) -> LearningFigure {
         .map(|r| r.metrics.whole_windows().len())
         .min()
         .unwrap_or(0);
-    let seed = crate::seeds::bootstrap_seed(s.seed);
+    let seed = swarm::seeds::bootstrap_seed(s.seed);
     let panel = |q: Quantity| -> Vec<Series> {
         let mut out = Vec::new();
         for c in Condition::ALL {
@@ -1679,7 +1679,7 @@ fn learning(s: &Scenario, runs: &[RunOutput]) -> LearningFigure {
 
 /// The corridor's space-time figure: each tracked robot's position along the corridor over
 /// the run (learning, repeat 0).
-fn spacetime(s: &Scenario, t: &crate::experiment::Track) -> SpaceTimeFigure {
+fn spacetime(s: &Scenario, t: &swarm::experiment::Track) -> SpaceTimeFigure {
     let length_m = t
         .walls
         .iter()
@@ -1697,10 +1697,10 @@ fn spacetime(s: &Scenario, t: &crate::experiment::Track) -> SpaceTimeFigure {
 }
 
 /// The arena figure as the paper's Fig. 8 shows learning: the first and the last
-/// [`crate::experiment::SNAPSHOT_STEPS`] steps' paths in two panels, with the outlines at the
+/// [`swarm::experiment::SNAPSHOT_STEPS`] steps' paths in two panels, with the outlines at the
 /// start and the end of each.
-fn arena(s: &Scenario, t: &crate::experiment::Track) -> Vec<ArenaFigure> {
-    let k = crate::experiment::SNAPSHOT_STEPS.min(s.steps as usize);
+fn arena(s: &Scenario, t: &swarm::experiment::Track) -> Vec<ArenaFigure> {
+    let k = swarm::experiment::SNAPSHOT_STEPS.min(s.steps as usize);
     let n = s.steps as usize;
     let first_of = |from: usize, to: usize| -> ArenaFigure {
         let paths = if from == 0 { &t.early } else { &t.late }.clone();

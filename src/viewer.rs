@@ -1,5 +1,5 @@
 //! The browser viewer's page (`h8swarm run --replay`): the runs' recorded planes
-//! ([`crate::recording`]) joined behind a header (JSON: the arena, the bodies, the sensors, the
+//! ([`swarm::recording`]) joined behind a header (JSON: the arena, the bodies, the sensors, the
 //! runs, the learning curves) into one stream, compressed (gzip), encoded in base64 and written
 //! into a copy of the viewer page (`assets/viewer.html`), so the page opens from the file
 //! system with nothing else: no server, no network. The format, byte by byte, is in
@@ -8,10 +8,10 @@
 use std::io::{BufWriter, Read, Write};
 use std::path::{Path, PathBuf};
 
-use crate::output_error::OutputError;
-use crate::recording::{E_PLANE, MAGIC, PLANES, VERSION};
 use anyhow::{Context, Result, bail};
 use serde::{Deserialize, Serialize};
+use swarm::output_error::OutputError;
+use swarm::recording::{E_PLANE, MAGIC, PLANES, VERSION};
 
 /// The viewer page, with `/*H8SWARM_REPLAY_DATA*/` where the data go.
 pub const VIEWER_TEMPLATE: &str = include_str!("../assets/viewer.html");
@@ -297,8 +297,8 @@ pub fn decode(html: &str) -> Result<Decoded> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::recording::{RecordOptions, Recorder, RobotStep, flag, part_paths, quantum_m};
-    use crate::robot::Condition;
+    use swarm::recording::{RecordOptions, Recorder, RobotStep, flag, part_paths, quantum_m};
+    use swarm::robot::Condition;
 
     fn robot(i: usize, k: u32) -> RobotStep {
         let t = f64::from(k);

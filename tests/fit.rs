@@ -5,9 +5,9 @@
 use std::process::Command;
 
 use emu::board::model::ControllerConfig;
-use h8swarm::fit::{FirmwareUnderTest, FitConfig, fit_weight_seed, measure};
-use h8swarm::scenario::ControllerKind;
 use nn_q15::InputLayout;
+use swarm::fit::{FirmwareUnderTest, FitConfig, fit_weight_seed, measure};
+use swarm::scenario::ControllerKind;
 
 fn config(behaviours: usize, layout: InputLayout, corridor: bool) -> FitConfig {
     let seed = 3;

@@ -1,8 +1,8 @@
 //! Tests of the figures module (`src/plot.rs`) through its public API: files written and valid,
 //! output bytes deterministic, bad data and bad paths reported as errors.
 
-use h8swarm::experiment::Outline;
 use h8swarm::plot;
+use swarm::experiment::Outline;
 
 use std::path::{Path, PathBuf};
 

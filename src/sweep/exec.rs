@@ -203,7 +203,7 @@ pub fn run_task(
     for name in remove_dead_leftovers(&points)? {
         eprintln!(
             "removed points/{}: left by a task that was killed",
-            crate::text::printable(&name)
+            swarm::text::printable(&name)
         );
     }
     let share: Vec<&PlanLine> = lines
@@ -244,7 +244,7 @@ pub fn run_task(
             }
         };
         // One line per point as it ends, for Slurm's log (standard output holds the totals).
-        eprintln!("{}", crate::text::printable(&line_text));
+        eprintln!("{}", swarm::text::printable(&line_text));
     }
     let _ = writeln!(
         t,

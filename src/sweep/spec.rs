@@ -38,8 +38,8 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use crate::scenario::{Scenario, ScenarioFile};
-use crate::text::{one_line, toml_error};
+use swarm::scenario::{Scenario, ScenarioFile};
+use swarm::text::{one_line, toml_error};
 
 use super::SweepError;
 
