@@ -890,111 +890,37 @@ pub const OUTPUT_FILES: [&str; 9] = [
     "replay.html",
 ];
 
+/// The probes of one robot, taken by the first run that asks for them.
+type SharedProbes = std::sync::Mutex<Option<swarm::experiment::RobotProbes>>;
+
 /// Runs the experiment, writing its files into `stage`; returns the text to print and the
 /// files written.
 fn run_into(
     a: &RunArgs,
     s: &Scenario,
     images: Option<&swarm::robot::Images>,
-    (probes, replay): (
-        &std::sync::Mutex<Option<swarm::experiment::RobotProbes>>,
-        Option<&ReplayPlan>,
-    ),
+    (probes, replay): (&SharedProbes, Option<&ReplayPlan>),
     stage: &Stage,
     threads: usize,
 ) -> Result<(String, Vec<String>)> {
-    let metrics_path = stage.path("metrics.csv");
-
-    let mut jobs: Vec<(Condition, u32)> = Vec::new();
-    let mut kinds = vec![Condition::Learning];
-    if s.controls.learning_off {
-        kinds.push(Condition::LearningOff);
-    }
-    if s.controls.random_walk {
-        kinds.push(Condition::RandomWalk);
-    }
-    for c in &kinds {
-        for r in 0..s.repeats {
-            jobs.push((*c, r));
-        }
-    }
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .context("starting the worker threads")?;
-    let total = jobs.len() as u64 * u64::from(s.steps);
-    let bar = if std::io::stderr().is_terminal() {
-        let b = ProgressBar::new(total);
-        b.set_style(
-            ProgressStyle::with_template(
-                "{spinner} {elapsed_precise} [{bar:40}] {pos}/{len} robot-steps {msg} (eta {eta})",
-            )
-            .unwrap_or_else(|_| ProgressStyle::default_bar())
-            .progress_chars("=> "),
-        );
-        b.set_message(format!(
-            "x {} robots, {} runs on {threads} threads",
-            s.robots,
-            jobs.len()
-        ));
-        b
-    } else {
-        ProgressBar::hidden()
-    };
-    let started = Instant::now();
-    // Each run writes its rows as its steps complete into a file of its own in the staging
-    // folder; they are joined in run order into metrics.csv at the end.
-    let rows_path = |c: Condition, r: u32| stage.path(&format!(".rows-{}-{r}.csv", c.name()));
-    let recorded = |c: Condition, r: u32| -> bool {
-        replay.is_some_and(|p| p.repeats.contains(&r)) && kinds.contains(&c)
-    };
+    let (kinds, jobs) = run_jobs(s);
     let floor = swarm::experiment::arena_of(s)?;
-    let runs: Vec<RunOutput> = pool.install(|| {
-        jobs.par_iter()
-            .map(|&(c, r)| {
-                let track = c == Condition::Learning && r == 0;
-                // The probes go to the learning run's first repeat.
-                let probes = if track {
-                    probes.lock().ok().and_then(|mut p| p.take())
-                } else {
-                    None
-                };
-                let replay = match replay.filter(|_| recorded(c, r)) {
-                    Some(p) => Some((
-                        swarm::recording::Recorder::new(
-                            p.opts.clone(),
-                            (floor.width_m(), floor.height_m()),
-                            swarm::recording::part_paths(&stage.dir, c, r),
-                        )?,
-                        p.robots,
-                    )),
-                    None => None,
-                };
-                run_one(
-                    s,
-                    c,
-                    r,
-                    images,
-                    &|k| bar.inc(k),
-                    RunOptions {
-                        record_track: track,
-                        keep_going: a.keep_going,
-                        rows: Some(rows_path(c, r)),
-                        probes: probes.unwrap_or_default(),
-                        replay,
-                        stack_guard: a.stack_guard.unwrap_or_default().into(),
-                    },
-                )
-            })
-            .collect::<Result<_>>()
-    })?;
-    bar.finish_and_clear();
+    let started = Instant::now();
+    let runs = run_all(
+        a,
+        s,
+        images,
+        (probes, replay),
+        stage,
+        threads,
+        &jobs,
+        &floor,
+    )?;
     let wall_s = started.elapsed().as_secs_f64();
 
-    let parts: Vec<PathBuf> = jobs.iter().map(|&(c, r)| rows_path(c, r)).collect();
-    write_metrics(&metrics_path, &parts)?;
-    let robots_path = stage.path("robots.csv");
-    write_robots(&robots_path, &runs)?;
+    let parts: Vec<PathBuf> = jobs.iter().map(|&(c, r)| rows_path(stage, c, r)).collect();
+    write_metrics(&stage.path("metrics.csv"), &parts)?;
+    write_robots(&stage.path("robots.csv"), &runs)?;
     let analysis = analyse(
         &runs,
         s.robots,
@@ -1021,38 +947,166 @@ fn run_into(
             .filter(|configured| !configured),
         battery: &battery,
     };
-    let summary_path = stage.path("summary.json");
-    std::fs::write(
-        &summary_path,
-        serde_json::to_string_pretty(&summary)? + "\n",
-    )
-    .map_err(anyhow::Error::new)
-    .context(OutputError(format!(
-        "cannot write `{}`",
-        summary_path.display()
-    )))?;
+    write_json(&stage.path("summary.json"), &summary)?;
+    let fit = measure_fit(s)?;
+    write_json(&stage.path("fit.json"), &fit)?;
+    let names = write_figures(s, stage, replay, &floor, &runs)?;
 
-    let fit = swarm::fit::measure(&swarm::fit::FitConfig {
+    let mut t = String::new();
+    render_header(&mut t, s, kinds.len(), jobs.len(), threads, wall_s);
+    for w in &warnings {
+        let _ = writeln!(t, "WARNING {w}");
+    }
+    render_battery(&mut t, &battery);
+    let _ = writeln!(t);
+    report(&mut t, s, &analysis);
+    render_failures(&mut t, &runs);
+    let _ = writeln!(t);
+    let _ = writeln!(t, "fit: {}", fit.verdict);
+    Ok((t, names))
+}
+
+/// The conditions `s` runs (learning, then the controls it asks for) and its runs: every
+/// condition's repeats, condition after condition.
+fn run_jobs(s: &Scenario) -> (Vec<Condition>, Vec<(Condition, u32)>) {
+    let mut kinds = vec![Condition::Learning];
+    if s.controls.learning_off {
+        kinds.push(Condition::LearningOff);
+    }
+    if s.controls.random_walk {
+        kinds.push(Condition::RandomWalk);
+    }
+    let jobs = kinds
+        .iter()
+        .flat_map(|&c| (0..s.repeats).map(move |r| (c, r)))
+        .collect();
+    (kinds, jobs)
+}
+
+/// The file a run writes its rows of metrics.csv into as its steps complete (they are joined
+/// in run order into metrics.csv at the end).
+fn rows_path(stage: &Stage, c: Condition, r: u32) -> PathBuf {
+    stage.path(&format!(".rows-{}-{r}.csv", c.name()))
+}
+
+/// The progress bar of `runs` runs on a terminal (hidden otherwise), counting robot-steps.
+fn progress_bar(s: &Scenario, runs: usize, threads: usize) -> ProgressBar {
+    if !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let b = ProgressBar::new(runs as u64 * u64::from(s.steps));
+    b.set_style(
+        ProgressStyle::with_template(
+            "{spinner} {elapsed_precise} [{bar:40}] {pos}/{len} robot-steps {msg} (eta {eta})",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar())
+        .progress_chars("=> "),
+    );
+    b.set_message(format!(
+        "x {} robots, {runs} runs on {threads} threads",
+        s.robots
+    ));
+    b
+}
+
+/// Runs every job on `threads` workers, each run writing its rows into the staging folder
+/// (and its frames, when the plan records it); the runs' outputs in job order.
+#[allow(clippy::too_many_arguments)]
+fn run_all(
+    a: &RunArgs,
+    s: &Scenario,
+    images: Option<&swarm::robot::Images>,
+    (probes, replay): (&SharedProbes, Option<&ReplayPlan>),
+    stage: &Stage,
+    threads: usize,
+    jobs: &[(Condition, u32)],
+    floor: &world::Arena,
+) -> Result<Vec<RunOutput>> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .context("starting the worker threads")?;
+    let bar = progress_bar(s, jobs.len(), threads);
+    // Every condition's runs are recorded in the repeats the plan names.
+    let recorded = |r: u32| replay.is_some_and(|p| p.repeats.contains(&r));
+    let runs = pool.install(|| {
+        jobs.par_iter()
+            .map(|&(c, r)| {
+                let track = c == Condition::Learning && r == 0;
+                // The probes go to the learning run's first repeat.
+                let probes = if track {
+                    probes.lock().ok().and_then(|mut p| p.take())
+                } else {
+                    None
+                };
+                let replay = match replay.filter(|_| recorded(r)) {
+                    Some(p) => Some((
+                        swarm::recording::Recorder::new(
+                            p.opts.clone(),
+                            (floor.width_m(), floor.height_m()),
+                            swarm::recording::part_paths(&stage.dir, c, r),
+                        )?,
+                        p.robots,
+                    )),
+                    None => None,
+                };
+                run_one(
+                    s,
+                    c,
+                    r,
+                    images,
+                    &|k| bar.inc(k),
+                    RunOptions {
+                        record_track: track,
+                        keep_going: a.keep_going,
+                        rows: Some(rows_path(stage, c, r)),
+                        probes: probes.unwrap_or_default(),
+                        replay,
+                        stack_guard: a.stack_guard.unwrap_or_default().into(),
+                    },
+                )
+            })
+            .collect::<Result<_>>()
+    })?;
+    bar.finish_and_clear();
+    Ok(runs)
+}
+
+/// Writes `value` as pretty JSON with a final newline to `path`.
+fn write_json(path: &Path, value: &impl Serialize) -> Result<()> {
+    std::fs::write(path, serde_json::to_string_pretty(value)? + "\n")
+        .map_err(anyhow::Error::new)
+        .context(OutputError::cannot_write(path))
+}
+
+/// The fit verdict of the scenario's learner on the robot firmware (400 steps, compared with
+/// the model), for fit.json.
+fn measure_fit(s: &Scenario) -> Result<swarm::fit::FitReport> {
+    Ok(swarm::fit::measure(&swarm::fit::FitConfig {
         controller: controller_config(s, swarm::fit::fit_weight_seed(s.seed))?,
         steps: 400,
         seed: s.seed,
         kind: swarm::scenario::ControllerKind::Firmware,
         firmware: swarm::fit::FirmwareUnderTest::robot()?,
         compare: true,
-    })?;
-    let fit_path = stage.path("fit.json");
-    std::fs::write(&fit_path, serde_json::to_string_pretty(&fit)? + "\n")
-        .map_err(anyhow::Error::new)
-        .context(OutputError(format!(
-            "cannot write `{}`",
-            fit_path.display()
-        )))?;
+    })?)
+}
 
+/// Draws the figures (the learning curves; the arena's paths or the corridor's space-time
+/// figure) and writes the viewer page when the plan asks for one; returns every file written
+/// so far, in [`OUTPUT_FILES`]' order up to the figures.
+fn write_figures(
+    s: &Scenario,
+    stage: &Stage,
+    replay: Option<&ReplayPlan>,
+    floor: &world::Arena,
+    runs: &[RunOutput],
+) -> Result<Vec<String>> {
     let (png, svg) = (stage.path("learning.png"), stage.path("learning.svg"));
     let drawn = |e: crate::plot::PlotError| {
         anyhow::Error::new(e).context(OutputError("cannot draw the figures".into()))
     };
-    learning_figure(&learning(s, &runs), &png, &svg).map_err(drawn)?;
+    learning_figure(&learning(s, runs), &png, &svg).map_err(drawn)?;
     let mut names: Vec<String> = [
         "metrics.csv",
         "robots.csv",
@@ -1064,14 +1118,7 @@ fn run_into(
     .map(String::from)
     .to_vec();
     if let Some(plan) = replay {
-        write_replay(
-            s,
-            &stage.path("replay.html"),
-            &stage.dir,
-            plan,
-            &floor,
-            &runs,
-        )?;
+        write_replay(s, &stage.path("replay.html"), &stage.dir, plan, floor, runs)?;
         names.push("replay.html".into());
     }
     if let Some(track) = runs.iter().find_map(|r| r.track.as_ref()) {
@@ -1083,10 +1130,20 @@ fn run_into(
             names.push("arena.png".into());
         }
     }
+    Ok(names)
+}
 
-    let robot_steps = jobs.len() as f64 * f64::from(s.steps) * s.robots as f64;
-    let simulated_s = jobs.len() as f64 * f64::from(s.steps) * s.timing.step_period_s;
-    let mut t = String::new();
+/// The report's first lines: what ran, and how fast.
+fn render_header(
+    t: &mut String,
+    s: &Scenario,
+    conditions: usize,
+    runs: usize,
+    threads: usize,
+    wall_s: f64,
+) {
+    let robot_steps = runs as f64 * f64::from(s.steps) * s.robots as f64;
+    let simulated_s = runs as f64 * f64::from(s.steps) * s.timing.step_period_s;
     let _ = writeln!(
         t,
         "h8swarm run {}: {} robots, {} steps of {} s, {} x {} conditions, seed {}",
@@ -1095,7 +1152,7 @@ fn run_into(
         s.steps,
         s.timing.step_period_s,
         plural(s.repeats, "repeat"),
-        kinds.len(),
+        conditions,
         s.seed
     );
     let _ = writeln!(
@@ -1105,13 +1162,11 @@ fn run_into(
         robot_steps / wall_s,
         simulated_s / wall_s
     );
-    for w in &warnings {
-        let _ = writeln!(t, "WARNING {w}");
-    }
-    render_battery(&mut t, &battery);
-    let _ = writeln!(t);
-    report(&mut t, s, &analysis);
-    for r in &runs {
+}
+
+/// One line per robot that died and per stack warning, run by run.
+fn render_failures(t: &mut String, runs: &[RunOutput]) {
+    for r in runs {
         for (i, why) in &r.dead {
             let _ = writeln!(
                 t,
@@ -1129,9 +1184,6 @@ fn run_into(
             );
         }
     }
-    let _ = writeln!(t);
-    let _ = writeln!(t, "fit: {}", fit.verdict);
-    Ok((t, names))
 }
 
 /// Writes the viewer page with the recorded runs (in run order).
