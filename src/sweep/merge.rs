@@ -341,50 +341,9 @@ pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepErro
     std::fs::create_dir_all(&plots)
         .map_err(|e| SweepError::tool(format!("cannot create `{}`: {e}", plots.display())))?;
 
-    // The CSV, rendered in memory, then written in one step.
-    let mut w = csv::Writer::from_writer(Vec::new());
-    let csv_err = |e: csv::Error| SweepError::tool(format!("writing sweep.csv: {e}"));
-    w.write_record(&m.columns).map_err(csv_err)?;
-    for row in &m.rows {
-        w.write_record(m.columns.iter().map(|c| csv_cell(row.get(c))))
-            .map_err(csv_err)?;
-    }
-    let bytes = w
-        .into_inner()
-        .map_err(|e| SweepError::tool(format!("writing sweep.csv: {e}")))?;
-    let csv_path = out.join("sweep.csv");
-    super::write_atomic(&csv_path, &bytes)?;
+    let csv_path = write_csv(&m, &out)?;
 
-    // Each claim's result per point, for the figures.
-    let series: Vec<ClaimSeries> = m
-        .claims
-        .iter()
-        .map(|(slug, text, paper)| ClaimSeries {
-            slug: slug.clone(),
-            text: text.clone(),
-            paper: *paper,
-            per_point: m
-                .rows
-                .iter()
-                .map(|r| {
-                    let n = |part: &str| {
-                        r.get(&format!("claim.{slug}.{part}"))
-                            .and_then(Value::as_u64)
-                            .map(|v| v as u32)
-                    };
-                    let (f, a, t) = (n("for")?, n("against")?, n("tied")?);
-                    Some(PointClaim {
-                        for_: f,
-                        against: a,
-                        defined: f + a + t,
-                        effect: r
-                            .get(&format!("claim.{slug}.effect"))
-                            .and_then(Value::as_f64),
-                    })
-                })
-                .collect(),
-        })
-        .collect();
+    let series = claim_series(&m);
     let coords: Vec<Vec<usize>> = lines.iter().map(|l| l.coords.clone()).collect();
     let paper: Vec<&ClaimSeries> = series.iter().filter(|s| s.paper).collect();
     let (inside, with_data) = region(&plan.axes, &coords, &paper);
@@ -412,17 +371,7 @@ pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepErro
         .filter_map(|p| p.file_name())
         .map(|n| format!("plots/{}", n.to_string_lossy()))
         .collect();
-    for old in earlier.iter().filter(|n| !figure_names.contains(n)) {
-        let p = out.join(old);
-        if p.is_file() {
-            std::fs::remove_file(&p).map_err(|e| {
-                SweepError::tool(format!(
-                    "cannot remove the earlier figure `{}`: {e}",
-                    p.display()
-                ))
-            })?;
-        }
-    }
+    remove_stale_figures(&out, &earlier, &figure_names)?;
     let mut doc = doc;
     doc["figures"] = json!(figure_names);
     let json_path = out.join("sweep.json");
@@ -442,35 +391,7 @@ pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepErro
         m.missing.len(),
         m.broken.len()
     );
-    for (id, why) in &m.failed {
-        let _ = writeln!(t, "FAILED  {id}: {}", printable(why));
-    }
-    for id in &m.missing {
-        let _ = writeln!(t, "MISSING {id}");
-    }
-    for (id, why) in &m.broken {
-        let _ = writeln!(
-            t,
-            "BROKEN  {id}: {} (the next `sweep run` redoes it)",
-            printable(why)
-        );
-    }
-    let host = host_name();
-    for tmp in temporaries(&dir.join("points")) {
-        let _ = if is_dead_leftover(&tmp, &host) {
-            writeln!(
-                t,
-                "LEFTOVER points/{} (its task was killed; the next `sweep run` removes it)",
-                printable(&tmp)
-            )
-        } else {
-            writeln!(
-                t,
-                "RUNNING points/{} (a task at work, or left by a killed one)",
-                printable(&tmp)
-            )
-        };
-    }
+    render_points(&mut t, &m, dir);
     for (slug, text, _) in &m.claims {
         let col = format!("claim.{slug}.outcome");
         let with: Vec<&str> = m
@@ -519,4 +440,111 @@ pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepErro
     }
     let complete = m.failed.is_empty() && m.missing.is_empty() && m.broken.is_empty();
     Ok((t, complete))
+}
+
+/// Writes the merged table as `out/sweep.csv` (rendered in memory, then written in one step);
+/// returns its path.
+fn write_csv(m: &Merged, out: &Path) -> Result<PathBuf, SweepError> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let csv_err = |e: csv::Error| SweepError::tool(format!("writing sweep.csv: {e}"));
+    w.write_record(&m.columns).map_err(csv_err)?;
+    for row in &m.rows {
+        w.write_record(m.columns.iter().map(|c| csv_cell(row.get(c))))
+            .map_err(csv_err)?;
+    }
+    let bytes = w
+        .into_inner()
+        .map_err(|e| SweepError::tool(format!("writing sweep.csv: {e}")))?;
+    let csv_path = out.join("sweep.csv");
+    super::write_atomic(&csv_path, &bytes)?;
+
+    Ok(csv_path)
+}
+
+/// Each claim's result per point (its repeats for, against and tied, and its effect), for the
+/// figures.
+fn claim_series(m: &Merged) -> Vec<ClaimSeries> {
+    m.claims
+        .iter()
+        .map(|(slug, text, paper)| ClaimSeries {
+            slug: slug.clone(),
+            text: text.clone(),
+            paper: *paper,
+            per_point: m
+                .rows
+                .iter()
+                .map(|r| {
+                    let n = |part: &str| {
+                        r.get(&format!("claim.{slug}.{part}"))
+                            .and_then(Value::as_u64)
+                            .map(|v| v as u32)
+                    };
+                    let (f, a, t) = (n("for")?, n("against")?, n("tied")?);
+                    Some(PointClaim {
+                        for_: f,
+                        against: a,
+                        defined: f + a + t,
+                        effect: r
+                            .get(&format!("claim.{slug}.effect"))
+                            .and_then(Value::as_f64),
+                    })
+                })
+                .collect(),
+        })
+        .collect()
+}
+
+/// Removes the figures an earlier merge into `out` drew (`earlier`, as its sweep.json lists
+/// them) that this one did not draw again (`drawn`).
+fn remove_stale_figures(
+    out: &Path,
+    earlier: &[String],
+    drawn: &[String],
+) -> Result<(), SweepError> {
+    for old in earlier.iter().filter(|n| !drawn.contains(n)) {
+        let p = out.join(old);
+        if p.is_file() {
+            std::fs::remove_file(&p).map_err(|e| {
+                SweepError::tool(format!(
+                    "cannot remove the earlier figure `{}`: {e}",
+                    p.display()
+                ))
+            })?;
+        }
+    }
+    Ok(())
+}
+
+/// The report's lines on the points that did not finish: failed, missing, broken, and the
+/// temporary folders under `dir/points` (a task at work, or a killed task's leftovers).
+fn render_points(t: &mut String, m: &Merged, dir: &Path) {
+    for (id, why) in &m.failed {
+        let _ = writeln!(t, "FAILED  {id}: {}", printable(why));
+    }
+    for id in &m.missing {
+        let _ = writeln!(t, "MISSING {id}");
+    }
+    for (id, why) in &m.broken {
+        let _ = writeln!(
+            t,
+            "BROKEN  {id}: {} (the next `sweep run` redoes it)",
+            printable(why)
+        );
+    }
+    let host = host_name();
+    for tmp in temporaries(&dir.join("points")) {
+        let _ = if is_dead_leftover(&tmp, &host) {
+            writeln!(
+                t,
+                "LEFTOVER points/{} (its task was killed; the next `sweep run` removes it)",
+                printable(&tmp)
+            )
+        } else {
+            writeln!(
+                t,
+                "RUNNING points/{} (a task at work, or left by a killed one)",
+                printable(&tmp)
+            )
+        };
+    }
 }
