@@ -2,7 +2,7 @@
 //! H8 meter, next to a plain-`i32` reference loop of the same step in the same group, so the
 //! ratios are read from one run.
 //!
-//! Targets (issue 2): the unmetered step within 1.5× of the reference; the H8 meter under 2× the
+//! Targets: the unmetered step within 1.5× of the reference; the H8 meter under 2× the
 //! unmetered step.
 //!
 //! Every variant walks the same 1 024 pre-drawn (x, E) pairs; E is uniform in −40 … 40, so with

@@ -9,7 +9,7 @@
 //! (robots stepped one after the other on the benchmark's own thread); 1 000 and 10 000 robots
 //! on two (robots stepped in parallel, the whole measurement inside a two-thread pool).
 //! Firmware robots (the robot firmware as machine code on the H8/300H core), in the same run:
-//! 3 robots on one thread, 100 and 1 000 on two — issue 11's targets are 2 000×, 50× and 5×
+//! 3 robots on one thread, 100 and 1 000 on two; the targets are 2 000×, 50× and 5×
 //! real time.
 //!
 //! The cost of a step grows as the robots learn their way into corners and against each other

@@ -1,4 +1,4 @@
-//! What the bumpers read inside a step (issue 12): runs a scenario's learning condition with
+//! What the bumpers read inside a step: runs a scenario's learning condition with
 //! model robots to step STEP, then replays the next STEPS steps' world sub-step by sub-step on
 //! a copy of it (the commands the robots set, which do not change within a step) and prints,
 //! per robot, its pose and wheel speeds at the step's start and its four switches (front,

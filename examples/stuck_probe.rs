@@ -1,4 +1,4 @@
-//! What a stuck robot senses, evaluates and chooses (issue 12): runs the learning and
+//! What a stuck robot senses, evaluates and chooses: runs the learning and
 //! learning-off conditions of a scenario with model robots and, for every robot-step of the last
 //! window, records whether the robot is stuck (the metric's rule: its motors drove and it moved
 //! < 1 mm over the last 100 steps), its four proximities p (du), E = D(t) − D(t−1) (the

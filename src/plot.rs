@@ -1,4 +1,4 @@
-//! The experiment's figures (issue 5), drawn with `plotters`.
+//! The experiment's figures, drawn with `plotters`.
 //!
 //! * [`learning_figure`]: the paper's Fig. 6/7 — left panel the mean over robots of the summed
 //!   sensor distance D (du), right panel the collisions per robot, both per window of learning

@@ -1,4 +1,4 @@
-//! Firmware robots and model robots side by side (issue 11 item 5): with identical sensor
+//! Firmware robots and model robots side by side: with identical sensor
 //! inputs the learner's state (weights, x, O, D, the motors) stays equal step for step, and the swarm's learning runs agree.
 
 use swarm::robot::{Brain, Condition, Images, Robot};

@@ -1,5 +1,5 @@
 //! `h8swarm fit` measured on the firmware, with the model beside it: the model's figures per
-//! phase against the firmware's over a grid of networks (issue 10 item 5), and the command's
+//! phase against the firmware's over a grid of networks, and the command's
 //! options for a user's image.
 
 use std::process::Command;

@@ -1,4 +1,4 @@
-//! Drives `h8swarm sweep plan/run/merge` through the real binary (issue 15): the same table
+//! Drives `h8swarm sweep plan/run/merge` through the real binary: the same table
 //! byte for byte however the points are split into tasks; reruns skip finished points and redo
 //! broken ones; failed and missing points are listed; bad input is a one-line error with exit
 //! status 2. The real-Slurm test is `scripts/slurm-test.sh`.
