@@ -140,7 +140,7 @@ pub fn collect(
     cols.add("seed");
     let mut m = Merged::default();
     let mut stat_cols = Columns::default();
-    let mut claim_slugs: BTreeMap<String, String> = BTreeMap::new();
+    let mut claims = Claims::default();
     let mut claim_cols = Columns::default();
     for line in &lines {
         let mut row = Map::new();
@@ -186,98 +186,8 @@ pub fn collect(
             None
         };
         if let Some(summary) = summary {
-            for c in summary["conditions"].as_array().into_iter().flatten() {
-                let cond = c["condition"].as_str().unwrap_or("condition");
-                if let Some(robots) = c["robots"].as_object() {
-                    for (k, v) in robots {
-                        if let Some(est) = v.as_object() {
-                            for part in ["mean", "lo", "hi"] {
-                                let col = format!("{cond}.robots.{k}.{part}");
-                                stat_cols.add(&col);
-                                row.insert(col, est.get(part).cloned().unwrap_or(Value::Null));
-                            }
-                        } else {
-                            let col = format!("{cond}.robots.{k}");
-                            stat_cols.add(&col);
-                            row.insert(col, v.clone());
-                        }
-                    }
-                }
-                for w in ["first", "last"] {
-                    let Some(win) = c[w].as_object() else {
-                        continue;
-                    };
-                    let mut keys: Vec<&String> = STAT_ORDER
-                        .iter()
-                        .filter_map(|k| win.get_key_value(*k).map(|(k, _)| k))
-                        .collect();
-                    let mut rest: Vec<&String> = win
-                        .keys()
-                        .filter(|k| !STAT_ORDER.contains(&k.as_str()))
-                        .collect();
-                    rest.sort();
-                    keys.extend(rest);
-                    for k in keys {
-                        let Some(est) = win[k].as_object() else {
-                            continue;
-                        };
-                        if !est.contains_key("mean") {
-                            continue;
-                        }
-                        for part in ["mean", "lo", "hi"] {
-                            let col = format!("{cond}.{w}.{k}.{part}");
-                            stat_cols.add(&col);
-                            row.insert(col, est.get(part).cloned().unwrap_or(Value::Null));
-                        }
-                    }
-                }
-            }
-            for c in summary["claims"].as_array().into_iter().flatten() {
-                let text = c["claim"].as_str().unwrap_or_default().to_string();
-                let slug = match claim_slugs.get(&text) {
-                    Some(s) => s.clone(),
-                    None => {
-                        let base = claim_slug(&text);
-                        let mut slug = base.clone();
-                        let mut n = 2;
-                        while claim_slugs.values().any(|s| *s == slug) {
-                            slug = format!("{base}_{n}");
-                            n += 1;
-                        }
-                        claim_slugs.insert(text.clone(), slug.clone());
-                        let paper = c["paper"].as_bool().unwrap_or(false);
-                        m.claims.push((slug.clone(), text.clone(), paper));
-                        slug
-                    }
-                };
-                let a = c["values"][0].as_f64();
-                let b = c["values"][1].as_f64();
-                let r = &c["repeats"];
-                let cells = [
-                    ("outcome", c["outcome"].clone()),
-                    ("means_agree", c["means_agree"].clone()),
-                    ("apart", c["apart"].clone()),
-                    ("a", a.map_or(Value::Null, num)),
-                    ("b", b.map_or(Value::Null, num)),
-                    (
-                        "effect",
-                        match (a, b) {
-                            (Some(a), Some(b)) => num(b - a),
-                            _ => Value::Null,
-                        },
-                    ),
-                    ("for", r["for"].clone()),
-                    ("against", r["against"].clone()),
-                    ("tied", r["tied"].clone()),
-                    ("undefined", r["undefined"].clone()),
-                    ("p", r["p"].clone()),
-                ];
-                for (part, v) in cells {
-                    let col = format!("claim.{slug}.{part}");
-                    claim_cols.add(&col);
-                    row.insert(col, v);
-                }
-            }
+            condition_cells(&summary, &mut row, &mut stat_cols);
+            claim_cells(&summary, &mut row, &mut claims, &mut claim_cols);
         }
         m.rows.push(row);
     }
@@ -286,6 +196,7 @@ pub fn collect(
     }
     cols.add("error");
     m.columns = cols.order;
+    m.claims = claims.order;
     Ok((plan, lines, m))
 }
 
@@ -546,5 +457,120 @@ fn render_points(t: &mut String, m: &Merged, dir: &Path) {
                 printable(&tmp)
             )
         };
+    }
+}
+
+/// The claims met so far over the points: each claim's text with its column slug, and the
+/// claims (slug, text, whether it is the paper's) in the order they were first met.
+#[derive(Default)]
+struct Claims {
+    slugs: BTreeMap<String, String>,
+    order: Vec<(String, String, bool)>,
+}
+
+/// A finished point's window statistics into `row`: every condition's per-robot figures and
+/// its first and last windows' estimates (mean, lo, hi), their columns added to `cols`.
+fn condition_cells(summary: &Value, row: &mut Map<String, Value>, cols: &mut Columns) {
+    for c in summary["conditions"].as_array().into_iter().flatten() {
+        let cond = c["condition"].as_str().unwrap_or("condition");
+        if let Some(robots) = c["robots"].as_object() {
+            for (k, v) in robots {
+                if let Some(est) = v.as_object() {
+                    for part in ["mean", "lo", "hi"] {
+                        let col = format!("{cond}.robots.{k}.{part}");
+                        cols.add(&col);
+                        row.insert(col, est.get(part).cloned().unwrap_or(Value::Null));
+                    }
+                } else {
+                    let col = format!("{cond}.robots.{k}");
+                    cols.add(&col);
+                    row.insert(col, v.clone());
+                }
+            }
+        }
+        for w in ["first", "last"] {
+            let Some(win) = c[w].as_object() else {
+                continue;
+            };
+            let mut keys: Vec<&String> = STAT_ORDER
+                .iter()
+                .filter_map(|k| win.get_key_value(*k).map(|(k, _)| k))
+                .collect();
+            let mut rest: Vec<&String> = win
+                .keys()
+                .filter(|k| !STAT_ORDER.contains(&k.as_str()))
+                .collect();
+            rest.sort();
+            keys.extend(rest);
+            for k in keys {
+                let Some(est) = win[k].as_object() else {
+                    continue;
+                };
+                if !est.contains_key("mean") {
+                    continue;
+                }
+                for part in ["mean", "lo", "hi"] {
+                    let col = format!("{cond}.{w}.{k}.{part}");
+                    cols.add(&col);
+                    row.insert(col, est.get(part).cloned().unwrap_or(Value::Null));
+                }
+            }
+        }
+    }
+}
+
+/// A finished point's claims into `row`: outcome, values, effect and repeats per claim, under
+/// a column slug of the claim's (new claims added to `claims`, their columns to `cols`).
+fn claim_cells(
+    summary: &Value,
+    row: &mut Map<String, Value>,
+    claims: &mut Claims,
+    cols: &mut Columns,
+) {
+    for c in summary["claims"].as_array().into_iter().flatten() {
+        let text = c["claim"].as_str().unwrap_or_default().to_string();
+        let slug = match claims.slugs.get(&text) {
+            Some(s) => s.clone(),
+            None => {
+                let base = claim_slug(&text);
+                let mut slug = base.clone();
+                let mut n = 2;
+                while claims.slugs.values().any(|s| *s == slug) {
+                    slug = format!("{base}_{n}");
+                    n += 1;
+                }
+                claims.slugs.insert(text.clone(), slug.clone());
+                let paper = c["paper"].as_bool().unwrap_or(false);
+                claims.order.push((slug.clone(), text.clone(), paper));
+                slug
+            }
+        };
+        let a = c["values"][0].as_f64();
+        let b = c["values"][1].as_f64();
+        let r = &c["repeats"];
+        let cells = [
+            ("outcome", c["outcome"].clone()),
+            ("means_agree", c["means_agree"].clone()),
+            ("apart", c["apart"].clone()),
+            ("a", a.map_or(Value::Null, num)),
+            ("b", b.map_or(Value::Null, num)),
+            (
+                "effect",
+                match (a, b) {
+                    (Some(a), Some(b)) => num(b - a),
+                    _ => Value::Null,
+                },
+            ),
+            ("for", r["for"].clone()),
+            ("against", r["against"].clone()),
+            ("tied", r["tied"].clone()),
+            ("undefined", r["undefined"].clone()),
+            ("p", r["p"].clone()),
+        ];
+        for (part, v) in cells {
+            let col = format!("claim.{slug}.{part}");
+            cols.add(&col);
+            row.insert(col, v);
+        }
     }
 }
