@@ -686,7 +686,12 @@ mod tests {
         );
         assert_eq!(a.eta_q15(), 983, "eta 0.03, by the claim map's rule");
         assert_eq!(a.world.mu_wall, 0.1);
-        let paper = Scenario::load("scenarios/arena-paper.toml").unwrap();
+        // The scenario files stand at the workspace's root, one folder above this crate.
+        let paper = Scenario::load(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../scenarios/arena-paper.toml"
+        ))
+        .unwrap();
         assert_eq!((paper.eta_q15(), paper.world.mu_wall), (33, 0.3));
         let c = Scenario::corridor();
         assert_eq!((c.steps, c.learner.behaviours, c.eta_q15()), (500, 2, 3277));
