@@ -22,9 +22,9 @@ use std::hint::black_box;
 use std::time::{Duration, Instant};
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use h8swarm::experiment::Swarm;
-use h8swarm::robot::{Condition, Images};
-use h8swarm::scenario::Scenario;
+use swarm::experiment::Swarm;
+use swarm::robot::{Condition, Images};
+use swarm::scenario::Scenario;
 
 /// Steps of a swarm's life that are measured before it is replaced.
 const LIFE: usize = 1000;
@@ -36,7 +36,7 @@ fn swarm(robots: usize, parallel: bool, firmware: bool) -> Swarm {
     s.robots = robots;
     s.steps = LIFE as u32;
     if firmware {
-        s.controller.kind = h8swarm::fit::ControllerKind::Firmware;
+        s.controller.kind = swarm::scenario::ControllerKind::Firmware;
     }
     let images = Images::load(&s).expect("the robot firmware");
     let mut swarm =

@@ -10,9 +10,9 @@
 //! e.g. `scenarios/arena-learning-only.toml 10 2 50790 1`.
 
 use anyhow::{Context, bail};
-use h8swarm::experiment::{Swarm, period_states};
-use h8swarm::robot::Condition;
-use h8swarm::scenario::Scenario;
+use swarm::experiment::{Swarm, period_states};
+use swarm::robot::Condition;
+use swarm::scenario::Scenario;
 
 fn main() -> anyhow::Result<()> {
     let a: Vec<String> = std::env::args().skip(1).collect();

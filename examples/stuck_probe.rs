@@ -9,10 +9,10 @@
 //!
 //!     cargo run --release --example stuck_probe [arena|corridor|FILE.toml] [REPEATS] [SEED]
 
-use h8swarm::collisions::StuckDetector;
-use h8swarm::experiment::Swarm;
-use h8swarm::robot::{Brain, Condition};
-use h8swarm::scenario::Scenario;
+use swarm::collisions::StuckDetector;
+use swarm::experiment::Swarm;
+use swarm::robot::{Brain, Condition};
+use swarm::scenario::Scenario;
 
 #[derive(Default)]
 struct Tally {

@@ -4,7 +4,7 @@
 //! The learner runs `steps` steps on proximities drawn from a seeded generator (uniform 0–255 per
 //! sensor, so every branch of the step is taken: rewards, punishments, dead zones, saturations);
 //! its initial weights are drawn from the same stream, uniform in ±0.5. The stream is robot 0's
-//! cost-input stream under the seed ([`crate::seeds`], purpose `CostInputs`). The report gives the
+//! cost-input stream under the seed ([`swarm::seeds`], purpose `CostInputs`). The report gives the
 //! minimum, mean and maximum states per phase and per step, their time at φ = 25 MHz, the share
 //! of a step period that is, and the RAM items.
 
@@ -179,7 +179,7 @@ pub fn measure(cfg: &CostConfig) -> Result<CostReport> {
     let layout = InputLayout::new(cfg.history, cfg.bias).context("--history")?;
     let params = Params::new(cfg.eta, cfg.threshold).context("--eta/--threshold")?;
     let n_in = layout.n_inputs(cfg.outputs);
-    let mut rng = ChaCha8Rng::seed_from_u64(crate::seeds::robot_stream(
+    let mut rng = ChaCha8Rng::seed_from_u64(swarm::seeds::robot_stream(
         cfg.seed,
         0,
         0,

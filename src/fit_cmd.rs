@@ -1,16 +1,12 @@
 //! `h8swarm fit`: the verdict of docs/design.md §6 for the default network and the paper's two settings,
 //! what-ifs, and the largest network within a CPU budget, all measured by running the
-//! controller on the emulated H8/3052F ([`crate::fit`]): by default the robot firmware on the
+//! controller on the emulated H8/3052F ([`swarm::fit`]): by default the robot firmware on the
 //! H8/300H core, with the Rust model's figures beside each phase.
 
 use std::fmt::Write as _;
 
 use std::path::PathBuf;
 
-use crate::fit::{
-    Budget, ControllerKind, FirmwareUnderTest, FitConfig, FitReport, fit_weight_seed,
-    largest_fitting, measure, robot_phases,
-};
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use emu::board::firmware::Firmware;
@@ -18,6 +14,11 @@ use emu::board::model::ControllerConfig;
 use emu::board::profile::PhaseDef;
 use nn_q15::InputLayout;
 use serde::Serialize;
+use swarm::fit::{
+    Budget, FirmwareUnderTest, FitConfig, FitReport, fit_weight_seed, largest_fitting, measure,
+    robot_phases,
+};
+use swarm::scenario::ControllerKind;
 
 /// Which of the paper's settings to start from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -242,13 +243,13 @@ fn parse_budget(text: &str) -> Result<f64> {
 }
 
 /// `--capacity-mah`: a capacity from 1 mAh to 100 Ah (default
-/// [`crate::energy::DEFAULT_CAPACITY_MAH`]).
+/// [`swarm::energy::DEFAULT_CAPACITY_MAH`]).
 ///
 /// # Errors
 /// A value outside that range, or not a number.
 pub fn parse_capacity(given: Option<f64>) -> Result<f64> {
     match given {
-        None => Ok(crate::energy::DEFAULT_CAPACITY_MAH),
+        None => Ok(swarm::energy::DEFAULT_CAPACITY_MAH),
         Some(c) if c.is_finite() && (1.0..=100_000.0).contains(&c) => Ok(c),
         Some(c) => bail!(
             "--capacity-mah {c}: give a cell's capacity from 1 to 100000 mAh (AA NiMH cells hold 1 900-2 700 mAh)"
@@ -272,7 +273,7 @@ pub fn run(a: &FitArgs) -> Result<String> {
         );
     }
     let budget = a.cpu_budget.as_deref().map(parse_budget).transpose()?;
-    let pack = crate::energy::Pack::paper(parse_capacity(a.capacity_mah)?);
+    let pack = swarm::energy::Pack::paper(parse_capacity(a.capacity_mah)?);
     let settings: Vec<Setting> = match (a.setting, a.what_if()) {
         (Some(s), _) => vec![s],
         (None, true) => vec![Setting::Arena],
@@ -396,8 +397,10 @@ fn render(s: &mut String, name: &str, r: &FitReport) {
         s,
         "measured: {}{}",
         match r.controller {
-            crate::fit::ControllerKind::Firmware => format!("{} on the H8/300H core", r.source),
-            crate::fit::ControllerKind::Model => "the Rust model of the controller".to_string(),
+            swarm::scenario::ControllerKind::Firmware =>
+                format!("{} on the H8/300H core", r.source),
+            swarm::scenario::ControllerKind::Model =>
+                "the Rust model of the controller".to_string(),
         },
         match &r.compared_with {
             Some(o) => format!("; beside it: {o}"),
@@ -408,8 +411,8 @@ fn render(s: &mut String, name: &str, r: &FitReport) {
         format!(
             " {:>12} {:>7}",
             match r.controller {
-                crate::fit::ControllerKind::Firmware => "model mean",
-                crate::fit::ControllerKind::Model => "fw mean",
+                swarm::scenario::ControllerKind::Firmware => "model mean",
+                swarm::scenario::ControllerKind::Model => "fw mean",
             },
             "ratio"
         )
@@ -509,7 +512,7 @@ fn render(s: &mut String, name: &str, r: &FitReport) {
     let _ = writeln!(s, "verdict: {}", r.verdict);
 }
 
-fn render_energy(s: &mut String, e: &crate::fit::EnergyReport) {
+fn render_energy(s: &mut String, e: &swarm::fit::EnergyReport) {
     let _ = writeln!(
         s,
         "energy from the pack ({} x {} V NiMH, {} V, {:.0} mAh), wheels free (each at its command's speed):",

@@ -1,28 +1,22 @@
-//! # h8swarm — the tool's library
+//! # h8swarm — the command-line tool
 //!
-//! The root package is both the `h8swarm` command-line tool (`src/main.rs`) and this library,
-//! which holds what the commands do, so that benchmarks and tests can drive it directly:
-//! the swarm experiment ([`scenario`], [`robot`], [`experiment`], [`summary`], [`plot`],
-//! [`run_cmd`]), the fit verdict of docs/design.md §6 ([`fit`], measured on the emulated MCU, and its
-//! command [`fit_cmd`]), the learner's cost summary ([`cost_report`]) and the replay of docs/design.md §2.6
-//! ([`replay`]). The parts of the robot live in the workspace's other
+//! The root package is the `h8swarm` command-line tool (`src/main.rs`) and this library of its
+//! commands, so that benchmarks and tests can drive them directly: the swarm experiment's
+//! command with its outputs ([`run_cmd`]), its figures ([`plot`]) and its viewer page
+//! ([`viewer`]), the fit verdict's command ([`fit_cmd`]), the learner's cost summary
+//! ([`cost_report`]), the replay of docs/design.md §2.6 ([`replay`]), parameter sweeps
+//! ([`sweep`]) and the removal of half-written outputs on a signal ([`cleanup`]). What the
+//! commands run is the `swarm` crate's (the scenario, the robots, the experiment, its
+//! statistics, energy and the fit); the parts of the robot live in the workspace's other
 //! crates: `nn_q15`, `sensors`, `eeprom`, `emu` and `world`.
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 
 pub mod cleanup;
-pub mod collisions;
 pub mod cost_report;
-pub mod energy;
-pub mod experiment;
-pub mod fit;
 pub mod fit_cmd;
 pub mod plot;
-pub mod recording;
 pub mod replay;
-pub mod robot;
 pub mod run_cmd;
-pub mod scenario;
-pub mod seeds;
-pub mod summary;
 pub mod sweep;
+pub mod viewer;

@@ -17,7 +17,7 @@ use std::io::{self, BufRead, BufReader, BufWriter, Write};
 use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand};
-use h8swarm::sweep::spec::printable;
+use swarm::text::printable;
 
 /// Hardware-faithful, fixed-point emulator of the Hartono–Kakita (2008) swarm of H8/3052F robots
 /// that learn obstacle avoidance together.
@@ -346,9 +346,9 @@ fn sweep(args: &h8swarm::sweep::SweepArgs) -> Result<(), Failure> {
 }
 
 /// An error of `run`: a tool failure when some output could not be written
-/// ([`run_cmd::OutputError`] in its chain), else bad input.
+/// ([`swarm::output_error::OutputError`] in its chain), else bad input.
 fn run_failure(e: anyhow::Error) -> Failure {
-    if run_cmd::is_output_error(&e) {
+    if swarm::output_error::is_output_error(&e) {
         Failure::Tool(e)
     } else {
         Failure::Input(e)

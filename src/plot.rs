@@ -1,4 +1,4 @@
-//! The experiment's figures (issue 5), drawn with `plotters`.
+//! The experiment's figures, drawn with `plotters`.
 //!
 //! * [`learning_figure`]: the paper's Fig. 6/7 — left panel the mean over robots of the summed
 //!   sensor distance D (du), right panel the collisions per robot, both per window of learning
@@ -6,7 +6,7 @@
 //!   band `[lo, hi]`; the learning run is drawn solid over a translucent band, the controls the
 //!   paper lacks (learning off, random walk) dashed.
 //! * [`arena_figure`]: the paper's Fig. 8 — the arena seen from above, in metres at equal aspect
-//!   ratio, with every robot's trajectory and its outline at a few instants ([`Outline`]).
+//!   ratio, with every robot's trajectory and its outline at a few instants ([`Outline`](swarm::experiment::Outline)).
 //!
 //! Choices where the spec is silent (docs/design.md §5 names the metrics, not the drawing):
 //! * **Font.** DejaVu Sans 2.37 (`assets/DejaVuSans.ttf`, licence in
@@ -40,6 +40,8 @@ use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
+
+use swarm::experiment::Outline;
 
 /// Size in pixels of the learning figure (PNG and SVG): two panels side by side, with a
 /// one-row legend under them. Each further legend row (many or long labels) adds
@@ -177,19 +179,6 @@ pub struct SpaceTimeFigure {
     /// One path per robot: (learning step, position along the corridor in metres), steps
     /// increasing.
     pub paths: Vec<Vec<(f64, f64)>>,
-}
-
-/// A robot's outline at one instant.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Outline {
-    /// Robot number: index into [`ArenaFigure::paths`].
-    pub robot: usize,
-    /// Time of the snapshot in seconds; outlines with equal times share a legend entry.
-    pub time_s: f64,
-    /// Corners of the body in metres, in order around it.
-    pub corners: [(f64, f64); 4],
-    /// Heading as a unit vector (any non-zero length is accepted and normalised).
-    pub heading: (f64, f64),
 }
 
 /// Why a figure could not be drawn or written.

@@ -16,14 +16,15 @@ use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::experiment::{RunOptions, RunOutput, build_world, run_one};
 use crate::plot::{
     ArenaFigure, LearningFigure, Panel, Series, SpaceTimeFigure, arena_figure_panels,
     learning_figure, spacetime_figure,
 };
-use crate::robot::{Condition, controller_config};
-use crate::scenario::Scenario;
-use crate::summary::{Analysis, Claim, ConditionStats, Estimate, Pairing, Quantity, analyse};
+use swarm::experiment::{RunOptions, RunOutput, build_world, run_one};
+use swarm::output_error::OutputError;
+use swarm::robot::{Condition, controller_config};
+use swarm::scenario::Scenario;
+use swarm::summary::{Analysis, Claim, ConditionStats, Estimate, Pairing, Quantity, analyse};
 
 /// Options of `h8swarm run`.
 #[derive(Args, Debug, Default, Clone)]
@@ -133,7 +134,7 @@ impl From<StackGuardArg> for emu::core::cpu::StackGuardMode {
 /// What `--replay` asks for, checked.
 #[derive(Clone, Debug)]
 struct ReplayPlan {
-    opts: crate::recording::RecordOptions,
+    opts: swarm::recording::RecordOptions,
     repeats: Vec<u32>,
     robots: usize,
 }
@@ -155,8 +156,8 @@ fn replay_plan(a: &RunArgs, s: &Scenario) -> Result<Option<ReplayPlan>> {
                 let r: u32 = part.trim().parse().map_err(|_| {
                     anyhow::anyhow!(
                         "--replay-repeats `{}`: `{}` is not a repeat: give repeats 0 to {} separated by commas, or `all`",
-                        crate::sweep::spec::one_line(list),
-                        crate::sweep::spec::one_line(part),
+                        swarm::text::one_line(list),
+                        swarm::text::one_line(part),
                         s.repeats - 1
                     )
                 })?;
@@ -184,7 +185,7 @@ fn replay_plan(a: &RunArgs, s: &Scenario) -> Result<Option<ReplayPlan>> {
         );
     }
     Ok(Some(ReplayPlan {
-        opts: crate::recording::RecordOptions::for_steps(s.steps, a.replay_stride),
+        opts: swarm::recording::RecordOptions::for_steps(s.steps, a.replay_stride),
         repeats,
         robots,
     }))
@@ -203,7 +204,7 @@ fn probed_robot(option: &str, k: usize, s: &Scenario) -> Result<usize> {
             s.robots - 1
         );
     }
-    if s.controller.kind != crate::fit::ControllerKind::Firmware {
+    if s.controller.kind != swarm::scenario::ControllerKind::Firmware {
         bail!(
             "{option} {k}: robot {k} runs the Rust model, which has no firmware to look at (use --controller firmware, or --firmware IMAGE)"
         );
@@ -213,8 +214,8 @@ fn probed_robot(option: &str, k: usize, s: &Scenario) -> Result<usize> {
 
 /// The probes `--vcd` and `--gdb` ask for, checked (a bad value fails before any run); the
 /// GDB stub is listening when this returns.
-fn probes(a: &RunArgs, s: &Scenario) -> Result<crate::experiment::RobotProbes> {
-    let mut p = crate::experiment::RobotProbes::default();
+fn probes(a: &RunArgs, s: &Scenario) -> Result<swarm::experiment::RobotProbes> {
+    let mut p = swarm::experiment::RobotProbes::default();
     if let Some(path) = &a.vcd {
         let robot = probed_robot("--vcd-robot", a.vcd_robot.unwrap_or(0), s)?;
         let from = a.vcd_from.unwrap_or(0);
@@ -236,7 +237,7 @@ fn probes(a: &RunArgs, s: &Scenario) -> Result<crate::experiment::RobotProbes> {
                 "--vcd: cannot create `{}`",
                 path.display()
             )))?;
-        p.vcd = Some(crate::experiment::VcdProbe {
+        p.vcd = Some(swarm::experiment::VcdProbe {
             robot,
             from,
             steps: steps.min(s.steps - from),
@@ -270,7 +271,7 @@ struct Summary<'a> {
     /// settings, not the scenario's); absent otherwise.
     #[serde(skip_serializing_if = "Option::is_none")]
     image_configured: Option<bool>,
-    battery: &'a crate::energy::BatteryReport,
+    battery: &'a swarm::battery::BatteryReport,
 }
 
 /// Runs the experiment; returns the text to print.
@@ -283,25 +284,25 @@ pub fn run(a: &RunArgs) -> Result<String> {
     let mut s = Scenario::load(what)?;
     if let Some(k) = a.controller {
         s.controller.kind = match k {
-            crate::fit_cmd::ControllerArg::Firmware => crate::fit::ControllerKind::Firmware,
-            crate::fit_cmd::ControllerArg::Model => crate::fit::ControllerKind::Model,
+            crate::fit_cmd::ControllerArg::Firmware => swarm::scenario::ControllerKind::Firmware,
+            crate::fit_cmd::ControllerArg::Model => swarm::scenario::ControllerKind::Model,
         };
     }
     if let Some(image) = &a.firmware {
         if a.controller == Some(crate::fit_cmd::ControllerArg::Model) {
             bail!("--firmware runs an image on the core: it cannot go with --controller model");
         }
-        s.controller.kind = crate::fit::ControllerKind::Firmware;
+        s.controller.kind = swarm::scenario::ControllerKind::Firmware;
         s.controller.image = Some(image.display().to_string());
     }
     let s = s.with_overrides(a.robots, a.steps, a.repeats, a.seed)?;
     crate::fit_cmd::parse_capacity(a.capacity_mah)?;
-    let images = crate::robot::Images::load(&s)?;
+    let images = swarm::robot::Images::load(&s)?;
     let unconfigured = unconfigured_image(&s, images.as_ref())?;
     if let Some(image) = &unconfigured {
         eprintln!(
             "warning: {}: the image has no configuration block, so it runs with its own built-in settings, not the scenario's learner, timing and sensor settings (summary.json says \"image_configured\": false); give its symbol table (IMAGE.sym beside it, or controller.symbols) to configure it",
-            crate::sweep::spec::printable(image)
+            swarm::text::printable(image)
         );
     }
     let max_threads = max_threads();
@@ -387,7 +388,7 @@ pub fn run(a: &RunArgs) -> Result<String> {
 /// An image without a configuration block and a control condition on.
 fn unconfigured_image(
     s: &Scenario,
-    images: Option<&crate::robot::Images>,
+    images: Option<&swarm::robot::Images>,
 ) -> Result<Option<String>> {
     let Some((fw, _)) = images.and_then(|i| i.user.as_ref()) else {
         return Ok(None);
@@ -422,8 +423,8 @@ pub const BASE_BYTES: u64 = 64 << 20;
 pub fn estimated_memory(s: &Scenario, threads: usize) -> u64 {
     let (runs, at_once) = run_counts(s, threads);
     let per_robot = match s.controller.kind {
-        crate::fit::ControllerKind::Firmware => FIRMWARE_ROBOT_BYTES,
-        crate::fit::ControllerKind::Model => MODEL_ROBOT_BYTES,
+        swarm::scenario::ControllerKind::Firmware => FIRMWARE_ROBOT_BYTES,
+        swarm::scenario::ControllerKind::Model => MODEL_ROBOT_BYTES,
     };
     BASE_BYTES
         .saturating_add(
@@ -442,13 +443,6 @@ fn run_counts(s: &Scenario, threads: usize) -> (u64, u64) {
     let conditions = 1 + u64::from(s.controls.learning_off) + u64::from(s.controls.random_walk);
     let runs = conditions.saturating_mul(u64::from(s.repeats));
     (runs, runs.min(threads as u64).max(1))
-}
-
-/// Whether `e` is an output that could not be written ([`OutputError`] anywhere in its chain
-/// of contexts): the tool failed (exit status 1), not the input.
-#[must_use]
-pub fn is_output_error(e: &anyhow::Error) -> bool {
-    e.downcast_ref::<OutputError>().is_some()
 }
 
 /// The memory the machine has available now (`MemAvailable` of /proc/meminfo), if known.
@@ -714,19 +708,6 @@ pub fn default_out_name(what: &str) -> String {
     }
 }
 
-/// An output that cannot be written (the tool failed: exit status 1), as the context of the
-/// error that says why.
-#[derive(Debug)]
-pub struct OutputError(pub String);
-
-impl std::fmt::Display for OutputError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.0)
-    }
-}
-
-impl std::error::Error for OutputError {}
-
 /// A staging folder beside the output folder: `<parent>/.<name>.partial-<pid>`, registered
 /// for removal on SIGINT, SIGTERM and SIGHUP ([`crate::cleanup`]) while it exists.
 struct Stage {
@@ -909,117 +890,43 @@ pub const OUTPUT_FILES: [&str; 9] = [
     "replay.html",
 ];
 
+/// The probes of one robot, taken by the first run that asks for them.
+type SharedProbes = std::sync::Mutex<Option<swarm::experiment::RobotProbes>>;
+
 /// Runs the experiment, writing its files into `stage`; returns the text to print and the
 /// files written.
 fn run_into(
     a: &RunArgs,
     s: &Scenario,
-    images: Option<&crate::robot::Images>,
-    (probes, replay): (
-        &std::sync::Mutex<Option<crate::experiment::RobotProbes>>,
-        Option<&ReplayPlan>,
-    ),
+    images: Option<&swarm::robot::Images>,
+    (probes, replay): (&SharedProbes, Option<&ReplayPlan>),
     stage: &Stage,
     threads: usize,
 ) -> Result<(String, Vec<String>)> {
-    let metrics_path = stage.path("metrics.csv");
-
-    let mut jobs: Vec<(Condition, u32)> = Vec::new();
-    let mut kinds = vec![Condition::Learning];
-    if s.controls.learning_off {
-        kinds.push(Condition::LearningOff);
-    }
-    if s.controls.random_walk {
-        kinds.push(Condition::RandomWalk);
-    }
-    for c in &kinds {
-        for r in 0..s.repeats {
-            jobs.push((*c, r));
-        }
-    }
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .context("starting the worker threads")?;
-    let total = jobs.len() as u64 * u64::from(s.steps);
-    let bar = if std::io::stderr().is_terminal() {
-        let b = ProgressBar::new(total);
-        b.set_style(
-            ProgressStyle::with_template(
-                "{spinner} {elapsed_precise} [{bar:40}] {pos}/{len} robot-steps {msg} (eta {eta})",
-            )
-            .unwrap_or_else(|_| ProgressStyle::default_bar())
-            .progress_chars("=> "),
-        );
-        b.set_message(format!(
-            "x {} robots, {} runs on {threads} threads",
-            s.robots,
-            jobs.len()
-        ));
-        b
-    } else {
-        ProgressBar::hidden()
-    };
+    let (kinds, jobs) = run_jobs(s);
+    let floor = swarm::experiment::arena_of(s)?;
     let started = Instant::now();
-    // Each run writes its rows as its steps complete into a file of its own in the staging
-    // folder; they are joined in run order into metrics.csv at the end.
-    let rows_path = |c: Condition, r: u32| stage.path(&format!(".rows-{}-{r}.csv", c.name()));
-    let recorded = |c: Condition, r: u32| -> bool {
-        replay.is_some_and(|p| p.repeats.contains(&r)) && kinds.contains(&c)
-    };
-    let floor = crate::experiment::arena_of(s)?;
-    let runs: Vec<RunOutput> = pool.install(|| {
-        jobs.par_iter()
-            .map(|&(c, r)| {
-                let track = c == Condition::Learning && r == 0;
-                // The probes go to the learning run's first repeat.
-                let probes = if track {
-                    probes.lock().ok().and_then(|mut p| p.take())
-                } else {
-                    None
-                };
-                let replay = match replay.filter(|_| recorded(c, r)) {
-                    Some(p) => Some((
-                        crate::recording::Recorder::new(
-                            p.opts.clone(),
-                            (floor.width_m(), floor.height_m()),
-                            crate::recording::part_paths(&stage.dir, c, r),
-                        )?,
-                        p.robots,
-                    )),
-                    None => None,
-                };
-                run_one(
-                    s,
-                    c,
-                    r,
-                    images,
-                    &|k| bar.inc(k),
-                    RunOptions {
-                        record_track: track,
-                        keep_going: a.keep_going,
-                        rows: Some(rows_path(c, r)),
-                        probes: probes.unwrap_or_default(),
-                        replay,
-                        stack_guard: a.stack_guard.unwrap_or_default().into(),
-                    },
-                )
-            })
-            .collect::<Result<_>>()
-    })?;
-    bar.finish_and_clear();
+    let runs = run_all(
+        a,
+        s,
+        images,
+        (probes, replay),
+        stage,
+        threads,
+        &jobs,
+        &floor,
+    )?;
     let wall_s = started.elapsed().as_secs_f64();
 
-    let parts: Vec<PathBuf> = jobs.iter().map(|&(c, r)| rows_path(c, r)).collect();
-    write_metrics(&metrics_path, &parts)?;
-    let robots_path = stage.path("robots.csv");
-    write_robots(&robots_path, &runs)?;
+    let parts: Vec<PathBuf> = jobs.iter().map(|&(c, r)| rows_path(stage, c, r)).collect();
+    write_metrics(&stage.path("metrics.csv"), &parts)?;
+    write_robots(&stage.path("robots.csv"), &runs)?;
     let analysis = analyse(
         &runs,
         s.robots,
         s.steps,
         s.window,
-        crate::seeds::bootstrap_seed(s.seed),
+        swarm::seeds::bootstrap_seed(s.seed),
     );
     let warnings = warnings(s);
     let saves: u64 = runs.iter().map(|r| r.saves).sum();
@@ -1040,38 +947,166 @@ fn run_into(
             .filter(|configured| !configured),
         battery: &battery,
     };
-    let summary_path = stage.path("summary.json");
-    std::fs::write(
-        &summary_path,
-        serde_json::to_string_pretty(&summary)? + "\n",
-    )
-    .map_err(anyhow::Error::new)
-    .context(OutputError(format!(
-        "cannot write `{}`",
-        summary_path.display()
-    )))?;
+    write_json(&stage.path("summary.json"), &summary)?;
+    let fit = measure_fit(s)?;
+    write_json(&stage.path("fit.json"), &fit)?;
+    let names = write_figures(s, stage, replay, &floor, &runs)?;
 
-    let fit = crate::fit::measure(&crate::fit::FitConfig {
-        controller: controller_config(s, crate::fit::fit_weight_seed(s.seed))?,
+    let mut t = String::new();
+    render_header(&mut t, s, kinds.len(), jobs.len(), threads, wall_s);
+    for w in &warnings {
+        let _ = writeln!(t, "WARNING {w}");
+    }
+    render_battery(&mut t, &battery);
+    let _ = writeln!(t);
+    report(&mut t, s, &analysis);
+    render_failures(&mut t, &runs);
+    let _ = writeln!(t);
+    let _ = writeln!(t, "fit: {}", fit.verdict);
+    Ok((t, names))
+}
+
+/// The conditions `s` runs (learning, then the controls it asks for) and its runs: every
+/// condition's repeats, condition after condition.
+fn run_jobs(s: &Scenario) -> (Vec<Condition>, Vec<(Condition, u32)>) {
+    let mut kinds = vec![Condition::Learning];
+    if s.controls.learning_off {
+        kinds.push(Condition::LearningOff);
+    }
+    if s.controls.random_walk {
+        kinds.push(Condition::RandomWalk);
+    }
+    let jobs = kinds
+        .iter()
+        .flat_map(|&c| (0..s.repeats).map(move |r| (c, r)))
+        .collect();
+    (kinds, jobs)
+}
+
+/// The file a run writes its rows of metrics.csv into as its steps complete (they are joined
+/// in run order into metrics.csv at the end).
+fn rows_path(stage: &Stage, c: Condition, r: u32) -> PathBuf {
+    stage.path(&format!(".rows-{}-{r}.csv", c.name()))
+}
+
+/// The progress bar of `runs` runs on a terminal (hidden otherwise), counting robot-steps.
+fn progress_bar(s: &Scenario, runs: usize, threads: usize) -> ProgressBar {
+    if !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let b = ProgressBar::new(runs as u64 * u64::from(s.steps));
+    b.set_style(
+        ProgressStyle::with_template(
+            "{spinner} {elapsed_precise} [{bar:40}] {pos}/{len} robot-steps {msg} (eta {eta})",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar())
+        .progress_chars("=> "),
+    );
+    b.set_message(format!(
+        "x {} robots, {runs} runs on {threads} threads",
+        s.robots
+    ));
+    b
+}
+
+/// Runs every job on `threads` workers, each run writing its rows into the staging folder
+/// (and its frames, when the plan records it); the runs' outputs in job order.
+#[allow(clippy::too_many_arguments)]
+fn run_all(
+    a: &RunArgs,
+    s: &Scenario,
+    images: Option<&swarm::robot::Images>,
+    (probes, replay): (&SharedProbes, Option<&ReplayPlan>),
+    stage: &Stage,
+    threads: usize,
+    jobs: &[(Condition, u32)],
+    floor: &world::Arena,
+) -> Result<Vec<RunOutput>> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .context("starting the worker threads")?;
+    let bar = progress_bar(s, jobs.len(), threads);
+    // Every condition's runs are recorded in the repeats the plan names.
+    let recorded = |r: u32| replay.is_some_and(|p| p.repeats.contains(&r));
+    let runs = pool.install(|| {
+        jobs.par_iter()
+            .map(|&(c, r)| {
+                let track = c == Condition::Learning && r == 0;
+                // The probes go to the learning run's first repeat.
+                let probes = if track {
+                    probes.lock().ok().and_then(|mut p| p.take())
+                } else {
+                    None
+                };
+                let replay = match replay.filter(|_| recorded(r)) {
+                    Some(p) => Some((
+                        swarm::recording::Recorder::new(
+                            p.opts.clone(),
+                            (floor.width_m(), floor.height_m()),
+                            swarm::recording::part_paths(&stage.dir, c, r),
+                        )?,
+                        p.robots,
+                    )),
+                    None => None,
+                };
+                run_one(
+                    s,
+                    c,
+                    r,
+                    images,
+                    &|k| bar.inc(k),
+                    RunOptions {
+                        record_track: track,
+                        keep_going: a.keep_going,
+                        rows: Some(rows_path(stage, c, r)),
+                        probes: probes.unwrap_or_default(),
+                        replay,
+                        stack_guard: a.stack_guard.unwrap_or_default().into(),
+                    },
+                )
+            })
+            .collect::<Result<_>>()
+    })?;
+    bar.finish_and_clear();
+    Ok(runs)
+}
+
+/// Writes `value` as pretty JSON with a final newline to `path`.
+fn write_json(path: &Path, value: &impl Serialize) -> Result<()> {
+    std::fs::write(path, serde_json::to_string_pretty(value)? + "\n")
+        .map_err(anyhow::Error::new)
+        .context(OutputError::cannot_write(path))
+}
+
+/// The fit verdict of the scenario's learner on the robot firmware (400 steps, compared with
+/// the model), for fit.json.
+fn measure_fit(s: &Scenario) -> Result<swarm::fit::FitReport> {
+    Ok(swarm::fit::measure(&swarm::fit::FitConfig {
+        controller: controller_config(s, swarm::fit::fit_weight_seed(s.seed))?,
         steps: 400,
         seed: s.seed,
-        kind: crate::fit::ControllerKind::Firmware,
-        firmware: crate::fit::FirmwareUnderTest::robot()?,
+        kind: swarm::scenario::ControllerKind::Firmware,
+        firmware: swarm::fit::FirmwareUnderTest::robot()?,
         compare: true,
-    })?;
-    let fit_path = stage.path("fit.json");
-    std::fs::write(&fit_path, serde_json::to_string_pretty(&fit)? + "\n")
-        .map_err(anyhow::Error::new)
-        .context(OutputError(format!(
-            "cannot write `{}`",
-            fit_path.display()
-        )))?;
+    })?)
+}
 
+/// Draws the figures (the learning curves; the arena's paths or the corridor's space-time
+/// figure) and writes the viewer page when the plan asks for one; returns every file written
+/// so far, in [`OUTPUT_FILES`]' order up to the figures.
+fn write_figures(
+    s: &Scenario,
+    stage: &Stage,
+    replay: Option<&ReplayPlan>,
+    floor: &world::Arena,
+    runs: &[RunOutput],
+) -> Result<Vec<String>> {
     let (png, svg) = (stage.path("learning.png"), stage.path("learning.svg"));
     let drawn = |e: crate::plot::PlotError| {
         anyhow::Error::new(e).context(OutputError("cannot draw the figures".into()))
     };
-    learning_figure(&learning(s, &runs), &png, &svg).map_err(drawn)?;
+    learning_figure(&learning(s, runs), &png, &svg).map_err(drawn)?;
     let mut names: Vec<String> = [
         "metrics.csv",
         "robots.csv",
@@ -1083,18 +1118,11 @@ fn run_into(
     .map(String::from)
     .to_vec();
     if let Some(plan) = replay {
-        write_replay(
-            s,
-            &stage.path("replay.html"),
-            &stage.dir,
-            plan,
-            &floor,
-            &runs,
-        )?;
+        write_replay(s, &stage.path("replay.html"), &stage.dir, plan, floor, runs)?;
         names.push("replay.html".into());
     }
     if let Some(track) = runs.iter().find_map(|r| r.track.as_ref()) {
-        if s.arena == crate::scenario::ArenaKind::Corridor {
+        if s.arena == swarm::scenario::ArenaKind::Corridor {
             spacetime_figure(&spacetime(s, track), &stage.path("spacetime.png")).map_err(drawn)?;
             names.push("spacetime.png".into());
         } else {
@@ -1102,10 +1130,20 @@ fn run_into(
             names.push("arena.png".into());
         }
     }
+    Ok(names)
+}
 
-    let robot_steps = jobs.len() as f64 * f64::from(s.steps) * s.robots as f64;
-    let simulated_s = jobs.len() as f64 * f64::from(s.steps) * s.timing.step_period_s;
-    let mut t = String::new();
+/// The report's first lines: what ran, and how fast.
+fn render_header(
+    t: &mut String,
+    s: &Scenario,
+    conditions: usize,
+    runs: usize,
+    threads: usize,
+    wall_s: f64,
+) {
+    let robot_steps = runs as f64 * f64::from(s.steps) * s.robots as f64;
+    let simulated_s = runs as f64 * f64::from(s.steps) * s.timing.step_period_s;
     let _ = writeln!(
         t,
         "h8swarm run {}: {} robots, {} steps of {} s, {} x {} conditions, seed {}",
@@ -1114,7 +1152,7 @@ fn run_into(
         s.steps,
         s.timing.step_period_s,
         plural(s.repeats, "repeat"),
-        kinds.len(),
+        conditions,
         s.seed
     );
     let _ = writeln!(
@@ -1124,13 +1162,11 @@ fn run_into(
         robot_steps / wall_s,
         simulated_s / wall_s
     );
-    for w in &warnings {
-        let _ = writeln!(t, "WARNING {w}");
-    }
-    render_battery(&mut t, &battery);
-    let _ = writeln!(t);
-    report(&mut t, s, &analysis);
-    for r in &runs {
+}
+
+/// One line per robot that died and per stack warning, run by run.
+fn render_failures(t: &mut String, runs: &[RunOutput]) {
+    for r in runs {
         for (i, why) in &r.dead {
             let _ = writeln!(
                 t,
@@ -1148,9 +1184,6 @@ fn run_into(
             );
         }
     }
-    let _ = writeln!(t);
-    let _ = writeln!(t, "fit: {}", fit.verdict);
-    Ok((t, names))
 }
 
 /// Writes the viewer page with the recorded runs (in run order).
@@ -1162,7 +1195,8 @@ fn write_replay(
     arena: &world::Arena,
     runs: &[RunOutput],
 ) -> Result<()> {
-    use crate::recording::{CurveHeader, Header, MountHeader, RunHeader, part_paths};
+    use crate::viewer::{CurveHeader, Header, MountHeader, RunHeader};
+    use swarm::recording::part_paths;
     let mut headers = Vec::new();
     let mut parts = Vec::new();
     for r in runs {
@@ -1195,18 +1229,18 @@ fn write_replay(
             stuck_percent: find(&fig.stuck, &d.label),
         })
         .collect();
-    let params = crate::experiment::world_params(s);
-    let n_in = crate::robot::controller_config(s, 0)?.n_inputs();
+    let params = swarm::experiment::world_params(s);
+    let n_in = swarm::robot::controller_config(s, 0)?.n_inputs();
     let header = Header {
-        version: crate::recording::VERSION,
+        version: swarm::recording::VERSION,
         name: s.name.clone(),
         arena: match s.arena {
-            crate::scenario::ArenaKind::Corridor => "corridor".into(),
-            crate::scenario::ArenaKind::Square => "square".into(),
+            swarm::scenario::ArenaKind::Corridor => "corridor".into(),
+            swarm::scenario::ArenaKind::Square => "square".into(),
         },
         width_m: arena.width_m(),
         height_m: arena.height_m(),
-        quantum_m: crate::recording::quantum_m(arena.width_m(), arena.height_m()),
+        quantum_m: swarm::recording::quantum_m(arena.width_m(), arena.height_m()),
         walls: arena
             .walls()
             .iter()
@@ -1228,8 +1262,8 @@ fn write_replay(
         stride: plan.opts.stride,
         step_period_s: s.timing.step_period_s,
         controller: match s.controller.kind {
-            crate::fit::ControllerKind::Firmware => "firmware".into(),
-            crate::fit::ControllerKind::Model => "model".into(),
+            swarm::scenario::ControllerKind::Firmware => "firmware".into(),
+            swarm::scenario::ControllerKind::Model => "model".into(),
         },
         seed: s.seed,
         weights_shape: [n_in, s.learner.behaviours],
@@ -1238,7 +1272,7 @@ fn write_replay(
         runs: headers,
         curves,
     };
-    crate::recording::write_viewer(html, &header, &parts)
+    crate::viewer::write_viewer(html, &header, &parts)
 }
 
 /// `n` and the noun, plural when `n` is not 1.
@@ -1381,7 +1415,7 @@ fn report(t: &mut String, s: &Scenario, a: &Analysis) {
             p.both_stuck + p.neither,
             p.both_stuck,
             p.neither,
-            crate::summary::fmt_p(p.p)
+            swarm::summary::fmt_p(p.p)
         );
     }
     let _ = writeln!(t);
@@ -1414,7 +1448,7 @@ fn report(t: &mut String, s: &Scenario, a: &Analysis) {
     let paper: Vec<&Claim> = a.claims.iter().filter(|c| c.paper).collect();
     let held = paper
         .iter()
-        .filter(|c| c.outcome == crate::summary::Outcome::Holds)
+        .filter(|c| c.outcome == swarm::summary::Outcome::Holds)
         .count();
     let _ = writeln!(
         t,
@@ -1444,20 +1478,20 @@ fn fmt_mean(e: &Estimate) -> String {
     }
 }
 
-/// The battery life of each condition ([`crate::energy::BatteryReport`]) for the pack
+/// The battery life of each condition ([`swarm::battery::BatteryReport`]) for the pack
 /// `--capacity-mah` gives.
 fn battery_report(
     a: &RunArgs,
     s: &Scenario,
     stats: &[ConditionStats],
     runs: &[RunOutput],
-) -> Result<crate::energy::BatteryReport> {
-    let pack = crate::energy::Pack::paper(crate::fit_cmd::parse_capacity(a.capacity_mah)?);
-    let mut b = crate::energy::BatteryReport::of(stats, pack, s.timing.step_period_s);
+) -> Result<swarm::battery::BatteryReport> {
+    let pack = swarm::energy::Pack::paper(crate::fit_cmd::parse_capacity(a.capacity_mah)?);
+    let mut b = swarm::battery::BatteryReport::of(stats, pack, s.timing.step_period_s);
     let robot_seconds = s.robots as f64 * f64::from(s.steps) * s.timing.step_period_s;
     for c in stats {
         let of_c: Vec<&RunOutput> = runs.iter().filter(|r| r.condition == c.condition).collect();
-        b.by_part.push(crate::energy::ConditionParts::of(
+        b.by_part.push(swarm::battery::ConditionParts::of(
             c.condition,
             &of_c,
             robot_seconds,
@@ -1468,7 +1502,7 @@ fn battery_report(
 
 /// The battery lines of the summary: each condition's battery life in its first and last
 /// windows, its mean current by part, and what learning costs or saves against the controls.
-fn render_battery(t: &mut String, b: &crate::energy::BatteryReport) {
+fn render_battery(t: &mut String, b: &swarm::battery::BatteryReport) {
     let _ = writeln!(t);
     let _ = writeln!(
         t,
@@ -1571,18 +1605,17 @@ fn write_robots(path: &Path, runs: &[RunOutput]) -> Result<()> {
         w.flush()?;
         Ok(())
     };
-    write().context(OutputError(format!("cannot write `{}`", path.display())))
+    write().context(OutputError::cannot_write(path))
 }
 
 /// Joins the runs' row files (in run order) under the header into `path`, removing them.
 fn write_metrics(path: &Path, parts: &[PathBuf]) -> Result<()> {
-    write_metrics_csv(path, parts)
-        .context(OutputError(format!("cannot write `{}`", path.display())))
+    write_metrics_csv(path, parts).context(OutputError::cannot_write(path))
 }
 
 fn write_metrics_csv(path: &Path, parts: &[PathBuf]) -> Result<()> {
     let mut w = csv::Writer::from_path(path)?;
-    w.write_record(crate::experiment::METRICS_HEADER)?;
+    w.write_record(swarm::experiment::METRICS_HEADER)?;
     let mut out = w
         .into_inner()
         .map_err(|e| anyhow::anyhow!("{}", e.error()))?;
@@ -1609,7 +1642,7 @@ fn learning(s: &Scenario, runs: &[RunOutput]) -> LearningFigure {
         .map(|r| r.metrics.whole_windows().len())
         .min()
         .unwrap_or(0);
-    let seed = crate::seeds::bootstrap_seed(s.seed);
+    let seed = swarm::seeds::bootstrap_seed(s.seed);
     let panel = |q: Quantity| -> Vec<Series> {
         let mut out = Vec::new();
         for c in Condition::ALL {
@@ -1706,7 +1739,7 @@ fn learning(s: &Scenario, runs: &[RunOutput]) -> LearningFigure {
 
 /// The corridor's space-time figure: each tracked robot's position along the corridor over
 /// the run (learning, repeat 0).
-fn spacetime(s: &Scenario, t: &crate::experiment::Track) -> SpaceTimeFigure {
+fn spacetime(s: &Scenario, t: &swarm::experiment::Track) -> SpaceTimeFigure {
     let length_m = t
         .walls
         .iter()
@@ -1724,10 +1757,10 @@ fn spacetime(s: &Scenario, t: &crate::experiment::Track) -> SpaceTimeFigure {
 }
 
 /// The arena figure as the paper's Fig. 8 shows learning: the first and the last
-/// [`crate::experiment::SNAPSHOT_STEPS`] steps' paths in two panels, with the outlines at the
+/// [`swarm::experiment::SNAPSHOT_STEPS`] steps' paths in two panels, with the outlines at the
 /// start and the end of each.
-fn arena(s: &Scenario, t: &crate::experiment::Track) -> Vec<ArenaFigure> {
-    let k = crate::experiment::SNAPSHOT_STEPS.min(s.steps as usize);
+fn arena(s: &Scenario, t: &swarm::experiment::Track) -> Vec<ArenaFigure> {
+    let k = swarm::experiment::SNAPSHOT_STEPS.min(s.steps as usize);
     let n = s.steps as usize;
     let first_of = |from: usize, to: usize| -> ArenaFigure {
         let paths = if from == 0 { &t.early } else { &t.late }.clone();
@@ -1846,18 +1879,6 @@ mod tests {
         };
         let e = check_memory_within(&s, 2, Some(1 << 40), 0, &small_as).unwrap_err();
         assert!(e.to_string().contains("ulimit -v"), "{e}");
-    }
-
-    #[test]
-    fn output_errors_are_found_under_any_context() {
-        let direct = anyhow::Error::new(OutputError("cannot write".into()));
-        assert!(is_output_error(&direct));
-        let wrapped = anyhow::Error::new(std::io::Error::other("disk full"))
-            .context(OutputError("cannot write `metrics.csv`".into()))
-            .context("the run into `out` failed; nothing was written");
-        assert!(is_output_error(&wrapped));
-        let input = anyhow::anyhow!("`steps` = 0 is out of range").context("scenario file");
-        assert!(!is_output_error(&input));
     }
 
     #[test]

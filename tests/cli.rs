@@ -651,7 +651,7 @@ fn replay_changes_no_other_output_and_is_the_same_for_any_thread_count() {
         std::fs::read(rec2b.join("replay.html")).unwrap(),
         "the page differs between 1 and 2 threads"
     );
-    let decoded = h8swarm::recording::decode(&String::from_utf8(page).unwrap()).unwrap();
+    let decoded = h8swarm::viewer::decode(&String::from_utf8(page).unwrap()).unwrap();
     assert_eq!(decoded.header.runs.len(), 6, "3 conditions x 2 repeats");
     assert_eq!(decoded.frames[0].len(), 150);
     assert_eq!(decoded.frames[0][0].len(), 4);

@@ -4,11 +4,12 @@
 //! adds up to the robots' charge; the fit's energy report by part.
 
 use emu::board::model::ControllerConfig;
-use h8swarm::energy::{DriveMeter, Pack, Part};
-use h8swarm::experiment::{Swarm, world_params};
-use h8swarm::fit::{ControllerKind, FirmwareUnderTest, FitConfig, fit_weight_seed, measure};
-use h8swarm::robot::Condition;
-use h8swarm::scenario::Scenario;
+use swarm::energy::{DriveMeter, Pack, Part};
+use swarm::experiment::{Swarm, world_params};
+use swarm::fit::{FirmwareUnderTest, FitConfig, fit_weight_seed, measure};
+use swarm::robot::Condition;
+use swarm::scenario::ControllerKind;
+use swarm::scenario::Scenario;
 use world::dc_motor::DcMotor;
 use world::{Arena, Behaviour, Pose, World};
 

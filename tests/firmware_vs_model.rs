@@ -1,8 +1,8 @@
-//! Firmware robots and model robots side by side (issue 11 item 5): with identical sensor
+//! Firmware robots and model robots side by side: with identical sensor
 //! inputs the learner's state (weights, x, O, D, the motors) stays equal step for step, and the swarm's learning runs agree.
 
-use h8swarm::robot::{Brain, Condition, Images, Robot};
-use h8swarm::scenario::Scenario;
+use swarm::robot::{Brain, Condition, Images, Robot};
+use swarm::scenario::Scenario;
 
 fn scenario(corridor: bool) -> Scenario {
     let mut s = if corridor {
@@ -47,7 +47,7 @@ fn firmware_learner(r: &Robot, n_in: usize, m: usize) -> (Vec<i16>, Vec<i8>, Vec
 
 fn side_by_side(corridor: bool, condition: Condition, steps: u32) -> (u64, i64) {
     let mut s = scenario(corridor);
-    s.controller.kind = h8swarm::fit::ControllerKind::Firmware;
+    s.controller.kind = swarm::scenario::ControllerKind::Firmware;
     let images = Images::load(&s).unwrap();
     let mut fw = Robot::new(&s, condition, 0, 0, images.as_ref()).unwrap();
     let mut model = Robot::new(&s, condition, 0, 0, None).unwrap();

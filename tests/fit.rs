@@ -5,8 +5,9 @@
 use std::process::Command;
 
 use emu::board::model::ControllerConfig;
-use h8swarm::fit::{ControllerKind, FirmwareUnderTest, FitConfig, fit_weight_seed, measure};
 use nn_q15::InputLayout;
+use swarm::fit::{FirmwareUnderTest, FitConfig, fit_weight_seed, measure};
+use swarm::scenario::ControllerKind;
 
 fn config(behaviours: usize, layout: InputLayout, corridor: bool) -> FitConfig {
     let seed = 3;

@@ -170,7 +170,7 @@ fn scenario_files_never_panic_and_fail_in_one_line() {
     runner()
         .run(&prop::collection::vec(edit(), 1..6), |edits| {
             let text = apply(&example, &edits);
-            match h8swarm::scenario::Scenario::from_toml(&text) {
+            match swarm::scenario::Scenario::from_toml(&text) {
                 Ok(s) => {
                     ok.set(ok.get() + 1);
                     // What a run checks next must not panic either.

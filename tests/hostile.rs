@@ -707,7 +707,7 @@ fn emu_streams_its_vcd_and_runs_under_a_small_memory_limit() {
 #[test]
 fn a_run_too_big_for_the_process_limit_is_refused_not_aborted() {
     // 100 000 robots under a 4 GB address-space limit: status 2 and a message naming the
-    // limit, at once (it used to abort with SIGABRT after seconds).
+    // limit, at once.
     let root = fresh("rlimit-run");
     let o = under_rlimit(
         4_000_000,

@@ -2,12 +2,12 @@
 //! output bytes deterministic, bad data and bad paths reported as errors.
 
 use h8swarm::plot;
+use swarm::experiment::Outline;
 
 use std::path::{Path, PathBuf};
 
 use plot::{
-    ArenaFigure, LEARNING_SIZE_PX, LearningFigure, Outline, PlotError, Series, arena_figure,
-    learning_figure,
+    ArenaFigure, LEARNING_SIZE_PX, LearningFigure, PlotError, Series, arena_figure, learning_figure,
 };
 
 /// A fresh, empty folder for one test's files.

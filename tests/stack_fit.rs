@@ -8,7 +8,8 @@ use std::path::Path;
 use emu::board::firmware::Firmware;
 use emu::board::model::ControllerConfig;
 use emu::board::profile::PhaseDef;
-use h8swarm::fit::{ControllerKind, FirmwareUnderTest, FitConfig, fit_weight_seed, measure};
+use swarm::fit::{FirmwareUnderTest, FitConfig, fit_weight_seed, measure};
+use swarm::scenario::ControllerKind;
 
 #[test]
 fn the_robot_firmware_states_the_stack_room_it_leaves() {

@@ -16,10 +16,10 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-use h8swarm::experiment::Swarm;
-use h8swarm::robot::Condition;
-use h8swarm::scenario::Scenario;
 use serde_json::{Value, json};
+use swarm::experiment::Swarm;
+use swarm::robot::Condition;
+use swarm::scenario::Scenario;
 
 fn chromium() -> Option<PathBuf> {
     if let Ok(p) = std::env::var("H8SWARM_CHROMIUM") {
@@ -222,7 +222,7 @@ fn ready(tab: &mut Tab) {
 }
 
 /// The robots' poses at step `k` of the learning run's repeat 0, from the library.
-fn truth(s: &Scenario, images: Option<&h8swarm::robot::Images>, k: u32) -> Vec<(f64, f64, f64)> {
+fn truth(s: &Scenario, images: Option<&swarm::robot::Images>, k: u32) -> Vec<(f64, f64, f64)> {
     let mut swarm = Swarm::new(s, Condition::Learning, 0, false, images).unwrap();
     for _ in 0..=k {
         swarm.step().unwrap();
@@ -257,7 +257,7 @@ fn check_page(browser: &Browser, dir: &Path, s: &Scenario, k: u32, controller: &
         k
     );
     let drawn = tab.eval("h8.drawn()");
-    let images = h8swarm::robot::Images::load(s).unwrap();
+    let images = swarm::robot::Images::load(s).unwrap();
     let truth = truth(s, images.as_ref(), k);
     for (i, (x, y, h)) in truth.iter().enumerate() {
         let d = &drawn[i];
@@ -397,7 +397,7 @@ fn the_viewer_shows_the_run_as_recorded() {
         .unwrap()
         .with_overrides(None, Some(60), Some(1), None)
         .unwrap();
-    s.controller.kind = h8swarm::fit::ControllerKind::Firmware;
+    s.controller.kind = swarm::scenario::ControllerKind::Firmware;
     check_page(&browser, &fw, &s, 41, "firmware");
 }
 

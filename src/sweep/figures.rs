@@ -1,7 +1,7 @@
 //! The sweep's figures, drawn with `plotters`: a **claim map** for every claim and a **region**
 //! figure for the paper's text claims together.
 //!
-//! A claim says "a below b", checked in every point repeat by repeat ([`crate::summary`]). A
+//! A claim says "a below b", checked in every point repeat by repeat ([`swarm::summary`]). A
 //! map's cell is one combination of the swept values; it pools the points that differ only in
 //! their master seed: their repeats' counts for and against the claim are added and judged by
 //! the same one-sided exact sign test at the same level, so a cell of 5 seeds × 10 repeats is
@@ -25,7 +25,7 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::SweepError;
 use super::spec::Axis;
-use crate::summary::{SIGNIFICANCE, sign_test_p};
+use swarm::summary::{SIGNIFICANCE, sign_test_p};
 
 /// The font family the run's figures register (DejaVu Sans, embedded).
 const FONT: &str = "sans-serif";

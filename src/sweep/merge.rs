@@ -31,10 +31,10 @@ use std::path::{Path, PathBuf};
 use serde_json::{Map, Value, json};
 
 use super::SweepError;
-use super::exec::{PointState, point_state};
 use super::figures::{ClaimSeries, PointClaim, cell_values, claim_figures, region};
 use super::plan::read_plan;
-use super::spec::printable;
+use super::points::{PointState, host_name, is_dead_leftover, point_state, read_summary};
+use swarm::text::printable;
 
 /// The statistics of a window in the order the table lists them (others follow, sorted).
 const STAT_ORDER: [&str; 9] = [
@@ -140,7 +140,7 @@ pub fn collect(
     cols.add("seed");
     let mut m = Merged::default();
     let mut stat_cols = Columns::default();
-    let mut claim_slugs: BTreeMap<String, String> = BTreeMap::new();
+    let mut claims = Claims::default();
     let mut claim_cols = Columns::default();
     for line in &lines {
         let mut row = Map::new();
@@ -186,98 +186,8 @@ pub fn collect(
             None
         };
         if let Some(summary) = summary {
-            for c in summary["conditions"].as_array().into_iter().flatten() {
-                let cond = c["condition"].as_str().unwrap_or("condition");
-                if let Some(robots) = c["robots"].as_object() {
-                    for (k, v) in robots {
-                        if let Some(est) = v.as_object() {
-                            for part in ["mean", "lo", "hi"] {
-                                let col = format!("{cond}.robots.{k}.{part}");
-                                stat_cols.add(&col);
-                                row.insert(col, est.get(part).cloned().unwrap_or(Value::Null));
-                            }
-                        } else {
-                            let col = format!("{cond}.robots.{k}");
-                            stat_cols.add(&col);
-                            row.insert(col, v.clone());
-                        }
-                    }
-                }
-                for w in ["first", "last"] {
-                    let Some(win) = c[w].as_object() else {
-                        continue;
-                    };
-                    let mut keys: Vec<&String> = STAT_ORDER
-                        .iter()
-                        .filter_map(|k| win.get_key_value(*k).map(|(k, _)| k))
-                        .collect();
-                    let mut rest: Vec<&String> = win
-                        .keys()
-                        .filter(|k| !STAT_ORDER.contains(&k.as_str()))
-                        .collect();
-                    rest.sort();
-                    keys.extend(rest);
-                    for k in keys {
-                        let Some(est) = win[k].as_object() else {
-                            continue;
-                        };
-                        if !est.contains_key("mean") {
-                            continue;
-                        }
-                        for part in ["mean", "lo", "hi"] {
-                            let col = format!("{cond}.{w}.{k}.{part}");
-                            stat_cols.add(&col);
-                            row.insert(col, est.get(part).cloned().unwrap_or(Value::Null));
-                        }
-                    }
-                }
-            }
-            for c in summary["claims"].as_array().into_iter().flatten() {
-                let text = c["claim"].as_str().unwrap_or_default().to_string();
-                let slug = match claim_slugs.get(&text) {
-                    Some(s) => s.clone(),
-                    None => {
-                        let base = claim_slug(&text);
-                        let mut slug = base.clone();
-                        let mut n = 2;
-                        while claim_slugs.values().any(|s| *s == slug) {
-                            slug = format!("{base}_{n}");
-                            n += 1;
-                        }
-                        claim_slugs.insert(text.clone(), slug.clone());
-                        let paper = c["paper"].as_bool().unwrap_or(false);
-                        m.claims.push((slug.clone(), text.clone(), paper));
-                        slug
-                    }
-                };
-                let a = c["values"][0].as_f64();
-                let b = c["values"][1].as_f64();
-                let r = &c["repeats"];
-                let cells = [
-                    ("outcome", c["outcome"].clone()),
-                    ("means_agree", c["means_agree"].clone()),
-                    ("apart", c["apart"].clone()),
-                    ("a", a.map_or(Value::Null, num)),
-                    ("b", b.map_or(Value::Null, num)),
-                    (
-                        "effect",
-                        match (a, b) {
-                            (Some(a), Some(b)) => num(b - a),
-                            _ => Value::Null,
-                        },
-                    ),
-                    ("for", r["for"].clone()),
-                    ("against", r["against"].clone()),
-                    ("tied", r["tied"].clone()),
-                    ("undefined", r["undefined"].clone()),
-                    ("p", r["p"].clone()),
-                ];
-                for (part, v) in cells {
-                    let col = format!("claim.{slug}.{part}");
-                    claim_cols.add(&col);
-                    row.insert(col, v);
-                }
-            }
+            condition_cells(&summary, &mut row, &mut stat_cols);
+            claim_cells(&summary, &mut row, &mut claims, &mut claim_cols);
         }
         m.rows.push(row);
     }
@@ -286,20 +196,8 @@ pub fn collect(
     }
     cols.add("error");
     m.columns = cols.order;
+    m.claims = claims.order;
     Ok((plan, lines, m))
-}
-
-/// A finished point's `summary.json`, or why it cannot be read (an object with its
-/// `conditions` and `claims`).
-pub(crate) fn read_summary(path: &Path) -> Result<Value, String> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| format!("its summary.json cannot be read: {e}"))?;
-    let v: Value =
-        serde_json::from_str(&text).map_err(|e| format!("its summary.json is not JSON: {e}"))?;
-    if !(v["conditions"].is_array() && v["claims"].is_array()) {
-        return Err("its summary.json has no `conditions` and `claims` lists".into());
-    }
-    Ok(v)
 }
 
 /// Leftover temporary folders under `points/` (tasks running now, or killed).
@@ -354,50 +252,9 @@ pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepErro
     std::fs::create_dir_all(&plots)
         .map_err(|e| SweepError::tool(format!("cannot create `{}`: {e}", plots.display())))?;
 
-    // The CSV, rendered in memory, then written in one step.
-    let mut w = csv::Writer::from_writer(Vec::new());
-    let csv_err = |e: csv::Error| SweepError::tool(format!("writing sweep.csv: {e}"));
-    w.write_record(&m.columns).map_err(csv_err)?;
-    for row in &m.rows {
-        w.write_record(m.columns.iter().map(|c| csv_cell(row.get(c))))
-            .map_err(csv_err)?;
-    }
-    let bytes = w
-        .into_inner()
-        .map_err(|e| SweepError::tool(format!("writing sweep.csv: {e}")))?;
-    let csv_path = out.join("sweep.csv");
-    super::write_atomic(&csv_path, &bytes)?;
+    let csv_path = write_csv(&m, &out)?;
 
-    // Each claim's result per point, for the figures.
-    let series: Vec<ClaimSeries> = m
-        .claims
-        .iter()
-        .map(|(slug, text, paper)| ClaimSeries {
-            slug: slug.clone(),
-            text: text.clone(),
-            paper: *paper,
-            per_point: m
-                .rows
-                .iter()
-                .map(|r| {
-                    let n = |part: &str| {
-                        r.get(&format!("claim.{slug}.{part}"))
-                            .and_then(Value::as_u64)
-                            .map(|v| v as u32)
-                    };
-                    let (f, a, t) = (n("for")?, n("against")?, n("tied")?);
-                    Some(PointClaim {
-                        for_: f,
-                        against: a,
-                        defined: f + a + t,
-                        effect: r
-                            .get(&format!("claim.{slug}.effect"))
-                            .and_then(Value::as_f64),
-                    })
-                })
-                .collect(),
-        })
-        .collect();
+    let series = claim_series(&m);
     let coords: Vec<Vec<usize>> = lines.iter().map(|l| l.coords.clone()).collect();
     let paper: Vec<&ClaimSeries> = series.iter().filter(|s| s.paper).collect();
     let (inside, with_data) = region(&plan.axes, &coords, &paper);
@@ -425,17 +282,7 @@ pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepErro
         .filter_map(|p| p.file_name())
         .map(|n| format!("plots/{}", n.to_string_lossy()))
         .collect();
-    for old in earlier.iter().filter(|n| !figure_names.contains(n)) {
-        let p = out.join(old);
-        if p.is_file() {
-            std::fs::remove_file(&p).map_err(|e| {
-                SweepError::tool(format!(
-                    "cannot remove the earlier figure `{}`: {e}",
-                    p.display()
-                ))
-            })?;
-        }
-    }
+    remove_stale_figures(&out, &earlier, &figure_names)?;
     let mut doc = doc;
     doc["figures"] = json!(figure_names);
     let json_path = out.join("sweep.json");
@@ -455,35 +302,7 @@ pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepErro
         m.missing.len(),
         m.broken.len()
     );
-    for (id, why) in &m.failed {
-        let _ = writeln!(t, "FAILED  {id}: {}", printable(why));
-    }
-    for id in &m.missing {
-        let _ = writeln!(t, "MISSING {id}");
-    }
-    for (id, why) in &m.broken {
-        let _ = writeln!(
-            t,
-            "BROKEN  {id}: {} (the next `sweep run` redoes it)",
-            printable(why)
-        );
-    }
-    let host = super::exec::host_name();
-    for tmp in temporaries(&dir.join("points")) {
-        let _ = if super::exec::is_dead_leftover(&tmp, &host) {
-            writeln!(
-                t,
-                "LEFTOVER points/{} (its task was killed; the next `sweep run` removes it)",
-                printable(&tmp)
-            )
-        } else {
-            writeln!(
-                t,
-                "RUNNING points/{} (a task at work, or left by a killed one)",
-                printable(&tmp)
-            )
-        };
-    }
+    render_points(&mut t, &m, dir);
     for (slug, text, _) in &m.claims {
         let col = format!("claim.{slug}.outcome");
         let with: Vec<&str> = m
@@ -532,4 +351,226 @@ pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepErro
     }
     let complete = m.failed.is_empty() && m.missing.is_empty() && m.broken.is_empty();
     Ok((t, complete))
+}
+
+/// Writes the merged table as `out/sweep.csv` (rendered in memory, then written in one step);
+/// returns its path.
+fn write_csv(m: &Merged, out: &Path) -> Result<PathBuf, SweepError> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let csv_err = |e: csv::Error| SweepError::tool(format!("writing sweep.csv: {e}"));
+    w.write_record(&m.columns).map_err(csv_err)?;
+    for row in &m.rows {
+        w.write_record(m.columns.iter().map(|c| csv_cell(row.get(c))))
+            .map_err(csv_err)?;
+    }
+    let bytes = w
+        .into_inner()
+        .map_err(|e| SweepError::tool(format!("writing sweep.csv: {e}")))?;
+    let csv_path = out.join("sweep.csv");
+    super::write_atomic(&csv_path, &bytes)?;
+
+    Ok(csv_path)
+}
+
+/// Each claim's result per point (its repeats for, against and tied, and its effect), for the
+/// figures.
+fn claim_series(m: &Merged) -> Vec<ClaimSeries> {
+    m.claims
+        .iter()
+        .map(|(slug, text, paper)| ClaimSeries {
+            slug: slug.clone(),
+            text: text.clone(),
+            paper: *paper,
+            per_point: m
+                .rows
+                .iter()
+                .map(|r| {
+                    let n = |part: &str| {
+                        r.get(&format!("claim.{slug}.{part}"))
+                            .and_then(Value::as_u64)
+                            .map(|v| v as u32)
+                    };
+                    let (f, a, t) = (n("for")?, n("against")?, n("tied")?);
+                    Some(PointClaim {
+                        for_: f,
+                        against: a,
+                        defined: f + a + t,
+                        effect: r
+                            .get(&format!("claim.{slug}.effect"))
+                            .and_then(Value::as_f64),
+                    })
+                })
+                .collect(),
+        })
+        .collect()
+}
+
+/// Removes the figures an earlier merge into `out` drew (`earlier`, as its sweep.json lists
+/// them) that this one did not draw again (`drawn`).
+fn remove_stale_figures(
+    out: &Path,
+    earlier: &[String],
+    drawn: &[String],
+) -> Result<(), SweepError> {
+    for old in earlier.iter().filter(|n| !drawn.contains(n)) {
+        let p = out.join(old);
+        if p.is_file() {
+            std::fs::remove_file(&p).map_err(|e| {
+                SweepError::tool(format!(
+                    "cannot remove the earlier figure `{}`: {e}",
+                    p.display()
+                ))
+            })?;
+        }
+    }
+    Ok(())
+}
+
+/// The report's lines on the points that did not finish: failed, missing, broken, and the
+/// temporary folders under `dir/points` (a task at work, or a killed task's leftovers).
+fn render_points(t: &mut String, m: &Merged, dir: &Path) {
+    for (id, why) in &m.failed {
+        let _ = writeln!(t, "FAILED  {id}: {}", printable(why));
+    }
+    for id in &m.missing {
+        let _ = writeln!(t, "MISSING {id}");
+    }
+    for (id, why) in &m.broken {
+        let _ = writeln!(
+            t,
+            "BROKEN  {id}: {} (the next `sweep run` redoes it)",
+            printable(why)
+        );
+    }
+    let host = host_name();
+    for tmp in temporaries(&dir.join("points")) {
+        let _ = if is_dead_leftover(&tmp, &host) {
+            writeln!(
+                t,
+                "LEFTOVER points/{} (its task was killed; the next `sweep run` removes it)",
+                printable(&tmp)
+            )
+        } else {
+            writeln!(
+                t,
+                "RUNNING points/{} (a task at work, or left by a killed one)",
+                printable(&tmp)
+            )
+        };
+    }
+}
+
+/// The claims met so far over the points: each claim's text with its column slug, and the
+/// claims (slug, text, whether it is the paper's) in the order they were first met.
+#[derive(Default)]
+struct Claims {
+    slugs: BTreeMap<String, String>,
+    order: Vec<(String, String, bool)>,
+}
+
+/// A finished point's window statistics into `row`: every condition's per-robot figures and
+/// its first and last windows' estimates (mean, lo, hi), their columns added to `cols`.
+fn condition_cells(summary: &Value, row: &mut Map<String, Value>, cols: &mut Columns) {
+    for c in summary["conditions"].as_array().into_iter().flatten() {
+        let cond = c["condition"].as_str().unwrap_or("condition");
+        if let Some(robots) = c["robots"].as_object() {
+            for (k, v) in robots {
+                if let Some(est) = v.as_object() {
+                    for part in ["mean", "lo", "hi"] {
+                        let col = format!("{cond}.robots.{k}.{part}");
+                        cols.add(&col);
+                        row.insert(col, est.get(part).cloned().unwrap_or(Value::Null));
+                    }
+                } else {
+                    let col = format!("{cond}.robots.{k}");
+                    cols.add(&col);
+                    row.insert(col, v.clone());
+                }
+            }
+        }
+        for w in ["first", "last"] {
+            let Some(win) = c[w].as_object() else {
+                continue;
+            };
+            let mut keys: Vec<&String> = STAT_ORDER
+                .iter()
+                .filter_map(|k| win.get_key_value(*k).map(|(k, _)| k))
+                .collect();
+            let mut rest: Vec<&String> = win
+                .keys()
+                .filter(|k| !STAT_ORDER.contains(&k.as_str()))
+                .collect();
+            rest.sort();
+            keys.extend(rest);
+            for k in keys {
+                let Some(est) = win[k].as_object() else {
+                    continue;
+                };
+                if !est.contains_key("mean") {
+                    continue;
+                }
+                for part in ["mean", "lo", "hi"] {
+                    let col = format!("{cond}.{w}.{k}.{part}");
+                    cols.add(&col);
+                    row.insert(col, est.get(part).cloned().unwrap_or(Value::Null));
+                }
+            }
+        }
+    }
+}
+
+/// A finished point's claims into `row`: outcome, values, effect and repeats per claim, under
+/// a column slug of the claim's (new claims added to `claims`, their columns to `cols`).
+fn claim_cells(
+    summary: &Value,
+    row: &mut Map<String, Value>,
+    claims: &mut Claims,
+    cols: &mut Columns,
+) {
+    for c in summary["claims"].as_array().into_iter().flatten() {
+        let text = c["claim"].as_str().unwrap_or_default().to_string();
+        let slug = match claims.slugs.get(&text) {
+            Some(s) => s.clone(),
+            None => {
+                let base = claim_slug(&text);
+                let mut slug = base.clone();
+                let mut n = 2;
+                while claims.slugs.values().any(|s| *s == slug) {
+                    slug = format!("{base}_{n}");
+                    n += 1;
+                }
+                claims.slugs.insert(text.clone(), slug.clone());
+                let paper = c["paper"].as_bool().unwrap_or(false);
+                claims.order.push((slug.clone(), text.clone(), paper));
+                slug
+            }
+        };
+        let a = c["values"][0].as_f64();
+        let b = c["values"][1].as_f64();
+        let r = &c["repeats"];
+        let cells = [
+            ("outcome", c["outcome"].clone()),
+            ("means_agree", c["means_agree"].clone()),
+            ("apart", c["apart"].clone()),
+            ("a", a.map_or(Value::Null, num)),
+            ("b", b.map_or(Value::Null, num)),
+            (
+                "effect",
+                match (a, b) {
+                    (Some(a), Some(b)) => num(b - a),
+                    _ => Value::Null,
+                },
+            ),
+            ("for", r["for"].clone()),
+            ("against", r["against"].clone()),
+            ("tied", r["tied"].clone()),
+            ("undefined", r["undefined"].clone()),
+            ("p", r["p"].clone()),
+        ];
+        for (part, v) in cells {
+            let col = format!("claim.{slug}.{part}");
+            cols.add(&col);
+            row.insert(col, v);
+        }
+    }
 }

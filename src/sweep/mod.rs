@@ -13,7 +13,7 @@
 //!   ([`figures`]), and the failed and missing points listed.
 //!
 //! A point's results depend only on its scenario (its master seed included: every stream is
-//! derived from it by [`crate::seeds`]), so the merged table is the same byte for byte however
+//! derived from it by [`swarm::seeds`]), so the merged table is the same byte for byte however
 //! the points are split into tasks, in what order they run, and on which machine.
 //!
 //! Exit status: 2 for bad input (a malformed sweep file, an unknown key, an empty grid, a task
@@ -25,6 +25,7 @@ pub mod exec;
 pub mod figures;
 pub mod merge;
 pub mod plan;
+pub mod points;
 pub mod spec;
 
 use std::path::{Path, PathBuf};
@@ -133,8 +134,8 @@ pub fn command(args: &SweepArgs) -> (String, Result<(), SweepError>) {
     match &args.command {
         SweepCommand::Plan { sweep, out, bin } => {
             let planned = (|| {
-                let max = crate::scenario::MAX_FILE_BYTES;
-                let text = crate::scenario::read_text(sweep, max).map_err(|e| {
+                let max = swarm::scenario::MAX_FILE_BYTES;
+                let text = swarm::scenario::read_text(sweep, max).map_err(|e| {
                     SweepError::input(format!(
                         "cannot read sweep file `{}`: {e} (give a .toml sweep file)",
                         sweep.display()

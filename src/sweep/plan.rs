@@ -30,7 +30,7 @@ use serde::{Deserialize, Serialize};
 
 use super::spec::{Axis, Point, SlurmSpec, Sweep};
 use super::{SweepError, write_atomic};
-use crate::fit::ControllerKind;
+use swarm::scenario::ControllerKind;
 
 /// Default points per array task.
 pub const DEFAULT_POINTS_PER_TASK: usize = 1;
@@ -242,7 +242,7 @@ pub struct PointCost {
 impl PointCost {
     /// The cost of a point's scenario.
     #[must_use]
-    pub fn of(s: &crate::scenario::Scenario) -> PointCost {
+    pub fn of(s: &swarm::scenario::Scenario) -> PointCost {
         let runs = (1 + u32::from(s.controls.learning_off) + u32::from(s.controls.random_walk))
             * s.repeats;
         PointCost {
@@ -272,7 +272,7 @@ pub fn requests(
     let mut cpus = 1usize;
     for c in costs {
         let factor = (c.robots as usize)
-            .div_ceil(crate::experiment::PARALLEL_ROBOTS)
+            .div_ceil(swarm::experiment::PARALLEL_ROBOTS)
             .max(1);
         cpus = cpus.max((c.runs as usize * factor).min(max_cpus));
     }
@@ -295,7 +295,7 @@ pub fn requests(
         } else {
             MODEL_ROBOT_MB
         };
-        let tracked = robots.min(crate::experiment::TRACKED_ROBOTS as f64);
+        let tracked = robots.min(swarm::experiment::TRACKED_ROBOTS as f64);
         let mem = BASE_MEM_MB
             + concurrent * robots * per_robot
             + (runs as f64 * steps * 72.0 + steps * tracked * 16.0) / 1_048_576.0;
@@ -542,7 +542,7 @@ pub fn write_plan(
     })?;
     write_atomic(&dir.join("plan.json"), plan_json.as_bytes())?;
     write_atomic(&dir.join("sweep.sbatch"), script.as_bytes())?;
-    let dir_text = super::spec::printable(&dir.display().to_string());
+    let dir_text = swarm::text::printable(&dir.display().to_string());
 
     let mut t = String::new();
     let _ = writeln!(

@@ -38,7 +38,8 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use crate::scenario::{Scenario, ScenarioFile};
+use swarm::scenario::{Scenario, ScenarioFile};
+use swarm::text::{one_line, toml_error};
 
 use super::SweepError;
 
@@ -264,83 +265,6 @@ impl Point {
     }
 }
 
-/// A TOML error in one line: where (line, column and the line's text) and what.
-#[must_use]
-pub fn toml_error(text: &str, e: &toml::de::Error) -> String {
-    let Some(span) = e.span() else {
-        return one_line(e.message());
-    };
-    let before = &text[..span.start.min(text.len())];
-    let line = before.matches('\n').count() + 1;
-    let column = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
-    let source: String = text
-        .lines()
-        .nth(line - 1)
-        .unwrap_or_default()
-        .trim()
-        .chars()
-        .take(60)
-        .collect();
-    format!(
-        "line {line}, column {column} (`{source}`): {}",
-        one_line(e.message())
-    )
-}
-
-/// `text` safe to show on a terminal, in one line: every control character (ESC, newline,
-/// carriage return, tab, backspace, DEL, the C1 controls such as CSI) and every Unicode
-/// bidirectional control is written as an escape (`\e`, `\n`, `\r`, `\t`, `\u{9b}`), so
-/// no text from a file or an argument can move the cursor, recolour or retitle the terminal,
-/// or break a one-line message into lines. Everything else is kept as it is.
-///
-/// This is the one place where text that came from a user is made printable: every message
-/// that echoes a path, a value, a line of a file or a message built from them goes through
-/// it (the error line `h8swarm` prints, `sweep merge`'s and `sweep run`'s lists, `emu`'s
-/// reports).
-#[must_use]
-pub fn printable(text: &str) -> String {
-    let mut out = String::with_capacity(text.len());
-    for c in text.chars() {
-        match c {
-            '\u{1b}' => out.push_str("\\e"),
-            '\n' => out.push_str("\\n"),
-            '\r' => out.push_str("\\r"),
-            '\t' => out.push_str("\\t"),
-            c if c.is_control() || is_bidi_control(c) => {
-                let _ = write!(out, "\\u{{{:x}}}", u32::from(c));
-            }
-            c => out.push(c),
-        }
-    }
-    out
-}
-
-/// The Unicode controls that reorder text on display (U+061C, U+200E, U+200F, U+202A to
-/// U+202E, U+2066 to U+2069).
-fn is_bidi_control(c: char) -> bool {
-    matches!(c, '\u{61c}' | '\u{200e}' | '\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}')
-}
-
-/// A message of several lines (the TOML parser's, with its source excerpt) in one: the
-/// excerpt's lines dropped, the rest joined by `: `, and what is left made [`printable`].
-#[must_use]
-pub fn one_line(text: &str) -> String {
-    let joined = text
-        .lines()
-        .map(str::trim)
-        .filter(|l| {
-            !l.is_empty()
-                && !l.starts_with('|')
-                && !l.starts_with("TOML parse error")
-                && !l
-                    .split_once('|')
-                    .is_some_and(|(n, _)| n.trim().chars().all(|c| c.is_ascii_digit()))
-        })
-        .collect::<Vec<_>>()
-        .join(": ");
-    printable(&joined)
-}
-
 /// Cuts a point's `window` to its `steps` (a point that shortens the run without naming a
 /// window gets one window of the whole run, as a scenario file does).
 fn clamp_window(t: &mut toml::Table) {
@@ -539,20 +463,7 @@ pub fn parse(text: &str, file: &Path) -> Result<Sweep, SweepError> {
     let where_ = format!("sweep file `{}`", file.display());
     let f: SweepFile = toml::from_str(text)
         .map_err(|e| SweepError::input(format!("{where_}, {}", toml_error(text, &e))))?;
-
-    let base_name = f.base.clone().unwrap_or_else(|| "arena".to_string());
-    let base = if base_name == "arena" || base_name == "corridor" {
-        Scenario::builtin(&base_name)
-    } else {
-        let p = Path::new(&base_name);
-        let p = if p.is_relative() {
-            file.parent().unwrap_or(Path::new("")).join(p)
-        } else {
-            p.to_path_buf()
-        };
-        Scenario::load(&p.display().to_string())
-    }
-    .map_err(|e| SweepError::input(format!("{where_}: key `base` = \"{base_name}\": {e:#}")))?;
+    let base = load_base(f.base.as_deref(), file, &where_)?;
     let keys = Keys::new(&base)?;
 
     let name = f.name.clone().unwrap_or_else(|| {
@@ -561,121 +472,19 @@ pub fn parse(text: &str, file: &Path) -> Result<Sweep, SweepError> {
     });
     let name = sanitize(&name, 48);
 
-    // The fixed changes.
     let mut table = keys.base.clone();
-    let mut set = Vec::new();
-    if let Some(t) = &f.set {
-        flatten("", t, &mut set);
-    }
-    // As in a scenario file: `steps` set without `window` cuts the base's window to the run.
-    let window_given = set.iter().any(|(k, _)| k == "window");
-    for (k, v) in set {
-        keys.check(&k, &format!("{where_}, [set]"))?;
-        let v = keys.coerce(&k, v);
-        set_key(&mut table, &k, v)
-            .map_err(|e| SweepError::input(format!("{where_}, [set] `{k}`: {e}")))?;
-    }
+    let window_given = apply_set(&keys, &mut table, f.set.as_ref(), &where_)?;
 
-    // The axes.
-    let mut axes = Vec::new();
-    let mut seen = BTreeSet::new();
-    let mut grid = Vec::new();
-    if let Some(t) = &f.grid {
-        flatten("", t, &mut grid);
-    }
-    for (k, v) in &grid {
-        let at = format!("{where_}, [grid] `{k}`");
-        keys.check(k, &at)?;
-        let values = list(v, &at)?;
-        axes.push(Axis {
-            keys: vec![k.clone()],
-            values: values
-                .iter()
-                .map(|v| vec![keys.coerce(k, v.clone())])
-                .collect(),
-        });
-    }
+    let mut axes = grid_axes(&keys, f.grid.as_ref(), &where_)?;
     for (z, t) in f.zip.iter().flatten().enumerate() {
-        let mut entries = Vec::new();
-        flatten("", t, &mut entries);
-        let at = format!("{where_}, [[zip]] number {}", z + 1);
-        if entries.is_empty() {
-            return Err(SweepError::input(format!(
-                "{at} is empty: give two or more keys with lists of equal length"
-            )));
-        }
-        let mut lists = Vec::new();
-        for (k, v) in &entries {
-            let at_k = format!("{at}, `{k}`");
-            keys.check(k, &at_k)?;
-            lists.push(list(v, &at_k)?);
-        }
-        let n = lists[0].len();
-        if let Some((i, l)) = lists.iter().enumerate().find(|(_, l)| l.len() != n) {
-            return Err(SweepError::input(format!(
-                "{at}: `{}` has {} values but `{}` has {n}: zipped lists must be of equal length",
-                entries[i].0,
-                l.len(),
-                entries[0].0
-            )));
-        }
-        axes.push(Axis {
-            keys: entries.iter().map(|(k, _)| k.clone()).collect(),
-            values: (0..n)
-                .map(|i| {
-                    entries
-                        .iter()
-                        .zip(&lists)
-                        .map(|((k, _), l)| keys.coerce(k, l[i].clone()))
-                        .collect()
-                })
-                .collect(),
-        });
+        axes.push(zip_axis(
+            &keys,
+            t,
+            &format!("{where_}, [[zip]] number {}", z + 1),
+        )?);
     }
-    for a in &axes {
-        for k in &a.keys {
-            if !seen.insert(k.clone()) {
-                return Err(SweepError::input(format!(
-                    "{where_}: key `{k}` is swept twice (in [grid] and [[zip]], or in two [[zip]] tables): give it once"
-                )));
-            }
-        }
-    }
-
-    // The seeds.
-    let seeds: Vec<u64> = match &f.seeds {
-        None => vec![base.seed],
-        Some(toml::Value::Integer(n)) if (1..=100_000).contains(n) => (1..=*n as u64).collect(),
-        Some(toml::Value::Array(a)) if !a.is_empty() => {
-            let mut out = Vec::new();
-            for v in a {
-                match v {
-                    toml::Value::Integer(s) if *s >= 0 => out.push(*s as u64),
-                    other => {
-                        return Err(SweepError::input(format!(
-                            "{where_}: `seeds` holds {other}: every seed must be a whole number >= 0"
-                        )));
-                    }
-                }
-            }
-            let distinct: BTreeSet<u64> = out.iter().copied().collect();
-            if distinct.len() != out.len() {
-                return Err(SweepError::input(format!(
-                    "{where_}: `seeds` = {}: a seed is listed twice",
-                    f.seeds
-                        .as_ref()
-                        .map(ToString::to_string)
-                        .unwrap_or_default()
-                )));
-            }
-            out
-        }
-        Some(other) => {
-            return Err(SweepError::input(format!(
-                "{where_}: `seeds` = {other}: give a list of master seeds like [1, 2, 3], or a count from 1 to 100000"
-            )));
-        }
-    };
+    let swept = swept_once(&axes, &where_)?;
+    let seeds = seeds(f.seeds.as_ref(), base.seed, &where_)?;
 
     let mut count: usize = seeds.len();
     for a in &axes {
@@ -693,10 +502,169 @@ pub fn parse(text: &str, file: &Path) -> Result<Sweep, SweepError> {
         seeds,
         slurm: f.slurm.unwrap_or_default(),
         count,
-        clamp_window: !window_given && !seen.contains("window"),
+        clamp_window: !window_given && !swept.contains("window"),
         table,
         where_,
     })
+}
+
+/// The sweep's base scenario: `arena` (the default), `corridor`, or a scenario file (a
+/// relative path is taken from the sweep file's folder).
+fn load_base(base: Option<&str>, file: &Path, where_: &str) -> Result<Scenario, SweepError> {
+    let base_name = base.unwrap_or("arena");
+    if base_name == "arena" || base_name == "corridor" {
+        Scenario::builtin(base_name)
+    } else {
+        let p = Path::new(base_name);
+        let p = if p.is_relative() {
+            file.parent().unwrap_or(Path::new("")).join(p)
+        } else {
+            p.to_path_buf()
+        };
+        Scenario::load(&p.display().to_string())
+    }
+    .map_err(|e| SweepError::input(format!("{where_}: key `base` = \"{base_name}\": {e:#}")))
+}
+
+/// Applies the fixed changes of `[set]` to `table`; returns whether they set `window` (as in a
+/// scenario file, `steps` set without `window` cuts the base's window to the run).
+fn apply_set(
+    keys: &Keys,
+    table: &mut toml::Table,
+    set: Option<&toml::Table>,
+    where_: &str,
+) -> Result<bool, SweepError> {
+    let mut entries = Vec::new();
+    if let Some(t) = set {
+        flatten("", t, &mut entries);
+    }
+    let window_given = entries.iter().any(|(k, _)| k == "window");
+    for (k, v) in entries {
+        keys.check(&k, &format!("{where_}, [set]"))?;
+        let v = keys.coerce(&k, v);
+        set_key(table, &k, v)
+            .map_err(|e| SweepError::input(format!("{where_}, [set] `{k}`: {e}")))?;
+    }
+    Ok(window_given)
+}
+
+/// The axes of `[grid]`: one per key, in the file's order.
+fn grid_axes(
+    keys: &Keys,
+    grid: Option<&toml::Table>,
+    where_: &str,
+) -> Result<Vec<Axis>, SweepError> {
+    let mut entries = Vec::new();
+    if let Some(t) = grid {
+        flatten("", t, &mut entries);
+    }
+    let mut axes = Vec::new();
+    for (k, v) in &entries {
+        let at = format!("{where_}, [grid] `{k}`");
+        keys.check(k, &at)?;
+        let values = list(v, &at)?;
+        axes.push(Axis {
+            keys: vec![k.clone()],
+            values: values
+                .iter()
+                .map(|v| vec![keys.coerce(k, v.clone())])
+                .collect(),
+        });
+    }
+    Ok(axes)
+}
+
+/// The axis of one `[[zip]]` table (named `at` in messages): its keys move together, so their
+/// lists must be of equal length.
+fn zip_axis(keys: &Keys, t: &toml::Table, at: &str) -> Result<Axis, SweepError> {
+    let mut entries = Vec::new();
+    flatten("", t, &mut entries);
+    if entries.is_empty() {
+        return Err(SweepError::input(format!(
+            "{at} is empty: give two or more keys with lists of equal length"
+        )));
+    }
+    let mut lists = Vec::new();
+    for (k, v) in &entries {
+        let at_k = format!("{at}, `{k}`");
+        keys.check(k, &at_k)?;
+        lists.push(list(v, &at_k)?);
+    }
+    let n = lists[0].len();
+    if let Some((i, l)) = lists.iter().enumerate().find(|(_, l)| l.len() != n) {
+        return Err(SweepError::input(format!(
+            "{at}: `{}` has {} values but `{}` has {n}: zipped lists must be of equal length",
+            entries[i].0,
+            l.len(),
+            entries[0].0
+        )));
+    }
+    Ok(Axis {
+        keys: entries.iter().map(|(k, _)| k.clone()).collect(),
+        values: (0..n)
+            .map(|i| {
+                entries
+                    .iter()
+                    .zip(&lists)
+                    .map(|((k, _), l)| keys.coerce(k, l[i].clone()))
+                    .collect()
+            })
+            .collect(),
+    })
+}
+
+/// The keys the axes sweep, each swept once.
+///
+/// # Errors
+/// A key in two axes.
+fn swept_once(axes: &[Axis], where_: &str) -> Result<BTreeSet<String>, SweepError> {
+    let mut seen = BTreeSet::new();
+    for a in axes {
+        for k in &a.keys {
+            if !seen.insert(k.clone()) {
+                return Err(SweepError::input(format!(
+                    "{where_}: key `{k}` is swept twice (in [grid] and [[zip]], or in two [[zip]] tables): give it once"
+                )));
+            }
+        }
+    }
+    Ok(seen)
+}
+
+/// The master seeds: the base's when `seeds` is absent, 1 to n for a count n, else the listed
+/// ones (whole numbers, each once).
+fn seeds(
+    seeds: Option<&toml::Value>,
+    base_seed: u64,
+    where_: &str,
+) -> Result<Vec<u64>, SweepError> {
+    match seeds {
+        None => Ok(vec![base_seed]),
+        Some(toml::Value::Integer(n)) if (1..=100_000).contains(n) => Ok((1..=*n as u64).collect()),
+        Some(list @ toml::Value::Array(a)) if !a.is_empty() => {
+            let mut out = Vec::new();
+            for v in a {
+                match v {
+                    toml::Value::Integer(s) if *s >= 0 => out.push(*s as u64),
+                    other => {
+                        return Err(SweepError::input(format!(
+                            "{where_}: `seeds` holds {other}: every seed must be a whole number >= 0"
+                        )));
+                    }
+                }
+            }
+            let distinct: BTreeSet<u64> = out.iter().copied().collect();
+            if distinct.len() != out.len() {
+                return Err(SweepError::input(format!(
+                    "{where_}: `seeds` = {list}: a seed is listed twice"
+                )));
+            }
+            Ok(out)
+        }
+        Some(other) => Err(SweepError::input(format!(
+            "{where_}: `seeds` = {other}: give a list of master seeds like [1, 2, 3], or a count from 1 to 100000"
+        ))),
+    }
 }
 
 #[cfg(test)]
@@ -802,30 +770,5 @@ mod tests {
         }
         assert_eq!(sanitize("eta0.001", 40), "eta0.001");
         assert_eq!(sanitize("a b//c", 40), "a_b_c");
-    }
-
-    #[test]
-    fn printable_text_has_no_control_characters_left() {
-        assert_eq!(printable("plain `x` = 1.5"), "plain `x` = 1.5");
-        assert_eq!(printable("a\u{1b}]0;title\u{7}b"), "a\\e]0;title\\u{7}b");
-        assert_eq!(printable("two\nlines\r\t"), "two\\nlines\\r\\t");
-        assert_eq!(
-            printable("\u{9b}31m\u{202e}x\u{7f}"),
-            "\\u{9b}31m\\u{202e}x\\u{7f}"
-        );
-        assert_eq!(printable("Ω é"), "Ω é");
-        for c in (0u32..0x110000).filter_map(char::from_u32) {
-            let p = printable(&c.to_string());
-            assert!(
-                !p.chars().any(|c| c.is_control() || is_bidi_control(c)),
-                "U+{:04X}",
-                u32::from(c)
-            );
-        }
-        // A TOML error with a source excerpt is one printable line.
-        assert_eq!(
-            one_line("TOML parse error at line 1\n  |\n1 | a\u{1b}\n  |\n bad \u{1b}[2J"),
-            "bad \\e[2J"
-        );
     }
 }

@@ -45,22 +45,13 @@ use crate::energy::{
     Charge, DriveMeter, ElectronicsMeter, FreeWheels, PAPER_BATTERY_LIFE_H, Pack, Part,
     mean_current_ma,
 };
+use crate::scenario::ControllerKind;
 use crate::seeds::robot_stream;
 
 /// Endurance of a 24LC256 page: 1 000 000 write cycles (docs/design.md §3.6; Microchip DS21203).
 pub const ENDURANCE_CYCLES: f64 = 1_000_000.0;
 /// Longest boot the fit waits for before calling the image stuck: 10 s of MCU time.
 pub const BOOT_LIMIT_S: f64 = 10.0;
-
-/// Which controller a robot runs (the fit measures; the swarm runs).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, serde::Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum ControllerKind {
-    /// Machine code on the H8/300H core: the robot firmware or a user's image.
-    Firmware,
-    /// The Rust model of the controller.
-    Model,
-}
 
 /// A firmware image to measure and its phases.
 #[derive(Clone, Debug)]

@@ -169,7 +169,7 @@ impl Images {
     /// # Errors
     /// An image or symbol file that cannot be read or parsed, naming it.
     pub fn load(s: &Scenario) -> Result<Option<Images>> {
-        if s.controller.kind == crate::fit::ControllerKind::Model {
+        if s.controller.kind == crate::scenario::ControllerKind::Model {
             return Ok(None);
         }
         let robot = Firmware::robot().context("the built-in robot firmware")?;

@@ -101,13 +101,23 @@ pub struct SensorSpec {
     pub channels: [u8; 4],
 }
 
+/// Which controller a robot runs (the fit measures; the swarm runs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ControllerKind {
+    /// Machine code on the H8/300H core: the robot firmware or a user's image.
+    Firmware,
+    /// The Rust model of the controller.
+    Model,
+}
+
 /// The robots' controller.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ControllerSpec {
     /// `firmware` (the robot firmware, machine code on the emulated H8/300H) or `model` (the
     /// Rust model of it, checked against it).
-    pub kind: crate::fit::ControllerKind,
+    pub kind: ControllerKind,
     /// A firmware image of the user's (Motorola S-records) for the robots in `robots` (every
     /// robot when `robots` is absent); the others run the robot firmware. Firmware only.
     pub image: Option<String>,
@@ -122,7 +132,7 @@ pub struct ControllerSpec {
 impl Default for ControllerSpec {
     fn default() -> Self {
         Self {
-            kind: crate::fit::ControllerKind::Model,
+            kind: ControllerKind::Model,
             image: None,
             symbols: None,
             robots: None,
@@ -224,7 +234,7 @@ impl From<Channels> for [u8; 4] {
     }
 }
 patch!(ControlPatch for ControlSpec { learning_off: bool, random_walk: bool });
-patch!(ControllerPatch for ControllerSpec { kind: crate::fit::ControllerKind, image: Option<String>, symbols: Option<String>, robots: Option<Vec<usize>> });
+patch!(ControllerPatch for ControllerSpec { kind: ControllerKind, image: Option<String>, symbols: Option<String>, robots: Option<Vec<usize>> });
 
 /// The largest scenario or sweep file read (1 MiB; the documented example is 4 KB).
 pub const MAX_FILE_BYTES: u64 = 1 << 20;
@@ -435,7 +445,7 @@ impl Scenario {
     pub fn from_toml(text: &str) -> Result<Self> {
         // One line: where (line, column, the line's text) and what.
         let file: ScenarioFile = toml::from_str(text)
-            .map_err(|e| anyhow::anyhow!("{}", crate::sweep::spec::toml_error(text, &e)))?;
+            .map_err(|e| anyhow::anyhow!("{}", crate::text::toml_error(text, &e)))?;
         let mut s = Self::builtin(file.base.as_deref().unwrap_or("arena")).context("key `base`")?;
         if let Some(v) = file.name {
             s.name = v;
@@ -612,8 +622,7 @@ impl Scenario {
             );
         }
         let c = &self.controller;
-        if c.kind == crate::fit::ControllerKind::Model && (c.image.is_some() || c.robots.is_some())
-        {
+        if c.kind == ControllerKind::Model && (c.image.is_some() || c.robots.is_some()) {
             bail!(
                 "`controller.image` and `controller.robots` need `controller.kind = \"firmware\"` (the model runs no image)"
             );
@@ -677,7 +686,12 @@ mod tests {
         );
         assert_eq!(a.eta_q15(), 983, "eta 0.03, by the claim map's rule");
         assert_eq!(a.world.mu_wall, 0.1);
-        let paper = Scenario::load("scenarios/arena-paper.toml").unwrap();
+        // The scenario files stand at the workspace's root, one folder above this crate.
+        let paper = Scenario::load(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../scenarios/arena-paper.toml"
+        ))
+        .unwrap();
         assert_eq!((paper.eta_q15(), paper.world.mu_wall), (33, 0.3));
         let c = Scenario::corridor();
         assert_eq!((c.steps, c.learner.behaviours, c.eta_q15()), (500, 2, 3277));

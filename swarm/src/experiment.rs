@@ -38,7 +38,6 @@ use world::{Arena, SensorMount, SubstepPlan, World, WorldParams};
 
 use crate::collisions::{ContactMeter, RobotTally, StuckDetector};
 
-use crate::plot::Outline;
 use crate::robot::{Condition, Images, Robot};
 use crate::scenario::{ArenaKind, Scenario};
 use crate::seeds::world_seed;
@@ -100,6 +99,19 @@ pub struct Track {
     /// Corridor only: per tracked robot, (step, position along the corridor in metres) every
     /// [`spacetime_stride`] steps and at the last step, for the space-time figure.
     pub spacetime: Vec<Vec<(f64, f64)>>,
+}
+
+/// A robot's outline at one instant.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Outline {
+    /// Robot number (the index of its path in a figure's paths).
+    pub robot: usize,
+    /// Time of the snapshot in seconds; outlines with equal times share a legend entry.
+    pub time_s: f64,
+    /// Corners of the body in metres, in order around it.
+    pub corners: [(f64, f64); 4],
+    /// Heading as a unit vector (any non-zero length is accepted and normalised).
+    pub heading: (f64, f64),
 }
 
 /// The space-time figure's most samples per robot.
@@ -498,11 +510,11 @@ impl Swarm {
     /// `path` as the step completes.
     ///
     /// # Errors
-    /// The file cannot be created (an [`crate::run_cmd::OutputError`]).
+    /// The file cannot be created (an [`crate::output_error::OutputError`]).
     pub fn set_rows(&mut self, path: &std::path::Path) -> Result<()> {
         let file = std::fs::File::create(path)
             .map_err(anyhow::Error::new)
-            .context(crate::run_cmd::OutputError(format!(
+            .context(crate::output_error::OutputError(format!(
                 "cannot create `{}`",
                 path.display()
             )))?;
@@ -578,14 +590,46 @@ impl Swarm {
     /// # Errors
     /// A world or controller failure (none is expected once the scenario checks out).
     pub fn step(&mut self) -> Result<()> {
-        let n = self.robots.len();
         let k = self.started;
-        let par = self.parallel;
+        let t_step = self.sleep_all()?;
+        let t_step_s = t_step as f64 / f64::from(self.scenario.timing.clock_hz);
+        self.close_step(t_step)?;
+        self.track_step(k, t_step_s)?;
+        let senses = self.sense_all()?;
+        let tally = self.step_robots(&senses)?;
+        let behaviours = self.drive()?;
+        self.record_frame(k, &tally.stepped, &behaviours, &senses)?;
+        self.pending_charge = (tally.charge_uc, tally.live);
+        let live_f = tally.live.max(1) as f64;
+        let mean_d = tally.sum_d / live_f;
+        let gap_cv = match self.scenario.arena {
+            ArenaKind::Corridor => self.world.corridor_gap_cv()?,
+            ArenaKind::Square => None,
+        };
+        self.started += 1;
+        self.pending = Some(StepMetrics {
+            mean_d,
+            collisions_per_robot: 0.0,
+            contact_percent: 0.0,
+            stuck_percent: 0.0,
+            moving_percent: 0.0,
+            moved_mm: 0.0,
+            gap_cv,
+            cpu_load_percent: tally.sum_load / live_f,
+            energy_per_robot_mj: 0.0,
+        });
+        Ok(())
+    }
+
+    /// Every live MCU sleeps to its next step instant; returns the step's instant, the
+    /// earliest of theirs (with every robot dead, one step period after the world's time).
+    fn sleep_all(&mut self) -> Result<u64> {
+        let n = self.robots.len();
         let dead = self.dead.clone();
         let sleep = |(i, r): (usize, &mut Robot)| -> Option<Result<u64>> {
             dead[i].is_none().then(|| r.sleep())
         };
-        let times: Vec<Option<Result<u64>>> = if par {
+        let times: Vec<Option<Result<u64>>> = if self.parallel {
             self.robots.par_iter_mut().enumerate().map(sleep).collect()
         } else {
             self.robots.iter_mut().enumerate().map(sleep).collect()
@@ -598,40 +642,46 @@ impl Swarm {
                 None => {}
             }
         }
-        let times = live_times;
-        let t_step = match times.iter().copied().min() {
+        Ok(match live_times.iter().copied().min() {
             Some(t) => t,
             // Every robot dead: the world goes on by the step period.
             None => self.world.elapsed_states() + self.period_states,
+        })
+    }
+
+    /// Step `k`'s share of the track, when one is kept: the paths of the first and last
+    /// steps, the outlines at the snapshot steps, the corridor's space-time samples.
+    fn track_step(&mut self, k: u32, t_step_s: f64) -> Result<()> {
+        let Some(t) = self.track.as_mut() else {
+            return Ok(());
         };
-        let t_step_s = t_step as f64 / f64::from(self.scenario.timing.clock_hz);
-        self.close_step(t_step)?;
-        if let Some(t) = self.track.as_mut() {
-            let (early, late) = (
-                (k as usize) < SNAPSHOT_STEPS,
-                k as usize + SNAPSHOT_STEPS >= self.scenario.steps as usize
-                    && k < self.scenario.steps,
-            );
-            record(
-                &self.world,
-                t,
-                self.tracked,
-                (early, late),
-                self.snapshots.contains(&k),
-                t_step_s,
-            )?;
-            let steps = self.scenario.steps;
-            if self.scenario.arena == ArenaKind::Corridor
-                && (k.is_multiple_of(spacetime_stride(steps)) || k + 1 == steps)
-            {
-                for (i, path) in t.spacetime.iter_mut().enumerate() {
-                    path.push((f64::from(k), self.world.pose(i)?.x_m));
-                }
+        let (early, late) = (
+            (k as usize) < SNAPSHOT_STEPS,
+            k as usize + SNAPSHOT_STEPS >= self.scenario.steps as usize && k < self.scenario.steps,
+        );
+        record(
+            &self.world,
+            t,
+            self.tracked,
+            (early, late),
+            self.snapshots.contains(&k),
+            t_step_s,
+        )?;
+        let steps = self.scenario.steps;
+        if self.scenario.arena == ArenaKind::Corridor
+            && (k.is_multiple_of(spacetime_stride(steps)) || k + 1 == steps)
+        {
+            for (i, path) in t.spacetime.iter_mut().enumerate() {
+                path.push((f64::from(k), self.world.pose(i)?.x_m));
             }
         }
+        Ok(())
+    }
+
+    /// What each robot's board shows its MCU for the step: the sensors' true distances and
+    /// the bumper switches as the latest sub-step left them (port 2's pins).
+    fn sense_all(&self) -> Result<Vec<Senses>> {
         let world = &self.world;
-        // What each robot's board shows its MCU for the step: the sensors' true distances and
-        // the bumper switches as the latest sub-step left them (port 2's pins).
         let sense = |i: usize| -> Result<Senses> {
             let mut d = [None; 4];
             for (k, dk) in d.iter_mut().enumerate() {
@@ -639,11 +689,17 @@ impl Swarm {
             }
             Ok((d, world.bumpers(i)?))
         };
-        let senses: Vec<Senses> = if par {
-            (0..n).into_par_iter().map(sense).collect::<Result<_>>()?
+        let n = self.robots.len();
+        if self.parallel {
+            (0..n).into_par_iter().map(sense).collect()
         } else {
-            (0..n).map(sense).collect::<Result<_>>()?
-        };
+            (0..n).map(sense).collect()
+        }
+    }
+
+    /// Every live robot steps on its senses; their charge, saves, D and CPU load are summed
+    /// (and kept per robot when the run is recorded).
+    fn step_robots(&mut self, senses: &[Senses]) -> Result<StepTally> {
         let dead = self.dead.clone();
         let step = |(i, (r, (d, b))): (usize, (&mut Robot, &Senses))| {
             dead[i].is_none().then(|| {
@@ -651,7 +707,7 @@ impl Swarm {
                 r.step(*d).map(|rep| (rep, r.take_busy_states()))
             })
         };
-        let results: Vec<_> = if par {
+        let results: Vec<_> = if self.parallel {
             self.robots
                 .par_iter_mut()
                 .zip(senses.par_iter())
@@ -661,39 +717,44 @@ impl Swarm {
         } else {
             self.robots
                 .iter_mut()
-                .zip(&senses)
+                .zip(senses)
                 .enumerate()
                 .map(step)
                 .collect()
         };
         let period_states =
             self.scenario.timing.step_period_s * f64::from(self.scenario.timing.clock_hz);
-        let (mut sum_d, mut sum_load, mut live) = (0.0, 0.0, 0usize);
         let recording = self.recorder.is_some();
-        let mut stepped: Vec<(i16, bool, f64)> = Vec::new();
-        let mut behaviours: Vec<u8> = Vec::new();
-        let mut charge_uc = 0.0;
+        let mut tally = StepTally::default();
         for (i, res) in results.into_iter().enumerate() {
             let mut this = (0, false, 0.0);
             match res {
                 Some(Ok((rep, busy))) => {
                     let q = self.robots[i].step_charge();
-                    charge_uc += q.total_uc();
+                    tally.charge_uc += q.total_uc();
                     self.energy.add(&q);
                     self.saves += u64::from(rep.saved);
-                    sum_d += f64::from(rep.d);
+                    tally.sum_d += f64::from(rep.d);
                     let load = busy as f64 / period_states * 100.0;
-                    sum_load += load;
-                    live += 1;
+                    tally.sum_load += load;
+                    tally.live += 1;
                     this = (rep.d, rep.saved, load);
                 }
                 Some(Err(e)) => self.fail(i, e)?,
                 None => {}
             }
             if recording {
-                stepped.push(this);
+                tally.stepped.push(this);
             }
         }
+        Ok(tally)
+    }
+
+    /// Hands every robot's wheel commands to the world and its drive meter (a dead robot
+    /// coasts); returns the behaviours they run when the run is recorded.
+    fn drive(&mut self) -> Result<Vec<u8>> {
+        let recording = self.recorder.is_some();
+        let mut behaviours: Vec<u8> = Vec::new();
         for (i, r) in self.robots.iter_mut().enumerate() {
             let (left, right) = if self.dead[i].is_some() {
                 let coast = world::WheelCommand {
@@ -718,47 +779,40 @@ impl Swarm {
             self.world.set_wheels(i, left, right)?;
             self.drives[i].set_commands(left, right);
         }
-        if let Some((rec, count)) = self.recorder.as_mut() {
-            let mut frame = Vec::with_capacity(*count);
-            for (i, &(d, saved, load)) in stepped.iter().enumerate().take(*count) {
-                let p = self.world.pose(i)?;
-                frame.push(crate::recording::RobotStep {
-                    x_m: p.x_m,
-                    y_m: p.y_m,
-                    heading_rad: p.heading_rad,
-                    behaviour: behaviours[i],
-                    bumpers: senses[i].1,
-                    p: self.robots[i].readings_du(),
-                    d,
-                    stuck: self.tallies[i].stuck_now(),
-                    saved,
-                    dead: self.dead[i].is_some(),
-                    load_percent: load,
-                });
-            }
-            let robots = &self.robots;
-            rec.step(k, &frame, &mut |i| robots[i].weights())?;
-        }
-        self.pending_charge = (charge_uc, live);
-        let live_f = live.max(1) as f64;
-        let mean_d = sum_d / live_f;
-        let gap_cv = match self.scenario.arena {
-            ArenaKind::Corridor => self.world.corridor_gap_cv()?,
-            ArenaKind::Square => None,
+        Ok(behaviours)
+    }
+
+    /// Step `k`'s frame for the recorder, when the run is recorded: the recorded robots'
+    /// poses, behaviours, bumpers, readings, D, flags and load.
+    fn record_frame(
+        &mut self,
+        k: u32,
+        stepped: &[(i16, bool, f64)],
+        behaviours: &[u8],
+        senses: &[Senses],
+    ) -> Result<()> {
+        let Some((rec, count)) = self.recorder.as_mut() else {
+            return Ok(());
         };
-        self.started += 1;
-        self.pending = Some(StepMetrics {
-            mean_d,
-            collisions_per_robot: 0.0,
-            contact_percent: 0.0,
-            stuck_percent: 0.0,
-            moving_percent: 0.0,
-            moved_mm: 0.0,
-            gap_cv,
-            cpu_load_percent: sum_load / live_f,
-            energy_per_robot_mj: 0.0,
-        });
-        Ok(())
+        let mut frame = Vec::with_capacity(*count);
+        for (i, &(d, saved, load)) in stepped.iter().enumerate().take(*count) {
+            let p = self.world.pose(i)?;
+            frame.push(crate::recording::RobotStep {
+                x_m: p.x_m,
+                y_m: p.y_m,
+                heading_rad: p.heading_rad,
+                behaviour: behaviours[i],
+                bumpers: senses[i].1,
+                p: self.robots[i].readings_du(),
+                d,
+                stuck: self.tallies[i].stuck_now(),
+                saved,
+                dead: self.dead[i].is_some(),
+                load_percent: load,
+            });
+        }
+        let robots = &self.robots;
+        rec.step(k, &frame, &mut |i| robots[i].weights())
     }
 
     /// Advances the world to `t_states` (the behaviour of the latest step runs to its end)
@@ -815,7 +869,7 @@ impl Swarm {
                     .write_record(metrics_row(self.condition, self.repeat, k, &last))
                     .map_err(anyhow::Error::new)
                     .with_context(|| {
-                        crate::run_cmd::OutputError(format!(
+                        crate::output_error::OutputError(format!(
                             "cannot write `{}`",
                             rows.path.display()
                         ))
@@ -865,10 +919,7 @@ impl Swarm {
             rows.w
                 .flush()
                 .map_err(anyhow::Error::new)
-                .context(crate::run_cmd::OutputError(format!(
-                    "cannot write `{}`",
-                    rows.path.display()
-                )))?;
+                .context(crate::output_error::OutputError::cannot_write(&rows.path))?;
         }
         let dead = self.dead();
         for t in &mut self.tallies {
@@ -1053,6 +1104,22 @@ fn vcd_info(
 /// What a robot's board shows its MCU for a step: each sensor's true distance (mm, `None`
 /// beyond range) and the bumper switches (front, rear, left, right).
 type Senses = ([Option<f64>; 4], [bool; 4]);
+
+/// What the live robots' steps add up to in one swarm step.
+#[derive(Default)]
+struct StepTally {
+    /// Sum of their D, du.
+    sum_d: f64,
+    /// Sum of their CPU loads, percent.
+    sum_load: f64,
+    /// Robots that stepped.
+    live: usize,
+    /// Their charge over the step, µC.
+    charge_uc: f64,
+    /// Per robot (when the run is recorded): D, whether it saved, CPU load (zeros for a dead
+    /// robot).
+    stepped: Vec<(i16, bool, f64)>,
+}
 
 /// The step period in clock states.
 #[must_use]

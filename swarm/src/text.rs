@@ -1,0 +1,112 @@
+//! Text from users and parsers made fit for one line on a terminal: [`printable`] escapes every
+//! control character, [`one_line`] folds a parser's message of several lines into one, and
+//! [`toml_error`] says where in a TOML file an error stands.
+
+use std::fmt::Write as _;
+
+/// A TOML error in one line: where (line, column and the line's text) and what.
+#[must_use]
+pub fn toml_error(text: &str, e: &toml::de::Error) -> String {
+    let Some(span) = e.span() else {
+        return one_line(e.message());
+    };
+    let before = &text[..span.start.min(text.len())];
+    let line = before.matches('\n').count() + 1;
+    let column = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
+    let source: String = text
+        .lines()
+        .nth(line - 1)
+        .unwrap_or_default()
+        .trim()
+        .chars()
+        .take(60)
+        .collect();
+    format!(
+        "line {line}, column {column} (`{source}`): {}",
+        one_line(e.message())
+    )
+}
+
+/// `text` safe to show on a terminal, in one line: every control character (ESC, newline,
+/// carriage return, tab, backspace, DEL, the C1 controls such as CSI) and every Unicode
+/// bidirectional control is written as an escape (`\e`, `\n`, `\r`, `\t`, `\u{9b}`), so
+/// no text from a file or an argument can move the cursor, recolour or retitle the terminal,
+/// or break a one-line message into lines. Everything else is kept as it is.
+///
+/// This is the one place where text that came from a user is made printable: every message
+/// that echoes a path, a value, a line of a file or a message built from them goes through
+/// it (the error line `h8swarm` prints, `sweep merge`'s and `sweep run`'s lists, `emu`'s
+/// reports).
+#[must_use]
+pub fn printable(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            '\u{1b}' => out.push_str("\\e"),
+            '\n' => out.push_str("\\n"),
+            '\r' => out.push_str("\\r"),
+            '\t' => out.push_str("\\t"),
+            c if c.is_control() || is_bidi_control(c) => {
+                let _ = write!(out, "\\u{{{:x}}}", u32::from(c));
+            }
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+/// The Unicode controls that reorder text on display (U+061C, U+200E, U+200F, U+202A to
+/// U+202E, U+2066 to U+2069).
+fn is_bidi_control(c: char) -> bool {
+    matches!(c, '\u{61c}' | '\u{200e}' | '\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}')
+}
+
+/// A message of several lines (the TOML parser's, with its source excerpt) in one: the
+/// excerpt's lines dropped, the rest joined by `: `, and what is left made [`printable`].
+#[must_use]
+pub fn one_line(text: &str) -> String {
+    let joined = text
+        .lines()
+        .map(str::trim)
+        .filter(|l| {
+            !l.is_empty()
+                && !l.starts_with('|')
+                && !l.starts_with("TOML parse error")
+                && !l
+                    .split_once('|')
+                    .is_some_and(|(n, _)| n.trim().chars().all(|c| c.is_ascii_digit()))
+        })
+        .collect::<Vec<_>>()
+        .join(": ");
+    printable(&joined)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn printable_text_has_no_control_characters_left() {
+        assert_eq!(printable("plain `x` = 1.5"), "plain `x` = 1.5");
+        assert_eq!(printable("a\u{1b}]0;title\u{7}b"), "a\\e]0;title\\u{7}b");
+        assert_eq!(printable("two\nlines\r\t"), "two\\nlines\\r\\t");
+        assert_eq!(
+            printable("\u{9b}31m\u{202e}x\u{7f}"),
+            "\\u{9b}31m\\u{202e}x\\u{7f}"
+        );
+        assert_eq!(printable("Ω é"), "Ω é");
+        for c in (0u32..0x110000).filter_map(char::from_u32) {
+            let p = printable(&c.to_string());
+            assert!(
+                !p.chars().any(|c| c.is_control() || is_bidi_control(c)),
+                "U+{:04X}",
+                u32::from(c)
+            );
+        }
+        // A TOML error with a source excerpt is one printable line.
+        assert_eq!(
+            one_line("TOML parse error at line 1\n  |\n1 | a\u{1b}\n  |\n bad \u{1b}[2J"),
+            "bad \\e[2J"
+        );
+    }
+}
