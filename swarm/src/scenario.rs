@@ -701,6 +701,20 @@ mod tests {
         c.check().unwrap();
     }
 
+    /// `scenarios/example.toml` names every key with the built-in arena's values: loaded, it is
+    /// the built-in arena but for its name (so it cannot drift from the defaults unseen).
+    #[test]
+    fn the_example_file_holds_the_arena_s_values() {
+        let mut example = Scenario::load(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../scenarios/example.toml"
+        ))
+        .unwrap();
+        let arena = Scenario::arena();
+        example.name.clone_from(&arena.name);
+        assert_eq!(example, arena);
+    }
+
     #[test]
     fn files_override_the_base_and_unknown_keys_fail() {
         let s = Scenario::from_toml("base = \"corridor\"\nrobots = 4\n[learner]\neta = 0.05\n")
