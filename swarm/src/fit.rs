@@ -835,14 +835,14 @@ impl FirmwareRun {
         for k in 0..u64::from(steps) {
             // The world moves before each step's A/D scan.
             self.rig.move_world();
-            let ended = if self.step_phase == usize::MAX {
+            let fault = if self.step_phase == usize::MAX {
                 window_end += self.period;
-                self.run_window(window_end)
+                self.run_window(window_end)?
             } else {
                 self.run_step(k)?
             };
-            if let Err(e) = ended {
-                return Ok(Some(overflow(e)?));
+            if fault.is_some() {
+                return Ok(fault);
             }
             let now = self.profiler.states();
             periods.push(&before, now);
@@ -853,19 +853,22 @@ impl FirmwareRun {
         Ok(None)
     }
 
-    /// Runs up to `window_end` or the next SLEEP, whichever comes first.
-    fn run_window(&mut self, window_end: u64) -> Result<(), FitError> {
+    /// Runs up to `window_end` or the next SLEEP, whichever comes first. A stack overflow on
+    /// the way is returned.
+    fn run_window(&mut self, window_end: u64) -> Result<Option<Box<StackFault>>, FitError> {
         while self.rig.mcu.now() < window_end {
-            if let Event::Asleep = self.step(window_end)? {
-                break;
+            match self.step(window_end) {
+                Ok(Event::Asleep) => break,
+                Ok(_) => {}
+                Err(e) => return Ok(Some(overflow(e)?)),
             }
         }
-        Ok(())
+        Ok(None)
     }
 
-    /// Runs until step `k + 1` begins (the `k + 2`th entry into the step's first phase). Too
-    /// long is an error (the outer one); an error of the run is returned (the inner one).
-    fn run_step(&mut self, k: u64) -> Result<Result<(), FitError>, FitError> {
+    /// Runs until step `k + 1` begins (the `k + 2`th entry into the step's first phase); taking
+    /// too long is an error. A stack overflow on the way is returned.
+    fn run_step(&mut self, k: u64) -> Result<Option<Box<StackFault>>, FitError> {
         let limit = self.rig.mcu.now() + 2 * self.period + self.boot_limit;
         while self.profiler.entries(self.step_phase) < k + 2 {
             if self.rig.mcu.now() >= limit {
@@ -875,10 +878,10 @@ impl FirmwareRun {
                 });
             }
             if let Err(e) = self.step(limit) {
-                return Ok(Err(e));
+                return Ok(Some(overflow(e)?));
             }
         }
-        Ok(Ok(()))
+        Ok(None)
     }
 
     /// The stack's room and what the firmware left of it, with the overflow if there was one.
