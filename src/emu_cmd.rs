@@ -25,8 +25,10 @@ use std::path::Path;
 use std::sync::Arc;
 
 use emu::board::symbols::SymbolTable;
-use emu::chip::gdb::{GdbError, GdbListener};
+use emu::chip::gdb::{Debugger, GdbError, GdbListener};
 use emu::chip::machine::Machine;
+use emu::chip::mcu::Mcu;
+use emu::chip::pins::NullBoard;
 use emu::chip::run::{Outcome, Probes, RunOptions, drain_into, run_mcu_probed};
 use emu::chip::trace::{CodeNames, PhaseRecorder};
 use emu::chip::vcd::{VcdInfo, VcdStream};
@@ -96,44 +98,19 @@ fn symbols(image: &str, given: Option<&Path>) -> Result<Option<SymbolTable>, Fai
         .map_err(|e| input(format!("symbol file `{}`: {e}", path.display())))
 }
 
+/// Runs the image as `o` asks: the console on standard output, the trace, the summary and the
+/// stop's reason on standard error; the error carries the exit status (module docs).
+///
+/// # Errors
+/// A bad image, symbol file or option ([`Failure::Input`]), an output that cannot be written
+/// ([`Failure::Tool`]), or the program's own exit status ([`Failure::Program`]).
 pub fn run(o: &EmuOptions<'_>) -> Result<(), Failure> {
     let image = o.image;
-    let max = emu::board::firmware::Firmware::MAX_FILE_BYTES;
-    let bytes =
-        emu::board::firmware::read_bounded(std::path::Path::new(image), max).map_err(|e| {
-            input(format!(
-                "cannot read image `{image}`: {e} (give a Motorola S-record file, .mot)"
-            ))
-        })?;
-    let srec = srec::parse(&bytes).map_err(|e| {
-        Failure::Input(anyhow::Error::new(e).context(format!("image `{image}`: bad image")))
-    })?;
-    let mut machine = Machine::with_image(&srec).map_err(|e| {
-        Failure::Input(anyhow::Error::new(e).context(format!("image `{image}`: cannot load image")))
-    })?;
+    let mut machine = load(image)?;
     let names = symbols(image, o.symbols)?.map(Arc::new);
     // Fail on a file that cannot be created before the program runs.
-    let mut vcd_file = match o.vcd {
-        Some(path) => Some(std::fs::File::create(path).map_err(|e| {
-            input(format!(
-                "--vcd: cannot create `{}`: {e} (give a writable file path)",
-                path.display()
-            ))
-        })?),
-        None => None,
-    };
-    let debugger = match o.gdb {
-        Some(addr) => {
-            let listener = GdbListener::bind(addr).map_err(gdb_failure)?;
-            let at = listener.local_addr();
-            eprintln!(
-                "h8swarm emu: GDB stub listening on {at}; waiting for a client (target remote {at})"
-            );
-            Some(listener.accept().map_err(gdb_failure)?)
-        }
-        None => None,
-    };
-    let mut debugger = debugger;
+    let vcd_file = create_vcd(o.vcd)?;
+    let mut debugger = wait_for_debugger(o.gdb)?;
     let mut cpu = Cpu::new();
     let room = names
         .as_deref()
@@ -144,39 +121,14 @@ pub fn run(o: &EmuOptions<'_>) -> Result<(), Failure> {
     }));
     cpu.reset(&mut machine);
     let mcu = machine.mcu_mut();
-    let mut phases = None;
-    let vcd_failure = |e: io::Error| {
-        Failure::Tool(anyhow::Error::new(e).context(format!(
-            "writing the VCD file `{}`",
-            o.vcd.map(|p| p.display().to_string()).unwrap_or_default()
-        )))
-    };
     // The trace is written as the run makes it (never held whole).
-    let mut stream = None;
-    if let Some(file) = vcd_file.take() {
-        mcu.start_trace(cpu.sleeping());
-        let mut phase_at_start = None;
-        if let Some(n) = &names {
-            let mut p = PhaseRecorder::new(n.clone());
-            p.observe(mcu.now(), cpu.pc());
-            phase_at_start = p.drain_before(mcu.now() + 1).pop().map(|(_, name)| name);
-            phases = Some(p);
+    let (mut stream, mut phases) = match vcd_file {
+        Some(file) => {
+            let (stream, phases) = start_vcd(file, &cpu, mcu, names.as_ref(), o)?;
+            (Some(stream), phases)
         }
-        let (start, initial) = mcu.trace_beginning().unwrap_or_default();
-        stream = Some(
-            VcdStream::start(
-                Box::new(file),
-                mcu.clock_hz(),
-                start,
-                initial,
-                phase_at_start.as_deref(),
-                &VcdInfo {
-                    source: format!("{image} on h8swarm emu"),
-                },
-            )
-            .map_err(vcd_failure)?,
-        );
-    }
+        None => (None, None),
+    };
     let options = RunOptions {
         max_states: o.max_states,
     };
@@ -200,13 +152,8 @@ pub fn run(o: &EmuOptions<'_>) -> Result<(), Failure> {
     );
     let _ = trace_out.flush();
     drop(trace_out);
-    if let Some(mut v) = stream {
-        drain_into(&mut v, mcu, phases.as_mut()).map_err(vcd_failure)?;
-        if let Some(rest) = mcu.finish_trace() {
-            let changes = phases.as_mut().map(PhaseRecorder::take).unwrap_or_default();
-            v.finish(&rest.changes, &changes, rest.end)
-                .map_err(vcd_failure)?;
-        }
+    if let Some(v) = stream {
+        finish_vcd(v, mcu, phases.as_mut()).map_err(|e| vcd_failure(o, e))?;
     }
     let report = match report {
         Ok(r) => r,
@@ -223,17 +170,119 @@ pub fn run(o: &EmuOptions<'_>) -> Result<(), Failure> {
     if let Some(f) = &report.stack_fault {
         eprintln!("warning: image `{image}`: {f}");
     }
-    match report.outcome {
+    exit(&report.outcome, report.stats.states, image)
+}
+
+/// The image loaded into a fresh machine.
+fn load(image: &str) -> Result<Machine, Failure> {
+    let max = emu::board::firmware::Firmware::MAX_FILE_BYTES;
+    let bytes =
+        emu::board::firmware::read_bounded(std::path::Path::new(image), max).map_err(|e| {
+            input(format!(
+                "cannot read image `{image}`: {e} (give a Motorola S-record file, .mot)"
+            ))
+        })?;
+    let srec = srec::parse(&bytes).map_err(|e| {
+        Failure::Input(anyhow::Error::new(e).context(format!("image `{image}`: bad image")))
+    })?;
+    Machine::with_image(&srec).map_err(|e| {
+        Failure::Input(anyhow::Error::new(e).context(format!("image `{image}`: cannot load image")))
+    })
+}
+
+/// The `--vcd` file, created (empty) when asked for.
+fn create_vcd(vcd: Option<&Path>) -> Result<Option<std::fs::File>, Failure> {
+    match vcd {
+        Some(path) => Ok(Some(std::fs::File::create(path).map_err(|e| {
+            input(format!(
+                "--vcd: cannot create `{}`: {e} (give a writable file path)",
+                path.display()
+            ))
+        })?)),
+        None => Ok(None),
+    }
+}
+
+/// With `--gdb ADDR`, listens there and waits for a GDB client.
+fn wait_for_debugger(gdb: Option<&str>) -> Result<Option<Debugger>, Failure> {
+    match gdb {
+        Some(addr) => {
+            let listener = GdbListener::bind(addr).map_err(gdb_failure)?;
+            let at = listener.local_addr();
+            eprintln!(
+                "h8swarm emu: GDB stub listening on {at}; waiting for a client (target remote {at})"
+            );
+            Ok(Some(listener.accept().map_err(gdb_failure)?))
+        }
+        None => Ok(None),
+    }
+}
+
+/// A VCD file that cannot be written: the tool's failure.
+fn vcd_failure(o: &EmuOptions<'_>, e: io::Error) -> Failure {
+    Failure::Tool(anyhow::Error::new(e).context(format!(
+        "writing the VCD file `{}`",
+        o.vcd.map(|p| p.display().to_string()).unwrap_or_default()
+    )))
+}
+
+/// Starts the pin trace into `file`: its header and the values at reset, with a phase signal
+/// (and the recorder that follows it) when the image has symbols.
+fn start_vcd(
+    file: std::fs::File,
+    cpu: &Cpu,
+    mcu: &mut Mcu<NullBoard>,
+    names: Option<&Arc<SymbolTable>>,
+    o: &EmuOptions<'_>,
+) -> Result<(VcdStream<'static>, Option<PhaseRecorder>), Failure> {
+    mcu.start_trace(cpu.sleeping());
+    let mut phases = None;
+    let mut phase_at_start = None;
+    if let Some(n) = names {
+        let mut p = PhaseRecorder::new(n.clone());
+        p.observe(mcu.now(), cpu.pc());
+        phase_at_start = p.drain_before(mcu.now() + 1).pop().map(|(_, name)| name);
+        phases = Some(p);
+    }
+    let (start, initial) = mcu.trace_beginning().unwrap_or_default();
+    let stream = VcdStream::start(
+        Box::new(file),
+        mcu.clock_hz(),
+        start,
+        initial,
+        phase_at_start.as_deref(),
+        &VcdInfo {
+            source: format!("{} on h8swarm emu", o.image),
+        },
+    )
+    .map_err(|e| vcd_failure(o, e))?;
+    Ok((stream, phases))
+}
+
+/// Writes the rest of the pin trace and the phases, and the trace's end.
+fn finish_vcd(
+    mut v: VcdStream<'_>,
+    mcu: &mut Mcu<NullBoard>,
+    mut phases: Option<&mut PhaseRecorder>,
+) -> io::Result<()> {
+    drain_into(&mut v, mcu, phases.as_deref_mut())?;
+    if let Some(rest) = mcu.finish_trace() {
+        let changes = phases.map(PhaseRecorder::take).unwrap_or_default();
+        v.finish(&rest.changes, &changes, rest.end)?;
+    }
+    Ok(())
+}
+
+/// The exit the run's outcome calls for, with its line on standard error (module docs).
+fn exit(outcome: &Outcome, states: u64, image: &str) -> Result<(), Failure> {
+    match *outcome {
         Outcome::Halted { exit_status: 0 } => Ok(()),
         Outcome::Halted { exit_status } => Err(Failure::Program(exit_status)),
         Outcome::MaxStates => {
-            eprintln!(
-                "h8swarm emu: stopped after {} states (--max-states)",
-                report.stats.states
-            );
+            eprintln!("h8swarm emu: stopped after {states} states (--max-states)");
             Err(Failure::Program(EXIT_MAX_STATES))
         }
-        Outcome::Error(e) => {
+        Outcome::Error(ref e) => {
             eprintln!("error: image `{image}`: the core stopped: {e}");
             Err(Failure::Program(EXIT_CORE_ERROR))
         }

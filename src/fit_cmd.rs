@@ -376,8 +376,20 @@ pub fn run(a: &FitArgs) -> Result<String> {
     Ok(s)
 }
 
+/// One controller's report as `fit` prints it, headed `name`.
 fn render(s: &mut String, name: &str, r: &FitReport) {
-    let us = |states: f64| states / f64::from(r.clock_hz) * 1e6;
+    render_settings(s, name, r);
+    render_states(s, r);
+    render_ram(s, r);
+    render_rom_and_eeprom(s, r);
+    if let Some(en) = &r.energy {
+        render_energy(s, en);
+    }
+    let _ = writeln!(s, "verdict: {}", r.verdict);
+}
+
+/// The heading: the controller's settings and what was measured (and beside what).
+fn render_settings(s: &mut String, name: &str, r: &FitReport) {
     let _ = writeln!(s, "== {name}");
     let _ = writeln!(
         s,
@@ -407,6 +419,12 @@ fn render(s: &mut String, name: &str, r: &FitReport) {
             None => String::new(),
         }
     );
+}
+
+/// The states per step period, phase by phase (with the other controller's mean and the
+/// ratio when both ran), the busy states and the CPU's share.
+fn render_states(s: &mut String, r: &FitReport) {
+    let us = |states: f64| states / f64::from(r.clock_hz) * 1e6;
     let other = if r.compared_with.is_some() {
         format!(
             " {:>12} {:>7}",
@@ -453,6 +471,10 @@ fn render(s: &mut String, name: &str, r: &FitReport) {
         "CPU: {:.3} % of the step period on average, {:.2} % in the worst step (a save); boot {} states",
         r.cpu_mean_percent, r.cpu_worst_percent, r.boot_states
     );
+}
+
+/// The RAM, item by item, and the stack's room and what the firmware left of it.
+fn render_ram(s: &mut String, r: &FitReport) {
     let _ = writeln!(s, "RAM (bytes):");
     for m in &r.ram {
         let _ = writeln!(s, "  H'{:06X} {:>6}  {}", m.addr, m.bytes, m.item);
@@ -484,6 +506,11 @@ fn render(s: &mut String, name: &str, r: &FitReport) {
             }
         }
     }
+}
+
+/// The ROM, and the EEPROM's traffic and lifetime.
+fn render_rom_and_eeprom(s: &mut String, r: &FitReport) {
+    let us = |states: f64| states / f64::from(r.clock_hz) * 1e6;
     let _ = writeln!(s, "ROM (bytes):");
     for m in &r.rom {
         let _ = writeln!(s, "  {:>6}  {}", m.bytes, m.item);
@@ -506,10 +533,6 @@ fn render(s: &mut String, name: &str, r: &FitReport) {
         e.save_max_states,
         us(e.save_max_states as f64) / 1000.0
     );
-    if let Some(en) = &r.energy {
-        render_energy(s, en);
-    }
-    let _ = writeln!(s, "verdict: {}", r.verdict);
 }
 
 fn render_energy(s: &mut String, e: &swarm::fit::EnergyReport) {

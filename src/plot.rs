@@ -37,6 +37,7 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 use plotters::coord::Shift;
+use plotters::coord::types::RangedCoordf64;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -1198,6 +1199,11 @@ fn time_label(time_s: f64) -> String {
     format!("t = {s} s")
 }
 
+/// The chart of an arena figure: metres on both axes.
+type ArenaChart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+/// Draws the arena figure: the title, the chart (the paths, the outlines, the walls) and the
+/// legend beside it.
 fn draw_arena<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     fig: &ArenaFigure,
@@ -1227,12 +1233,29 @@ fn draw_arena<DB: DrawingBackend>(
         0,
         0,
     );
+    let (mut chart, m_per_px) = arena_chart(&chart_area, layout)?;
+    draw_paths(&mut chart, fig, layout, m_per_px)?;
+    draw_outlines(&mut chart, fig, layout)?;
+    for wall in &fig.walls {
+        chart.draw_series(std::iter::once(PathElement::new(
+            wall.to_vec(),
+            WALL_COLOUR.stroke_width(5),
+        )))?;
+    }
+    draw_arena_legend(&legend_area, fig.paths.len(), layout)
+}
 
+/// The arena's chart on `area`, its mesh drawn, with an equal aspect ratio; and the metres a
+/// pixel spans.
+fn arena_chart<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    layout: &ArenaLayout,
+) -> Result<(ArenaChart<'a, DB>, f64), DrawingAreaErrorKind<DB::ErrorType>> {
     // Equal aspect ratio: measure the plotting area, then widen one range so a metre spans as
     // many pixels across as up.
     let (mt, mb, ml, mr) = ARENA_MARGIN_PX;
     let build = |x: std::ops::Range<f64>, y: std::ops::Range<f64>| {
-        ChartBuilder::on(&chart_area)
+        ChartBuilder::on(area)
             .margin_top(mt)
             .margin_bottom(mb)
             .margin_left(ml)
@@ -1266,16 +1289,28 @@ fn draw_arena<DB: DrawingBackend>(
         .x_label_formatter(&fmt)
         .y_label_formatter(&fmt)
         .draw()?;
+    Ok((chart, m_per_px))
+}
 
-    let robots = fig.paths.len();
-    let colour = |r: usize| ROBOT_PALETTE[r % ROBOT_PALETTE.len()];
+/// The robots' colours, repeating past the palette.
+fn robot_colour(r: usize) -> RGBColor {
+    ROBOT_PALETTE[r % ROBOT_PALETTE.len()]
+}
+
+/// Each robot's path (thinned to what `m_per_px` shows) and a circle at its start.
+fn draw_paths<DB: DrawingBackend>(
+    chart: &mut ArenaChart<'_, DB>,
+    fig: &ArenaFigure,
+    layout: &ArenaLayout,
+    m_per_px: f64,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
     let (path_px, path_alpha) = layout.path_style;
     // Each step of a path is a segment of its own: plotters joins a wide polyline's segments
     // with mitres, and where a robot reverses (backward after forward) the two segments meet
     // at almost 180° and the mitre becomes a long thin spike far past the path.
     for (r, path) in fig.paths.iter().enumerate() {
         let thin = thin_path(path, 0.75 * m_per_px);
-        let style = colour(r).mix(path_alpha).stroke_width(path_px);
+        let style = robot_colour(r).mix(path_alpha).stroke_width(path_px);
         chart.draw_series(
             thin.windows(2)
                 .map(|w| PathElement::new(vec![w[0], w[1]], style)),
@@ -1286,18 +1321,26 @@ fn draw_arena<DB: DrawingBackend>(
             chart.draw_series(std::iter::once(Circle::new(
                 start,
                 5,
-                colour(r).stroke_width(2),
+                robot_colour(r).stroke_width(2),
             )))?;
         }
     }
+    Ok(())
+}
 
+/// The robots' outlines at the snapshots, each filled by its time, bordered, with its heading.
+fn draw_outlines<DB: DrawingBackend>(
+    chart: &mut ArenaChart<'_, DB>,
+    fig: &ArenaFigure,
+    layout: &ArenaLayout,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
     // Outlines from the earliest snapshot to the latest, so the latest lie on top.
-    let border_px = if robots <= 30 { 2 } else { 1 };
+    let border_px = if fig.paths.len() <= 30 { 2 } else { 1 };
     let mut order: Vec<usize> = (0..fig.outlines.len()).collect();
     order.sort_by(|&a, &b| fig.outlines[a].time_s.total_cmp(&fig.outlines[b].time_s));
     for i in order {
         let o = &fig.outlines[i];
-        let c = colour(o.robot);
+        let c = robot_colour(o.robot);
         let corners: Vec<(f64, f64)> = o.corners.to_vec();
         chart.draw_series(std::iter::once(Polygon::new(
             corners.clone(),
@@ -1315,17 +1358,11 @@ fn draw_arena<DB: DrawingBackend>(
             darker(c).filled(),
         )))?;
     }
-
-    for wall in &fig.walls {
-        chart.draw_series(std::iter::once(PathElement::new(
-            wall.to_vec(),
-            WALL_COLOUR.stroke_width(5),
-        )))?;
-    }
-
-    draw_arena_legend(&legend_area, robots, layout)
+    Ok(())
 }
 
+/// The legend beside the arena: the robots' colours, the start marker, the snapshots' times
+/// and the heading marker.
 fn draw_arena_legend<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     robots: usize,

@@ -1337,6 +1337,27 @@ const UNITS: Units = Units {
 /// The printed tables: per condition the first and last window, the robots, the pairings and
 /// the claims.
 fn report(t: &mut String, s: &Scenario, a: &Analysis) {
+    report_conditions(t, a);
+    if s.repeats < 2 {
+        let _ = writeln!(
+            t,
+            "(windows of {} steps; first -> last window; one repeat, so no intervals)",
+            s.window
+        );
+    } else {
+        let _ = writeln!(
+            t,
+            "(windows of {} steps; first -> last window, mean over repeats; [95 % interval: expanded percentile bootstrap over repeats])",
+            s.window
+        );
+    }
+    report_pairings(t, a);
+    report_claims(t, a);
+}
+
+/// Per condition: the first and last window's measures, and the robots that ended stuck or
+/// had a lasting stuck spell.
+fn report_conditions(t: &mut String, a: &Analysis) {
     let _ = writeln!(
         t,
         "{:<14} {:>26} {:>26} {:>26}",
@@ -1391,19 +1412,10 @@ fn report(t: &mut String, s: &Scenario, a: &Analysis) {
             r.robots,
         );
     }
-    if s.repeats < 2 {
-        let _ = writeln!(
-            t,
-            "(windows of {} steps; first -> last window; one repeat, so no intervals)",
-            s.window
-        );
-    } else {
-        let _ = writeln!(
-            t,
-            "(windows of {} steps; first -> last window, mean over repeats; [95 % interval: expanded percentile bootstrap over repeats])",
-            s.window
-        );
-    }
+}
+
+/// Robot by robot, learning against each control: the robots it frees and traps.
+fn report_pairings(t: &mut String, a: &Analysis) {
     for p in &a.pairings {
         let _ = writeln!(
             t,
@@ -1418,6 +1430,11 @@ fn report(t: &mut String, s: &Scenario, a: &Analysis) {
             swarm::summary::fmt_p(p.p)
         );
     }
+}
+
+/// The paper's claims, then those against the controls it lacks, and how many of its text
+/// claims hold together.
+fn report_claims(t: &mut String, a: &Analysis) {
     let _ = writeln!(t);
     let _ = writeln!(
         t,

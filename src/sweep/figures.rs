@@ -262,47 +262,7 @@ pub fn claim_figures(
             continue;
         }
         let path = dir.join(format!("{}.png", s.slug));
-        let cells = cells(axes, coords, s);
-        let labels: Vec<[String; 3]> = cells
-            .iter()
-            .map(|c| {
-                let o = c.outcome();
-                if o == CellOutcome::NoData {
-                    return [
-                        "no data".into(),
-                        format!("{}/{} points", c.finished, c.planned),
-                        String::new(),
-                    ];
-                }
-                [
-                    o.word().to_string(),
-                    format!("{}/{}", c.for_, c.defined),
-                    c.mean_effect().map_or_else(String::new, fmt_effect),
-                ]
-            })
-            .collect();
-        let fills: Vec<(RGBColor, bool)> = cells
-            .iter()
-            .map(|c| {
-                let o = c.outcome();
-                (
-                    o.colour(),
-                    matches!(o, CellOutcome::Holds | CellOutcome::Opposite),
-                )
-            })
-            .collect();
-        let note = "each cell pools its seeds: outcome of the one-sided sign test on all their repeats (holds, unsure, fails, opposite), repeats for the claim / repeats with a value, mean effect b - a over its points";
-        let key: Vec<(RGBColor, &str)> = [
-            CellOutcome::Holds,
-            CellOutcome::Unsure,
-            CellOutcome::Fails,
-            CellOutcome::Opposite,
-            CellOutcome::NoData,
-        ]
-        .iter()
-        .map(|o| (o.colour(), o.word()))
-        .collect();
-        draw_map(&path, &grid, &s.text, &labels, &fills, &key, note)?;
+        draw_map(&path, &grid, &claim_map(&s.text, &cells(axes, coords, s)))?;
         written.push(path);
     }
     let paper: Vec<&ClaimSeries> = series.iter().filter(|s| s.paper).collect();
@@ -313,66 +273,137 @@ pub fn claim_figures(
     {
         let path = dir.join("region.png");
         let per_claim: Vec<Vec<Cell>> = paper.iter().map(|s| cells(axes, coords, s)).collect();
-        let k = paper.len();
-        let n = per_claim[0].len();
-        let mut labels = Vec::with_capacity(n);
-        let mut fills = Vec::with_capacity(n);
-        let outcomes = |i: usize| per_claim.iter().map(move |c| c[i].outcome());
-        for i in 0..n {
-            let holding: Vec<usize> = outcomes(i)
-                .enumerate()
-                .filter(|(_, o)| *o == CellOutcome::Holds)
-                .map(|(j, _)| j)
-                .collect();
-            let data = outcomes(i).any(|o| o != CellOutcome::NoData);
-            let all = holding.len() == k;
-            let names: Vec<String> = holding.iter().map(|j| (j + 1).to_string()).collect();
-            labels.push([
-                if all {
-                    "ALL HOLD".to_string()
-                } else if data {
-                    format!("{} of {k}", holding.len())
-                } else {
-                    "no data".to_string()
-                },
-                if names.is_empty() {
-                    "-".into()
-                } else {
-                    names.join(" ")
-                },
-                String::new(),
-            ]);
-            let shade = |t: f64| {
-                let mix =
-                    |w: u8, b: u8| (f64::from(w) * (1.0 - t) + f64::from(b) * t).round() as u8;
-                RGBColor(mix(255, UNSURE.0), mix(255, UNSURE.1), mix(255, UNSURE.2))
-            };
-            fills.push(if all {
-                (HOLDS, true)
-            } else if !data {
-                (NO_DATA, false)
-            } else {
-                (shade(holding.len() as f64 / k as f64), false)
-            });
-        }
-        let mut title =
-            "Where the paper's text claims hold together (pooled over seeds):".to_string();
-        for (j, s) in paper.iter().enumerate() {
-            let short = s.text.split(':').next().unwrap_or(&s.text);
-            title.push_str(&format!(" {} {short};", j + 1));
-        }
-        title.pop();
-        let key = vec![
-            (HOLDS, "all hold"),
-            (UNSURE, "some hold"),
-            (RGBColor(255, 255, 255), "none holds"),
-            (NO_DATA, "no data"),
-        ];
-        let note = "each cell: how many of the claims hold there (pooled sign test at p < 0.05) and which (their numbers)";
-        draw_map(&path, &grid, &title, &labels, &fills, &key, note)?;
+        draw_map(&path, &grid, &region_map(&paper, &per_claim))?;
         written.push(path);
     }
     Ok(written)
+}
+
+/// What a map shows: its title, each cell's three lines of label and its fill (a colour, and
+/// whether the label is drawn on it in white), the key and the note under it.
+struct Map<'a> {
+    title: String,
+    labels: Vec<[String; 3]>,
+    fills: Vec<(RGBColor, bool)>,
+    key: Vec<(RGBColor, &'a str)>,
+    note: &'a str,
+}
+
+/// One claim's map: each cell's outcome, its repeats for the claim of those with a value, and
+/// the mean effect.
+fn claim_map(text: &str, cells: &[Cell]) -> Map<'static> {
+    let labels: Vec<[String; 3]> = cells
+        .iter()
+        .map(|c| {
+            let o = c.outcome();
+            if o == CellOutcome::NoData {
+                return [
+                    "no data".into(),
+                    format!("{}/{} points", c.finished, c.planned),
+                    String::new(),
+                ];
+            }
+            [
+                o.word().to_string(),
+                format!("{}/{}", c.for_, c.defined),
+                c.mean_effect().map_or_else(String::new, fmt_effect),
+            ]
+        })
+        .collect();
+    let fills: Vec<(RGBColor, bool)> = cells
+        .iter()
+        .map(|c| {
+            let o = c.outcome();
+            (
+                o.colour(),
+                matches!(o, CellOutcome::Holds | CellOutcome::Opposite),
+            )
+        })
+        .collect();
+    let note = "each cell pools its seeds: outcome of the one-sided sign test on all their repeats (holds, unsure, fails, opposite), repeats for the claim / repeats with a value, mean effect b - a over its points";
+    let key: Vec<(RGBColor, &str)> = [
+        CellOutcome::Holds,
+        CellOutcome::Unsure,
+        CellOutcome::Fails,
+        CellOutcome::Opposite,
+        CellOutcome::NoData,
+    ]
+    .iter()
+    .map(|o| (o.colour(), o.word()))
+    .collect();
+    Map {
+        title: text.to_string(),
+        labels,
+        fills,
+        key,
+        note,
+    }
+}
+
+/// The map of where the paper's text claims (`paper`, their cells `per_claim`) hold together:
+/// in each cell, how many hold and which.
+fn region_map(paper: &[&ClaimSeries], per_claim: &[Vec<Cell>]) -> Map<'static> {
+    let k = paper.len();
+    let n = per_claim[0].len();
+    let mut labels = Vec::with_capacity(n);
+    let mut fills = Vec::with_capacity(n);
+    let outcomes = |i: usize| per_claim.iter().map(move |c| c[i].outcome());
+    for i in 0..n {
+        let holding: Vec<usize> = outcomes(i)
+            .enumerate()
+            .filter(|(_, o)| *o == CellOutcome::Holds)
+            .map(|(j, _)| j)
+            .collect();
+        let data = outcomes(i).any(|o| o != CellOutcome::NoData);
+        let all = holding.len() == k;
+        let names: Vec<String> = holding.iter().map(|j| (j + 1).to_string()).collect();
+        labels.push([
+            if all {
+                "ALL HOLD".to_string()
+            } else if data {
+                format!("{} of {k}", holding.len())
+            } else {
+                "no data".to_string()
+            },
+            if names.is_empty() {
+                "-".into()
+            } else {
+                names.join(" ")
+            },
+            String::new(),
+        ]);
+        let shade = |t: f64| {
+            let mix = |w: u8, b: u8| (f64::from(w) * (1.0 - t) + f64::from(b) * t).round() as u8;
+            RGBColor(mix(255, UNSURE.0), mix(255, UNSURE.1), mix(255, UNSURE.2))
+        };
+        fills.push(if all {
+            (HOLDS, true)
+        } else if !data {
+            (NO_DATA, false)
+        } else {
+            (shade(holding.len() as f64 / k as f64), false)
+        });
+    }
+    let mut title = "Where the paper's text claims hold together (pooled over seeds):".to_string();
+    for (j, s) in paper.iter().enumerate() {
+        let short = s.text.split(':').next().unwrap_or(&s.text);
+        title.push_str(&format!(" {} {short};", j + 1));
+    }
+    title.pop();
+    let key = vec![
+        (HOLDS, "all hold"),
+        (UNSURE, "some hold"),
+        (RGBColor(255, 255, 255), "none holds"),
+        (NO_DATA, "no data"),
+    ];
+    let note = "each cell: how many of the claims hold there (pooled sign test at p < 0.05) and which (their numbers)";
+    Map {
+        title,
+        labels,
+        fills,
+        key,
+        note,
+    }
 }
 
 /// The layout of a map: cells in panels, panels in a grid.
@@ -440,47 +471,36 @@ const PANEL_TOP: i32 = 50;
 /// Space between panels.
 const PANEL_GAP: i32 = 26;
 
-#[allow(clippy::too_many_arguments)]
-fn draw_map(
-    path: &Path,
-    g: &Grid,
-    title: &str,
-    labels: &[[String; 3]],
-    fills: &[(RGBColor, bool)],
-    key: &[(RGBColor, &str)],
-    note: &str,
-) -> Result<(), SweepError> {
+/// Draws `map` on the grid `g` into the PNG file `path`, sized to hold its panels.
+fn draw_map(path: &Path, g: &Grid, map: &Map<'_>) -> Result<(), SweepError> {
     let (nr, nc) = (g.rows.1.len() as i32, g.cols.1.len() as i32);
     let panel_w = PANEL_LEFT + nc * CELL_W;
     let panel_h = PANEL_TOP + nr * CELL_H + 30;
     let per_row = g.per_row as i32;
     let grid_rows = (g.panels.len() as i32 + per_row - 1) / per_row;
     let width = (40 + per_row * (panel_w + PANEL_GAP)).max(1000);
-    let title_lines = wrap(title, (width as usize / 11).max(40));
+    let title_lines = wrap(&map.title, (width as usize / 11).max(40));
     let top = 20 + 26 * title_lines.len() as i32 + 60;
     let height = top + grid_rows * (panel_h + PANEL_GAP) + 70;
     let size = (width as u32, height as u32);
     let mut rgb = vec![0u8; width as usize * height as usize * 3];
     {
         let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
-        draw_map_on(&root, g, &title_lines, labels, fills, key, note, top)
-            .map_err(|e| tool(path, e))?;
+        draw_map_on(&root, g, &title_lines, map, top).map_err(|e| tool(path, e))?;
         root.present().map_err(|e| tool(path, e))?;
     }
     crate::plot::write_png(path, size, &rgb).map_err(|e| tool(path, e))
 }
 
-#[allow(clippy::too_many_arguments)]
+/// Draws `map` on `root`: the title's lines, the key, the panels from `top` down, the note.
 fn draw_map_on(
     root: &DrawingArea<BitMapBackend<'_>, Shift>,
     g: &Grid,
     title_lines: &[String],
-    labels: &[[String; 3]],
-    fills: &[(RGBColor, bool)],
-    key: &[(RGBColor, &str)],
-    note: &str,
+    map: &Map<'_>,
     top: i32,
 ) -> Result<(), String> {
+    let (labels, fills, key, note) = (&map.labels, &map.fills, &map.key, map.note);
     let e = |e: DrawingAreaErrorKind<_>| e.to_string();
     root.fill(&WHITE).map_err(e)?;
     let title_font = (FONT, 20).into_font().color(&INK);

@@ -447,6 +447,43 @@ pub fn write_plan(
     dir: &Path,
     bin: Option<&Path>,
 ) -> Result<String, SweepError> {
+    let plan = plan_of(sweep)?;
+    let dir = plan_folder(dir)?;
+    let bin: PathBuf = match bin {
+        Some(b) => b.to_path_buf(),
+        None => std::env::current_exe()
+            .map_err(|e| SweepError::tool(format!("cannot find this program's path: {e}")))?,
+    };
+    let script = sbatch_script(&plan, &sweep.slurm, &dir, &bin)?;
+    // Second pass: the run list, a point at a time, into a temporary file beside it.
+    let list_path = dir.join("points.jsonl");
+    let tmp = dir.join(format!(".points.jsonl.tmp-{}", std::process::id()));
+    if let Err(e) = write_new_list(sweep, plan.points_per_task, &tmp, &list_path, &dir) {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(e);
+    }
+    for sub in ["points", "logs"] {
+        let p = dir.join(sub);
+        std::fs::create_dir_all(&p)
+            .map_err(|e| SweepError::tool(format!("cannot create `{}`: {e}", p.display())))?;
+    }
+    let plan_json = serde_json::to_string_pretty(&plan)
+        .map_err(|e| SweepError::tool(format!("writing plan.json: {e}")))?
+        + "\n";
+    write_atomic(&dir.join("sweep.toml"), sweep_text.as_bytes())?;
+    std::fs::rename(&tmp, &list_path).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        SweepError::tool(format!("cannot write `{}`: {e}", list_path.display()))
+    })?;
+    write_atomic(&dir.join("plan.json"), plan_json.as_bytes())?;
+    write_atomic(&dir.join("sweep.sbatch"), script.as_bytes())?;
+    let dir_text = swarm::text::printable(&dir.display().to_string());
+    Ok(plan_summary(&plan, &dir_text))
+}
+
+/// The plan of `sweep`: its points shared into array tasks within Slurm's limits, every point
+/// checked, and what each task asks for.
+fn plan_of(sweep: &Sweep) -> Result<Plan, SweepError> {
     let slurm = &sweep.slurm;
     let per_task = count_in(
         slurm.points_per_task,
@@ -484,7 +521,7 @@ pub fn write_plan(
     })?;
     let requests = requests(&costs, slurm, per_task)?;
     drop(costs);
-    let plan = Plan {
+    Ok(Plan {
         h8swarm_version: env!("CARGO_PKG_VERSION").to_string(),
         sweep: sweep.name.clone(),
         axes: sweep.axes.clone(),
@@ -494,56 +531,42 @@ pub fn write_plan(
         tasks,
         max_parallel,
         requests,
-    };
+    })
+}
 
+/// The sweep folder `dir`, created if need be, as an absolute path.
+fn plan_folder(dir: &Path) -> Result<PathBuf, SweepError> {
     std::fs::create_dir_all(dir).map_err(|e| {
         SweepError::tool(format!(
             "cannot create the sweep folder `{}`: {e}",
             dir.display()
         ))
     })?;
-    let dir = dir
-        .canonicalize()
-        .map_err(|e| SweepError::tool(format!("cannot resolve `{}`: {e}", dir.display())))?;
-    let bin: PathBuf = match bin {
-        Some(b) => b.to_path_buf(),
-        None => std::env::current_exe()
-            .map_err(|e| SweepError::tool(format!("cannot find this program's path: {e}")))?,
-    };
-    let script = sbatch_script(&plan, slurm, &dir, &bin)?;
-    // Second pass: the run list, a point at a time, into a temporary file beside it.
-    let list_path = dir.join("points.jsonl");
-    let tmp = dir.join(format!(".points.jsonl.tmp-{}", std::process::id()));
-    let written = write_list(sweep, per_task, &tmp).and_then(|()| {
-        if list_path.exists() && !same_file_bytes(&list_path, &tmp)? {
-            return Err(SweepError::input(format!(
-                "`{}` already holds a different sweep plan (its points.jsonl differs): give --out a new folder, or remove the old one",
-                dir.display()
-            )));
-        }
-        Ok(())
-    });
-    if let Err(e) = written {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(e);
-    }
-    for sub in ["points", "logs"] {
-        let p = dir.join(sub);
-        std::fs::create_dir_all(&p)
-            .map_err(|e| SweepError::tool(format!("cannot create `{}`: {e}", p.display())))?;
-    }
-    let plan_json = serde_json::to_string_pretty(&plan)
-        .map_err(|e| SweepError::tool(format!("writing plan.json: {e}")))?
-        + "\n";
-    write_atomic(&dir.join("sweep.toml"), sweep_text.as_bytes())?;
-    std::fs::rename(&tmp, &list_path).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        SweepError::tool(format!("cannot write `{}`: {e}", list_path.display()))
-    })?;
-    write_atomic(&dir.join("plan.json"), plan_json.as_bytes())?;
-    write_atomic(&dir.join("sweep.sbatch"), script.as_bytes())?;
-    let dir_text = swarm::text::printable(&dir.display().to_string());
+    dir.canonicalize()
+        .map_err(|e| SweepError::tool(format!("cannot resolve `{}`: {e}", dir.display())))
+}
 
+/// Writes the run list into `tmp`; a run list already at `list_path` must be the same (the
+/// folder `dir` holds no other plan).
+fn write_new_list(
+    sweep: &Sweep,
+    per_task: usize,
+    tmp: &Path,
+    list_path: &Path,
+    dir: &Path,
+) -> Result<(), SweepError> {
+    write_list(sweep, per_task, tmp)?;
+    if list_path.exists() && !same_file_bytes(list_path, tmp)? {
+        return Err(SweepError::input(format!(
+            "`{}` already holds a different sweep plan (its points.jsonl differs): give --out a new folder, or remove the old one",
+            dir.display()
+        )));
+    }
+    Ok(())
+}
+
+/// What `sweep plan` prints: the plan in a line, the requests, and what to run next.
+fn plan_summary(plan: &Plan, dir_text: &str) -> String {
     let mut t = String::new();
     let _ = writeln!(
         t,
@@ -579,7 +602,7 @@ pub fn write_plan(
     let _ = writeln!(t, "on a cluster: sbatch {dir_text}/sweep.sbatch");
     let _ = writeln!(t, "on this machine: h8swarm sweep run {dir_text}");
     let _ = writeln!(t, "then: h8swarm sweep merge {dir_text}");
-    Ok(t)
+    t
 }
 
 /// Writes the run list of `sweep` to `path`, one point at a time.

@@ -621,30 +621,156 @@ impl Measured {
 /// Runs the firmware for `cfg.steps` step periods.
 fn measure_firmware(cfg: &FitConfig) -> Result<Measured, FitError> {
     let fw = &cfg.firmware.firmware;
-    let block = ConfigBlock::from_controller(&cfg.controller)?;
-    let block = if fw.has_config_block() {
-        Some(block)
-    } else if block == ConfigBlock::ARENA {
-        None
-    } else {
-        return Err(FitError::NoBlock {
-            image: fw.name.clone(),
-        });
+    let block = config_block(cfg)?;
+    let mut run = FirmwareRun::start(cfg, block)?;
+    let mut periods = StepPeriods::new(run.profiler.names().len(), cfg.steps);
+    let mut boot_states = 0;
+    let mut meter = None;
+    // The measurement, up to a stack overflow if there is one.
+    let fault: Option<Box<StackFault>> = 'run: {
+        if let Some(f) = run.boot()? {
+            break 'run Some(f);
+        }
+        boot_states = run.profiler.states().iter().sum();
+        // Booted: what the firmware carved above its data is not the stack's.
+        fw.raise_stack_low(&mut run.cpu, &run.rig.mcu);
+        run.check_config_status(fw, block.as_ref())?;
+        let m = meter.insert(FitMeter::new(&run.rig.mcu));
+        run.step_periods(cfg.steps, &mut periods, m)?
     };
-    let mut rig = Rig::new(cfg)?;
-    let mut cpu = Cpu::new();
-    // The stack guard stops the measurement at a stack access outside the room: the verdict
-    // is then that it does not fit, with how far it went.
-    cpu.set_stack_guard(Some(StackGuard::stop(fw.stack_room())));
-    fw.install(&mut rig.mcu, &mut cpu, block.as_ref())?;
-    let mut profiler = Profiler::new(&fw.symbols, &cfg.firmware.phases, PHASE_OTHER)?;
-    let clock = f64::from(cfg.controller.clock_hz);
-    let step = |profiler: &mut Profiler, cpu: &mut Cpu, mcu: &mut Mcu<FitBoard>, deadline: u64| {
-        let at = mcu.now();
-        match profiler.run_one(cpu, mcu, deadline) {
+    let energy = match (fault.is_none(), meter) {
+        (true, Some(m)) => Some(m.finish(&run.rig.mcu, periods.busy.iter().sum())),
+        _ => None,
+    };
+    let fault = fault.map(|mut f| {
+        f.function = fw.symbols.function_at(f.pc).map(|s| s.c_name().to_string());
+        *f
+    });
+    let phases: Vec<(String, Vec<u64>)> = run
+        .profiler
+        .names()
+        .iter()
+        .cloned()
+        .zip(periods.per_phase)
+        .filter(|(n, _)| n != PHASE_BOOT)
+        .collect();
+    let stack_top = fw
+        .symbols
+        .addr("_stack_top")
+        .unwrap_or(emu::core::memmap::RAM_END + 1);
+    let stack_high_water = stack_top.saturating_sub(run.profiler.min_sp());
+    let stack = run.stack_line(fw, fault.as_ref());
+    Ok(Measured {
+        source: fw.name.clone(),
+        boot_states,
+        phases,
+        busy: periods.busy,
+        ram: firmware_ram(fw, &run.rig.mcu, stack_high_water),
+        stack_high_water: Some(stack_high_water),
+        stack: Some(stack),
+        energy,
+    })
+}
+
+/// The configuration block to install in the firmware: the controller's, or none for an image
+/// without one when the controller is the arena's (the image's own constants are then the
+/// arena's).
+fn config_block(cfg: &FitConfig) -> Result<Option<ConfigBlock>, FitError> {
+    let fw = &cfg.firmware.firmware;
+    let block = ConfigBlock::from_controller(&cfg.controller)?;
+    if fw.has_config_block() {
+        Ok(Some(block))
+    } else if block == ConfigBlock::ARENA {
+        Ok(None)
+    } else {
+        Err(FitError::NoBlock {
+            image: fw.name.clone(),
+        })
+    }
+}
+
+/// The states of each measured step period: per phase, and all of them (the busy states).
+struct StepPeriods {
+    per_phase: Vec<Vec<u64>>,
+    busy: Vec<u64>,
+}
+
+impl StepPeriods {
+    fn new(n_phases: usize, steps: u32) -> StepPeriods {
+        StepPeriods {
+            per_phase: vec![Vec::with_capacity(steps as usize); n_phases],
+            busy: Vec::with_capacity(steps as usize),
+        }
+    }
+
+    /// A step period ended with the profiler's counts at `now`, from `before` at its start.
+    fn push(&mut self, before: &[u64], now: &[u64]) {
+        for (i, v) in self.per_phase.iter_mut().enumerate() {
+            v.push(now[i] - before[i]);
+        }
+        self.busy
+            .push(now.iter().sum::<u64>() - before.iter().sum::<u64>());
+    }
+}
+
+/// The firmware under measurement: its robot, CPU and phase profiler, and the limits of the run.
+struct FirmwareRun {
+    rig: Rig,
+    cpu: Cpu,
+    profiler: Profiler,
+    /// The step's first phase (A/D for the robot firmware), or `usize::MAX` without phases
+    /// (the step periods are then fixed windows from the first SLEEP).
+    step_phase: usize,
+    /// The most states boot may take, and the slack of a step period beyond two periods.
+    boot_limit: u64,
+    /// A step period, states.
+    period: u64,
+    /// The MCU's clock, Hz.
+    clock: f64,
+}
+
+impl FirmwareRun {
+    /// The firmware installed (with `block`) on a fresh robot, at reset.
+    fn start(cfg: &FitConfig, block: Option<ConfigBlock>) -> Result<FirmwareRun, FitError> {
+        let fw = &cfg.firmware.firmware;
+        let mut rig = Rig::new(cfg)?;
+        let mut cpu = Cpu::new();
+        // The stack guard stops the measurement at a stack access outside the room: the verdict
+        // is then that it does not fit, with how far it went.
+        cpu.set_stack_guard(Some(StackGuard::stop(fw.stack_room())));
+        fw.install(&mut rig.mcu, &mut cpu, block.as_ref())?;
+        let profiler = Profiler::new(&fw.symbols, &cfg.firmware.phases, PHASE_OTHER)?;
+        let clock = f64::from(cfg.controller.clock_hz);
+        let step_phase = profiler
+            .names()
+            .iter()
+            .position(|n| n != PHASE_BOOT && n != PHASE_OTHER)
+            .unwrap_or(usize::MAX);
+        let period = match block {
+            Some(b) => b.step_period_states(),
+            None => ConfigBlock::ARENA.step_period_states(),
+        };
+        Ok(FirmwareRun {
+            rig,
+            cpu,
+            profiler,
+            step_phase,
+            boot_limit: (BOOT_LIMIT_S * clock) as u64,
+            period,
+            clock,
+        })
+    }
+
+    /// Runs the CPU up to one event, before `deadline`; a halt is an error.
+    fn step(&mut self, deadline: u64) -> Result<Event, FitError> {
+        let at = self.rig.mcu.now();
+        match self
+            .profiler
+            .run_one(&mut self.cpu, &mut self.rig.mcu, deadline)
+        {
             Ok(Event::Halted) => Err(FitError::Run {
                 at,
-                source: halted(cpu),
+                source: halted(&self.cpu),
             }),
             Ok(e) => Ok(e),
             Err(e) => Err(FitError::Run {
@@ -652,146 +778,129 @@ fn measure_firmware(cfg: &FitConfig) -> Result<Measured, FitError> {
                 source: RunError::Cpu(e),
             }),
         }
-    };
+    }
 
-    // Boot: from reset until the first step begins (the first entry into the step's first
-    // phase, A/D for the robot firmware). The step periods are counted from there.
-    let step_phase = profiler
-        .names()
-        .iter()
-        .position(|n| n != PHASE_BOOT && n != PHASE_OTHER)
-        .unwrap_or(usize::MAX);
-    let boot_limit = (BOOT_LIMIT_S * clock) as u64;
-    let period = match block {
-        Some(b) => b.step_period_states(),
-        None => ConfigBlock::ARENA.step_period_states(),
-    };
-    let n_phases = profiler.names().len();
-    let mut per_phase: Vec<Vec<u64>> = vec![Vec::with_capacity(cfg.steps as usize); n_phases];
-    let mut busy = Vec::with_capacity(cfg.steps as usize);
-    let mut boot_states = 0;
-    let mut meter = None;
-    // The measurement, up to a stack overflow if there is one.
-    let fault: Option<Box<StackFault>> = 'run: {
-        if step_phase == usize::MAX {
-            // No phases: count from the first SLEEP instead.
-            while !cpu.sleeping() {
-                if rig.mcu.now() >= boot_limit {
-                    return Err(FitError::BootTimeout { pc: cpu.pc() });
-                }
-                if let Err(e) = step(&mut profiler, &mut cpu, &mut rig.mcu, boot_limit) {
-                    break 'run Some(overflow(e)?);
-                }
+    /// Boot: from reset until the first step begins (the first entry into the step's first
+    /// phase, A/D for the robot firmware; without phases, the first SLEEP). The step periods
+    /// are counted from there. A stack overflow on the way is returned.
+    fn boot(&mut self) -> Result<Option<Box<StackFault>>, FitError> {
+        let booted = |run: &FirmwareRun| {
+            if run.step_phase == usize::MAX {
+                run.cpu.sleeping()
+            } else {
+                run.profiler.first_entry(run.step_phase).is_some()
             }
-        } else {
-            while profiler.first_entry(step_phase).is_none() {
-                if rig.mcu.now() >= boot_limit {
-                    return Err(FitError::BootTimeout { pc: cpu.pc() });
-                }
-                if let Err(e) = step(&mut profiler, &mut cpu, &mut rig.mcu, boot_limit) {
-                    break 'run Some(overflow(e)?);
-                }
+        };
+        while !booted(self) {
+            if self.rig.mcu.now() >= self.boot_limit {
+                return Err(FitError::BootTimeout { pc: self.cpu.pc() });
+            }
+            if let Err(e) = self.step(self.boot_limit) {
+                return Ok(Some(overflow(e)?));
             }
         }
-        boot_states = profiler.states().iter().sum();
-        // Booted: what the firmware carved above its data is not the stack's.
-        fw.raise_stack_low(&mut cpu, &rig.mcu);
+        Ok(None)
+    }
+
+    /// A firmware that checks its configuration block and rejected it is an error.
+    fn check_config_status(
+        &self,
+        fw: &Firmware,
+        block: Option<&ConfigBlock>,
+    ) -> Result<(), FitError> {
         if let Some(addr) = fw.symbols.addr("cfg_status")
             && block.is_some()
             && let ConfigStatus::Rejected { field, code } =
-                ConfigStatus::from_code(rig.mcu.peek(addr))
+                ConfigStatus::from_code(self.rig.mcu.peek(addr))
         {
             return Err(FitError::Rejected { field, code });
         }
+        Ok(())
+    }
 
-        let mut before: Vec<u64> = profiler.states().to_vec();
-        meter = Some(FitMeter::new(&rig.mcu));
+    /// Runs `steps` step periods after boot, counting their states into `periods` and their
+    /// charge into `meter`. A stack overflow on the way ends them and is returned.
+    fn step_periods(
+        &mut self,
+        steps: u32,
+        periods: &mut StepPeriods,
+        meter: &mut FitMeter,
+    ) -> Result<Option<Box<StackFault>>, FitError> {
+        let mut before: Vec<u64> = self.profiler.states().to_vec();
         // A step period runs from one step's start (the entry into its first phase) to the next
         // one's: one step, its ticks and the idle time up to the next (K ticks in steady state;
         // the first may be shorter when boot outlasted the first tick). Without phases, fixed
         // windows of K ticks from the first SLEEP.
-        let mut window_end = rig.mcu.now();
-        for k in 0..u64::from(cfg.steps) {
+        let mut window_end = self.rig.mcu.now();
+        for k in 0..u64::from(steps) {
             // The world moves before each step's A/D scan.
-            rig.move_world();
-            if step_phase == usize::MAX {
-                window_end += period;
-                while rig.mcu.now() < window_end {
-                    match step(&mut profiler, &mut cpu, &mut rig.mcu, window_end) {
-                        Ok(Event::Asleep) => break,
-                        Ok(_) => {}
-                        Err(e) => break 'run Some(overflow(e)?),
-                    }
-                }
+            self.rig.move_world();
+            let fault = if self.step_phase == usize::MAX {
+                window_end += self.period;
+                self.run_window(window_end)?
             } else {
-                let limit = rig.mcu.now() + 2 * period + boot_limit;
-                while profiler.entries(step_phase) < k + 2 {
-                    if rig.mcu.now() >= limit {
-                        return Err(FitError::StepTimeout {
-                            phase: profiler.names()[step_phase].clone(),
-                            pc: cpu.pc(),
-                        });
-                    }
-                    if let Err(e) = step(&mut profiler, &mut cpu, &mut rig.mcu, limit) {
-                        break 'run Some(overflow(e)?);
-                    }
-                }
+                self.run_step(k)?
+            };
+            if fault.is_some() {
+                return Ok(fault);
             }
-            let now = profiler.states();
-            for (i, v) in per_phase.iter_mut().enumerate() {
-                v.push(now[i] - before[i]);
-            }
-            busy.push(now.iter().sum::<u64>() - before.iter().sum::<u64>());
+            let now = self.profiler.states();
+            periods.push(&before, now);
             before = now.to_vec();
-            if let Some(m) = meter.as_mut() {
-                let seconds = period as f64 / clock;
-                m.period(&mut rig.mcu, seconds);
+            let seconds = self.period as f64 / self.clock;
+            meter.period(&mut self.rig.mcu, seconds);
+        }
+        Ok(None)
+    }
+
+    /// Runs up to `window_end` or the next SLEEP, whichever comes first. A stack overflow on
+    /// the way is returned.
+    fn run_window(&mut self, window_end: u64) -> Result<Option<Box<StackFault>>, FitError> {
+        while self.rig.mcu.now() < window_end {
+            match self.step(window_end) {
+                Ok(Event::Asleep) => break,
+                Ok(_) => {}
+                Err(e) => return Ok(Some(overflow(e)?)),
             }
         }
-        None
-    };
-    let energy = match (fault.is_none(), meter) {
-        (true, Some(m)) => Some(m.finish(&rig.mcu, busy.iter().sum())),
-        _ => None,
-    };
-    let fault = fault.map(|mut f| {
-        f.function = fw.symbols.function_at(f.pc).map(|s| s.c_name().to_string());
-        *f
-    });
-    let phases: Vec<(String, Vec<u64>)> = profiler
-        .names()
-        .iter()
-        .cloned()
-        .zip(per_phase)
-        .filter(|(n, _)| n != PHASE_BOOT)
-        .collect();
-    let stack_top = fw
-        .symbols
-        .addr("_stack_top")
-        .unwrap_or(emu::core::memmap::RAM_END + 1);
-    let stack_high_water = stack_top.saturating_sub(profiler.min_sp());
-    let room = cpu
-        .stack_guard()
-        .map_or_else(|| fw.stack_room(), |g| g.room);
-    let stack = StackLine {
-        room_low: room.low,
-        room_top: room.top,
-        room_bytes: room.bytes(),
-        lowest_sp: profiler.min_sp().min(room.top),
-        left_bytes: i64::from(profiler.min_sp().min(room.top)) - i64::from(room.low),
-        overflow: fault.as_ref().map(ToString::to_string),
-        overflow_bytes: fault.as_ref().map(StackFault::bytes_over),
-    };
-    Ok(Measured {
-        source: fw.name.clone(),
-        boot_states,
-        phases,
-        busy,
-        ram: firmware_ram(fw, &rig.mcu, stack_high_water),
-        stack_high_water: Some(stack_high_water),
-        stack: Some(stack),
-        energy,
-    })
+        Ok(None)
+    }
+
+    /// Runs until step `k + 1` begins (the `k + 2`th entry into the step's first phase); taking
+    /// too long is an error. A stack overflow on the way is returned.
+    fn run_step(&mut self, k: u64) -> Result<Option<Box<StackFault>>, FitError> {
+        let limit = self.rig.mcu.now() + 2 * self.period + self.boot_limit;
+        while self.profiler.entries(self.step_phase) < k + 2 {
+            if self.rig.mcu.now() >= limit {
+                return Err(FitError::StepTimeout {
+                    phase: self.profiler.names()[self.step_phase].clone(),
+                    pc: self.cpu.pc(),
+                });
+            }
+            if let Err(e) = self.step(limit) {
+                return Ok(Some(overflow(e)?));
+            }
+        }
+        Ok(None)
+    }
+
+    /// The stack's room and what the firmware left of it, with the overflow if there was one.
+    fn stack_line(&self, fw: &Firmware, fault: Option<&StackFault>) -> StackLine {
+        let room = self
+            .cpu
+            .stack_guard()
+            .map_or_else(|| fw.stack_room(), |g| g.room);
+        let lowest_sp = self.profiler.min_sp().min(room.top);
+        StackLine {
+            room_low: room.low,
+            room_top: room.top,
+            room_bytes: room.bytes(),
+            lowest_sp,
+            left_bytes: i64::from(lowest_sp) - i64::from(room.low),
+            overflow: fault.map(ToString::to_string),
+            overflow_bytes: fault.map(StackFault::bytes_over),
+        }
+    }
 }
 
 /// The stack fault an error of the measurement is, or the error itself.
@@ -966,24 +1075,7 @@ fn spread_of(values: &[u64]) -> Spread {
 fn report(cfg: &FitConfig, m: &Measured, other: Option<&Measured>) -> FitReport {
     let c = &cfg.controller;
     let clock_hz = c.clock_hz;
-    let us = |states: u64| states as f64 / f64::from(clock_hz) * 1e6;
-    let phases: Vec<PhaseLine> = m
-        .phases
-        .iter()
-        .map(|(name, v)| {
-            let s = spread_of(v);
-            let o = other.and_then(|o| o.phase(name)).map(spread_of);
-            PhaseLine {
-                phase: name.clone(),
-                states: s,
-                max_us: us(s.max),
-                other: o,
-                ratio: o
-                    .filter(|o| o.mean > 0.0 && s.mean > 0.0)
-                    .map(|o| s.mean / o.mean),
-            }
-        })
-        .collect();
+    let phases = phase_lines(clock_hz, m, other);
     let save_max = m
         .phase(PHASE_SAVE)
         .map_or(0, |v| v.iter().copied().max().unwrap_or(0));
@@ -992,73 +1084,16 @@ fn report(cfg: &FitConfig, m: &Measured, other: Option<&Measured>) -> FitReport 
     let cpu_mean_percent = busy_per_step.mean / period_states * 100.0;
     let cpu_worst_percent = busy_per_step.max as f64 / period_states * 100.0;
     let ram_used: u32 = m.ram.iter().map(|l| l.bytes).sum();
-
     let fw = &cfg.firmware.firmware;
-    let image = fw.rom_bytes() as u32;
-    let mut rom = vec![MemLine {
-        item: format!("{} (S-record data)", fw.name),
-        addr: 0,
-        bytes: image,
-    }];
-    if fw.has_config_block() {
-        rom.push(MemLine {
-            item: "of which the configuration block".to_string(),
-            addr: emu::board::firmware::CONFIG_BLOCK_ADDR,
-            bytes: emu::board::firmware::CONFIG_BLOCK_BYTES as u32,
-        });
-    }
-    let rom_used = image;
-
+    let rom = rom_lines(fw);
+    let rom_used = fw.rom_bytes() as u32;
     let n_in = c.n_inputs();
-    let payload = 2 * n_in * c.behaviours;
-    let record = eeprom::persist::RecordLayout::default();
-    let saves_per_hour = 3600.0 / (c.step_period_s * f64::from(c.save_every_steps));
-    let page_writes_per_hour = saves_per_hour / 2.0;
-    let eeprom = EepromLine {
-        bytes_per_save: record.bytes_per_save(payload),
-        pages_per_save: record.pages_per_record(payload),
-        saves_per_hour,
-        page_writes_per_hour,
-        lifetime_hours: ENDURANCE_CYCLES / page_writes_per_hour,
-        save_max_states: save_max,
-    };
-
-    let mut margins = vec![
-        (
-            "RAM",
-            100.0 * (1.0 - f64::from(ram_used) / f64::from(RAM_BYTES)),
-        ),
-        (
-            "ROM",
-            100.0 * (1.0 - f64::from(rom_used) / f64::from(ROM_BYTES)),
-        ),
-        ("CPU (worst step)", 100.0 - cpu_worst_percent),
-    ];
-    // The stack's room: what the lowest SP left of it, or how far past it the first access
-    // outside went (then it does not fit, whatever the RAM total says).
-    let mut stack_note = String::new();
-    if let Some(st) = &m.stack {
-        let room = f64::from(st.room_bytes.max(1));
-        let left = match st.overflow_bytes {
-            Some(over) => -f64::from(over),
-            None => st.left_bytes as f64,
-        };
-        margins.push(("stack", 100.0 * left / room));
-        if let Some(text) = &st.overflow {
-            stack_note = format!(
-                "the stack leaves its room by {} B ({text}); ",
-                st.overflow_bytes.unwrap_or(0)
-            );
-        }
-    }
-    let (tightest, tightest_margin_percent) = margins
-        .iter()
-        .copied()
-        .fold(("RAM", f64::INFINITY), |a, b| if b.1 < a.1 { b } else { a });
-    let fits = margins.iter().all(|m| m.1 >= 0.0);
+    let eeprom = eeprom_line(c, save_max);
+    let margins = Margins::new(ram_used, rom_used, cpu_worst_percent, m.stack.as_ref());
     let verdict = format!(
-        "{}: {stack_note}{} x {} network, RAM {} of {} B, ROM {} B of {} KB, worst step {:.2} % of the {} s period (mean {:.3} %); tightest margin: {} with {:.1} % left",
-        if fits { "FITS" } else { "DOES NOT FIT" },
+        "{}: {}{} x {} network, RAM {} of {} B, ROM {} B of {} KB, worst step {:.2} % of the {} s period (mean {:.3} %); tightest margin: {} with {:.1} % left",
+        if margins.fits { "FITS" } else { "DOES NOT FIT" },
+        margins.stack_note,
         n_in,
         c.behaviours,
         ram_used,
@@ -1068,8 +1103,8 @@ fn report(cfg: &FitConfig, m: &Measured, other: Option<&Measured>) -> FitReport 
         cpu_worst_percent,
         c.step_period_s,
         cpu_mean_percent,
-        tightest,
-        tightest_margin_percent
+        margins.tightest,
+        margins.tightest_percent
     );
     FitReport {
         controller: cfg.kind,
@@ -1103,10 +1138,124 @@ fn report(cfg: &FitConfig, m: &Measured, other: Option<&Measured>) -> FitReport 
         rom,
         rom_used,
         eeprom,
-        fits,
-        tightest,
-        tightest_margin_percent,
+        fits: margins.fits,
+        tightest: margins.tightest,
+        tightest_margin_percent: margins.tightest_percent,
         verdict,
+    }
+}
+
+/// Each phase's states per step period (the maximum in µs at `clock_hz`), with the other
+/// controller's and the ratio of the means when both ran.
+fn phase_lines(clock_hz: u32, m: &Measured, other: Option<&Measured>) -> Vec<PhaseLine> {
+    let us = |states: u64| states as f64 / f64::from(clock_hz) * 1e6;
+    m.phases
+        .iter()
+        .map(|(name, v)| {
+            let s = spread_of(v);
+            let o = other.and_then(|o| o.phase(name)).map(spread_of);
+            PhaseLine {
+                phase: name.clone(),
+                states: s,
+                max_us: us(s.max),
+                other: o,
+                ratio: o
+                    .filter(|o| o.mean > 0.0 && s.mean > 0.0)
+                    .map(|o| s.mean / o.mean),
+            }
+        })
+        .collect()
+}
+
+/// The image's ROM: its S-record data, and the configuration block within it when it has one.
+fn rom_lines(fw: &Firmware) -> Vec<MemLine> {
+    let mut rom = vec![MemLine {
+        item: format!("{} (S-record data)", fw.name),
+        addr: 0,
+        bytes: fw.rom_bytes() as u32,
+    }];
+    if fw.has_config_block() {
+        rom.push(MemLine {
+            item: "of which the configuration block".to_string(),
+            addr: emu::board::firmware::CONFIG_BLOCK_ADDR,
+            bytes: emu::board::firmware::CONFIG_BLOCK_BYTES as u32,
+        });
+    }
+    rom
+}
+
+/// The EEPROM traffic of the controller's saves and the lifetime the endurance allows (the
+/// longest save, `save_max` states, measured).
+fn eeprom_line(c: &ControllerConfig, save_max: u64) -> EepromLine {
+    let payload = 2 * c.n_inputs() * c.behaviours;
+    let record = eeprom::persist::RecordLayout::default();
+    let saves_per_hour = 3600.0 / (c.step_period_s * f64::from(c.save_every_steps));
+    let page_writes_per_hour = saves_per_hour / 2.0;
+    EepromLine {
+        bytes_per_save: record.bytes_per_save(payload),
+        pages_per_save: record.pages_per_record(payload),
+        saves_per_hour,
+        page_writes_per_hour,
+        lifetime_hours: ENDURANCE_CYCLES / page_writes_per_hour,
+        save_max_states: save_max,
+    }
+}
+
+/// The margins left in RAM, ROM, the CPU's worst step and the stack's room: the tightest, and
+/// whether all are left.
+struct Margins {
+    fits: bool,
+    tightest: &'static str,
+    tightest_percent: f64,
+    /// The verdict's note on a stack that left its room (empty when it did not).
+    stack_note: String,
+}
+
+impl Margins {
+    fn new(
+        ram_used: u32,
+        rom_used: u32,
+        cpu_worst_percent: f64,
+        stack: Option<&StackLine>,
+    ) -> Margins {
+        let mut margins = vec![
+            (
+                "RAM",
+                100.0 * (1.0 - f64::from(ram_used) / f64::from(RAM_BYTES)),
+            ),
+            (
+                "ROM",
+                100.0 * (1.0 - f64::from(rom_used) / f64::from(ROM_BYTES)),
+            ),
+            ("CPU (worst step)", 100.0 - cpu_worst_percent),
+        ];
+        // The stack's room: what the lowest SP left of it, or how far past it the first access
+        // outside went (then it does not fit, whatever the RAM total says).
+        let mut stack_note = String::new();
+        if let Some(st) = stack {
+            let room = f64::from(st.room_bytes.max(1));
+            let left = match st.overflow_bytes {
+                Some(over) => -f64::from(over),
+                None => st.left_bytes as f64,
+            };
+            margins.push(("stack", 100.0 * left / room));
+            if let Some(text) = &st.overflow {
+                stack_note = format!(
+                    "the stack leaves its room by {} B ({text}); ",
+                    st.overflow_bytes.unwrap_or(0)
+                );
+            }
+        }
+        let (tightest, tightest_percent) = margins
+            .iter()
+            .copied()
+            .fold(("RAM", f64::INFINITY), |a, b| if b.1 < a.1 { b } else { a });
+        Margins {
+            fits: margins.iter().all(|m| m.1 >= 0.0),
+            tightest,
+            tightest_percent,
+            stack_note,
+        }
     }
 }
 

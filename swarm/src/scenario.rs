@@ -346,6 +346,24 @@ pub const ARENA_ETA: f64 = 0.03;
 /// elsewhere).
 pub const ARENA_MU_WALL: f64 = 0.1;
 
+/// `v` within `lo..=hi`, else an error naming `key` and the valid range.
+fn range<T: PartialOrd + std::fmt::Display>(key: &str, v: T, lo: T, hi: T) -> Result<()> {
+    if v >= lo && v <= hi {
+        Ok(())
+    } else {
+        bail!("`{key}` = {v} is out of range: valid is {lo} to {hi}")
+    }
+}
+
+/// `v` finite and within `lo..=hi`, else an error naming `key` and the valid range.
+fn finite(key: &str, v: f64, lo: f64, hi: f64) -> Result<()> {
+    if v.is_finite() && v >= lo && v <= hi {
+        Ok(())
+    } else {
+        bail!("`{key}` = {v} is out of range: valid is {lo} to {hi}")
+    }
+}
+
 impl Scenario {
     /// Paper env. 2: three robots in the 1.8 m square, all four behaviours, T = 10, 0.45 s
     /// steps, 10 000 steps, 5 repeats; η = [`ARENA_ETA`] and the wall friction
@@ -506,20 +524,25 @@ impl Scenario {
     /// # Errors
     /// The first value out of range.
     pub fn check(&self) -> Result<()> {
-        fn range<T: PartialOrd + std::fmt::Display>(key: &str, v: T, lo: T, hi: T) -> Result<()> {
-            if v >= lo && v <= hi {
-                Ok(())
-            } else {
-                bail!("`{key}` = {v} is out of range: valid is {lo} to {hi}")
-            }
+        self.check_name()?;
+        if let Err(e) = emu::board::model::check_sensor_channels(&self.sensors.channels) {
+            bail!("`sensors.channels` = {:?}: {e}", self.sensors.channels);
         }
-        fn finite(key: &str, v: f64, lo: f64, hi: f64) -> Result<()> {
-            if v.is_finite() && v >= lo && v <= hi {
-                Ok(())
-            } else {
-                bail!("`{key}` = {v} is out of range: valid is {lo} to {hi}")
-            }
+        self.check_run_and_learner()?;
+        self.check_timing()?;
+        self.check_world_and_sensors()?;
+        if self.timing.step_period_s < self.world.substep_s {
+            bail!(
+                "`world.substep_s` = {} is longer than the step period {} s",
+                self.world.substep_s,
+                self.timing.step_period_s
+            );
         }
+        self.check_controller()
+    }
+
+    /// The name: short enough to title the figures, and printable.
+    fn check_name(&self) -> Result<()> {
         let name_chars = self.name.chars().count();
         if name_chars > MAX_NAME_CHARS {
             bail!(
@@ -532,9 +555,11 @@ impl Scenario {
                 u32::from(c)
             );
         }
-        if let Err(e) = emu::board::model::check_sensor_channels(&self.sensors.channels) {
-            bail!("`sensors.channels` = {:?}: {e}", self.sensors.channels);
-        }
+        Ok(())
+    }
+
+    /// The run's size (robots, steps, repeats, window) and the learner's settings.
+    fn check_run_and_learner(&self) -> Result<()> {
         range("robots", self.robots, 1, 100_000)?;
         range("steps", self.steps, 1, 10_000_000)?;
         range("repeats", self.repeats, 1, 1000)?;
@@ -549,6 +574,11 @@ impl Scenario {
             nn_q15::MAX_HISTORY,
         )?;
         range("learner.save_every", self.learner.save_every, 1, 1_000_000)?;
+        Ok(())
+    }
+
+    /// The step period (a whole number of ticks) and the clock.
+    fn check_timing(&self) -> Result<()> {
         finite(
             "timing.step_period_s",
             self.timing.step_period_s,
@@ -568,6 +598,11 @@ impl Scenario {
             emu::board::model::CLOCK_MIN_HZ,
             emu::board::model::CLOCK_MAX_HZ,
         )?;
+        Ok(())
+    }
+
+    /// The world's physics and the sensors' noise.
+    fn check_world_and_sensors(&self) -> Result<()> {
         finite(
             "world.top_speed_m_per_s",
             self.world.top_speed_m_per_s,
@@ -614,13 +649,11 @@ impl Scenario {
             0.0,
             1.0,
         )?;
-        if self.timing.step_period_s < self.world.substep_s {
-            bail!(
-                "`world.substep_s` = {} is longer than the step period {} s",
-                self.world.substep_s,
-                self.timing.step_period_s
-            );
-        }
+        Ok(())
+    }
+
+    /// The controller: an image only for the firmware, and robots that exist to run it.
+    fn check_controller(&self) -> Result<()> {
         let c = &self.controller;
         if c.kind == ControllerKind::Model && (c.image.is_some() || c.robots.is_some()) {
             bail!(
