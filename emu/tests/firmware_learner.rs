@@ -1,6 +1,6 @@
 //! The firmware's learner (firmware/learner.c, run on the H8/300H core) against `nn_q15`:
 //! bit-exact step for step (weights, y, O, winner), and the H8 meter's states against the
-//! states the core counts (the calibration of docs/design.md §2.7's cost model, issue 10 item 5).
+//! states the core counts (the calibration of docs/design.md §2.7's cost model).
 
 use emu::board::firmware::Firmware;
 use emu::board::oncore::LearnerOnCore;
@@ -263,7 +263,7 @@ fn mean(v: &[u64]) -> f64 {
     v.iter().sum::<u64>() as f64 / v.len() as f64
 }
 
-/// Issue 10 item 5: over a grid of shapes N 5…256 × M 2…8, the meter's mean states per phase
+/// Over a grid of shapes N 5…256 × M 2…8, the meter's mean states per phase
 /// within ±5 % of the firmware's measured mean on the same inputs, its worst step within ±10 %.
 /// (Today they are equal: the meter follows the firmware's listing block by block; the second
 /// assertion holds that, so that any drift of either side shows.)

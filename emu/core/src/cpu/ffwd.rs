@@ -1,4 +1,4 @@
-//! Exact loop fast-forwarding for [`Cpu::run_until`] (issue 11): a loop whose next iterations
+//! Exact loop fast-forwarding for [`Cpu::run_until`]: a loop whose next iterations
 //! are known without running them is advanced in closed form, to exactly the registers, flags,
 //! clock, instruction count and memory the stepped run would reach at the same instruction
 //! boundary. Nothing here knows a program: the loops are recognised by what they do.

@@ -1,4 +1,4 @@
-//! Idle cycles advanced in closed form (issue 11): a CPU that sleeps, is woken by a periodic
+//! Idle cycles advanced in closed form: a CPU that sleeps, is woken by a periodic
 //! interrupt, runs the handler and a little of the main loop, and sleeps again at the same
 //! place (a tick counter in RAM and a `while (ticks < next) sleep();`) repeats the same cycle
 //! until a counter reaches a threshold. [`Cpu::run_idle`] runs two such cycles, proves from
