@@ -47,8 +47,8 @@ use eeprom::persist::{Persistence, Record, RecordLayout};
 use eeprom::{I2cMaster, MasterTiming};
 use nn_q15::cost::Insn;
 use nn_q15::{
-    Behaviour, DynLearner, H8Meter, InputLayout, Params, Phase, Q15, ShapeError, UpdateKind,
-    ram_items,
+    Behaviour, DynLearner, H8Meter, InputLayout, Params, Phase, Q15, ShapeError, StepOut,
+    UpdateKind, ram_items,
 };
 
 use crate::ram::{RamMap, RamOverflow};
@@ -782,211 +782,30 @@ impl Controller {
         let due = (step + 1).is_multiple_of(u64::from(self.cfg.save_every_steps));
         let tick_period = u64::from(self.tick_counts) * PRESCALE;
         let mut next_tick_at = self.next_tick_at;
-        let (p, out, saved) = {
+        let (p, out, behaviour, saved) = {
             let mut fw = Fw::new(bus, &mut ticks, true);
             fw.tick_period = tick_period;
             fw.next_tick_at = next_tick_at;
-            // The instructions below follow the firmware's listing (`firmware/build.sh
-            // --listing`): main's loop after its due test fell through, robot_step, ad_scan and
-            // motors_set, instruction by instruction, each I/O access at its place. Phases are
-            // counted as the firmware's profile counts them: a routine from its first
-            // instruction to its RTS; the calls belong to the caller (the main loop).
-            let main0 = Mark::new(&fw);
-            // main: NEXT += K (MOV.W @cfg.ticks_per_step:24 ; EXTU.L ; ADD.L ; MOV.L ER2,@next:24) ;
-            // JSR @robot_step. robot_step: SUBS ; PUSH.L ER4 ; MOV.L ER7,ER4 ; ADDS ; MOV.L ER4,ER0 ;
-            // JSR @ad_scan.
-            fw.code(&[
-                Insn::MovBwAbs24,
-                Insn::Reg,
-                Insn::Reg,
-                Insn::MovLAbs24,
-                Insn::JsrAbs24,
-                Insn::Reg,
-                Insn::PushPopL,
-                Insn::Reg,
-                Insn::Reg,
-                Insn::Reg,
-                Insn::JsrAbs24,
-            ]);
-            let mut main_states = main0.done(&fw);
-
-            // 1. ad_scan: one scan of the sensors' group (AN0-AN3 by default), ADF polled, the
-            // scan stopped, the four codes through the du table.
-            let t = Mark::new(&fw);
-            let group_ch = (self.cfg.sensor_channels[0] & 4) | 3;
-            // MOV.B @cfg.channels:24,R2L ; AND.B #4 ; MOV.B R2L,R3L ; OR.B #3,R3L ; OR.B #H'3B,R2L ;
-            // MOV.B R2L,@ADCSR:8.
-            fw.code(&[Insn::MovBwAbs24, Insn::Reg, Insn::Reg, Insn::Reg, Insn::Reg]);
-            fw.write8(ADCSR, ADCSR_ADST | ADCSR_SCAN | ADCSR_CKS | group_ch);
-            // 1: MOV.B @ADCSR:8,R2L ; BGE 1b — 2 + 3 + 4 states a poll, the read ending 5
-            // states in.
-            const POLL_STATES: u64 = 9;
-            const POLL_READ_END: u64 = 5;
-            loop {
-                let v = fw.read8(ADCSR);
-                fw.code(&[Insn::Bcc8]);
-                if v & ADCSR_ADF != 0 {
-                    break;
-                }
-                // Shortcut: every poll whose read ends before the next peripheral event reads
-                // the same; let them pass unread, unless the tick could come meanwhile.
-                if self.cfg.fast_forward
-                    && v & ADCSR_ADF == 0
-                    && let (Some(event), Some(tick)) = (
-                        fw.bus.reads_stable_until(ADCSR).filter(|&e| e != u64::MAX),
-                        fw.next_tick_at,
-                    )
-                {
-                    let now = fw.now();
-                    let skip = event
-                        .saturating_sub(now + POLL_READ_END)
-                        .div_ceil(POLL_STATES);
-                    if skip > 0 && now + skip * POLL_STATES < tick {
-                        fw.idle(skip * POLL_STATES);
-                    }
-                }
-            }
-            // OR.B #H'18,R3L ; MOV.B R3L,@ADCSR:8 (ADF read as 1, written 0; ADST off) ; SUB.B.
-            fw.code(&[Insn::Reg]);
-            fw.write8(ADCSR, ADCSR_SCAN | ADCSR_CKS | group_ch);
-            fw.code(&[Insn::Reg]);
-            let mut p = [0u8; 4];
-            for (pk, &ch) in p.iter_mut().zip(&self.cfg.sensor_channels) {
-                // SUB.L ; MOV.B ; MOV.L ; ADD.L ; MOV.B @(cfg.channels:24,ER2),R2L ; AND.L #3 ;
-                // SHLL.L ; ADD.L #ADDRAH ; MOV.B @ER2,R2L (AN0/AN4 in ADDRA, AN1/AN5 in ADDRB …).
-                fw.code(&[
-                    Insn::Reg,
-                    Insn::Reg,
-                    Insn::Reg,
-                    Insn::Reg,
-                    Insn::MovBwDisp24,
-                    Insn::ImmL,
-                    Insn::Reg,
-                    Insn::ImmL,
-                ]);
-                let code8 = fw.read8(ADDRAH + 2 * u32::from(ch & 3));
-                // EXTU.W ; EXTU.L ; MOV.B @(du_table:24,ER2),R2L ; MOV.B R2L,@ER3 ; ADD.B ;
-                // CMP.B #3 ; BLS.
-                fw.code(&[
-                    Insn::Reg,
-                    Insn::Reg,
-                    Insn::MovBwDisp24,
-                    Insn::MovBwInd,
-                    Insn::Reg,
-                    Insn::Reg,
-                    Insn::Bcc8,
-                ]);
-                *pk = sensors::DU_TABLE[usize::from(code8)];
-            }
-            fw.code(&[Insn::Rts]);
-            phases.adc = t.done(&fw);
-
-            // robot_step: MOV.L ER4,ER0 ; JSR @learner_step.
-            let m = Mark::new(&fw);
-            fw.code(&[Insn::Reg, Insn::JsrAbs24]);
-            main_states += m.done(&fw);
-
-            // 2. The learner, charged phase by phase from its meter (re-derived from the
-            // firmware's learner routines, calls and returns included).
-            let mut meter = H8Meter::new();
-            let out = self.learner.step(&p, &mut meter);
-            for (phase, slot) in [
-                (Phase::Input, &mut phases.input),
-                (Phase::Update, &mut phases.update),
-                (Phase::Forward, &mut phases.forward),
-            ] {
-                let t = Mark::new(&fw);
-                fw.lump(meter.states(phase));
-                *slot = t.done(&fw);
-            }
-
-            // robot_step: MOV.B @cfg.flags:24,R2L ; BTST #1 ; BEQ — and in the random walk the
-            // draw (JSR @xorshift32 … JSR @__mulsi3 …, 332 states from the listing) — then
-            // MOV.B R0L,@behaviour:24 ; JSR @motors_set.
-            let m = Mark::new(&fw);
-            fw.code(&[Insn::MovBwAbs24, Insn::Reg, Insn::Bcc8]);
-            if forced.is_some() {
-                fw.lump(RANDOM_WALK_DRAW_STATES);
-            }
-            fw.code(&[Insn::MovBwAbs24, Insn::JsrAbs24]);
-            main_states += m.done(&fw);
-
-            // 3. motors_set: the behaviour table's row into GRB1, GRB2 and port B.
-            let t = Mark::new(&fw);
-            // EXTU.W ; EXTU.L ; MOV.L ; SHLL.L ; ADD.L ; SHLL.L ; ADD.L #motor_table ;
-            // MOV.W @ER2,R3 ; MOV.W R3,@GRB1:16 ; MOV.W @(2,ER2),R3 ; MOV.W R3,@GRB2:16 ;
-            // MOV.B @(4,ER2),R2L ; MOV.B R2L,@PBDR:8 ; RTS.
-            fw.code(&[
-                Insn::Reg,
-                Insn::Reg,
-                Insn::Reg,
-                Insn::Reg,
-                Insn::Reg,
-                Insn::Reg,
-                Insn::ImmL,
-                Insn::MovBwInd,
-            ]);
+            // The steps below follow the firmware's listing (`firmware/build.sh --listing`):
+            // main's loop after its due test fell through, robot_step, ad_scan and motors_set,
+            // instruction by instruction, each I/O access at its place. Phases are counted as
+            // the firmware's profile counts them: a routine from its first instruction to its
+            // RTS; the calls belong to the caller (the main loop).
+            let ((), mut main_states) = timed(&mut fw, main_calls_ad_scan);
+            let (p, adc) = timed(&mut fw, |fw| self.ad_scan(fw));
+            phases.adc = adc;
+            main_states += timed(&mut fw, robot_step_calls_learner).1;
+            let out = self.learn(&mut fw, &p, &mut phases);
+            main_states += timed(&mut fw, |fw| robot_step_calls_motors_set(fw, forced)).1;
             let behaviour = forced.unwrap_or(out.behaviour);
-            let (left, right, dir) = motor_row(behaviour);
-            fw.write16(ITU1 + GRB, left);
-            fw.code(&[Insn::MovBwAbs16]);
-            fw.write16(ITU2 + GRB, right);
-            fw.code(&[Insn::MovBwAbs16]);
-            fw.write8(PBDR, dir);
-            fw.code(&[Insn::Rts]);
-            phases.motors = t.done(&fw);
-
-            // 4. robot_step: MOV.W @cfg.save_every:24 ; BEQ ; MOV.W @save_count:24 ; ADDS ;
-            // CMP.W ; BCS ; when due SUB.W ; MOV.W R2,@save_count:24 ; JSR @record_save ; BRA,
-            // else MOV.W R2,@save_count:24.
-            let m = Mark::new(&fw);
-            fw.code(&[
-                Insn::MovBwAbs24,
-                Insn::Bcc8,
-                Insn::MovBwAbs24,
-                Insn::Reg,
-                Insn::Reg,
-                Insn::Bcc8,
-            ]);
-            let saved = if due {
-                fw.code(&[Insn::Reg, Insn::MovBwAbs24, Insn::JsrAbs24]);
-                main_states += m.done(&fw);
-                let t = Mark::new(&fw);
-                let s = self.save(&mut fw)?;
-                phases.save = t.done(&fw);
-                let m = Mark::new(&fw);
-                fw.code(&[Insn::Bcc8]);
-                main_states += m.done(&fw);
-                Some(s)
-            } else {
-                fw.code(&[Insn::MovBwAbs24]);
-                main_states += m.done(&fw);
-                None
-            };
-            // robot_step: steps++ (MOV.L @steps:24 ; ADDS ; MOV.L) ; POP.L ER4 ; ADDS ; RTS.
-            // main: BRA ; MOV.L @ticks:24 ; MOV.L @next:24 ; SUB.L ; MOV.L ; BGE (not taken).
-            let m = Mark::new(&fw);
-            fw.code(&[
-                Insn::MovLAbs24,
-                Insn::Reg,
-                Insn::MovLAbs24,
-                Insn::PushPopL,
-                Insn::Reg,
-                Insn::Rts,
-                Insn::Bcc8,
-                Insn::MovLAbs24,
-                Insn::MovLAbs24,
-                Insn::Reg,
-                Insn::Reg,
-                Insn::Bcc8,
-            ]);
-            main_states += m.done(&fw);
+            phases.motors = timed(&mut fw, |fw| motors_set(fw, behaviour)).1;
+            let saved = self.save_when_due(&mut fw, due, &mut main_states, &mut phases)?;
+            main_states += timed(&mut fw, robot_step_returns_to_main).1;
             phases.main = main_states;
             phases.isr = fw.isr_states;
             next_tick_at = fw.next_tick_at;
-            (p, (out, behaviour), saved)
+            (p, out, behaviour, saved)
         };
-        let (out, behaviour) = out;
         self.next_tick_at = next_tick_at;
         self.ticks = ticks;
         self.steps += 1;
@@ -1001,6 +820,137 @@ impl Controller {
             phases,
             saved,
         })
+    }
+
+    /// Step 1, `ad_scan`: one scan of the sensors' group (AN0-AN3 by default), ADF polled, the
+    /// scan stopped, the four codes through the du table. Returns the four sensor values.
+    fn ad_scan<B: ModelBus>(&self, fw: &mut Fw<'_, B>) -> [u8; 4] {
+        let group_ch = (self.cfg.sensor_channels[0] & 4) | 3;
+        // MOV.B @cfg.channels:24,R2L ; AND.B #4 ; MOV.B R2L,R3L ; OR.B #3,R3L ; OR.B #H'3B,R2L ;
+        // MOV.B R2L,@ADCSR:8.
+        fw.code(&[Insn::MovBwAbs24, Insn::Reg, Insn::Reg, Insn::Reg, Insn::Reg]);
+        fw.write8(ADCSR, ADCSR_ADST | ADCSR_SCAN | ADCSR_CKS | group_ch);
+        self.poll_adf(fw);
+        // OR.B #H'18,R3L ; MOV.B R3L,@ADCSR:8 (ADF read as 1, written 0; ADST off) ; SUB.B.
+        fw.code(&[Insn::Reg]);
+        fw.write8(ADCSR, ADCSR_SCAN | ADCSR_CKS | group_ch);
+        fw.code(&[Insn::Reg]);
+        let mut p = [0u8; 4];
+        for (pk, &ch) in p.iter_mut().zip(&self.cfg.sensor_channels) {
+            // SUB.L ; MOV.B ; MOV.L ; ADD.L ; MOV.B @(cfg.channels:24,ER2),R2L ; AND.L #3 ;
+            // SHLL.L ; ADD.L #ADDRAH ; MOV.B @ER2,R2L (AN0/AN4 in ADDRA, AN1/AN5 in ADDRB …).
+            fw.code(&[
+                Insn::Reg,
+                Insn::Reg,
+                Insn::Reg,
+                Insn::Reg,
+                Insn::MovBwDisp24,
+                Insn::ImmL,
+                Insn::Reg,
+                Insn::ImmL,
+            ]);
+            let code8 = fw.read8(ADDRAH + 2 * u32::from(ch & 3));
+            // EXTU.W ; EXTU.L ; MOV.B @(du_table:24,ER2),R2L ; MOV.B R2L,@ER3 ; ADD.B ;
+            // CMP.B #3 ; BLS.
+            fw.code(&[
+                Insn::Reg,
+                Insn::Reg,
+                Insn::MovBwDisp24,
+                Insn::MovBwInd,
+                Insn::Reg,
+                Insn::Reg,
+                Insn::Bcc8,
+            ]);
+            *pk = sensors::DU_TABLE[usize::from(code8)];
+        }
+        fw.code(&[Insn::Rts]);
+        p
+    }
+
+    /// `ad_scan`'s wait for the scan's end: `1: MOV.B @ADCSR:8,R2L ; BGE 1b` until ADF reads 1.
+    fn poll_adf<B: ModelBus>(&self, fw: &mut Fw<'_, B>) {
+        // 2 + 3 + 4 states a poll, the read ending 5 states in.
+        const POLL_STATES: u64 = 9;
+        const POLL_READ_END: u64 = 5;
+        loop {
+            let v = fw.read8(ADCSR);
+            fw.code(&[Insn::Bcc8]);
+            if v & ADCSR_ADF != 0 {
+                break;
+            }
+            // Shortcut: every poll whose read ends before the next peripheral event reads
+            // the same; let them pass unread, unless the tick could come meanwhile.
+            if self.cfg.fast_forward
+                && v & ADCSR_ADF == 0
+                && let (Some(event), Some(tick)) = (
+                    fw.bus.reads_stable_until(ADCSR).filter(|&e| e != u64::MAX),
+                    fw.next_tick_at,
+                )
+            {
+                let now = fw.now();
+                let skip = event
+                    .saturating_sub(now + POLL_READ_END)
+                    .div_ceil(POLL_STATES);
+                if skip > 0 && now + skip * POLL_STATES < tick {
+                    fw.idle(skip * POLL_STATES);
+                }
+            }
+        }
+    }
+
+    /// Step 2, the learner on the sensor values `p`, charged phase by phase (input, update,
+    /// forward) from its meter, re-derived from the firmware's learner routines, calls and
+    /// returns included.
+    fn learn<B: ModelBus>(
+        &mut self,
+        fw: &mut Fw<'_, B>,
+        p: &[u8; 4],
+        phases: &mut PhaseStates,
+    ) -> StepOut {
+        let mut meter = H8Meter::new();
+        let out = self.learner.step(p, &mut meter);
+        for (phase, slot) in [
+            (Phase::Input, &mut phases.input),
+            (Phase::Update, &mut phases.update),
+            (Phase::Forward, &mut phases.forward),
+        ] {
+            *slot = timed(fw, |fw| fw.lump(meter.states(phase))).1;
+        }
+        out
+    }
+
+    /// Step 4, robot_step's save test (MOV.W @cfg.save_every:24 ; BEQ ; MOV.W @save_count:24 ;
+    /// ADDS ; CMP.W ; BCS), and when `due` the record written: SUB.W ;
+    /// MOV.W R2,@save_count:24 ; JSR @record_save ; BRA — else MOV.W R2,@save_count:24.
+    /// robot_step's instructions go to `main_states`, record_save's to `phases.save`.
+    fn save_when_due<B: ModelBus>(
+        &mut self,
+        fw: &mut Fw<'_, B>,
+        due: bool,
+        main_states: &mut u64,
+        phases: &mut PhaseStates,
+    ) -> Result<Option<SaveSummary>, ControllerError> {
+        let m = Mark::new(fw);
+        fw.code(&[
+            Insn::MovBwAbs24,
+            Insn::Bcc8,
+            Insn::MovBwAbs24,
+            Insn::Reg,
+            Insn::Reg,
+            Insn::Bcc8,
+        ]);
+        if !due {
+            fw.code(&[Insn::MovBwAbs24]);
+            *main_states += m.done(fw);
+            return Ok(None);
+        }
+        fw.code(&[Insn::Reg, Insn::MovBwAbs24, Insn::JsrAbs24]);
+        *main_states += m.done(fw);
+        let (summary, save_states) = timed(fw, |fw| self.save(fw));
+        let summary = summary?;
+        phases.save = save_states;
+        *main_states += timed(fw, |fw| fw.code(&[Insn::Bcc8])).1;
+        Ok(Some(summary))
     }
 
     /// Writes the weights as the next A/B record.
@@ -1065,6 +1015,95 @@ impl Mark {
     fn done<B: ModelBus>(&self, fw: &Fw<'_, B>) -> u64 {
         (fw.now() - self.t0) - (fw.isr_states - self.isr0)
     }
+}
+
+/// Runs `phase` on `fw` and returns its result with its states, interrupts excluded (see
+/// [`Mark`]).
+fn timed<'a, B: ModelBus, R>(
+    fw: &mut Fw<'a, B>,
+    phase: impl FnOnce(&mut Fw<'a, B>) -> R,
+) -> (R, u64) {
+    let m = Mark::new(fw);
+    let r = phase(fw);
+    (r, m.done(fw))
+}
+
+/// main: NEXT += K (MOV.W @cfg.ticks_per_step:24 ; EXTU.L ; ADD.L ; MOV.L ER2,@next:24) ;
+/// JSR @robot_step. robot_step: SUBS ; PUSH.L ER4 ; MOV.L ER7,ER4 ; ADDS ; MOV.L ER4,ER0 ;
+/// JSR @ad_scan.
+fn main_calls_ad_scan<B: ModelBus>(fw: &mut Fw<'_, B>) {
+    fw.code(&[
+        Insn::MovBwAbs24,
+        Insn::Reg,
+        Insn::Reg,
+        Insn::MovLAbs24,
+        Insn::JsrAbs24,
+        Insn::Reg,
+        Insn::PushPopL,
+        Insn::Reg,
+        Insn::Reg,
+        Insn::Reg,
+        Insn::JsrAbs24,
+    ]);
+}
+
+/// robot_step after ad_scan: MOV.L ER4,ER0 ; JSR @learner_step.
+fn robot_step_calls_learner<B: ModelBus>(fw: &mut Fw<'_, B>) {
+    fw.code(&[Insn::Reg, Insn::JsrAbs24]);
+}
+
+/// robot_step after the learner: MOV.B @cfg.flags:24,R2L ; BTST #1 ; BEQ — and in the random
+/// walk (a `forced` behaviour) the draw (JSR @xorshift32 … JSR @__mulsi3 …, 332 states from the
+/// listing) — then MOV.B R0L,@behaviour:24 ; JSR @motors_set.
+fn robot_step_calls_motors_set<B: ModelBus>(fw: &mut Fw<'_, B>, forced: Option<Behaviour>) {
+    fw.code(&[Insn::MovBwAbs24, Insn::Reg, Insn::Bcc8]);
+    if forced.is_some() {
+        fw.lump(RANDOM_WALK_DRAW_STATES);
+    }
+    fw.code(&[Insn::MovBwAbs24, Insn::JsrAbs24]);
+}
+
+/// Step 3, `motors_set`: the behaviour table's row into GRB1, GRB2 and port B.
+fn motors_set<B: ModelBus>(fw: &mut Fw<'_, B>, behaviour: Behaviour) {
+    // EXTU.W ; EXTU.L ; MOV.L ; SHLL.L ; ADD.L ; SHLL.L ; ADD.L #motor_table ;
+    // MOV.W @ER2,R3 ; MOV.W R3,@GRB1:16 ; MOV.W @(2,ER2),R3 ; MOV.W R3,@GRB2:16 ;
+    // MOV.B @(4,ER2),R2L ; MOV.B R2L,@PBDR:8 ; RTS.
+    fw.code(&[
+        Insn::Reg,
+        Insn::Reg,
+        Insn::Reg,
+        Insn::Reg,
+        Insn::Reg,
+        Insn::Reg,
+        Insn::ImmL,
+        Insn::MovBwInd,
+    ]);
+    let (left, right, dir) = motor_row(behaviour);
+    fw.write16(ITU1 + GRB, left);
+    fw.code(&[Insn::MovBwAbs16]);
+    fw.write16(ITU2 + GRB, right);
+    fw.code(&[Insn::MovBwAbs16]);
+    fw.write8(PBDR, dir);
+    fw.code(&[Insn::Rts]);
+}
+
+/// robot_step's end: steps++ (MOV.L @steps:24 ; ADDS ; MOV.L) ; POP.L ER4 ; ADDS ; RTS.
+/// Then main: BRA ; MOV.L @ticks:24 ; MOV.L @next:24 ; SUB.L ; MOV.L ; BGE (not taken).
+fn robot_step_returns_to_main<B: ModelBus>(fw: &mut Fw<'_, B>) {
+    fw.code(&[
+        Insn::MovLAbs24,
+        Insn::Reg,
+        Insn::MovLAbs24,
+        Insn::PushPopL,
+        Insn::Reg,
+        Insn::Rts,
+        Insn::Bcc8,
+        Insn::MovLAbs24,
+        Insn::MovLAbs24,
+        Insn::Reg,
+        Insn::Reg,
+        Insn::Bcc8,
+    ]);
 }
 
 /// GRB1, GRB2 and the port-B direction bits for a behaviour (docs/design.md §3.5: forward (v, v),
