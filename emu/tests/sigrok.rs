@@ -105,7 +105,11 @@ fn traced() -> Traced {
     let end = c.run_to_sensing(&mut mcu).unwrap();
     let phases = c.take_phases();
     let trace = mcu.finish_trace().unwrap();
-    let vcd = std::env::temp_dir().join(format!("h8swarm-sigrok-{}.vcd", std::process::id()));
+    // One file per call: the tests run on threads of one process, and each removes its own.
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let vcd =
+        std::env::temp_dir().join(format!("h8swarm-sigrok-{}-{call}.vcd", std::process::id()));
     write_vcd(
         std::fs::File::create(&vcd).unwrap(),
         &trace,
