@@ -335,14 +335,15 @@ pub fn run(a: &RunArgs) -> Result<String> {
     // Every file is written into a staging folder beside `out` and moved into place only
     // when the whole run succeeded; a failure before that leaves `out` as it was.
     let stage = Stage::new(&out)?;
-    let result = run_into(
+    let result = run_into(&RunContext {
         a,
-        &s,
-        images.as_ref(),
-        (&probes, replay.as_ref()),
-        &stage,
-        threads_or_all(a.threads),
-    );
+        s: &s,
+        images: images.as_ref(),
+        probes: &probes,
+        replay: replay.as_ref(),
+        stage: &stage,
+        threads: threads_or_all(a.threads),
+    });
     match result {
         Ok((mut text, names)) => {
             stage.commit(&names).map_err(|e| {
@@ -893,29 +894,34 @@ pub const OUTPUT_FILES: [&str; 9] = [
 /// The probes of one robot, taken by the first run that asks for them.
 type SharedProbes = std::sync::Mutex<Option<swarm::experiment::RobotProbes>>;
 
-/// Runs the experiment, writing its files into `stage`; returns the text to print and the
-/// files written.
-fn run_into(
-    a: &RunArgs,
-    s: &Scenario,
-    images: Option<&swarm::robot::Images>,
-    (probes, replay): (&SharedProbes, Option<&ReplayPlan>),
-    stage: &Stage,
+/// What one `run` works with: its options, its scenario, the robots' images, the probes and
+/// the replay plan, the staging folder its files go into, and its worker threads.
+struct RunContext<'r> {
+    a: &'r RunArgs,
+    s: &'r Scenario,
+    images: Option<&'r swarm::robot::Images>,
+    probes: &'r SharedProbes,
+    replay: Option<&'r ReplayPlan>,
+    stage: &'r Stage,
     threads: usize,
-) -> Result<(String, Vec<String>)> {
-    let (kinds, jobs) = run_jobs(s);
-    let floor = swarm::experiment::arena_of(s)?;
-    let started = Instant::now();
-    let runs = run_all(
+}
+
+/// Runs the experiment, writing its files into the staging folder; returns the text to print
+/// and the files written.
+fn run_into(cx: &RunContext) -> Result<(String, Vec<String>)> {
+    let RunContext {
         a,
         s,
         images,
-        (probes, replay),
+        replay,
         stage,
         threads,
-        &jobs,
-        &floor,
-    )?;
+        ..
+    } = *cx;
+    let (kinds, jobs) = run_jobs(s);
+    let floor = swarm::experiment::arena_of(s)?;
+    let started = Instant::now();
+    let runs = run_all(cx, &jobs, &floor)?;
     let wall_s = started.elapsed().as_secs_f64();
 
     let parts: Vec<PathBuf> = jobs.iter().map(|&(c, r)| rows_path(stage, c, r)).collect();
@@ -1009,19 +1015,22 @@ fn progress_bar(s: &Scenario, runs: usize, threads: usize) -> ProgressBar {
     b
 }
 
-/// Runs every job on `threads` workers, each run writing its rows into the staging folder
+/// Runs every job on the context's workers, each run writing its rows into the staging folder
 /// (and its frames, when the plan records it); the runs' outputs in job order.
-#[allow(clippy::too_many_arguments)]
 fn run_all(
-    a: &RunArgs,
-    s: &Scenario,
-    images: Option<&swarm::robot::Images>,
-    (probes, replay): (&SharedProbes, Option<&ReplayPlan>),
-    stage: &Stage,
-    threads: usize,
+    cx: &RunContext,
     jobs: &[(Condition, u32)],
     floor: &world::Arena,
 ) -> Result<Vec<RunOutput>> {
+    let RunContext {
+        a,
+        s,
+        images,
+        probes,
+        replay,
+        stage,
+        threads,
+    } = *cx;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
