@@ -256,6 +256,71 @@ pub fn drain_into<B: Board>(
     })
 }
 
+/// The trace's line for one step into `line`: the instruction (or the interrupt's entry, the
+/// sleep, the error) at `pc`, the states it took, and the code it ran in when `names` are
+/// known.
+fn trace_line(
+    line: &mut String,
+    cpu: &Cpu,
+    pc: u32,
+    states: u64,
+    event: &Result<Event, CpuError>,
+    names: Option<&dyn CodeNames>,
+) {
+    line.clear();
+    match event {
+        Ok(Event::Executed | Event::Halted) => {
+            let text = format_instr(cpu.last_executed(), pc).replacen('\t', " ", 1);
+            let _ = write!(line, "{pc:06x}: {text:<40} {states:>4} states");
+        }
+        Ok(Event::Interrupt(v)) => {
+            let _ = write!(
+                line,
+                "{pc:06x}: <interrupt vector {v} -> {:06x}> {states:>4} states",
+                cpu.pc()
+            );
+        }
+        Ok(Event::Asleep) => {
+            let _ = write!(line, "{pc:06x}: <asleep> {states:>4} states");
+        }
+        Err(e) => {
+            let _ = write!(line, "{pc:06x}: <error: {e}>");
+        }
+    }
+    if let Some(n) = names {
+        // The code the step ran in: the instruction's, or the handler's for an
+        // interrupt's entry (as the phase signal of a pin trace names it).
+        let at = match event {
+            Ok(Event::Interrupt(_)) => cpu.pc(),
+            _ => pc,
+        };
+        let _ = write!(line, "  {}", phase_name(n, at));
+    }
+    line.push('\n');
+}
+
+/// Tells the phase recorder where the step that began at `t0` left the program: after an
+/// instruction, at its end; after an interrupt's entry, at the instant the interrupt was
+/// taken (within the step).
+fn observe_step<B: Board>(
+    p: &mut PhaseRecorder,
+    cpu: &Cpu,
+    machine: &Mcu<B>,
+    t0: u64,
+    event: &Result<Event, CpuError>,
+) {
+    match event {
+        Ok(Event::Executed) => p.observe(machine.now(), cpu.pc()),
+        Ok(Event::Interrupt(_)) => {
+            let at = machine
+                .trace_last_interrupt()
+                .map_or(t0, |a| a.t.clamp(t0, machine.now()));
+            p.observe(at, cpu.pc());
+        }
+        _ => {}
+    }
+}
+
 /// [`run_mcu`] with every probe: an instruction trace naming the code, the phase signal of a
 /// pin trace, a debugger.
 ///
@@ -301,50 +366,11 @@ pub fn run_mcu_probed<B: Board>(
             None => cpu.step(machine, deadline),
         };
         if let Some(w) = trace.as_deref_mut() {
-            line.clear();
-            let states = machine.now() - t0;
-            match &event {
-                Ok(Event::Executed | Event::Halted) => {
-                    let text = format_instr(cpu.last_executed(), pc).replacen('\t', " ", 1);
-                    let _ = write!(line, "{pc:06x}: {text:<40} {states:>4} states");
-                }
-                Ok(Event::Interrupt(v)) => {
-                    let _ = write!(
-                        line,
-                        "{pc:06x}: <interrupt vector {v} -> {:06x}> {states:>4} states",
-                        cpu.pc()
-                    );
-                }
-                Ok(Event::Asleep) => {
-                    let _ = write!(line, "{pc:06x}: <asleep> {states:>4} states");
-                }
-                Err(e) => {
-                    let _ = write!(line, "{pc:06x}: <error: {e}>");
-                }
-            }
-            if let Some(n) = names {
-                // The code the step ran in: the instruction's, or the handler's for an
-                // interrupt's entry (as the phase signal of a pin trace names it).
-                let at = match &event {
-                    Ok(Event::Interrupt(_)) => cpu.pc(),
-                    _ => pc,
-                };
-                let _ = write!(line, "  {}", phase_name(n, at));
-            }
-            line.push('\n');
+            trace_line(&mut line, cpu, pc, machine.now() - t0, &event, names);
             w.write_all(line.as_bytes())?;
         }
         if let Some(p) = phases.as_deref_mut() {
-            match &event {
-                Ok(Event::Executed) => p.observe(machine.now(), cpu.pc()),
-                Ok(Event::Interrupt(_)) => {
-                    let at = machine
-                        .trace_last_interrupt()
-                        .map_or(t0, |a| a.t.clamp(t0, machine.now()));
-                    p.observe(at, cpu.pc());
-                }
-                _ => {}
-            }
+            observe_step(p, cpu, machine, t0, &event);
         }
         if let Some(v) = vcd.as_deref_mut()
             && (machine.trace_pending() >= crate::vcd::DRAIN_CHANGES
