@@ -7,6 +7,7 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use seeding::Purpose;
 
+use crate::cells::Cells;
 use crate::clock::Clock;
 use crate::datasheet::{
     ARRAY_BYTES, CONTROL_CODE, ENDURANCE_CYCLES, F_CLK_MAX_HZ, FIRST_DEVICE_ADDRESS,
@@ -344,8 +345,7 @@ pub struct Eeprom24lc256 {
     t_wc_min_states: u64,
     t_wc_max_states: u64,
     output_delay_states: u64,
-    memory: Vec<u8>,
-    stuck: Vec<u8>,
+    cells: Cells,
     writes: Vec<u32>,
     powered: bool,
     now: u64,
@@ -439,8 +439,7 @@ impl Eeprom24lc256 {
             t_wc_min_states,
             t_wc_max_states,
             output_delay_states,
-            memory: vec![ERASED_BYTE; ARRAY_BYTES],
-            stuck: vec![0; ARRAY_BYTES],
+            cells: Cells::fresh(),
             writes: vec![0; PAGES],
             powered: true,
             now: 0,
@@ -553,7 +552,7 @@ impl Eeprom24lc256 {
     /// Number of bits that wear has stuck, over the whole array.
     #[must_use]
     pub fn stuck_bit_count(&self) -> u64 {
-        self.stuck.iter().map(|m| u64::from(m.count_ones())).sum()
+        self.cells.stuck_bit_count()
     }
 
     /// Timing violations seen (the first 64 in detail).
@@ -609,7 +608,7 @@ impl Eeprom24lc256 {
         }
         check_range(u32::from(address), buf.len())?;
         let a = usize::from(address);
-        buf.copy_from_slice(&self.memory[a..a + buf.len()]);
+        self.cells.read(a, buf);
         Ok(())
     }
 
@@ -627,8 +626,7 @@ impl Eeprom24lc256 {
         check_range(u32::from(address), data.len())?;
         let a = usize::from(address);
         for (i, &d) in data.iter().enumerate() {
-            let m = self.stuck[a + i];
-            self.memory[a + i] = (d & !m) | (self.memory[a + i] & m);
+            self.cells.write(a + i, d);
         }
         Ok(())
     }
@@ -696,8 +694,7 @@ impl Eeprom24lc256 {
             let base = usize::from(cycle.info.page) * PAGE_BYTES;
             for (i, &d) in cycle.data.iter().enumerate() {
                 if cycle.loaded & (1 << i) != 0 {
-                    let m = self.stuck[base + i];
-                    self.memory[base + i] = (d & !m) | (self.memory[base + i] & m);
+                    self.cells.write(base + i, d);
                 }
             }
             self.last_cycle = Some(cycle.info);
@@ -710,7 +707,7 @@ impl Eeprom24lc256 {
     fn corrupt_page(&mut self, cycle: &WriteCycle) {
         let base = usize::from(cycle.info.page) * PAGE_BYTES;
         for i in 0..PAGE_BYTES {
-            let old = self.memory[base + i];
+            let old = self.cells.byte(base + i);
             let new = if cycle.loaded & (1 << i) != 0 {
                 cycle.data[i]
             } else {
@@ -733,8 +730,7 @@ impl Eeprom24lc256 {
                     v
                 }
             };
-            let m = self.stuck[base + i];
-            self.memory[base + i] = (value & !m) | (old & m);
+            self.cells.write(base + i, value);
         }
     }
 
@@ -749,7 +745,7 @@ impl Eeprom24lc256 {
         for i in 0..PAGE_BYTES {
             for b in 0..8 {
                 if self.rng_wear.random_bool(p) {
-                    self.stuck[base + i] |= 1 << b;
+                    self.cells.stick(base + i, b);
                 }
             }
         }
@@ -804,7 +800,7 @@ impl Eeprom24lc256 {
     }
 
     fn load_tx(&mut self) {
-        self.tx = self.memory[usize::from(self.pointer)];
+        self.tx = self.cells.byte(usize::from(self.pointer));
         self.pointer = (self.pointer + 1) & MAX_MEMORY_ADDRESS;
         self.stats.bytes_sent += 1;
     }

@@ -79,6 +79,7 @@
 #![deny(missing_docs)]
 
 pub mod bus;
+mod cells;
 pub mod clock;
 pub mod crc;
 pub mod datasheet;

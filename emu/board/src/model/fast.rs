@@ -18,6 +18,8 @@
 //! polls, the chips' contents — is the pin-level one; the controller's tests compare the two run
 //! for run. Only the bus's edge counter differs (it counts pin-level traffic).
 
+use std::sync::{Arc, Mutex, OnceLock};
+
 use eeprom::persist::{COMMIT_BYTES, Persistence, Record, SaveReport, chip_for_sequence};
 use eeprom::{I2cMaster, I2cPins, MasterTiming};
 
@@ -198,12 +200,13 @@ fn events(rec: &Recorder, kind: Event) -> Vec<u64> {
 }
 
 /// The recorded pieces of a save for one master timing; page writes are recorded when first
-/// needed (a save uses at most three sizes).
-#[derive(Clone, Debug, PartialEq, Eq)]
+/// needed (a save uses at most three sizes). The pieces are a function of the timing alone, so
+/// every controller with the same timing shares one set ([`SaveTimelines::shared`]).
+#[derive(Debug)]
 pub struct SaveTimelines {
     timing: MasterTiming,
-    /// Page writes of 1..=64 bytes (index n − 1), once recorded.
-    page_writes: Vec<Option<Piece>>,
+    /// Page writes of 1..=64 bytes (index n − 1), recorded by the first save that needs one.
+    page_writes: [OnceLock<Piece>; PAGE],
     /// ACK polling's opening START.
     poll_start: Piece,
     /// An unanswered poll: the control byte and the repeated START of the next.
@@ -216,7 +219,28 @@ fn master_error(e: eeprom::MasterError) -> ControllerError {
     ControllerError::Persist(e.into())
 }
 
+/// The timelines recorded so far in this process, one set per master timing.
+static SHARED: Mutex<Vec<Arc<SaveTimelines>>> = Mutex::new(Vec::new());
+
 impl SaveTimelines {
+    /// The process's one set of timelines for `timing`, recorded on first use.
+    ///
+    /// # Errors
+    /// Only if the master refuses its own recording (it cannot).
+    pub fn shared(timing: MasterTiming) -> Result<Arc<SaveTimelines>, ControllerError> {
+        // A panic elsewhere while the lock was held leaves the list as it was: every entry in
+        // it is complete, so a poisoned lock's contents are still good.
+        let mut sets = SHARED
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        if let Some(t) = sets.iter().find(|t| t.timing == timing) {
+            return Ok(Arc::clone(t));
+        }
+        let t = Arc::new(Self::record(timing)?);
+        sets.push(Arc::clone(&t));
+        Ok(t)
+    }
+
     /// Records the polling pieces by running the master with `timing` against recording pins.
     ///
     /// # Errors
@@ -235,29 +259,31 @@ impl SaveTimelines {
         };
         Ok(Self {
             timing,
-            page_writes: vec![None; PAGE],
+            page_writes: std::array::from_fn(|_| OnceLock::new()),
             poll_start: piece(&rec, 0, s0),
             poll_unanswered: piece(&rec, s1, s2),
             poll_answered: piece(&rec, s2, rec.t),
         })
     }
 
-    /// Records the page write of `n` bytes (1 ..= 64) unless it is recorded already.
-    fn ensure_page_write(&mut self, n: usize) -> Result<(), ControllerError> {
-        let slot = self.page_writes.get_mut(n.wrapping_sub(1)).ok_or_else(|| {
+    /// The page write of `n` bytes (1 ..= 64), recorded unless it is already.
+    fn page_write(&self, n: usize) -> Result<&Piece, ControllerError> {
+        let slot = self.page_writes.get(n.wrapping_sub(1)).ok_or_else(|| {
             master_error(eeprom::MasterError::EmptyTransfer {
                 operation: "page write",
             })
         })?;
-        if slot.is_none() {
-            let mut rec = Recorder::new(&[]);
-            I2cMaster::new(&mut rec, self.timing)
-                .page_write(0x50, 0, &[0; PAGE][..n])
-                .map_err(master_error)?;
-            let total = rec.t;
-            *slot = Some(piece(&rec, 0, total));
+        if let Some(p) = slot.get() {
+            return Ok(p);
         }
-        Ok(())
+        let mut rec = Recorder::new(&[]);
+        I2cMaster::new(&mut rec, self.timing)
+            .page_write(0x50, 0, &[0; PAGE][..n])
+            .map_err(master_error)?;
+        let total = rec.t;
+        // Two threads may record the same piece at once; the recordings are equal, and the
+        // first one stored is the one every save uses.
+        Ok(slot.get_or_init(|| piece(&rec, 0, total)))
     }
 }
 
@@ -349,7 +375,7 @@ fn chip_answers<B: ModelBus>(
 pub fn save<B: ModelBus>(
     fw: &mut Fw<'_, B>,
     persistence: &Persistence,
-    timelines: &mut SaveTimelines,
+    timelines: &SaveTimelines,
     isr_states: u64,
     record: &Record,
 ) -> Result<SaveReport, ControllerError> {
@@ -363,12 +389,7 @@ pub fn save<B: ModelBus>(
         .map(|(k, c)| (layout.body_addr() + (k * PAGE) as u16, c))
         .chain(std::iter::once((layout.slot_addr(), &commit[..])));
     for (address, data) in pages {
-        timelines.ensure_page_write(data.len())?;
-        let Some(piece) = &timelines.page_writes[data.len() - 1] else {
-            return Err(master_error(eeprom::MasterError::EmptyTransfer {
-                operation: "page write",
-            }));
-        };
+        let piece = timelines.page_write(data.len())?;
         let mut failure: Option<ControllerError> = None;
         walk(fw, piece, |fw, m, t| {
             if failure.is_some() {

@@ -356,7 +356,7 @@ pub struct Controller {
     /// The next tick's instant, once known (see [`ControllerConfig::fast_forward`]).
     next_tick_at: Option<u64>,
     /// The fast save's timelines (with [`ControllerConfig::fast_forward`]).
-    timelines: Option<SaveTimelines>,
+    timelines: Option<std::sync::Arc<SaveTimelines>>,
     /// States of one tick interrupt (entry to RTE), as measured on this MCU.
     isr_states: Option<u64>,
 }
@@ -494,7 +494,7 @@ impl Controller {
             booted: false,
             next_tick_at: None,
             timelines: if cfg_fast {
-                Some(SaveTimelines::record(timing)?)
+                Some(SaveTimelines::shared(timing)?)
             } else {
                 None
             },
@@ -973,7 +973,7 @@ impl Controller {
         fw.lump(page_gather_states(body.len()));
         fw.lump(SAVE_COMMIT_STATES + crc16_states(&commit[..commit.len() - 2], 1));
         let report = if let (Some(timelines), Some(isr), true) = (
-            self.timelines.as_mut(),
+            self.timelines.as_deref(),
             self.isr_states,
             fw.bus.eeprom_bus().is_some(),
         ) {
