@@ -3,11 +3,12 @@
 //! it, and running the image on the core.
 
 use std::path::Path;
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use crate::symbols::{SymbolError, SymbolTable};
+use h8_3052f::flash::Flash;
 use h8_3052f::gdb::{DebugAction, Debugger};
-use h8_3052f::mcu::{LoadError, Mcu};
+use h8_3052f::mcu::{LoadError, Mcu, check_image};
 use h8_3052f::pins::Board;
 use h8_3052f::trace::{CodeNames, PhaseRecorder};
 use h8300h::cpu::{Cpu, CpuError, Event, StackFault, StackGuard, StackGuardMode, StackRoom};
@@ -281,6 +282,10 @@ pub struct Firmware {
     pub symbols: SymbolTable,
     /// Where it came from (for messages).
     pub name: String,
+    /// The flash with the image programmed, built at the first install and shared by every
+    /// MCU the firmware is installed on, with the image it was built from (so that a changed
+    /// `image` is never served from an old flash).
+    flash: OnceLock<(SrecImage, Result<Flash, LoadError>)>,
 }
 
 /// The committed robot firmware (`firmware/robot.mot`, `firmware/robot.sym`), built into the
@@ -305,6 +310,7 @@ impl Firmware {
                 source,
             })?,
             name: name.to_string(),
+            flash: OnceLock::new(),
         })
     }
 
@@ -337,6 +343,7 @@ impl Firmware {
             image: image_parsed,
             symbols: table,
             name: image.display().to_string(),
+            flash: OnceLock::new(),
         })
     }
 
@@ -358,7 +365,26 @@ impl Firmware {
             })?,
             symbols: SymbolTable::default(),
             name: image.display().to_string(),
+            flash: OnceLock::new(),
         })
+    }
+
+    /// Programs the image into `mcu`'s flash: an MCU without flash takes the firmware's shared
+    /// flash (its pages copied only where the MCU writes), one with flash has the image
+    /// programmed over it.
+    fn program<B: Board>(&self, mcu: &mut Mcu<B>) -> Result<(), LoadError> {
+        if mcu.has_flash() {
+            return mcu.load_image(&self.image);
+        }
+        let (source, flash) = self.flash.get_or_init(|| {
+            let built = check_image(&self.image).map(|()| Flash::with_image(&self.image));
+            (self.image.clone(), built)
+        });
+        if *source != self.image {
+            return mcu.load_image(&self.image);
+        }
+        mcu.load_flash(flash.as_ref().map_err(Clone::clone)?);
+        Ok(())
     }
 
     /// Bytes of the image (its ROM).
@@ -411,7 +437,7 @@ impl Firmware {
         cpu: &mut Cpu,
         block: Option<&ConfigBlock>,
     ) -> Result<(), FirmwareError> {
-        mcu.load_image(&self.image)?;
+        self.program(mcu)?;
         if let Some(b) = block {
             mcu.poke(CONFIG_BLOCK_ADDR, &b.encode());
         }

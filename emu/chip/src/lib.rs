@@ -9,6 +9,7 @@
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 
+pub mod flash;
 pub mod gdb;
 pub mod machine;
 pub mod mcu;

@@ -50,6 +50,8 @@ use std::cell::Cell;
 
 use eeprom::{DeviceConfig, EepromError, I2cBus, PowerCutOutcome};
 
+use crate::flash::Flash;
+
 use crate::periph::Peripheral;
 use crate::periph::adc::{ADCR, ADDRA, Adc};
 use crate::periph::intc::Intc;
@@ -154,7 +156,7 @@ pub struct TiocaOutput {
 pub struct Mcu<B: Board> {
     now: u64,
     clock_hz: u32,
-    rom: Option<Box<[u8; ROM_BYTES as usize]>>,
+    rom: Option<Flash>,
     /// The flash's [`FastPathHints::code_generation`] token: a fresh one at every write to the flash.
     rom_generation: u64,
     ram: Option<Box<[u8; RAM_BYTES as usize]>>,
@@ -410,9 +412,9 @@ impl<B: Board> Mcu<B> {
 
     /// The flash, for writing (loading an image, poking): every caller may change it, so the
     /// CPU's decoded copies of it are out of date from here on.
-    fn rom_mut(&mut self) -> &mut [u8; ROM_BYTES as usize] {
+    fn rom_mut(&mut self) -> &mut Flash {
         self.rom_generation = fresh_code_generation();
-        self.rom.get_or_insert_with(new_erased_flash)
+        self.rom.get_or_insert_with(Flash::erased)
     }
 
     #[inline]
@@ -426,24 +428,16 @@ impl<B: Board> Mcu<B> {
     /// # Errors
     /// [`LoadError`] if the image has data outside the flash or none at all.
     pub fn load_image(&mut self, image: &SrecImage) -> Result<(), LoadError> {
-        if image.data_len() == 0 {
-            return Err(LoadError::Empty);
-        }
-        for c in &image.chunks {
-            let end = u64::from(c.address) + c.data.len() as u64;
-            if end > u64::from(ROM_BYTES) {
-                return Err(LoadError::OutsideFlash {
-                    address: c.address,
-                    len: c.data.len(),
-                });
-            }
-        }
-        let rom = self.rom_mut();
-        for c in &image.chunks {
-            let a = c.address as usize;
-            rom[a..a + c.data.len()].copy_from_slice(&c.data);
-        }
+        check_image(image)?;
+        self.rom_mut().program(image);
         Ok(())
+    }
+
+    /// Makes `flash` this MCU's flash (its pages shared with `flash` until this MCU writes one):
+    /// what [`Mcu::load_image`] gives for the image `flash` holds, without a copy per MCU.
+    pub fn load_flash(&mut self, flash: &Flash) {
+        self.rom_generation = fresh_code_generation();
+        self.rom = Some(flash.clone());
     }
 
     /// Writes bytes into flash or RAM directly (no bus cycle, no time): test set-up. Bytes at
@@ -452,7 +446,7 @@ impl<B: Board> Mcu<B> {
         for (i, &b) in bytes.iter().enumerate() {
             let a = addr.wrapping_add(i as u32) & ADDRESS_MASK;
             match Area::of(a) {
-                Area::Rom => self.rom_mut()[a as usize & ROM_INDEX_MASK] = b,
+                Area::Rom => self.rom_mut().set(a as usize & ROM_INDEX_MASK, b),
                 Area::Ram => self.ram_mut()[(a - RAM_START) as usize & RAM_INDEX_MASK] = b,
                 _ => {}
             }
@@ -473,7 +467,7 @@ impl<B: Board> Mcu<B> {
     #[inline]
     fn rom_byte(&self, a: u32) -> u8 {
         match &self.rom {
-            Some(r) => r[a as usize & ROM_INDEX_MASK],
+            Some(r) => r.byte(a as usize & ROM_INDEX_MASK),
             None => 0xff,
         }
     }
@@ -806,14 +800,24 @@ impl<B: Board> Mcu<B> {
     }
 }
 
-#[cold]
-fn new_erased_flash() -> Box<[u8; ROM_BYTES as usize]> {
-    let v = vec![0xffu8; ROM_BYTES as usize].into_boxed_slice();
-    match v.try_into() {
-        Ok(b) => b,
-        // The length is ROM_BYTES by construction.
-        Err(_) => unreachable!(),
+/// Checks that `image` has data and that all of it lies inside the flash.
+///
+/// # Errors
+/// [`LoadError`] if the image has data outside the flash or none at all.
+pub fn check_image(image: &SrecImage) -> Result<(), LoadError> {
+    if image.data_len() == 0 {
+        return Err(LoadError::Empty);
     }
+    for c in &image.chunks {
+        let end = u64::from(c.address) + c.data.len() as u64;
+        if end > u64::from(ROM_BYTES) {
+            return Err(LoadError::OutsideFlash {
+                address: c.address,
+                len: c.data.len(),
+            });
+        }
+    }
+    Ok(())
 }
 
 #[cold]
@@ -849,7 +853,7 @@ impl<B: Board> Bus for Mcu<B> {
                 match &self.rom {
                     Some(r) => {
                         let i = a as usize & ROM_INDEX_MASK & !1;
-                        u16::from_be_bytes([r[i], r[i | 1]])
+                        u16::from_be_bytes([r.byte(i), r.byte(i | 1)])
                     }
                     None => 0xffff,
                 }
