@@ -880,3 +880,71 @@ pub fn read_bounded(path: &Path, limit: u64) -> std::io::Result<Vec<u8>> {
     }
     Ok(bytes)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use h8_3052f::mcu::McuConfig;
+    use h8_3052f::pins::NullBoard;
+
+    fn flash_bytes(mcu: &Mcu<NullBoard>, image: &SrecImage) -> Vec<u8> {
+        image
+            .chunks
+            .iter()
+            .flat_map(|c| (0..c.data.len()).map(move |i| c.address + i as u32))
+            .map(|a| mcu.peek(a))
+            .collect()
+    }
+
+    /// MCUs sharing the firmware's flash read the image, each keeps its own configuration
+    /// block, and a firmware whose image changed after its flash was built installs the new
+    /// image, not the old flash.
+    #[test]
+    fn shared_flash_reads_as_the_image_each_mcu_wrote() {
+        let fw = Firmware::robot().expect("the robot firmware");
+        let want: Vec<u8> = fw
+            .image
+            .chunks
+            .iter()
+            .flat_map(|c| c.data.clone())
+            .collect();
+        let mut mcus = Vec::new();
+        for seed in [1u32, 2] {
+            let mut mcu = Mcu::new(McuConfig::default(), NullBoard).expect("mcu");
+            let mut cpu = Cpu::new();
+            let block = ConfigBlock {
+                seed,
+                ..ConfigBlock::ARENA
+            };
+            fw.install(&mut mcu, &mut cpu, Some(&block))
+                .expect("install");
+            mcus.push(mcu);
+        }
+        let blocks: Vec<Vec<u8>> = mcus
+            .iter()
+            .map(|m| {
+                let len = ConfigBlock::ARENA.encode().len() as u32;
+                (0..len).map(|i| m.peek(CONFIG_BLOCK_ADDR + i)).collect()
+            })
+            .collect();
+        assert_ne!(blocks[0], blocks[1], "each MCU keeps its own block");
+        let mut plain = Mcu::new(McuConfig::default(), NullBoard).expect("mcu");
+        plain.load_image(&fw.image).expect("load");
+        for m in &mcus {
+            for a in (0..0x2000u32).filter(|a| {
+                !(CONFIG_BLOCK_ADDR..CONFIG_BLOCK_ADDR + CONFIG_BLOCK_BYTES as u32).contains(a)
+            }) {
+                assert_eq!(m.peek(a), plain.peek(a), "flash byte at H'{a:06X}");
+            }
+        }
+        let mut changed = fw.clone();
+        changed.image.chunks[0].data[0] ^= 0xFF;
+        let mut mcu = Mcu::new(McuConfig::default(), NullBoard).expect("mcu");
+        changed
+            .install(&mut mcu, &mut Cpu::new(), None)
+            .expect("install");
+        let got = flash_bytes(&mcu, &changed.image);
+        assert_eq!(got[0], want[0] ^ 0xFF);
+        assert_eq!(&got[1..], &want[1..]);
+    }
+}
