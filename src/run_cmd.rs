@@ -406,12 +406,13 @@ fn unconfigured_image(
     Ok(Some(image))
 }
 
-/// Host memory one robot takes while its run is going (measured: the peak resident size of
-/// `h8swarm run --robots 1000` less that of 100 robots, per robot, with model robots 148 KB,
-/// with firmware robots 855 KB: the MCU's flash image, RAM and decode cache), with a margin.
-pub const MODEL_ROBOT_BYTES: u64 = 192 << 10;
+/// Host memory one robot takes while its run is going, with a margin (measured, see
+/// docs/performance.md: the peak resident size of `h8swarm run --robots 10000` less that of
+/// 1 000 robots, per robot: model robots 16 KB; firmware robots 208 KB, most of it the CPU's
+/// decode caches, the flash being shared).
+pub const MODEL_ROBOT_BYTES: u64 = 24 << 10;
 /// See [`MODEL_ROBOT_BYTES`].
-pub const FIRMWARE_ROBOT_BYTES: u64 = 1 << 20;
+pub const FIRMWARE_ROBOT_BYTES: u64 = 256 << 10;
 /// Host memory per window of a run kept for the summary and the plots (the window's sums;
 /// the steps themselves are written as they complete and not kept), with a margin.
 pub const WINDOW_BYTES: u64 = 128;
@@ -1166,11 +1167,23 @@ fn render_header(
     );
     let _ = writeln!(
         t,
-        "wall {:.1} s on {threads} threads: {:.0} robot-steps/s, {:.0}x real time per run",
+        "wall {:.1} s on {}: {:.0} robot-steps/s, {}x real time per run",
         wall_s,
+        plural(u32::try_from(threads).unwrap_or(u32::MAX), "thread"),
         robot_steps / wall_s,
-        simulated_s / wall_s
+        factor_text(simulated_s / wall_s)
     );
+}
+
+/// A real-time factor with two significant digits below 10 (0.28, 3.1), whole above.
+fn factor_text(f: f64) -> String {
+    if f >= 10.0 {
+        format!("{f:.0}")
+    } else if f >= 1.0 {
+        format!("{f:.1}")
+    } else {
+        format!("{f:.2}")
+    }
 }
 
 /// One line per robot that died and per stack warning, run by run.

@@ -1195,7 +1195,7 @@ fn runs_under_a_memory_limit_finish_or_are_refused_never_aborted() {
     let n = Cell::new(0u32);
     let command = prop_oneof![
         3 => (
-            prop_oneof![Just("1"), Just("3"), Just("10"), Just("20000"), Just("100000")],
+            prop_oneof![Just("1"), Just("3"), Just("10"), Just("2000"), Just("1000000")],
             prop_oneof![Just("5"), Just("20")],
             prop_oneof![Just("1"), Just("2"), Just("16")],
             prop_oneof![Just("model"), Just("firmware")],

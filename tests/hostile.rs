@@ -706,14 +706,16 @@ fn emu_streams_its_vcd_and_runs_under_a_small_memory_limit() {
 
 #[test]
 fn a_run_too_big_for_the_process_limit_is_refused_not_aborted() {
-    // 100 000 robots under a 4 GB address-space limit: status 2 and a message naming the
-    // limit, at once.
+    // 100 000 firmware robots under a 4 GB address-space limit: status 2 and a message naming
+    // the limit, at once.
     let root = fresh("rlimit-run");
     let o = under_rlimit(
         4_000_000,
         &[
             "run",
             "arena",
+            "--controller",
+            "firmware",
             "--robots",
             "100000",
             "--threads",
@@ -730,6 +732,33 @@ fn a_run_too_big_for_the_process_limit_is_refused_not_aborted() {
         "{err}"
     );
     assert_eq!(err.lines().count(), 1, "{err}");
+}
+
+#[test]
+fn a_hundred_thousand_model_robots_run_in_4_gb() {
+    // The memory target: 100 000 model robots fit a 4 GB address-space limit and run.
+    let root = fresh("rlimit-100k");
+    let o = under_rlimit(
+        4_000_000,
+        &[
+            "run",
+            "scenarios/arena-learning-only.toml",
+            "--robots",
+            "100000",
+            "--steps",
+            "1",
+            "--repeats",
+            "1",
+            "--threads",
+            "2",
+            "--out",
+            s(&root.join("o")),
+        ],
+    );
+    let err = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    assert!(root.join("o").join("metrics.csv").is_file());
+    let _ = std::fs::remove_dir_all(&root);
 }
 
 #[test]
