@@ -308,18 +308,28 @@ fn temp_dir(name: &str) -> std::path::PathBuf {
 
 #[test]
 fn run_writes_identical_metrics_for_any_thread_count() {
-    for robots in ["3", "80"] {
+    // Runs spread over the threads (3 and 80 robots, six runs), and one run of 1 200 robots
+    // whose stages run in parallel inside it.
+    let learning_only = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/scenarios/arena-learning-only.toml"
+    );
+    for (scenario, robots, repeats) in [
+        ("arena", "3", "2"),
+        ("arena", "80", "2"),
+        (learning_only, "1200", "1"),
+    ] {
         let mut files = Vec::new();
         for threads in ["1", "2"] {
             let dir = temp_dir(&format!("det-{robots}-{threads}"));
             let out = h8swarm(
                 &[
                     "run",
-                    "arena",
+                    scenario,
                     "--steps",
                     "40",
                     "--repeats",
-                    "2",
+                    repeats,
                     "--robots",
                     robots,
                     "--threads",

@@ -1160,20 +1160,47 @@ fn advance_world(
             world.advance_states(len);
         }
         let dt_s = len as f64 / clock_hz;
-        for (i, d) in drives.iter_mut().enumerate() {
-            d.add_substep(dt_s, world.wheel_mean_speeds(i)?, world.wheel_forces(i)?);
-        }
-        for (i, m) in meters.iter_mut().enumerate() {
-            let pressed = world.bumpers(i)?.iter().any(|&b| b);
+        let w: &World = world;
+        // Each robot's meters take its own wheels and bumpers: robot by robot, in any order
+        // (the sums are of integers).
+        let drive = |(i, d): (usize, &mut crate::energy::DriveMeter)| -> Result<()> {
+            d.add_substep(dt_s, w.wheel_mean_speeds(i)?, w.wheel_forces(i)?);
+            Ok(())
+        };
+        let meter = |(i, (m, c)): (usize, (&mut ContactMeter, &mut u64))| -> Result<(u64, u64)> {
+            let pressed = w.bumpers(i)?.iter().any(|&b| b);
             m.sample(pressed, len);
-            let (c, t) = m.take();
-            per_robot[i] += c;
-            collisions += c;
-            contact += t;
-        }
+            let (n, t) = m.take();
+            *c += n;
+            Ok((n, t))
+        };
+        let add = |a: (u64, u64), b: (u64, u64)| (a.0 + b.0, a.1 + b.1);
+        let (c, t) = if par && meters.len() > PAR_ROBOTS {
+            drives.par_iter_mut().enumerate().try_for_each(drive)?;
+            meters
+                .par_iter_mut()
+                .zip(per_robot.par_iter_mut())
+                .enumerate()
+                .map(meter)
+                .try_reduce(|| (0, 0), |a, b| Ok(add(a, b)))?
+        } else {
+            drives.iter_mut().enumerate().try_for_each(drive)?;
+            meters
+                .iter_mut()
+                .zip(per_robot.iter_mut())
+                .enumerate()
+                .map(meter)
+                .try_fold((0, 0), |a, b| b.map(|b| add(a, b)))?
+        };
+        collisions += c;
+        contact += t;
     }
     Ok((collisions, contact))
 }
+
+/// Robots above which the per-robot meters of a sub-step run on rayon's pool (below, the
+/// pool's overhead is larger than the work).
+const PAR_ROBOTS: usize = 256;
 
 /// Records the tracked robots' centres in the early and/or late paths, and their outlines at a
 /// snapshot instant.

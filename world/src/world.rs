@@ -17,6 +17,7 @@ use crate::pipeline::islands::Islands;
 use crate::pipeline::narrow_phase::{NarrowPhase, Probe, speculative_m};
 use crate::pipeline::par::PAR_CHUNK;
 use crate::pipeline::sensing::{Bumpers, MountRays, RayScene};
+use crate::pipeline::solver::IslandBody;
 use crate::pipeline::warm_start::WarmStart;
 use crate::placement::{place_corridor, place_open, stream_rng, unit};
 
@@ -152,6 +153,8 @@ pub struct World {
     broad: BroadPhase,
     narrow: NarrowPhase,
     islands: Islands,
+    /// The solved robots' motions of the latest sub-step (scratch, in `narrow.active`'s order).
+    solved: Vec<SolvedMotion>,
     warm: WarmStart,
     corrections: Corrections,
     /// Lag coefficients for the two sub-step lengths of the latest plan (length in states).
@@ -274,6 +277,7 @@ impl World {
             broad,
             narrow: NarrowPhase::new(n),
             islands: Islands::new(n),
+            solved: Vec::new(),
             warm: WarmStart::new(n),
             corrections: Corrections::new(n),
             lag_cache: [(max_substep_states, lag), (0, lag)],
@@ -672,6 +676,7 @@ impl World {
             &self.motion,
             &mut self.wheel_imp,
             self.substeps,
+            parallel,
         );
         self.islands.build(
             &mut self.narrow.active,
@@ -688,27 +693,33 @@ impl World {
             self.params.solver_iterations,
             parallel,
         );
-        let inv_h = 1.0 / h;
-        for (k, &i) in self.narrow.active.iter().enumerate() {
-            let b = &self.islands.bodies[k];
-            self.vel[i as usize] = b.vel;
-            self.wheel_imp[i as usize] = b.wheel_imp;
-            // The wheels' rolling impulses over the sub-step, as mean forces.
-            self.wheel_force[i as usize] = [b.wheel_imp[0] * inv_h, b.wheel_imp[2] * inv_h];
+        // Each solved robot's motion over the sub-step (per robot, so on any thread), then
+        // written back in order.
+        let pose = &self.pose;
+        let moved = |(&i, b): (&u32, &IslandBody)| solved_motion(pose[i as usize], b, h);
+        self.solved.clear();
+        if parallel && self.narrow.active.len() > PAR_CHUNK {
+            self.narrow
+                .active
+                .par_iter()
+                .zip(self.islands.bodies.par_iter())
+                .map(moved)
+                .collect_into_vec(&mut self.solved);
+        } else {
+            self.solved.extend(
+                self.narrow
+                    .active
+                    .iter()
+                    .zip(self.islands.bodies.iter())
+                    .map(moved),
+            );
         }
-        for &i in &self.narrow.active {
+        for (&i, m) in self.narrow.active.iter().zip(&self.solved) {
             let i = i as usize;
-            let p = &mut self.pose[i];
-            let v = &mut self.vel[i];
-            let along = v[0] * p.c + v[1] * p.s;
-            let across = -v[0] * p.s + v[1] * p.c;
-            let (dx, dy, c, s) = arc_step_twist(p.c, p.s, along, across, v[2], h);
-            p.x += dx;
-            p.y += dy;
-            p.c = c;
-            p.s = s;
-            v[0] = along * c - across * s;
-            v[1] = along * s + across * c;
+            self.pose[i] = m.pose;
+            self.vel[i] = m.vel;
+            self.wheel_imp[i] = m.wheel_imp;
+            self.wheel_force[i] = m.wheel_force;
         }
     }
 
@@ -869,6 +880,39 @@ pub fn coefficient_of_variation(values: &[f64]) -> Option<f64> {
     }
     let var = values.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / n;
     Some(var.sqrt() / mean)
+}
+
+/// A solved robot after its sub-step: pose, velocity, wheel impulses and the wheels' mean
+/// forces.
+#[derive(Debug, Clone, Copy)]
+struct SolvedMotion {
+    pose: BodyPose,
+    vel: [f64; 3],
+    wheel_imp: [f64; 4],
+    wheel_force: [f64; 2],
+}
+
+/// Where a robot that started the sub-step of `h` seconds at `p` ends with its solved
+/// velocity (the exact motion of a constant twist), and what its wheels did.
+fn solved_motion(mut p: BodyPose, b: &IslandBody, h: f64) -> SolvedMotion {
+    let inv_h = 1.0 / h;
+    let mut v = b.vel;
+    let along = v[0] * p.c + v[1] * p.s;
+    let across = -v[0] * p.s + v[1] * p.c;
+    let (dx, dy, c, s) = arc_step_twist(p.c, p.s, along, across, v[2], h);
+    p.x += dx;
+    p.y += dy;
+    p.c = c;
+    p.s = s;
+    v[0] = along * c - across * s;
+    v[1] = along * s + across * c;
+    SolvedMotion {
+        pose: p,
+        vel: v,
+        wheel_imp: b.wheel_imp,
+        // The wheels' rolling impulses over the sub-step, as mean forces.
+        wheel_force: [b.wheel_imp[0] * inv_h, b.wheel_imp[2] * inv_h],
+    }
 }
 
 fn check_robot_count(n: usize) -> Result<(), WorldError> {

@@ -1,8 +1,11 @@
 //! The warm start: a solve starts from the impulses the previous sub-step's solve ended with,
 //! for the same contacts and wheels, so that a steady push converges in a sweep or two.
 
+use rayon::prelude::*;
+
 use crate::motor::MODE_DRIVE;
 use crate::pipeline::drive::Motion;
+use crate::pipeline::par::PAR_CHUNK;
 use crate::pipeline::solver::{Contact, WALL};
 
 /// The share of the previous sub-step's impulses a solve starts from: all of them, so that a
@@ -44,6 +47,7 @@ impl WarmStart {
         motion: &[Motion],
         wheel_imp: &mut [[f64; 4]],
         substep: u64,
+        parallel: bool,
     ) {
         let driven = |i: u32| {
             i != WALL
@@ -53,20 +57,30 @@ impl WarmStart {
                     .zip(motion[i as usize].target)
                     .any(|(&m, t)| m == MODE_DRIVE && t != 0.0)
         };
-        for ct in contacts.iter_mut() {
+        let kept = &self.kept;
+        let warm = |ct: &mut Contact| {
             // A contact between robots whose motors do not drive starts from nothing (a
             // braked robot against a wall is statically indeterminate, see WARM_START).
             if !driven(ct.a) && !driven(ct.b) {
-                continue;
+                return;
             }
-            if let Ok(k) = self.kept.binary_search_by(|w| w.0.cmp(&ct.id()))
-                && self.kept[k].1 == ct.count
+            if let Ok(k) = kept.binary_search_by(|w| w.0.cmp(&ct.id()))
+                && kept[k].1 == ct.count
             {
-                for (p, [ln, lt]) in ct.pts.iter_mut().zip(self.kept[k].2) {
+                for (p, [ln, lt]) in ct.pts.iter_mut().zip(kept[k].2) {
                     p.ln = WARM_START * ln;
                     p.lt = WARM_START * lt;
                 }
             }
+        };
+        // Each contact looks up its own impulses: on any thread, the same result.
+        if parallel && contacts.len() > PAR_CHUNK {
+            contacts
+                .par_iter_mut()
+                .with_min_len(PAR_CHUNK / 4)
+                .for_each(warm);
+        } else {
+            contacts.iter_mut().for_each(warm);
         }
         for &i in active {
             let i = i as usize;

@@ -1059,9 +1059,10 @@ fn same_seed_gives_identical_state_after_10000_substeps() {
 
 #[test]
 fn thread_count_does_not_change_the_result() {
-    // 1 500 robots: three parallel chunks; dense enough (3× paper density) for contacts.
-    let n = 1500;
-    let side = Arena::scaled_square(n).unwrap().width_m() / 3f64.sqrt();
+    // 3 000 robots: six parallel chunks; dense enough (6× paper density) for contacts in
+    // chunks too.
+    let n = 3000;
+    let side = Arena::scaled_square(n).unwrap().width_m() / 6f64.sqrt();
     let arena = Arena::rectangle(side, side).unwrap();
     let mk = || World::new(arena, WorldParams::default(), n, 77).unwrap();
     let mut seq = mk();
@@ -1070,6 +1071,14 @@ fn thread_count_does_not_change_the_result() {
     assert!(
         (0..seq.robot_count()).any(|i| seq.bumpers.bits(i) != 0),
         "some contacts happened"
+    );
+    // Enough robots in contact that the solved robots' stages run in parallel chunks.
+    let st = seq.solver_stats();
+    assert!(
+        st.active_robot_substeps > st.substeps * PAR_CHUNK as u64,
+        "{} solved robot-sub-steps in {} sub-steps",
+        st.active_robot_substeps,
+        st.substeps
     );
     for threads in [1, 2, 3, 4] {
         let pool = rayon::ThreadPoolBuilder::new()
