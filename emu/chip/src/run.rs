@@ -373,38 +373,23 @@ pub fn run_mcu_probed<B: Board>(
             observe_step(p, cpu, machine, t0, &event);
         }
         if let Some(v) = vcd.as_deref_mut()
-            && (machine.trace_pending() >= crate::vcd::DRAIN_CHANGES
-                || phases
-                    .as_deref()
-                    .is_some_and(|p| p.pending() >= crate::vcd::DRAIN_CHANGES)
-                || machine.now() - drained_at >= crate::vcd::DRAIN_SLICE_STATES)
+            && drain_due(machine, phases.as_deref(), drained_at)
         {
             drain_into(v, machine, phases.as_deref_mut())?;
             drained_at = machine.now();
         }
-        match event {
-            Ok(Event::Executed) => {}
-            Ok(Event::Interrupt(_)) => interrupts += 1,
-            Ok(Event::Halted) => {
-                break Outcome::Halted {
-                    exit_status: cpu.er(0) as u8,
-                };
-            }
-            Ok(Event::Asleep) => {
-                if deadline == u64::MAX {
-                    break Outcome::SleptForever { pc: cpu.pc() };
-                }
-                break Outcome::MaxStates;
-            }
-            Err(mut e) => {
-                if let Some(d) = debugger.as_deref_mut() {
-                    d.report_error(cpu, machine);
-                }
-                if let (CpuError::StackOverflow(f), Some(n)) = (&mut e, names) {
-                    f.function = n.name_at(f.pc).map(str::to_string);
-                }
-                break Outcome::Error(e);
-            }
+        if let Ok(Event::Interrupt(_)) = event {
+            interrupts += 1;
+        }
+        if let Some(end) = ended_by(
+            event,
+            cpu,
+            machine,
+            deadline,
+            debugger.as_deref_mut(),
+            names,
+        ) {
+            break end;
         }
         if machine.sci().has_output() {
             console.write_all(machine.sci().output())?;
@@ -426,6 +411,65 @@ pub fn run_mcu_probed<B: Board>(
     if let Some(w) = trace {
         w.flush()?;
     }
+    Ok(report(
+        cpu,
+        machine,
+        outcome,
+        names,
+        start_instructions,
+        interrupts,
+    ))
+}
+
+/// Whether the pin trace's or the phases' changes are due to be written to the VCD (see
+/// [`Probes::vcd`]), the last write having been at `drained_at`.
+fn drain_due<B: Board>(machine: &Mcu<B>, phases: Option<&PhaseRecorder>, drained_at: u64) -> bool {
+    machine.trace_pending() >= crate::vcd::DRAIN_CHANGES
+        || phases.is_some_and(|p| p.pending() >= crate::vcd::DRAIN_CHANGES)
+        || machine.now() - drained_at >= crate::vcd::DRAIN_SLICE_STATES
+}
+
+/// How the step whose result is `event` ended the run, or `None` when the run goes on. An
+/// error is reported to the debugger, and a stack overflow names its function when `names`
+/// are known.
+fn ended_by<B: Board>(
+    event: Result<Event, CpuError>,
+    cpu: &mut Cpu,
+    machine: &mut Mcu<B>,
+    deadline: u64,
+    debugger: Option<&mut crate::gdb::Debugger>,
+    names: Option<&dyn CodeNames>,
+) -> Option<Outcome> {
+    match event {
+        Ok(Event::Executed | Event::Interrupt(_)) => None,
+        Ok(Event::Halted) => Some(Outcome::Halted {
+            exit_status: cpu.er(0) as u8,
+        }),
+        Ok(Event::Asleep) if deadline == u64::MAX => Some(Outcome::SleptForever { pc: cpu.pc() }),
+        Ok(Event::Asleep) => Some(Outcome::MaxStates),
+        Err(mut e) => {
+            if let Some(d) = debugger {
+                d.report_error(cpu, machine);
+            }
+            if let (CpuError::StackOverflow(f), Some(n)) = (&mut e, names) {
+                f.function = n.name_at(f.pc).map(str::to_string);
+            }
+            Some(Outcome::Error(e))
+        }
+    }
+}
+
+/// The report of a run that ended with `outcome`: the stack guard's fault (named when `names`
+/// are known; an overflow that stopped the run is in the outcome) and the statistics since
+/// `start_instructions`.
+fn report<B: Board>(
+    cpu: &Cpu,
+    machine: &Mcu<B>,
+    outcome: Outcome,
+    names: Option<&dyn CodeNames>,
+    start_instructions: u64,
+    interrupts: u64,
+) -> RunReport {
     let states = machine.now();
     let stack_fault = match &outcome {
         Outcome::Error(CpuError::StackOverflow(_)) => None,
@@ -435,7 +479,7 @@ pub fn run_mcu_probed<B: Board>(
             f
         }),
     };
-    Ok(RunReport {
+    RunReport {
         stack_fault,
         outcome,
         stats: RunStats {
@@ -445,5 +489,5 @@ pub fn run_mcu_probed<B: Board>(
             interrupts,
             console_bytes: machine.sci().bytes_sent(),
         },
-    })
+    }
 }
