@@ -378,18 +378,19 @@ pub fn run_mcu_probed<B: Board>(
             drain_into(v, machine, phases.as_deref_mut())?;
             drained_at = machine.now();
         }
-        if let Ok(Event::Interrupt(_)) = event {
-            interrupts += 1;
-        }
-        if let Some(end) = ended_by(
-            event,
-            cpu,
-            machine,
-            deadline,
-            debugger.as_deref_mut(),
-            names,
-        ) {
-            break end;
+        match event {
+            Ok(Event::Executed) => {}
+            Ok(Event::Interrupt(_)) => interrupts += 1,
+            Ok(Event::Halted) => {
+                break Outcome::Halted {
+                    exit_status: cpu.er(0) as u8,
+                };
+            }
+            Ok(Event::Asleep) if deadline == u64::MAX => {
+                break Outcome::SleptForever { pc: cpu.pc() };
+            }
+            Ok(Event::Asleep) => break Outcome::MaxStates,
+            Err(e) => break stopped_by(e, cpu, machine, debugger.as_deref_mut(), names),
         }
         if machine.sci().has_output() {
             console.write_all(machine.sci().output())?;
@@ -429,34 +430,23 @@ fn drain_due<B: Board>(machine: &Mcu<B>, phases: Option<&PhaseRecorder>, drained
         || machine.now() - drained_at >= crate::vcd::DRAIN_SLICE_STATES
 }
 
-/// How the step whose result is `event` ended the run, or `None` when the run goes on. An
-/// error is reported to the debugger, and a stack overflow names its function when `names`
-/// are known.
-fn ended_by<B: Board>(
-    event: Result<Event, CpuError>,
+/// The outcome of a run the core stopped with error `e`: the error is reported to the
+/// debugger, and a stack overflow names its function when `names` are known.
+#[cold]
+fn stopped_by<B: Board>(
+    mut e: CpuError,
     cpu: &mut Cpu,
     machine: &mut Mcu<B>,
-    deadline: u64,
     debugger: Option<&mut crate::gdb::Debugger>,
     names: Option<&dyn CodeNames>,
-) -> Option<Outcome> {
-    match event {
-        Ok(Event::Executed | Event::Interrupt(_)) => None,
-        Ok(Event::Halted) => Some(Outcome::Halted {
-            exit_status: cpu.er(0) as u8,
-        }),
-        Ok(Event::Asleep) if deadline == u64::MAX => Some(Outcome::SleptForever { pc: cpu.pc() }),
-        Ok(Event::Asleep) => Some(Outcome::MaxStates),
-        Err(mut e) => {
-            if let Some(d) = debugger {
-                d.report_error(cpu, machine);
-            }
-            if let (CpuError::StackOverflow(f), Some(n)) = (&mut e, names) {
-                f.function = n.name_at(f.pc).map(str::to_string);
-            }
-            Some(Outcome::Error(e))
-        }
+) -> Outcome {
+    if let Some(d) = debugger {
+        d.report_error(cpu, machine);
     }
+    if let (CpuError::StackOverflow(f), Some(n)) = (&mut e, names) {
+        f.function = n.name_at(f.pc).map(str::to_string);
+    }
+    Outcome::Error(e)
 }
 
 /// The report of a run that ended with `outcome`: the stack guard's fault (named when `names`
