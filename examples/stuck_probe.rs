@@ -9,6 +9,7 @@
 //!
 //!     cargo run --release --example stuck_probe [arena|corridor|FILE.toml] [REPEATS] [SEED]
 
+use nn_q15::DynLearner;
 use swarm::collisions::StuckDetector;
 use swarm::experiment::Swarm;
 use swarm::robot::{Brain, Condition};
@@ -78,6 +79,159 @@ struct Sample {
     bumpers: [bool; 4],
 }
 
+/// What one condition's runs gathered.
+#[derive(Default)]
+struct Gathered {
+    stuck: Tally,
+    moving: Tally,
+    /// Stuck spells that ended in the last window.
+    spells_ended: u64,
+    /// Stuck spells lasting to the end.
+    spells_to_end: u64,
+    /// The behaviour that ended each of `spells_ended`.
+    ended_by: [u64; 4],
+    /// Every stuck spell of the whole run: its length in steps (counted from the step the
+    /// detector first flags it) and whether it ended before the run did.
+    spells: Vec<(u32, bool)>,
+}
+
+/// What a learner senses and chooses: its four proximities p (du), the winning behaviour, and
+/// the winner's margin over the runner-up in the outputs O.
+fn choice(l: &DynLearner) -> ([i16; 4], usize, i32) {
+    let x = l.inputs();
+    let p: [i16; 4] = std::array::from_fn(|k| i16::from(x[k].to_bits()) + 128);
+    let o: Vec<i32> = l.outputs().iter().map(|v| i32::from(v.to_bits())).collect();
+    let mut win = 0;
+    for (j, &v) in o.iter().enumerate() {
+        if v > o[win] {
+            win = j;
+        }
+    }
+    let second = o
+        .iter()
+        .enumerate()
+        .filter(|&(j, _)| j != win)
+        .map(|(_, &v)| v)
+        .max()
+        .unwrap_or(o[win]);
+    (p, win, o[win] - second)
+}
+
+/// Runs repeat `repeat` of `condition` and adds its robot-steps to `g`.
+fn run_repeat(
+    s: &Scenario,
+    condition: Condition,
+    repeat: u32,
+    last_from: u32,
+    g: &mut Gathered,
+) -> anyhow::Result<()> {
+    let threshold = s.learner.threshold;
+    let mut sw = Swarm::new(s, condition, repeat, false, None)?;
+    let n = s.robots;
+    let mut det = vec![StuckDetector::default(); n];
+    let mut was_stuck = vec![false; n];
+    let mut xy: Vec<(f64, f64)> = (0..n)
+        .map(|i| {
+            let p = sw.world().pose(i).unwrap();
+            (p.x_m, p.y_m)
+        })
+        .collect();
+    let mut d_prev = vec![None::<i16>; n];
+    let mut prev_win = vec![0usize; n];
+    let mut since = vec![0u32; n];
+    for step in 0..s.steps {
+        sw.step()?;
+        for i in 0..n {
+            let pose = sw.world().pose(i)?;
+            let moved = (pose.x_m - xy[i].0).hypot(pose.y_m - xy[i].1);
+            xy[i] = (pose.x_m, pose.y_m);
+            let speeds = sw.world().wheel_speeds(i)?;
+            let is_stuck = det[i].record(moved, speeds.iter().any(|&v| v != 0.0));
+            let bumpers = sw.world().bumpers(i)?;
+            let Some(robot) = sw.robot_mut(i) else {
+                continue;
+            };
+            let Brain::Model(c) = &robot.brain else {
+                anyhow::bail!("the probe reads model robots only");
+            };
+            let (p, win, margin) = choice(c.learner());
+            let d: i16 = p.iter().sum();
+            let e = d_prev[i].map_or(0, |dp| d - dp);
+            d_prev[i] = Some(d);
+            if step >= last_from {
+                let sample = Sample {
+                    win,
+                    p,
+                    e,
+                    margin,
+                    bumpers,
+                };
+                if is_stuck {
+                    g.stuck.add(&sample, threshold);
+                } else {
+                    g.moving.add(&sample, threshold);
+                }
+                if was_stuck[i] && !is_stuck {
+                    // The move that ended it ran the behaviour chosen a step ago.
+                    g.spells_ended += 1;
+                    g.ended_by[prev_win[i]] += 1;
+                }
+            }
+            if is_stuck && !was_stuck[i] {
+                since[i] = step;
+            }
+            if was_stuck[i] && !is_stuck {
+                g.spells.push((step - since[i], true));
+            }
+            was_stuck[i] = is_stuck;
+            prev_win[i] = win;
+        }
+    }
+    g.spells_to_end += was_stuck.iter().filter(|&&b| b).count() as u64;
+    for i in 0..n {
+        if was_stuck[i] {
+            g.spells.push((s.steps - since[i], false));
+        }
+    }
+    Ok(())
+}
+
+/// Prints what `condition`'s runs gathered, `runs` the robot-runs (repeats × robots).
+fn print_gathered(condition: Condition, runs: usize, g: &Gathered) {
+    g.stuck.print(&format!("{}, stuck", condition.name()));
+    g.moving.print(&format!("{}, moving", condition.name()));
+    println!(
+        "|  {}: stuck spells ended in the last window {} (the behaviour then: fwd {}, back {}, left {}, right {}); robots stuck at the end {} of {} |",
+        condition.name(),
+        g.spells_ended,
+        g.ended_by[0],
+        g.ended_by[1],
+        g.ended_by[2],
+        g.ended_by[3],
+        g.spells_to_end,
+        runs
+    );
+    let spells = &g.spells;
+    let mut ended: Vec<u32> = spells.iter().filter(|x| x.1).map(|x| x.0).collect();
+    ended.sort_unstable();
+    let total: u64 = spells.iter().map(|x| u64::from(x.0)).sum();
+    let long: u64 = spells
+        .iter()
+        .filter(|x| x.0 >= 1000)
+        .map(|x| u64::from(x.0))
+        .sum();
+    println!(
+        "|  {}: whole run: {} stuck spells, {} ended (median length {} steps, 90th percentile {}), {} lasted to the end; spells of 1 000 steps or more hold {:.0} % of the stuck robot-steps |",
+        condition.name(),
+        spells.len(),
+        ended.len(),
+        ended.get(ended.len() / 2).copied().unwrap_or(0),
+        ended.get(ended.len() * 9 / 10).copied().unwrap_or(0),
+        spells.len() - ended.len(),
+        100.0 * long as f64 / total.max(1) as f64
+    );
+}
+
 fn main() -> anyhow::Result<()> {
     let mut args = std::env::args().skip(1);
     let mut s = Scenario::load(&args.next().unwrap_or_else(|| "arena".into()))?;
@@ -96,126 +250,11 @@ fn main() -> anyhow::Result<()> {
     );
     println!("|---|---:|---|---|---|---:|---|");
     for condition in [Condition::Learning, Condition::LearningOff] {
-        let (mut stuck, mut moving) = (Tally::default(), Tally::default());
-        // Stuck spells in the last window: ended by which behaviour, or lasting to the end.
-        let (mut spells_ended, mut spells_to_end, mut ended_by) = (0u64, 0u64, [0u64; 4]);
-        // Every stuck spell of the whole run: its length in steps (counted from the step the
-        // detector first flags it) and whether it ended before the run did.
-        let mut spells: Vec<(u32, bool)> = Vec::new();
+        let mut g = Gathered::default();
         for repeat in 0..repeats {
-            let mut sw = Swarm::new(&s, condition, repeat, false, None)?;
-            let n = s.robots;
-            let mut det = vec![StuckDetector::default(); n];
-            let mut was_stuck = vec![false; n];
-            let mut xy: Vec<(f64, f64)> = (0..n)
-                .map(|i| {
-                    let p = sw.world().pose(i).unwrap();
-                    (p.x_m, p.y_m)
-                })
-                .collect();
-            let mut d_prev = vec![None::<i16>; n];
-            let mut prev_win = vec![0usize; n];
-            let mut since = vec![0u32; n];
-            for step in 0..s.steps {
-                sw.step()?;
-                for i in 0..n {
-                    let pose = sw.world().pose(i)?;
-                    let moved = (pose.x_m - xy[i].0).hypot(pose.y_m - xy[i].1);
-                    xy[i] = (pose.x_m, pose.y_m);
-                    let speeds = sw.world().wheel_speeds(i)?;
-                    let is_stuck = det[i].record(moved, speeds.iter().any(|&v| v != 0.0));
-                    let bumpers = sw.world().bumpers(i)?;
-                    let Some(robot) = sw.robot_mut(i) else {
-                        continue;
-                    };
-                    let Brain::Model(c) = &robot.brain else {
-                        anyhow::bail!("the probe reads model robots only");
-                    };
-                    let l = c.learner();
-                    let x = l.inputs();
-                    let p: [i16; 4] = std::array::from_fn(|k| i16::from(x[k].to_bits()) + 128);
-                    let d: i16 = p.iter().sum();
-                    let e = d_prev[i].map_or(0, |dp| d - dp);
-                    d_prev[i] = Some(d);
-                    let o: Vec<i32> = l.outputs().iter().map(|v| i32::from(v.to_bits())).collect();
-                    let mut win = 0;
-                    for (j, &v) in o.iter().enumerate() {
-                        if v > o[win] {
-                            win = j;
-                        }
-                    }
-                    let second = o
-                        .iter()
-                        .enumerate()
-                        .filter(|&(j, _)| j != win)
-                        .map(|(_, &v)| v)
-                        .max()
-                        .unwrap_or(o[win]);
-                    if step >= last_from {
-                        let sample = Sample {
-                            win,
-                            p,
-                            e,
-                            margin: o[win] - second,
-                            bumpers,
-                        };
-                        if is_stuck {
-                            stuck.add(&sample, threshold);
-                        } else {
-                            moving.add(&sample, threshold);
-                        }
-                        if was_stuck[i] && !is_stuck {
-                            // The move that ended it ran the behaviour chosen a step ago.
-                            spells_ended += 1;
-                            ended_by[prev_win[i]] += 1;
-                        }
-                    }
-                    if is_stuck && !was_stuck[i] {
-                        since[i] = step;
-                    }
-                    if was_stuck[i] && !is_stuck {
-                        spells.push((step - since[i], true));
-                    }
-                    was_stuck[i] = is_stuck;
-                    prev_win[i] = win;
-                }
-            }
-            spells_to_end += was_stuck.iter().filter(|&&b| b).count() as u64;
-            for i in 0..n {
-                if was_stuck[i] {
-                    spells.push((s.steps - since[i], false));
-                }
-            }
+            run_repeat(&s, condition, repeat, last_from, &mut g)?;
         }
-        stuck.print(&format!("{}, stuck", condition.name()));
-        moving.print(&format!("{}, moving", condition.name()));
-        println!(
-            "|  {}: stuck spells ended in the last window {spells_ended} (the behaviour then: fwd {}, back {}, left {}, right {}); robots stuck at the end {spells_to_end} of {} |",
-            condition.name(),
-            ended_by[0],
-            ended_by[1],
-            ended_by[2],
-            ended_by[3],
-            repeats as usize * s.robots
-        );
-        let mut ended: Vec<u32> = spells.iter().filter(|x| x.1).map(|x| x.0).collect();
-        ended.sort_unstable();
-        let total: u64 = spells.iter().map(|x| u64::from(x.0)).sum();
-        let long: u64 = spells
-            .iter()
-            .filter(|x| x.0 >= 1000)
-            .map(|x| u64::from(x.0))
-            .sum();
-        println!(
-            "|  {}: whole run: {} stuck spells, {} ended (median length {} steps, 90th percentile {}), {} lasted to the end; spells of 1 000 steps or more hold {:.0} % of the stuck robot-steps |",
-            condition.name(),
-            spells.len(),
-            ended.len(),
-            ended.get(ended.len() / 2).copied().unwrap_or(0),
-            ended.get(ended.len() * 9 / 10).copied().unwrap_or(0),
-            spells.len() - ended.len(),
-            100.0 * long as f64 / total.max(1) as f64
-        );
+        print_gathered(condition, repeats as usize * s.robots, &g);
     }
     Ok(())
 }

@@ -823,6 +823,50 @@ enum SessionEnd {
     Lost(String),
 }
 
+/// The three ends of a session's connection `conn`: the framer reading the client's bytes,
+/// the framing's own writer (acknowledgements and error answers), and the stub's writer; the
+/// two writers share the last packet sent.
+fn ends_of(conn: TcpStream) -> io::Result<(Framer, Wire, Wire)> {
+    let framer = Framer::new(conn.try_clone()?);
+    let last = std::rc::Rc::new(std::cell::RefCell::new(Vec::new()));
+    let wire_out = Wire {
+        stream: conn.try_clone()?,
+        pending: Vec::new(),
+        last: std::rc::Rc::clone(&last),
+    };
+    let wire = Wire {
+        stream: conn,
+        pending: Vec::new(),
+        last: std::rc::Rc::clone(&last),
+    };
+    Ok((framer, wire_out, wire))
+}
+
+/// The bytes of `incoming` for the stub's state machine, or `None` when the framing has
+/// answered it itself on `wire_out`: a packet the stub cannot take (an error), a bad checksum
+/// (`-`), a packet too long (an error), a `-` from the client (the last packet again).
+fn for_stub(incoming: Incoming, wire_out: &mut Wire) -> io::Result<Option<Vec<u8>>> {
+    match incoming {
+        Incoming::Packet(p) => {
+            let p = normalised(p);
+            if stub_takes(&p) {
+                return Ok(Some(p));
+            }
+            wire_out.answer(E_MALFORMED)?;
+        }
+        Incoming::Interrupt => return Ok(Some(vec![0x03])),
+        Incoming::BadChecksum => wire_out.send_raw(b"-")?,
+        Incoming::TooLong => wire_out.answer(E_TOO_LONG)?,
+        Incoming::Nack => {
+            let again = wire_out.last.borrow().clone();
+            if !again.is_empty() {
+                wire_out.send_raw(&again)?;
+            }
+        }
+    }
+    Ok(None)
+}
+
 /// Runs the stub on `conn` until the session ends: packets are framed here (bounded, bad
 /// checksums answered with `-`, packets the stub cannot take answered with an error) and fed
 /// to `gdbstub`'s state machine; while the program runs, its stop reports and the client's
@@ -830,24 +874,9 @@ enum SessionEnd {
 fn serve(conn: TcpStream, target: &mut RemoteTarget) -> SessionEnd {
     use gdbstub::stub::state_machine::GdbStubStateMachine as Sm;
     let lost = |e: &dyn std::fmt::Display| SessionEnd::Lost(e.to_string());
-    let reader = match conn.try_clone() {
-        Ok(r) => r,
+    let (mut framer, mut wire_out, wire) = match ends_of(conn) {
+        Ok(ends) => ends,
         Err(e) => return lost(&e),
-    };
-    let mut framer = Framer::new(reader);
-    let last = std::rc::Rc::new(std::cell::RefCell::new(Vec::new()));
-    let mut wire_out = match conn.try_clone() {
-        Ok(w) => Wire {
-            stream: w,
-            pending: Vec::new(),
-            last: std::rc::Rc::clone(&last),
-        },
-        Err(e) => return lost(&e),
-    };
-    let wire = Wire {
-        stream: conn,
-        pending: Vec::new(),
-        last: std::rc::Rc::clone(&last),
     };
     let stub = match GdbStub::<RemoteTarget, Wire>::builder(wire)
         .packet_buffer_size(MAX_PACKET_BYTES)
@@ -911,39 +940,10 @@ fn serve(conn: TcpStream, target: &mut RemoteTarget) -> SessionEnd {
                 }
             }
         };
-        let bytes = match incoming {
-            Incoming::Packet(p) => {
-                let p = normalised(p);
-                if !stub_takes(&p) {
-                    if let Err(e) = wire_out.answer(E_MALFORMED) {
-                        return lost(&e);
-                    }
-                    continue;
-                }
-                p
-            }
-            Incoming::Interrupt => vec![0x03],
-            Incoming::BadChecksum => {
-                if let Err(e) = wire_out.send_raw(b"-") {
-                    return lost(&e);
-                }
-                continue;
-            }
-            Incoming::TooLong => {
-                if let Err(e) = wire_out.answer(E_TOO_LONG) {
-                    return lost(&e);
-                }
-                continue;
-            }
-            Incoming::Nack => {
-                let again = last.borrow().clone();
-                if !again.is_empty()
-                    && let Err(e) = wire_out.send_raw(&again)
-                {
-                    return lost(&e);
-                }
-                continue;
-            }
+        let bytes = match for_stub(incoming, &mut wire_out) {
+            Ok(Some(bytes)) => bytes,
+            Ok(None) => continue,
+            Err(e) => return lost(&e),
         };
         for b in bytes {
             let next = match sm {

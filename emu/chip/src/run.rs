@@ -373,11 +373,7 @@ pub fn run_mcu_probed<B: Board>(
             observe_step(p, cpu, machine, t0, &event);
         }
         if let Some(v) = vcd.as_deref_mut()
-            && (machine.trace_pending() >= crate::vcd::DRAIN_CHANGES
-                || phases
-                    .as_deref()
-                    .is_some_and(|p| p.pending() >= crate::vcd::DRAIN_CHANGES)
-                || machine.now() - drained_at >= crate::vcd::DRAIN_SLICE_STATES)
+            && drain_due(machine, phases.as_deref(), drained_at)
         {
             drain_into(v, machine, phases.as_deref_mut())?;
             drained_at = machine.now();
@@ -390,21 +386,11 @@ pub fn run_mcu_probed<B: Board>(
                     exit_status: cpu.er(0) as u8,
                 };
             }
-            Ok(Event::Asleep) => {
-                if deadline == u64::MAX {
-                    break Outcome::SleptForever { pc: cpu.pc() };
-                }
-                break Outcome::MaxStates;
+            Ok(Event::Asleep) if deadline == u64::MAX => {
+                break Outcome::SleptForever { pc: cpu.pc() };
             }
-            Err(mut e) => {
-                if let Some(d) = debugger.as_deref_mut() {
-                    d.report_error(cpu, machine);
-                }
-                if let (CpuError::StackOverflow(f), Some(n)) = (&mut e, names) {
-                    f.function = n.name_at(f.pc).map(str::to_string);
-                }
-                break Outcome::Error(e);
-            }
+            Ok(Event::Asleep) => break Outcome::MaxStates,
+            Err(e) => break stopped_by(e, cpu, machine, debugger.as_deref_mut(), names),
         }
         if machine.sci().has_output() {
             console.write_all(machine.sci().output())?;
@@ -426,6 +412,54 @@ pub fn run_mcu_probed<B: Board>(
     if let Some(w) = trace {
         w.flush()?;
     }
+    Ok(report(
+        cpu,
+        machine,
+        outcome,
+        names,
+        start_instructions,
+        interrupts,
+    ))
+}
+
+/// Whether the pin trace's or the phases' changes are due to be written to the VCD (see
+/// [`Probes::vcd`]), the last write having been at `drained_at`.
+fn drain_due<B: Board>(machine: &Mcu<B>, phases: Option<&PhaseRecorder>, drained_at: u64) -> bool {
+    machine.trace_pending() >= crate::vcd::DRAIN_CHANGES
+        || phases.is_some_and(|p| p.pending() >= crate::vcd::DRAIN_CHANGES)
+        || machine.now() - drained_at >= crate::vcd::DRAIN_SLICE_STATES
+}
+
+/// The outcome of a run the core stopped with error `e`: the error is reported to the
+/// debugger, and a stack overflow names its function when `names` are known.
+#[cold]
+fn stopped_by<B: Board>(
+    mut e: CpuError,
+    cpu: &mut Cpu,
+    machine: &mut Mcu<B>,
+    debugger: Option<&mut crate::gdb::Debugger>,
+    names: Option<&dyn CodeNames>,
+) -> Outcome {
+    if let Some(d) = debugger {
+        d.report_error(cpu, machine);
+    }
+    if let (CpuError::StackOverflow(f), Some(n)) = (&mut e, names) {
+        f.function = n.name_at(f.pc).map(str::to_string);
+    }
+    Outcome::Error(e)
+}
+
+/// The report of a run that ended with `outcome`: the stack guard's fault (named when `names`
+/// are known; an overflow that stopped the run is in the outcome) and the statistics since
+/// `start_instructions`.
+fn report<B: Board>(
+    cpu: &Cpu,
+    machine: &Mcu<B>,
+    outcome: Outcome,
+    names: Option<&dyn CodeNames>,
+    start_instructions: u64,
+    interrupts: u64,
+) -> RunReport {
     let states = machine.now();
     let stack_fault = match &outcome {
         Outcome::Error(CpuError::StackOverflow(_)) => None,
@@ -435,7 +469,7 @@ pub fn run_mcu_probed<B: Board>(
             f
         }),
     };
-    Ok(RunReport {
+    RunReport {
         stack_fault,
         outcome,
         stats: RunStats {
@@ -445,5 +479,5 @@ pub fn run_mcu_probed<B: Board>(
             interrupts,
             console_bytes: machine.sci().bytes_sent(),
         },
-    })
+    }
 }

@@ -8,7 +8,8 @@
 use std::fmt::Write as _;
 
 use super::decode::{
-    AluOp, BitNum, BitTarget, Decoded, Instr, JumpTarget, Operand, Size, WordSource, decode,
+    AluOp, BitNum, BitOp, BitTarget, Decoded, Instr, JumpTarget, MulDivOp, Operand, Size, UnaryOp,
+    WordSource, decode,
 };
 
 const BYTE_REGS: [&str; 16] = [
@@ -81,6 +82,75 @@ fn jump_target(out: &mut String, t: JumpTarget) {
     };
 }
 
+fn mov(s: &mut String, size: Size, src: Operand, dst: Operand) {
+    let _ = write!(s, "mov.{}\t", size.suffix());
+    operand(s, size, src);
+    s.push(',');
+    operand(s, size, dst);
+}
+
+/// A two-operand ALU operation (ADDX and SUBX have no size suffix).
+fn alu(s: &mut String, op: AluOp, size: Size, src: Operand, rd: u8) {
+    if matches!(op, AluOp::Addx | AluOp::Subx) {
+        let _ = write!(s, "{}\t", op.mnemonic());
+    } else {
+        let _ = write!(s, "{}.{}\t", op.mnemonic(), size.suffix());
+    }
+    operand(s, size, src);
+    let _ = write!(s, ",{}", reg_name(size, rd));
+}
+
+/// INC or DEC (`mnemonic`); the byte form is `byte_form Rd`, without the amount.
+fn inc_dec(s: &mut String, mnemonic: &str, byte_form: &str, size: Size, amount: u8, rd: u8) {
+    if size == Size::Byte {
+        let _ = write!(s, "{byte_form}\t{}", reg_name(size, rd));
+    } else {
+        let _ = write!(
+            s,
+            "{mnemonic}.{}\t#{amount},{}",
+            size.suffix(),
+            reg_name(size, rd)
+        );
+    }
+}
+
+fn unary(s: &mut String, op: UnaryOp, size: Size, rd: u8) {
+    let _ = write!(
+        s,
+        "{}.{}\t{}",
+        op.mnemonic(),
+        size.suffix(),
+        reg_name(size, rd)
+    );
+}
+
+/// MULXU/MULXS/DIVXU/DIVXS: the destination is twice the source's size.
+fn muldiv(s: &mut String, op: MulDivOp, size: Size, rs: u8, rd: u8) {
+    let dsize = if size == Size::Byte {
+        Size::Word
+    } else {
+        Size::Long
+    };
+    let _ = write!(
+        s,
+        "{}.{}\t{},{}",
+        op.mnemonic(),
+        size.suffix(),
+        reg_name(size, rs),
+        reg_name(dsize, rd)
+    );
+}
+
+fn bit_instr(s: &mut String, op: BitOp, num: BitNum, target: BitTarget) {
+    let _ = write!(s, "{}\t", op.mnemonic());
+    let _ = match num {
+        BitNum::Imm(n) => write!(s, "#0x{n:x}"),
+        BitNum::Reg(r) => write!(s, "{}", reg_name(Size::Byte, r)),
+    };
+    s.push(',');
+    bit_target(s, target);
+}
+
 /// The objdump text of `d`, an instruction at address `addr` (used for branch targets).
 #[must_use]
 pub fn format_instr(d: Decoded, addr: u32) -> String {
@@ -92,87 +162,32 @@ pub fn format_instr(d: Decoded, addr: u32) -> String {
         Instr::Sleep => s.push_str("sleep\t"),
         Instr::Rts => s.push_str("rts\t"),
         Instr::Rte => s.push_str("rte\t"),
-        Instr::Mov { size, src, dst } => {
-            let _ = write!(s, "mov.{}\t", size.suffix());
-            operand(s, size, src);
-            s.push(',');
-            operand(s, size, dst);
-        }
+        Instr::Mov { size, src, dst } => mov(s, size, src, dst),
         Instr::Movfpe { addr, rd } => {
             let _ = write!(s, "movfpe\t@0x{addr:x}:16,{}", reg_name(Size::Byte, rd));
         }
         Instr::Movtpe { rs, addr } => {
             let _ = write!(s, "movtpe\t{},@0x{addr:x}:16", reg_name(Size::Byte, rs));
         }
-        Instr::Alu { op, size, src, rd } => {
-            if matches!(op, AluOp::Addx | AluOp::Subx) {
-                let _ = write!(s, "{}\t", op.mnemonic());
-            } else {
-                let _ = write!(s, "{}.{}\t", op.mnemonic(), size.suffix());
-            }
-            operand(s, size, src);
-            let _ = write!(s, ",{}", reg_name(size, rd));
-        }
-        Instr::Inc { size, amount, rd } => {
-            // objdump 2.16.1 prints INC.B without its suffix but DEC.B with it.
-            if size == Size::Byte {
-                let _ = write!(s, "inc\t{}", reg_name(size, rd));
-            } else {
-                let _ = write!(s, "inc.{}\t#{amount},{}", size.suffix(), reg_name(size, rd));
-            }
-        }
-        Instr::Dec { size, amount, rd } => {
-            if size == Size::Byte {
-                let _ = write!(s, "dec.b\t{}", reg_name(size, rd));
-            } else {
-                let _ = write!(s, "dec.{}\t#{amount},{}", size.suffix(), reg_name(size, rd));
-            }
-        }
+        Instr::Alu { op, size, src, rd } => alu(s, op, size, src, rd),
+        // objdump 2.16.1 prints INC.B without its suffix but DEC.B with it.
+        Instr::Inc { size, amount, rd } => inc_dec(s, "inc", "inc", size, amount, rd),
+        Instr::Dec { size, amount, rd } => inc_dec(s, "dec", "dec.b", size, amount, rd),
         Instr::Adds { amount, rd } => {
             let _ = write!(s, "adds\t#{amount},{}", er(rd));
         }
         Instr::Subs { amount, rd } => {
             let _ = write!(s, "subs\t#{amount},{}", er(rd));
         }
-        Instr::Unary { op, size, rd } => {
-            let _ = write!(
-                s,
-                "{}.{}\t{}",
-                op.mnemonic(),
-                size.suffix(),
-                reg_name(size, rd)
-            );
-        }
+        Instr::Unary { op, size, rd } => unary(s, op, size, rd),
         Instr::Daa(r) => {
             let _ = write!(s, "daa\t{}", reg_name(Size::Byte, r));
         }
         Instr::Das(r) => {
             let _ = write!(s, "das\t{}", reg_name(Size::Byte, r));
         }
-        Instr::MulDiv { op, size, rs, rd } => {
-            let dsize = if size == Size::Byte {
-                Size::Word
-            } else {
-                Size::Long
-            };
-            let _ = write!(
-                s,
-                "{}.{}\t{},{}",
-                op.mnemonic(),
-                size.suffix(),
-                reg_name(size, rs),
-                reg_name(dsize, rd)
-            );
-        }
-        Instr::Bit { op, bit, target } => {
-            let _ = write!(s, "{}\t", op.mnemonic());
-            let _ = match bit {
-                BitNum::Imm(n) => write!(s, "#0x{n:x}"),
-                BitNum::Reg(r) => write!(s, "{}", reg_name(Size::Byte, r)),
-            };
-            s.push(',');
-            bit_target(s, target);
-        }
+        Instr::MulDiv { op, size, rs, rd } => muldiv(s, op, size, rs, rd),
+        Instr::Bit { op, bit, target } => bit_instr(s, op, bit, target),
         Instr::Bcc { cond, disp, .. } => {
             let _ = write!(s, "{}\t", BCC[usize::from(cond & 15)]);
             branch(s, next, disp);

@@ -426,18 +426,7 @@ impl Cpu {
     ) -> Result<Event, CpuError> {
         match d.instr {
             Instr::Nop => {}
-            Instr::Mov { size, src, dst } => {
-                let bytes = sz(size).bytes;
-                if stack_operand(src) {
-                    self.stack_ok(self.stack_target(src, bytes), bytes, StackAccess::Read, pc)?;
-                }
-                if stack_operand(dst) {
-                    self.stack_ok(self.stack_target(dst, bytes), bytes, StackAccess::Write, pc)?;
-                }
-                let v = self.read_operand(bus, size, src);
-                self.write_operand(bus, size, dst, v);
-                self.flags_nzv0(sz(size), v);
-            }
+            Instr::Mov { size, src, dst } => self.mov(bus, size, src, dst, pc)?,
             Instr::Alu { op, size, src, rd } => {
                 let b = match src {
                     Operand::Reg(r) => self.reg(size, r),
@@ -460,152 +449,18 @@ impl Cpu {
             Instr::Daa(r) => self.daa(r),
             Instr::Das(r) => self.das(r),
             Instr::MulDiv { op, size, rs, rd } => self.muldiv(bus, op, size, rs, rd),
-            Instr::Bit { op, bit, target } => {
-                if matches!(target, BitTarget::Ind(r) if r & 7 == 7) {
-                    let writes = matches!(
-                        op,
-                        BitOp::Bset | BitOp::Bclr | BitOp::Bnot | BitOp::Bst | BitOp::Bist
-                    );
-                    let access = if writes {
-                        StackAccess::Write
-                    } else {
-                        StackAccess::Read
-                    };
-                    self.stack_ok(self.er[7], 1, access, pc)?;
-                }
-                self.bit(bus, op, bit, target);
-            }
-            Instr::Bcc { cond, disp, long } => {
-                let taken = self.cond(cond);
-                let target = next.wrapping_add(disp as i32 as u32) & ADDRESS_MASK;
-                if long {
-                    bus.internal(t::N_BRANCH_D16);
-                } else {
-                    Self::fetch_charge(bus, if taken { target } else { next });
-                }
-                if taken {
-                    self.jump_to(target);
-                }
-            }
-            Instr::Bsr { disp, long } => {
-                let target = next.wrapping_add(disp as i32 as u32) & ADDRESS_MASK;
-                self.push32(bus, next, StackAccess::Call, pc)?;
-                if long {
-                    bus.internal(t::N_BRANCH_D16);
-                } else {
-                    Self::fetch_charge(bus, target);
-                }
-                self.jump_to(target);
-            }
-            Instr::Jmp(tgt) | Instr::Jsr(tgt) => {
-                let call = matches!(d.instr, Instr::Jsr(_));
-                let target = match tgt {
-                    JumpTarget::Reg(r) => self.er[usize::from(r & 7)] & ADDRESS_MASK,
-                    JumpTarget::Abs24(a) => a & ADDRESS_MASK,
-                    JumpTarget::MemInd(a) => {
-                        let a = u32::from(a);
-                        let hi = u32::from(bus.read16(a));
-                        let lo = u32::from(bus.read16(a + 2));
-                        ((hi << 16) | lo) & ADDRESS_MASK
-                    }
-                };
-                if call {
-                    self.push32(bus, next, StackAccess::Call, pc)?;
-                }
-                match tgt {
-                    // JMP/JSR @ERn: I = 2 (the target prefetch).
-                    JumpTarget::Reg(_) => Self::fetch_charge(bus, target),
-                    // @aa:24: I = 2 (both words of the instruction), N = 2.
-                    JumpTarget::Abs24(_) => bus.internal(t::N_JUMP_ABS24),
-                    // @@aa:8: I = 2 (the target prefetch); JMP has N = 2, JSR none.
-                    JumpTarget::MemInd(_) => {
-                        Self::fetch_charge(bus, target);
-                        if !call {
-                            bus.internal(t::N_JMP_MEM_INDIRECT);
-                        }
-                    }
-                }
-                self.jump_to(target);
-            }
-            Instr::Rts => {
-                let ret = self.pop32(bus, StackAccess::Return, pc)? & ADDRESS_MASK;
-                Self::fetch_charge(bus, ret);
-                bus.internal(t::N_RETURN);
-                self.jump_to(ret);
-            }
-            Instr::Rte => {
-                let frame = self.pop32(bus, StackAccess::ReturnFromException, pc)?;
-                self.ccr = (frame >> 24) as u8;
-                let ret = frame & ADDRESS_MASK;
-                Self::fetch_charge(bus, ret);
-                bus.internal(t::N_RETURN);
-                self.jump_to(ret);
-            }
-            Instr::Trapa(n) => {
-                let v = super::VECTOR_TRAPA0 + (n & 3);
-                self.enter_exception(bus, v, next, StackAccess::Trap, pc)?;
-                let target = self.pc;
-                Self::fetch_charge(bus, target);
-                bus.internal(t::N_TRAPA);
-            }
-            Instr::Sleep => {
-                let nmi = bus.pending_irq() == Some(super::VECTOR_NMI);
-                if self.ccr & CCR_I != 0 && !nmi {
-                    self.state = RunState::Halted;
-                    return Ok(Event::Halted);
-                }
-                self.state = RunState::Sleeping;
-                bus.cpu_signal(crate::bus::CpuSignal::Sleep);
-            }
-            Instr::Eepmov { word } => {
-                let count = if word {
-                    u32::from(self.r16(4))
-                } else {
-                    u32::from(self.r8(12))
-                };
-                let src_area = Area::of(self.er[5]);
-                let dst_area = Area::of(self.er[6]);
-                for _ in 0..count {
-                    let b = bus.read8(self.er[5]);
-                    bus.write8(self.er[6], b);
-                    self.er[5] = self.er[5].wrapping_add(1);
-                    self.er[6] = self.er[6].wrapping_add(1);
-                }
-                if word {
-                    self.set_r16(4, 0);
-                } else {
-                    self.set_r8(12, 0);
-                }
-                debug_assert_eq!(t::EEPMOV_EXTRA_BYTE_ACCESSES, 2);
-                bus.internal(src_area.byte_states() + dst_area.byte_states());
-            }
-            Instr::Ldc(src) => {
-                if stack_operand(src) {
-                    self.stack_ok(self.stack_target(src, 2), 2, StackAccess::Read, pc)?;
-                }
-                self.ccr = match src {
-                    Operand::Imm(v) => v as u8,
-                    Operand::Reg(r) => self.r8(r),
-                    mem => {
-                        let a = self.ea(bus, mem, 2);
-                        (bus.read16(a) >> 8) as u8
-                    }
-                };
-                self.irq_inhibit = true;
-            }
-            Instr::Stc(dst) => match dst {
-                _ if stack_operand(dst) => {
-                    self.stack_ok(self.stack_target(dst, 2), 2, StackAccess::Write, pc)?;
-                    let a = self.ea(bus, dst, 2);
-                    bus.write16(a, u16::from_be_bytes([self.ccr, self.ccr]));
-                }
-                Operand::Reg(r) => self.set_r8(r, self.ccr),
-                Operand::Imm(_) => {}
-                mem => {
-                    let a = self.ea(bus, mem, 2);
-                    bus.write16(a, u16::from_be_bytes([self.ccr, self.ccr]));
-                }
-            },
+            Instr::Bit { op, bit, target } => self.bit_guarded(bus, op, bit, target, pc)?,
+            Instr::Bcc { cond, disp, long } => self.bcc(bus, cond, disp, long, next),
+            Instr::Bsr { disp, long } => self.bsr(bus, disp, long, pc, next)?,
+            Instr::Jmp(tgt) => self.jmp_jsr(bus, tgt, false, pc, next)?,
+            Instr::Jsr(tgt) => self.jmp_jsr(bus, tgt, true, pc, next)?,
+            Instr::Rts => self.rts(bus, pc)?,
+            Instr::Rte => self.rte(bus, pc)?,
+            Instr::Trapa(n) => self.trapa(bus, n, pc, next)?,
+            Instr::Sleep => return Ok(self.sleep(bus)),
+            Instr::Eepmov { word } => self.eepmov(bus, word),
+            Instr::Ldc(src) => self.ldc(bus, src, pc)?,
+            Instr::Stc(dst) => self.stc(bus, dst, pc)?,
             Instr::Andc(v) => {
                 self.ccr &= v;
                 self.irq_inhibit = true;
@@ -618,17 +473,258 @@ impl Cpu {
                 self.ccr ^= v;
                 self.irq_inhibit = true;
             }
-            Instr::Movfpe { .. } | Instr::Movtpe { .. } => {
-                self.pc = pc;
-                self.instructions -= 1;
-                return Err(CpuError::Unsupported {
-                    pc,
-                    text: super::disasm::format_instr(d, pc),
-                    why: "MOVFPE/MOVTPE synchronise with the E clock, which the H8/3052F does not have",
-                });
-            }
+            Instr::Movfpe { .. } | Instr::Movtpe { .. } => return Err(self.e_clock_move(d, pc)),
         }
         Ok(Event::Executed)
+    }
+
+    /// `mov.size src,dst`, its stack operands checked by the stack guard first.
+    #[inline(always)]
+    fn mov<B: Bus>(
+        &mut self,
+        bus: &mut B,
+        size: Size,
+        src: Operand,
+        dst: Operand,
+        pc: u32,
+    ) -> Result<(), CpuError> {
+        let bytes = sz(size).bytes;
+        if stack_operand(src) {
+            self.stack_ok(self.stack_target(src, bytes), bytes, StackAccess::Read, pc)?;
+        }
+        if stack_operand(dst) {
+            self.stack_ok(self.stack_target(dst, bytes), bytes, StackAccess::Write, pc)?;
+        }
+        let v = self.read_operand(bus, size, src);
+        self.write_operand(bus, size, dst, v);
+        self.flags_nzv0(sz(size), v);
+        Ok(())
+    }
+
+    /// A bit instruction, its access through `@ER7` checked by the stack guard first (a write
+    /// for the ones that change the byte).
+    #[inline(always)]
+    fn bit_guarded<B: Bus>(
+        &mut self,
+        bus: &mut B,
+        op: BitOp,
+        bit: BitNum,
+        target: BitTarget,
+        pc: u32,
+    ) -> Result<(), CpuError> {
+        if matches!(target, BitTarget::Ind(r) if r & 7 == 7) {
+            let writes = matches!(
+                op,
+                BitOp::Bset | BitOp::Bclr | BitOp::Bnot | BitOp::Bst | BitOp::Bist
+            );
+            let access = if writes {
+                StackAccess::Write
+            } else {
+                StackAccess::Read
+            };
+            self.stack_ok(self.er[7], 1, access, pc)?;
+        }
+        self.bit(bus, op, bit, target);
+        Ok(())
+    }
+
+    /// `bcc d:8` / `bcc d:16` with the instruction after it at `next`: d:16 has N = 2, d:8
+    /// the prefetch at the target if taken, after the instruction if not.
+    #[inline(always)]
+    fn bcc<B: Bus>(&mut self, bus: &mut B, cond: u8, disp: i16, long: bool, next: u32) {
+        let taken = self.cond(cond);
+        let target = next.wrapping_add(disp as i32 as u32) & ADDRESS_MASK;
+        if long {
+            bus.internal(t::N_BRANCH_D16);
+        } else {
+            Self::fetch_charge(bus, if taken { target } else { next });
+        }
+        if taken {
+            self.jump_to(target);
+        }
+    }
+
+    /// `bsr d:8` / `bsr d:16`: push the return address `next`, then as an always-taken Bcc.
+    #[inline(always)]
+    fn bsr<B: Bus>(
+        &mut self,
+        bus: &mut B,
+        disp: i16,
+        long: bool,
+        pc: u32,
+        next: u32,
+    ) -> Result<(), CpuError> {
+        let target = next.wrapping_add(disp as i32 as u32) & ADDRESS_MASK;
+        self.push32(bus, next, StackAccess::Call, pc)?;
+        if long {
+            bus.internal(t::N_BRANCH_D16);
+        } else {
+            Self::fetch_charge(bus, target);
+        }
+        self.jump_to(target);
+        Ok(())
+    }
+
+    /// `jmp` (`call` false) or `jsr` (`call` true, pushing `next`) to `tgt`.
+    #[inline(always)]
+    fn jmp_jsr<B: Bus>(
+        &mut self,
+        bus: &mut B,
+        tgt: JumpTarget,
+        call: bool,
+        pc: u32,
+        next: u32,
+    ) -> Result<(), CpuError> {
+        let target = match tgt {
+            JumpTarget::Reg(r) => self.er[usize::from(r & 7)] & ADDRESS_MASK,
+            JumpTarget::Abs24(a) => a & ADDRESS_MASK,
+            JumpTarget::MemInd(a) => {
+                let a = u32::from(a);
+                let hi = u32::from(bus.read16(a));
+                let lo = u32::from(bus.read16(a + 2));
+                ((hi << 16) | lo) & ADDRESS_MASK
+            }
+        };
+        if call {
+            self.push32(bus, next, StackAccess::Call, pc)?;
+        }
+        match tgt {
+            // JMP/JSR @ERn: I = 2 (the target prefetch).
+            JumpTarget::Reg(_) => Self::fetch_charge(bus, target),
+            // @aa:24: I = 2 (both words of the instruction), N = 2.
+            JumpTarget::Abs24(_) => bus.internal(t::N_JUMP_ABS24),
+            // @@aa:8: I = 2 (the target prefetch); JMP has N = 2, JSR none.
+            JumpTarget::MemInd(_) => {
+                Self::fetch_charge(bus, target);
+                if !call {
+                    bus.internal(t::N_JMP_MEM_INDIRECT);
+                }
+            }
+        }
+        self.jump_to(target);
+        Ok(())
+    }
+
+    /// `rts`: pop the return address, prefetch there, N = 2.
+    #[inline(always)]
+    fn rts<B: Bus>(&mut self, bus: &mut B, pc: u32) -> Result<(), CpuError> {
+        let ret = self.pop32(bus, StackAccess::Return, pc)? & ADDRESS_MASK;
+        Self::fetch_charge(bus, ret);
+        bus.internal(t::N_RETURN);
+        self.jump_to(ret);
+        Ok(())
+    }
+
+    /// `rte`: pop CCR and the return address, prefetch there, N = 2.
+    #[inline(always)]
+    fn rte<B: Bus>(&mut self, bus: &mut B, pc: u32) -> Result<(), CpuError> {
+        let frame = self.pop32(bus, StackAccess::ReturnFromException, pc)?;
+        self.ccr = (frame >> 24) as u8;
+        let ret = frame & ADDRESS_MASK;
+        Self::fetch_charge(bus, ret);
+        bus.internal(t::N_RETURN);
+        self.jump_to(ret);
+        Ok(())
+    }
+
+    /// `trapa #n`: exception handling through vector TRAPA0 + n, returning to `next`.
+    #[inline(always)]
+    fn trapa<B: Bus>(&mut self, bus: &mut B, n: u8, pc: u32, next: u32) -> Result<(), CpuError> {
+        let v = super::VECTOR_TRAPA0 + (n & 3);
+        self.enter_exception(bus, v, next, StackAccess::Trap, pc)?;
+        let target = self.pc;
+        Self::fetch_charge(bus, target);
+        bus.internal(t::N_TRAPA);
+        Ok(())
+    }
+
+    /// `sleep`: the CPU sleeps until an interrupt, or halts for good when interrupts are
+    /// masked and no NMI is pending (nothing could wake it).
+    #[inline(always)]
+    fn sleep<B: Bus>(&mut self, bus: &mut B) -> Event {
+        let nmi = bus.pending_irq() == Some(super::VECTOR_NMI);
+        if self.ccr & CCR_I != 0 && !nmi {
+            self.state = RunState::Halted;
+            return Event::Halted;
+        }
+        self.state = RunState::Sleeping;
+        bus.cpu_signal(crate::bus::CpuSignal::Sleep);
+        Event::Executed
+    }
+
+    /// `eepmov.b` / `eepmov.w` (`word`): copies R4L / R4 bytes from @ER5+ to @ER6+.
+    #[inline(always)]
+    fn eepmov<B: Bus>(&mut self, bus: &mut B, word: bool) {
+        let count = if word {
+            u32::from(self.r16(4))
+        } else {
+            u32::from(self.r8(12))
+        };
+        let src_area = Area::of(self.er[5]);
+        let dst_area = Area::of(self.er[6]);
+        for _ in 0..count {
+            let b = bus.read8(self.er[5]);
+            bus.write8(self.er[6], b);
+            self.er[5] = self.er[5].wrapping_add(1);
+            self.er[6] = self.er[6].wrapping_add(1);
+        }
+        if word {
+            self.set_r16(4, 0);
+        } else {
+            self.set_r8(12, 0);
+        }
+        debug_assert_eq!(t::EEPMOV_EXTRA_BYTE_ACCESSES, 2);
+        bus.internal(src_area.byte_states() + dst_area.byte_states());
+    }
+
+    /// `ldc src,ccr` (a memory source is a word access whose upper byte is CCR).
+    #[inline(always)]
+    fn ldc<B: Bus>(&mut self, bus: &mut B, src: Operand, pc: u32) -> Result<(), CpuError> {
+        if stack_operand(src) {
+            self.stack_ok(self.stack_target(src, 2), 2, StackAccess::Read, pc)?;
+        }
+        self.ccr = match src {
+            Operand::Imm(v) => v as u8,
+            Operand::Reg(r) => self.r8(r),
+            mem => {
+                let a = self.ea(bus, mem, 2);
+                (bus.read16(a) >> 8) as u8
+            }
+        };
+        self.irq_inhibit = true;
+        Ok(())
+    }
+
+    /// `stc ccr,dst` (a memory destination is a word write of CCR in both bytes).
+    #[inline(always)]
+    fn stc<B: Bus>(&mut self, bus: &mut B, dst: Operand, pc: u32) -> Result<(), CpuError> {
+        match dst {
+            _ if stack_operand(dst) => {
+                self.stack_ok(self.stack_target(dst, 2), 2, StackAccess::Write, pc)?;
+                let a = self.ea(bus, dst, 2);
+                bus.write16(a, u16::from_be_bytes([self.ccr, self.ccr]));
+            }
+            Operand::Reg(r) => self.set_r8(r, self.ccr),
+            Operand::Imm(_) => {}
+            mem => {
+                let a = self.ea(bus, mem, 2);
+                bus.write16(a, u16::from_be_bytes([self.ccr, self.ccr]));
+            }
+        }
+        Ok(())
+    }
+
+    /// MOVFPE/MOVTPE `d` at `pc` is not run: the instruction is undone (PC at it, not
+    /// counted) and this is the error.
+    #[cold]
+    fn e_clock_move(&mut self, d: Decoded, pc: u32) -> CpuError {
+        self.pc = pc;
+        self.instructions -= 1;
+        CpuError::Unsupported {
+            pc,
+            text: super::disasm::format_instr(d, pc),
+            why: "MOVFPE/MOVTPE synchronise with the E clock, which the H8/3052F does not have",
+        }
     }
 
     /// `op.size b,Rd` for the two-operand ALU operations, `b` the source value (masked).

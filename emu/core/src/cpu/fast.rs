@@ -428,136 +428,12 @@ const fn imm(size: Size, v: u32) -> u32 {
 
 /// The handler of `instr`, whose following instruction is at `next`.
 fn op_of(instr: Instr, next: u32) -> Op {
-    use Operand::{Imm, Reg};
     use Size::{Byte, Long, Word};
     let branch_target = |disp: i16| next.wrapping_add(disp as i32 as u32) & ADDRESS_MASK;
     match instr {
         Instr::Nop => Op::Nop,
-        Instr::Mov { size, src, dst } => match (size, src, dst) {
-            (Byte, Reg(rs), Reg(rd)) => Op::MovR8 { rs, rd },
-            (Word, Reg(rs), Reg(rd)) => Op::MovR16 { rs, rd },
-            (Long, Reg(rs), Reg(rd)) => Op::MovR32 { rs, rd },
-            (Byte, Imm(v), Reg(rd)) => Op::MovI8 {
-                v: imm(Byte, v),
-                rd,
-            },
-            (Word, Imm(v), Reg(rd)) => Op::MovI16 {
-                v: imm(Word, v),
-                rd,
-            },
-            (Long, Imm(v), Reg(rd)) => Op::MovI32 {
-                v: imm(Long, v),
-                rd,
-            },
-            (size, src, Reg(rd)) if stack_operand(src) => Op::LdStack { size, src, rd },
-            (size, Reg(rs), dst) if stack_operand(dst) => Op::StStack { size, rs, dst },
-            (Byte, src, Reg(rd)) if src.is_memory() => Op::Ld8 { src, rd },
-            (Word, src, Reg(rd)) if src.is_memory() => Op::Ld16 { src, rd },
-            (Long, src, Reg(rd)) if src.is_memory() => Op::Ld32 { src, rd },
-            (Byte, Reg(rs), dst) if dst.is_memory() => Op::St8 { rs, dst },
-            (Word, Reg(rs), dst) if dst.is_memory() => Op::St16 { rs, dst },
-            (Long, Reg(rs), dst) if dst.is_memory() => Op::St32 { rs, dst },
-            _ => Op::Generic,
-        },
-        Instr::Alu { op, size, src, rd } => match (op, size, src) {
-            (AluOp::Add, Byte, Reg(rs)) => Op::AddR8 { rs, rd },
-            (AluOp::Add, Word, Reg(rs)) => Op::AddR16 { rs, rd },
-            (AluOp::Add, Long, Reg(rs)) => Op::AddR32 { rs, rd },
-            (AluOp::Add, Byte, Imm(v)) => Op::AddI8 {
-                v: imm(Byte, v),
-                rd,
-            },
-            (AluOp::Add, Word, Imm(v)) => Op::AddI16 {
-                v: imm(Word, v),
-                rd,
-            },
-            (AluOp::Add, Long, Imm(v)) => Op::AddI32 {
-                v: imm(Long, v),
-                rd,
-            },
-            (AluOp::Sub, Byte, Reg(rs)) => Op::SubR8 { rs, rd },
-            (AluOp::Sub, Word, Reg(rs)) => Op::SubR16 { rs, rd },
-            (AluOp::Sub, Long, Reg(rs)) => Op::SubR32 { rs, rd },
-            (AluOp::Sub, Word, Imm(v)) => Op::SubI16 {
-                v: imm(Word, v),
-                rd,
-            },
-            (AluOp::Sub, Long, Imm(v)) => Op::SubI32 {
-                v: imm(Long, v),
-                rd,
-            },
-            (AluOp::Cmp, Byte, Reg(rs)) => Op::CmpR8 { rs, rd },
-            (AluOp::Cmp, Word, Reg(rs)) => Op::CmpR16 { rs, rd },
-            (AluOp::Cmp, Long, Reg(rs)) => Op::CmpR32 { rs, rd },
-            (AluOp::Cmp, Byte, Imm(v)) => Op::CmpI8 {
-                v: imm(Byte, v),
-                rd,
-            },
-            (AluOp::Cmp, Word, Imm(v)) => Op::CmpI16 {
-                v: imm(Word, v),
-                rd,
-            },
-            (AluOp::Cmp, Long, Imm(v)) => Op::CmpI32 {
-                v: imm(Long, v),
-                rd,
-            },
-            (AluOp::And, Byte, Reg(rs)) => Op::AndR8 { rs, rd },
-            (AluOp::And, Word, Reg(rs)) => Op::AndR16 { rs, rd },
-            (AluOp::And, Long, Reg(rs)) => Op::AndR32 { rs, rd },
-            (AluOp::And, Byte, Imm(v)) => Op::AndI8 {
-                v: imm(Byte, v),
-                rd,
-            },
-            (AluOp::And, Word, Imm(v)) => Op::AndI16 {
-                v: imm(Word, v),
-                rd,
-            },
-            (AluOp::And, Long, Imm(v)) => Op::AndI32 {
-                v: imm(Long, v),
-                rd,
-            },
-            (AluOp::Or, Byte, Reg(rs)) => Op::OrR8 { rs, rd },
-            (AluOp::Or, Word, Reg(rs)) => Op::OrR16 { rs, rd },
-            (AluOp::Or, Long, Reg(rs)) => Op::OrR32 { rs, rd },
-            (AluOp::Or, Byte, Imm(v)) => Op::OrI8 {
-                v: imm(Byte, v),
-                rd,
-            },
-            (AluOp::Or, Word, Imm(v)) => Op::OrI16 {
-                v: imm(Word, v),
-                rd,
-            },
-            (AluOp::Or, Long, Imm(v)) => Op::OrI32 {
-                v: imm(Long, v),
-                rd,
-            },
-            (AluOp::Xor, Byte, Reg(rs)) => Op::XorR8 { rs, rd },
-            (AluOp::Xor, Word, Reg(rs)) => Op::XorR16 { rs, rd },
-            (AluOp::Xor, Long, Reg(rs)) => Op::XorR32 { rs, rd },
-            (AluOp::Xor, Byte, Imm(v)) => Op::XorI8 {
-                v: imm(Byte, v),
-                rd,
-            },
-            (AluOp::Xor, Word, Imm(v)) => Op::XorI16 {
-                v: imm(Word, v),
-                rd,
-            },
-            (AluOp::Xor, Long, Imm(v)) => Op::XorI32 {
-                v: imm(Long, v),
-                rd,
-            },
-            (AluOp::Addx, Byte, Reg(rs)) => Op::AddxR8 { rs, rd },
-            (AluOp::Addx, Byte, Imm(v)) => Op::AddxI8 {
-                v: imm(Byte, v),
-                rd,
-            },
-            (AluOp::Subx, Byte, Reg(rs)) => Op::SubxR8 { rs, rd },
-            (AluOp::Subx, Byte, Imm(v)) => Op::SubxI8 {
-                v: imm(Byte, v),
-                rd,
-            },
-            _ => Op::Generic,
-        },
+        Instr::Mov { size, src, dst } => mov_op(size, src, dst),
+        Instr::Alu { op, size, src, rd } => alu_op(op, size, src, rd),
         Instr::Inc { size, amount, rd } => match size {
             Byte => Op::Inc8 { amount, rd },
             Word => Op::Inc16 { amount, rd },
@@ -584,35 +460,8 @@ fn op_of(instr: Instr, next: u32) -> Op {
             (op, Word) => Op::Un16 { op, rd },
             (op, Long) => Op::Un32 { op, rd },
         },
-        Instr::Bcc { cond, disp, long } => {
-            let target = branch_target(disp);
-            if long {
-                Op::Bcc16 {
-                    mask: cond_mask(cond),
-                    target: target & !1,
-                }
-            } else {
-                Op::Bcc8 {
-                    mask: cond_mask(cond),
-                    target: target & !1,
-                    taken_states: prefetch_states(target) as u8,
-                    next_states: prefetch_states(next) as u8,
-                }
-            }
-        }
-        Instr::Bsr { disp, long } => {
-            let target = branch_target(disp);
-            if long {
-                Op::Bsr16 {
-                    target: target & !1,
-                }
-            } else {
-                Op::Bsr8 {
-                    target: target & !1,
-                    prefetch_states: prefetch_states(target) as u8,
-                }
-            }
-        }
+        Instr::Bcc { cond, disp, long } => bcc_op(cond, branch_target(disp), long, next),
+        Instr::Bsr { disp, long } => bsr_op(branch_target(disp), long),
         Instr::Jmp(JumpTarget::Abs24(a)) => Op::JmpAbs {
             target: a & ADDRESS_MASK & !1,
         },
@@ -623,6 +472,174 @@ fn op_of(instr: Instr, next: u32) -> Op {
         Instr::Jsr(JumpTarget::Reg(r)) => Op::JsrReg { r },
         Instr::Rts => Op::Rts,
         _ => Op::Generic,
+    }
+}
+
+/// The handler of `mov.size src,dst`.
+fn mov_op(size: Size, src: Operand, dst: Operand) -> Op {
+    use Operand::{Imm, Reg};
+    use Size::{Byte, Long, Word};
+    match (size, src, dst) {
+        (Byte, Reg(rs), Reg(rd)) => Op::MovR8 { rs, rd },
+        (Word, Reg(rs), Reg(rd)) => Op::MovR16 { rs, rd },
+        (Long, Reg(rs), Reg(rd)) => Op::MovR32 { rs, rd },
+        (Byte, Imm(v), Reg(rd)) => Op::MovI8 {
+            v: imm(Byte, v),
+            rd,
+        },
+        (Word, Imm(v), Reg(rd)) => Op::MovI16 {
+            v: imm(Word, v),
+            rd,
+        },
+        (Long, Imm(v), Reg(rd)) => Op::MovI32 {
+            v: imm(Long, v),
+            rd,
+        },
+        (size, src, Reg(rd)) if stack_operand(src) => Op::LdStack { size, src, rd },
+        (size, Reg(rs), dst) if stack_operand(dst) => Op::StStack { size, rs, dst },
+        (Byte, src, Reg(rd)) if src.is_memory() => Op::Ld8 { src, rd },
+        (Word, src, Reg(rd)) if src.is_memory() => Op::Ld16 { src, rd },
+        (Long, src, Reg(rd)) if src.is_memory() => Op::Ld32 { src, rd },
+        (Byte, Reg(rs), dst) if dst.is_memory() => Op::St8 { rs, dst },
+        (Word, Reg(rs), dst) if dst.is_memory() => Op::St16 { rs, dst },
+        (Long, Reg(rs), dst) if dst.is_memory() => Op::St32 { rs, dst },
+        _ => Op::Generic,
+    }
+}
+
+/// The handler of `op.size src,Rd` (a two-operand ALU operation).
+fn alu_op(op: AluOp, size: Size, src: Operand, rd: u8) -> Op {
+    use Operand::{Imm, Reg};
+    use Size::{Byte, Long, Word};
+    match (op, size, src) {
+        (AluOp::Add, Byte, Reg(rs)) => Op::AddR8 { rs, rd },
+        (AluOp::Add, Word, Reg(rs)) => Op::AddR16 { rs, rd },
+        (AluOp::Add, Long, Reg(rs)) => Op::AddR32 { rs, rd },
+        (AluOp::Add, Byte, Imm(v)) => Op::AddI8 {
+            v: imm(Byte, v),
+            rd,
+        },
+        (AluOp::Add, Word, Imm(v)) => Op::AddI16 {
+            v: imm(Word, v),
+            rd,
+        },
+        (AluOp::Add, Long, Imm(v)) => Op::AddI32 {
+            v: imm(Long, v),
+            rd,
+        },
+        (AluOp::Sub, Byte, Reg(rs)) => Op::SubR8 { rs, rd },
+        (AluOp::Sub, Word, Reg(rs)) => Op::SubR16 { rs, rd },
+        (AluOp::Sub, Long, Reg(rs)) => Op::SubR32 { rs, rd },
+        (AluOp::Sub, Word, Imm(v)) => Op::SubI16 {
+            v: imm(Word, v),
+            rd,
+        },
+        (AluOp::Sub, Long, Imm(v)) => Op::SubI32 {
+            v: imm(Long, v),
+            rd,
+        },
+        (AluOp::Cmp, Byte, Reg(rs)) => Op::CmpR8 { rs, rd },
+        (AluOp::Cmp, Word, Reg(rs)) => Op::CmpR16 { rs, rd },
+        (AluOp::Cmp, Long, Reg(rs)) => Op::CmpR32 { rs, rd },
+        (AluOp::Cmp, Byte, Imm(v)) => Op::CmpI8 {
+            v: imm(Byte, v),
+            rd,
+        },
+        (AluOp::Cmp, Word, Imm(v)) => Op::CmpI16 {
+            v: imm(Word, v),
+            rd,
+        },
+        (AluOp::Cmp, Long, Imm(v)) => Op::CmpI32 {
+            v: imm(Long, v),
+            rd,
+        },
+        (AluOp::And, Byte, Reg(rs)) => Op::AndR8 { rs, rd },
+        (AluOp::And, Word, Reg(rs)) => Op::AndR16 { rs, rd },
+        (AluOp::And, Long, Reg(rs)) => Op::AndR32 { rs, rd },
+        (AluOp::And, Byte, Imm(v)) => Op::AndI8 {
+            v: imm(Byte, v),
+            rd,
+        },
+        (AluOp::And, Word, Imm(v)) => Op::AndI16 {
+            v: imm(Word, v),
+            rd,
+        },
+        (AluOp::And, Long, Imm(v)) => Op::AndI32 {
+            v: imm(Long, v),
+            rd,
+        },
+        (AluOp::Or, Byte, Reg(rs)) => Op::OrR8 { rs, rd },
+        (AluOp::Or, Word, Reg(rs)) => Op::OrR16 { rs, rd },
+        (AluOp::Or, Long, Reg(rs)) => Op::OrR32 { rs, rd },
+        (AluOp::Or, Byte, Imm(v)) => Op::OrI8 {
+            v: imm(Byte, v),
+            rd,
+        },
+        (AluOp::Or, Word, Imm(v)) => Op::OrI16 {
+            v: imm(Word, v),
+            rd,
+        },
+        (AluOp::Or, Long, Imm(v)) => Op::OrI32 {
+            v: imm(Long, v),
+            rd,
+        },
+        (AluOp::Xor, Byte, Reg(rs)) => Op::XorR8 { rs, rd },
+        (AluOp::Xor, Word, Reg(rs)) => Op::XorR16 { rs, rd },
+        (AluOp::Xor, Long, Reg(rs)) => Op::XorR32 { rs, rd },
+        (AluOp::Xor, Byte, Imm(v)) => Op::XorI8 {
+            v: imm(Byte, v),
+            rd,
+        },
+        (AluOp::Xor, Word, Imm(v)) => Op::XorI16 {
+            v: imm(Word, v),
+            rd,
+        },
+        (AluOp::Xor, Long, Imm(v)) => Op::XorI32 {
+            v: imm(Long, v),
+            rd,
+        },
+        (AluOp::Addx, Byte, Reg(rs)) => Op::AddxR8 { rs, rd },
+        (AluOp::Addx, Byte, Imm(v)) => Op::AddxI8 {
+            v: imm(Byte, v),
+            rd,
+        },
+        (AluOp::Subx, Byte, Reg(rs)) => Op::SubxR8 { rs, rd },
+        (AluOp::Subx, Byte, Imm(v)) => Op::SubxI8 {
+            v: imm(Byte, v),
+            rd,
+        },
+        _ => Op::Generic,
+    }
+}
+
+/// The handler of `bcc` (`long`: d:16) to `target`, the instruction after it at `next`.
+fn bcc_op(cond: u8, target: u32, long: bool, next: u32) -> Op {
+    if long {
+        Op::Bcc16 {
+            mask: cond_mask(cond),
+            target: target & !1,
+        }
+    } else {
+        Op::Bcc8 {
+            mask: cond_mask(cond),
+            target: target & !1,
+            taken_states: prefetch_states(target) as u8,
+            next_states: prefetch_states(next) as u8,
+        }
+    }
+}
+
+/// The handler of `bsr` (`long`: d:16) to `target`.
+fn bsr_op(target: u32, long: bool) -> Op {
+    if long {
+        Op::Bsr16 {
+            target: target & !1,
+        }
+    } else {
+        Op::Bsr8 {
+            target: target & !1,
+            prefetch_states: prefetch_states(target) as u8,
+        }
     }
 }
 
@@ -674,16 +691,8 @@ impl Cpu {
             Op::St8 { rs, dst } => self.store(bus, Size::Byte, rs, dst),
             Op::St16 { rs, dst } => self.store(bus, Size::Word, rs, dst),
             Op::St32 { rs, dst } => self.store(bus, Size::Long, rs, dst),
-            Op::LdStack { size, src, rd } => {
-                let bytes = sz(size).bytes;
-                self.stack_ok(self.stack_target(src, bytes), bytes, StackAccess::Read, pc)?;
-                self.load(bus, size, src, rd);
-            }
-            Op::StStack { size, rs, dst } => {
-                let bytes = sz(size).bytes;
-                self.stack_ok(self.stack_target(dst, bytes), bytes, StackAccess::Write, pc)?;
-                self.store(bus, size, rs, dst);
-            }
+            Op::LdStack { size, src, rd } => self.load_stack(bus, size, src, rd, pc)?,
+            Op::StStack { size, rs, dst } => self.store_stack(bus, size, rs, dst, pc)?,
             Op::AddR8 { rs, rd } => alu_r!(self, Add, Byte, rs, rd),
             Op::AddR16 { rs, rd } => alu_r!(self, Add, Word, rs, rd),
             Op::AddR32 { rs, rd } => alu_r!(self, Add, Long, rs, rd),
@@ -744,61 +753,160 @@ impl Cpu {
                 target,
                 taken_states,
                 next_states,
-            } => {
-                if (mask >> (self.ccr & 15)) & 1 != 0 {
-                    bus.internal(u32::from(taken_states));
-                    self.pc = target;
-                } else {
-                    bus.internal(u32::from(next_states));
-                }
-            }
-            Op::Bcc16 { mask, target } => {
-                bus.internal(t::N_BRANCH_D16);
-                if (mask >> (self.ccr & 15)) & 1 != 0 {
-                    self.pc = target;
-                }
-            }
+            } => self.bcc8(bus, mask, target, taken_states, next_states),
+            Op::Bcc16 { mask, target } => self.bcc16(bus, mask, target),
             Op::Bsr8 {
                 target,
                 prefetch_states,
-            } => {
-                self.push32(bus, next, StackAccess::Call, pc)?;
-                bus.internal(u32::from(prefetch_states));
-                self.pc = target;
-            }
-            Op::Bsr16 { target } => {
-                self.push32(bus, next, StackAccess::Call, pc)?;
-                bus.internal(t::N_BRANCH_D16);
-                self.pc = target;
-            }
-            Op::JmpAbs { target } => {
-                bus.internal(t::N_JUMP_ABS24);
-                self.pc = target;
-            }
-            Op::JsrAbs { target } => {
-                self.push32(bus, next, StackAccess::Call, pc)?;
-                bus.internal(t::N_JUMP_ABS24);
-                self.pc = target;
-            }
-            Op::JmpReg { r } => {
-                let target = self.er[usize::from(r & 7)] & ADDRESS_MASK;
-                bus.internal(prefetch_states(target));
-                self.jump_to(target);
-            }
-            Op::JsrReg { r } => {
-                // The target is read before the push (JSR @ER7 jumps to ER7's old value).
-                let target = self.er[usize::from(r & 7)] & ADDRESS_MASK;
-                self.push32(bus, next, StackAccess::Call, pc)?;
-                bus.internal(prefetch_states(target));
-                self.jump_to(target);
-            }
-            Op::Rts => {
-                let ret = self.pop32(bus, StackAccess::Return, pc)? & ADDRESS_MASK;
-                bus.internal(prefetch_states(ret) + t::N_RETURN);
-                self.jump_to(ret);
-            }
+            } => self.bsr8(bus, target, prefetch_states, pc, next)?,
+            Op::Bsr16 { target } => self.bsr16(bus, target, pc, next)?,
+            Op::JmpAbs { target } => self.jmp_abs(bus, target),
+            Op::JsrAbs { target } => self.jsr_abs(bus, target, pc, next)?,
+            Op::JmpReg { r } => self.jmp_reg(bus, r),
+            Op::JsrReg { r } => self.jsr_reg(bus, r, pc, next)?,
+            Op::Rts => self.rts_fast(bus, pc)?,
         }
         Ok(Event::Executed)
+    }
+
+    /// A load through ER7 ([`Op::LdStack`]), checked by the stack guard first.
+    #[inline(always)]
+    fn load_stack<B: Bus>(
+        &mut self,
+        bus: &mut B,
+        size: Size,
+        src: Operand,
+        rd: u8,
+        pc: u32,
+    ) -> Result<(), CpuError> {
+        let bytes = sz(size).bytes;
+        self.stack_ok(self.stack_target(src, bytes), bytes, StackAccess::Read, pc)?;
+        self.load(bus, size, src, rd);
+        Ok(())
+    }
+
+    /// A store through ER7 ([`Op::StStack`]), checked by the stack guard first.
+    #[inline(always)]
+    fn store_stack<B: Bus>(
+        &mut self,
+        bus: &mut B,
+        size: Size,
+        rs: u8,
+        dst: Operand,
+        pc: u32,
+    ) -> Result<(), CpuError> {
+        let bytes = sz(size).bytes;
+        self.stack_ok(self.stack_target(dst, bytes), bytes, StackAccess::Write, pc)?;
+        self.store(bus, size, rs, dst);
+        Ok(())
+    }
+
+    /// [`Op::Bcc8`]: the prefetch at the target if taken, after the instruction if not.
+    #[inline(always)]
+    fn bcc8<B: Bus>(
+        &mut self,
+        bus: &mut B,
+        mask: u16,
+        target: u32,
+        taken_states: u8,
+        next_states: u8,
+    ) {
+        if (mask >> (self.ccr & 15)) & 1 != 0 {
+            bus.internal(u32::from(taken_states));
+            self.pc = target;
+        } else {
+            bus.internal(u32::from(next_states));
+        }
+    }
+
+    /// [`Op::Bcc16`]: N = 2 either way.
+    #[inline(always)]
+    fn bcc16<B: Bus>(&mut self, bus: &mut B, mask: u16, target: u32) {
+        bus.internal(t::N_BRANCH_D16);
+        if (mask >> (self.ccr & 15)) & 1 != 0 {
+            self.pc = target;
+        }
+    }
+
+    /// [`Op::Bsr8`]: push `next`, prefetch at the target.
+    #[inline(always)]
+    fn bsr8<B: Bus>(
+        &mut self,
+        bus: &mut B,
+        target: u32,
+        prefetch_states: u8,
+        pc: u32,
+        next: u32,
+    ) -> Result<(), CpuError> {
+        self.push32(bus, next, StackAccess::Call, pc)?;
+        bus.internal(u32::from(prefetch_states));
+        self.pc = target;
+        Ok(())
+    }
+
+    /// [`Op::Bsr16`]: push `next`, N = 2.
+    #[inline(always)]
+    fn bsr16<B: Bus>(
+        &mut self,
+        bus: &mut B,
+        target: u32,
+        pc: u32,
+        next: u32,
+    ) -> Result<(), CpuError> {
+        self.push32(bus, next, StackAccess::Call, pc)?;
+        bus.internal(t::N_BRANCH_D16);
+        self.pc = target;
+        Ok(())
+    }
+
+    /// [`Op::JmpAbs`]: N = 2.
+    #[inline(always)]
+    fn jmp_abs<B: Bus>(&mut self, bus: &mut B, target: u32) {
+        bus.internal(t::N_JUMP_ABS24);
+        self.pc = target;
+    }
+
+    /// [`Op::JsrAbs`]: push `next`, N = 2.
+    #[inline(always)]
+    fn jsr_abs<B: Bus>(
+        &mut self,
+        bus: &mut B,
+        target: u32,
+        pc: u32,
+        next: u32,
+    ) -> Result<(), CpuError> {
+        self.push32(bus, next, StackAccess::Call, pc)?;
+        bus.internal(t::N_JUMP_ABS24);
+        self.pc = target;
+        Ok(())
+    }
+
+    /// [`Op::JmpReg`]: prefetch at the target.
+    #[inline(always)]
+    fn jmp_reg<B: Bus>(&mut self, bus: &mut B, r: u8) {
+        let target = self.er[usize::from(r & 7)] & ADDRESS_MASK;
+        bus.internal(prefetch_states(target));
+        self.jump_to(target);
+    }
+
+    /// [`Op::JsrReg`]: push `next`, prefetch at the target.
+    #[inline(always)]
+    fn jsr_reg<B: Bus>(&mut self, bus: &mut B, r: u8, pc: u32, next: u32) -> Result<(), CpuError> {
+        // The target is read before the push (JSR @ER7 jumps to ER7's old value).
+        let target = self.er[usize::from(r & 7)] & ADDRESS_MASK;
+        self.push32(bus, next, StackAccess::Call, pc)?;
+        bus.internal(prefetch_states(target));
+        self.jump_to(target);
+        Ok(())
+    }
+
+    /// [`Op::Rts`]: pop, prefetch at the return address, N = 2.
+    #[inline(always)]
+    fn rts_fast<B: Bus>(&mut self, bus: &mut B, pc: u32) -> Result<(), CpuError> {
+        let ret = self.pop32(bus, StackAccess::Return, pc)? & ADDRESS_MASK;
+        bus.internal(prefetch_states(ret) + t::N_RETURN);
+        self.jump_to(ret);
+        Ok(())
     }
 
     /// MOV of `v` into a register: the reference path's MOV with a register destination.
