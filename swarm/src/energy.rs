@@ -21,6 +21,7 @@
 //!   wheels up more, and a robot pressed against a wall (its wheels slipping at the floor's
 //!   traction) the current that holds the slipping wheel's friction torque.
 
+use emu::board::board::RobotBoard;
 use emu::board::wiring::Bridge;
 use emu::chip::mcu::Mcu;
 use emu::chip::pins::Board;
@@ -192,6 +193,12 @@ impl Charge {
     }
 }
 
+/// Each EEPROM's counters on `mcu`'s board (0x50, then 0x51).
+fn eeprom_stats<W: Board>(mcu: &Mcu<RobotBoard<W>>) -> Vec<eeprom::DeviceStats> {
+    let chips = mcu.board().eeproms().devices();
+    chips.iter().map(|d| d.stats()).collect()
+}
+
 /// The electronics of one robot (the MCU, its A/D converter, the IR sensors, the EEPROMs, the
 /// regulator), metered from the MCU's own counters between two calls.
 #[derive(Clone, Debug)]
@@ -202,20 +209,21 @@ pub struct ElectronicsMeter {
 }
 
 impl ElectronicsMeter {
-    /// A meter that counts from `mcu`'s present state.
+    /// A meter that counts from `mcu`'s present state (the chip's counters, the EEPROMs' on
+    /// its board).
     #[must_use]
-    pub fn new<B: Board>(mcu: &Mcu<B>) -> Self {
+    pub fn new<W: Board>(mcu: &Mcu<RobotBoard<W>>) -> Self {
         let now = mcu.now();
         ElectronicsMeter {
             last_states: now,
             last_converting: mcu.adc().converting_states(now),
-            last_eeproms: mcu.i2c().devices().iter().map(|d| d.stats()).collect(),
+            last_eeproms: eeprom_stats(mcu),
         }
     }
 
     /// The charge since the last call (or since [`Self::new`]), of which the CPU was busy for
     /// `busy_states`.
-    pub fn take<B: Board>(&mut self, mcu: &Mcu<B>, busy_states: u64) -> Charge {
+    pub fn take<W: Board>(&mut self, mcu: &Mcu<RobotBoard<W>>, busy_states: u64) -> Charge {
         let now = mcu.now();
         let clock_hz = mcu.clock_hz();
         let interval = now.saturating_sub(self.last_states);
@@ -235,8 +243,7 @@ impl ElectronicsMeter {
             IR_SENSORS * sensors::SUPPLY_CURRENT_MA * seconds * 1e3,
         );
         c.add_to(Part::Regulator, REGULATOR_QUIESCENT_MA * seconds * 1e3);
-        let stats: Vec<eeprom::DeviceStats> =
-            mcu.i2c().devices().iter().map(|d| d.stats()).collect();
+        let stats = eeprom_stats(mcu);
         let eeproms: f64 = stats
             .iter()
             .zip(&self.last_eeproms)

@@ -1336,7 +1336,7 @@ mod tests {
             for i in 0..s.robots {
                 let b = swarm.world().bumpers(i).unwrap();
                 pressed += usize::from(b.iter().any(|&x| x));
-                let board = swarm.robot_mut(i).unwrap().mcu.board_mut();
+                let board = &mut swarm.robot_mut(i).unwrap().mcu.board_mut().world;
                 assert_eq!(board.bumpers, b);
                 let [front, rear, left, right] = b;
                 let want =
