@@ -1,7 +1,7 @@
 //! The controller on the emulated MCU: boot, the tick, steps within bounds derived here from
 //! docs/design.md §4.2, saves and their restore, a power cut in the middle of a save, determinism.
 
-use emu::board::board::{CLOCK_HZ as DEFAULT_CLOCK_HZ, RobotBoard, RobotConfig, robot_mcu};
+use emu::board::board::{CLOCK_HZ, RobotBoard, RobotConfig, robot_mcu};
 use emu::board::model::{Controller, ControllerConfig, ModelBus, StepReport};
 use emu::chip::mcu::Mcu;
 use emu::chip::pins::Board;
@@ -14,7 +14,7 @@ struct Wave;
 
 impl Board for Wave {
     fn analog_volts(&mut self, channel: u8, now: u64) -> f64 {
-        let t = now as f64 / f64::from(DEFAULT_CLOCK_HZ);
+        let t = now as f64 / f64::from(CLOCK_HZ);
         1.4 + 1.1 * (t * (0.7 + 0.3 * f64::from(channel))).sin()
     }
     fn port2_pins(&mut self, _now: u64) -> u8 {
@@ -26,7 +26,7 @@ fn mcu(seed: u64) -> Mcu<RobotBoard<Wave>> {
     robot_mcu(
         Wave,
         &RobotConfig {
-            clock_hz: DEFAULT_CLOCK_HZ,
+            clock_hz: CLOCK_HZ,
             eeprom_seed: seed,
         },
     )
@@ -250,7 +250,7 @@ fn a_power_cut_in_the_middle_of_a_save_leaves_the_last_committed_weights() {
             assert!(bus.cut, "the cut happened at {frac}");
         }
         let now = m.now();
-        m.power_on(now + u64::from(DEFAULT_CLOCK_HZ));
+        m.power_on(now + u64::from(CLOCK_HZ));
         let mut rebooted = Controller::new(ControllerConfig::arena(12)).expect("valid");
         let boot = rebooted.boot(&mut m).expect("boots");
         assert_eq!(boot.restored, Some(0), "cut at {frac} of the save");
@@ -411,7 +411,7 @@ fn rewired_sensors_read_the_same() {
         let mut m = robot_mcu(
             Rewired { channels },
             &RobotConfig {
-                clock_hz: DEFAULT_CLOCK_HZ,
+                clock_hz: CLOCK_HZ,
                 eeprom_seed: 2,
             },
         )

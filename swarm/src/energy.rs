@@ -480,7 +480,7 @@ mod tests {
 
     /// One drive wheel's traction with the world's defaults, μ_floor · m·g/2 = 1.4710 N.
     fn traction_n() -> f64 {
-        WorldParams::default().wheel_traction_n()
+        WorldParams::with_clock(u64::from(emu::board::board::CLOCK_HZ)).wheel_traction_n()
     }
 
     #[test]
@@ -558,7 +558,7 @@ mod tests {
     fn free_wheels_settle_to_the_no_load_current_and_held_ones_to_the_friction_current() {
         let params = WorldParams {
             motor_gain_spread: 0.0,
-            ..WorldParams::default()
+            ..WorldParams::with_clock(u64::from(emu::board::board::CLOCK_HZ))
         };
         let mut d = DriveMeter::new(0.15, [1.0, 1.0]);
         d.set_commands(WheelCommand::forward(1.0), WheelCommand::forward(0.3));

@@ -488,10 +488,7 @@ impl Rig {
         let stream = |k: u64, purpose: Purpose| robot_stream(cfg.seed, 0, 0, k, purpose);
         let mut sensors_v = Vec::with_capacity(4);
         for k in 0..4 {
-            let params = sensors::IrParams {
-                clock_hz,
-                ..sensors::IrParams::default()
-            };
+            let params = sensors::IrParams::datasheet(clock_hz);
             sensors_v.push(
                 sensors::IrSensor::new(params, stream(k, Purpose::IrSensor)).map_err(|e| {
                     FitError::Sensor {
@@ -571,7 +568,7 @@ struct FitMeter {
 
 impl FitMeter {
     fn new<W: Board>(mcu: &Mcu<RobotBoard<W>>) -> FitMeter {
-        let params = world::WorldParams::default();
+        let params = world::WorldParams::with_clock(u64::from(emu::board::board::CLOCK_HZ));
         let top = params.top_speed_m_per_s;
         let wheels = || FreeWheels::new(&params);
         FitMeter {

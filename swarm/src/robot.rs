@@ -242,17 +242,14 @@ impl Robot {
         images: Option<&Images>,
     ) -> Result<Self> {
         let stream = |k: u64, purpose: Purpose| robot_stream(s.seed, repeat, index, k, purpose);
+        let clock_hz = s.timing.clock_hz;
         let ir = IrParams {
-            clock_hz: s.timing.clock_hz,
             noise_sigma_volts: s.sensors.noise_sigma_v,
             spike_probability: s.sensors.spike_probability,
             ..if s.sensors.spread {
-                IrParams::default()
+                IrParams::datasheet(clock_hz)
             } else {
-                IrParams {
-                    clock_hz: s.timing.clock_hz,
-                    ..IrParams::ideal()
-                }
+                IrParams::ideal(clock_hz)
             }
         };
         let mut sensors_v = Vec::with_capacity(4);

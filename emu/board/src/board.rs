@@ -13,7 +13,7 @@
 //! `h8swarm emu` runs images on `RobotBoard<NullBoard>`: the EEPROMs present (seed 0), nothing
 //! else connected, so a program that uses the EEPROMs runs as on the robot.
 
-use eeprom::{DeviceConfig, EepromError, I2cBus, PowerCutOutcome};
+use eeprom::{EepromError, I2cBus, PowerCutOutcome};
 use h8_3052f::mcu::{MAX_CLOCK_HZ, Mcu, McuConfig, McuError};
 use h8_3052f::periph::ports::{P4_SCL, P4_SDA};
 use h8_3052f::pins::Board;
@@ -73,11 +73,7 @@ impl<W> RobotBoard<W> {
     /// # Errors
     /// [`EepromError`] if the EEPROM model refuses the clock.
     pub fn new(world: W, config: &RobotConfig) -> Result<Self, EepromError> {
-        let chip = DeviceConfig {
-            clock_hz: config.clock_hz,
-            ..DeviceConfig::new(eeprom::CHIP_A, config.eeprom_seed)
-        };
-        let eeproms = I2cBus::with_chips(&[eeprom::CHIP_A, eeprom::CHIP_B], &chip)?;
+        let eeproms = I2cBus::robot(config.eeprom_seed, config.clock_hz)?;
         Ok(RobotBoard {
             world,
             eeproms,
