@@ -16,8 +16,11 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
 
-/// The H8/3052F clock of the AKI-H8/3052F board (docs/design.md §4.1): 25 MHz, 40 ns per state.
-pub const PHI_HZ: f64 = 25.0e6;
+/// The robot's clock φ in Hz (the board's, `emu::board::board::CLOCK_HZ`; docs/design.md §4.1):
+/// the firmware's states become microseconds at it.
+fn phi_hz() -> f64 {
+    f64::from(emu::board::board::CLOCK_HZ)
+}
 
 /// What to measure.
 #[derive(Clone, Copy, Debug)]
@@ -210,7 +213,7 @@ pub fn measure(cfg: &CostConfig) -> Result<CostReport> {
         per_step.add(meter.total_states());
     }
     let step_states = per_step.stats();
-    let step_max_us = step_states.max as f64 / PHI_HZ * 1e6;
+    let step_max_us = step_states.max as f64 / phi_hz() * 1e6;
     Ok(CostReport {
         n_in,
         n_out: cfg.outputs,
@@ -243,10 +246,12 @@ pub fn measure(cfg: &CostConfig) -> Result<CostReport> {
 #[must_use]
 pub fn render(r: &CostReport) -> String {
     let mut s = String::new();
-    let us = |states: f64| states / PHI_HZ * 1e6;
+    let us = |states: f64| states / phi_hz() * 1e6;
     let _ = writeln!(
         s,
-        "h8swarm: learner cost on the H8/300H at 25 MHz (1 state = 40 ns), from the H8 meter"
+        "h8swarm: learner cost on the H8/300H at {} MHz (1 state = {} ns), from the H8 meter",
+        phi_hz() / 1e6,
+        1e9 / phi_hz()
     );
     let _ = writeln!(
         s,

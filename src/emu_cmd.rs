@@ -1,5 +1,8 @@
 //! `h8swarm emu IMAGE.mot [--max-states N] [--trace] [--stats] [--vcd FILE] [--gdb ADDR]
-//! [--symbols FILE]`: runs a program on the emulated H8/3052F (docs/design.md §7). SCI1 is the console
+//! [--symbols FILE]`: runs a program on the emulated H8/3052F (docs/design.md §7) on the robot's
+//! board (`emu::board::board::RobotBoard`: its two EEPROMs on port 4, seed 0, and nothing else
+//! connected: the analog inputs at 0 V, port 2 released), so that programs that use the
+//! EEPROMs run as on the robot. SCI1 is the console
 //! (standard output); `--trace` writes one line per instruction (address, disassembly, states,
 //! and the function it is in when the image has symbols) and `--stats` a JSON summary, both on
 //! standard error. `--vcd` writes a pin trace of the whole run (`emu::chip::vcd`); `--gdb`
@@ -24,9 +27,9 @@ use std::io::{self, BufWriter, Write};
 use std::path::Path;
 use std::sync::Arc;
 
+use emu::board::board::{RobotBoard, RobotConfig, robot_mcu};
 use emu::board::symbols::SymbolTable;
 use emu::chip::gdb::{Debugger, GdbError, GdbListener};
-use emu::chip::machine::Machine;
 use emu::chip::mcu::Mcu;
 use emu::chip::pins::NullBoard;
 use emu::chip::run::{Outcome, Probes, RunOptions, drain_into, run_mcu_probed};
@@ -37,6 +40,9 @@ use emu::core::cpu::{Cpu, StackGuard, StackGuardMode, StackRoom};
 use emu::core::srec;
 
 use crate::Failure;
+
+/// The MCU `h8swarm emu` runs images on: the robot's board with nothing but its EEPROMs.
+type EmuMcu = Mcu<RobotBoard<NullBoard>>;
 
 /// Exit status when `--max-states` runs out (as `timeout(1)` does).
 pub const EXIT_MAX_STATES: u8 = 124;
@@ -106,7 +112,7 @@ fn symbols(image: &str, given: Option<&Path>) -> Result<Option<SymbolTable>, Fai
 /// ([`Failure::Tool`]), or the program's own exit status ([`Failure::Program`]).
 pub fn run(o: &EmuOptions<'_>) -> Result<(), Failure> {
     let image = o.image;
-    let mut machine = load(image)?;
+    let mut mcu = load(image)?;
     let names = symbols(image, o.symbols)?.map(Arc::new);
     // Fail on a file that cannot be created before the program runs.
     let vcd_file = create_vcd(o.vcd)?;
@@ -119,8 +125,8 @@ pub fn run(o: &EmuOptions<'_>) -> Result<(), Failure> {
         room,
         mode: o.stack_guard,
     }));
-    cpu.reset(&mut machine);
-    let mcu = machine.mcu_mut();
+    cpu.reset(&mut mcu);
+    let mcu = &mut mcu;
     // The trace is written as the run makes it (never held whole).
     let (mut stream, mut phases) = match vcd_file {
         Some(file) => {
@@ -173,8 +179,8 @@ pub fn run(o: &EmuOptions<'_>) -> Result<(), Failure> {
     exit(&report.outcome, report.stats.states, image)
 }
 
-/// The image loaded into a fresh machine.
-fn load(image: &str) -> Result<Machine, Failure> {
+/// The image loaded into a fresh MCU on the robot's board.
+fn load(image: &str) -> Result<EmuMcu, Failure> {
     let max = emu::board::firmware::Firmware::MAX_FILE_BYTES;
     let bytes =
         emu::board::firmware::read_bounded(std::path::Path::new(image), max).map_err(|e| {
@@ -185,9 +191,12 @@ fn load(image: &str) -> Result<Machine, Failure> {
     let srec = srec::parse(&bytes).map_err(|e| {
         Failure::Input(anyhow::Error::new(e).context(format!("image `{image}`: bad image")))
     })?;
-    Machine::with_image(&srec).map_err(|e| {
+    let mut mcu = robot_mcu(NullBoard, &RobotConfig::default())
+        .map_err(|e| Failure::Tool(anyhow::Error::new(e).context("building the robot's board")))?;
+    mcu.load_image(&srec).map_err(|e| {
         Failure::Input(anyhow::Error::new(e).context(format!("image `{image}`: cannot load image")))
-    })
+    })?;
+    Ok(mcu)
 }
 
 /// The `--vcd` file, created (empty) when asked for.
@@ -231,7 +240,7 @@ fn vcd_failure(o: &EmuOptions<'_>, e: io::Error) -> Failure {
 fn start_vcd(
     file: std::fs::File,
     cpu: &Cpu,
-    mcu: &mut Mcu<NullBoard>,
+    mcu: &mut EmuMcu,
     names: Option<&Arc<SymbolTable>>,
     o: &EmuOptions<'_>,
 ) -> Result<(VcdStream<'static>, Option<PhaseRecorder>), Failure> {
@@ -262,7 +271,7 @@ fn start_vcd(
 /// Writes the rest of the pin trace and the phases, and the trace's end.
 fn finish_vcd(
     mut v: VcdStream<'_>,
-    mcu: &mut Mcu<NullBoard>,
+    mcu: &mut EmuMcu,
     mut phases: Option<&mut PhaseRecorder>,
 ) -> io::Result<()> {
     drain_into(&mut v, mcu, phases.as_deref_mut())?;

@@ -10,6 +10,9 @@ use std::hint::black_box;
 use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
 use eeprom::{I2cBus, I2cMaster, MasterTiming, Persistence, Record, RecordLayout, SimPins};
 
+/// The MCU's φ these tests count in: the robot's 25 MHz (the crate has no clock of its own).
+const CLOCK_HZ: u32 = 25_000_000;
+
 fn record(seq: u32, len: usize) -> Record {
     Record {
         sequence: seq,
@@ -19,8 +22,8 @@ fn record(seq: u32, len: usize) -> Record {
 
 fn snapshot(p: &Persistence, len: usize) -> I2cBus {
     let mut m = I2cMaster::new(
-        SimPins::new(I2cBus::robot(1).unwrap()),
-        MasterTiming::default(),
+        SimPins::new(I2cBus::robot(1, CLOCK_HZ).unwrap()),
+        MasterTiming::fast_mode(CLOCK_HZ).unwrap(),
     );
     m.init();
     for s in 0..4 {
@@ -30,7 +33,10 @@ fn snapshot(p: &Persistence, len: usize) -> I2cBus {
 }
 
 fn report(p: &Persistence, bus: &I2cBus, len: usize) {
-    let mut m = I2cMaster::new(SimPins::new(bus.clone()), MasterTiming::default());
+    let mut m = I2cMaster::new(
+        SimPins::new(bus.clone()),
+        MasterTiming::fast_mode(CLOCK_HZ).unwrap(),
+    );
     let e0 = m.pins().edges();
     let t0 = m.pins().now();
     let rep = p.save(&mut m, &record(4, len)).unwrap();
@@ -39,7 +45,7 @@ fn report(p: &Persistence, bus: &I2cBus, len: usize) {
     let st = m.stats();
     let mut r = I2cMaster::new(
         SimPins::new(m.into_pins().into_bus().unwrap()),
-        MasterTiming::default(),
+        MasterTiming::fast_mode(CLOCK_HZ).unwrap(),
     );
     let r0 = r.pins().edges().total();
     let rt0 = r.pins().now();
@@ -79,7 +85,10 @@ fn bench_save(c: &mut Criterion) {
             b.iter_batched(
                 || bus.clone(),
                 |bus| {
-                    let mut m = I2cMaster::new(SimPins::new(bus), MasterTiming::default());
+                    let mut m = I2cMaster::new(
+                        SimPins::new(bus),
+                        MasterTiming::fast_mode(CLOCK_HZ).unwrap(),
+                    );
                     black_box(p.save(&mut m, black_box(&rec)).unwrap());
                     m
                 },

@@ -122,14 +122,15 @@ impl I2cBus {
         I2cBus::new(devices)
     }
 
-    /// The robot's bus: chips at 0x50 and 0x51 with datasheet defaults, streams from `seed`.
+    /// The robot's bus: chips at 0x50 and 0x51 with datasheet defaults, counting in the MCU's
+    /// `clock_hz`, streams from `seed`.
     ///
     /// # Errors
-    /// Never with these arguments; kept fallible for uniformity.
-    pub fn robot(seed: u64) -> Result<I2cBus, EepromError> {
+    /// [`EepromError::InvalidClock`] for a zero clock.
+    pub fn robot(seed: u64, clock_hz: u32) -> Result<I2cBus, EepromError> {
         I2cBus::with_chips(
             &[crate::persist::CHIP_A, crate::persist::CHIP_B],
-            &DeviceConfig::new(crate::persist::CHIP_A, seed),
+            &DeviceConfig::new(crate::persist::CHIP_A, seed, clock_hz),
         )
     }
 
@@ -448,7 +449,7 @@ mod line_log_tests {
 
     #[test]
     fn the_line_log_holds_every_change_with_its_instant() {
-        let mut bus = I2cBus::robot(7).unwrap();
+        let mut bus = I2cBus::robot(7, 25_000_000).unwrap();
         // No log yet: nothing is kept.
         bus.set_master(10, false, true).unwrap();
         assert!(bus.take_line_log().is_empty());

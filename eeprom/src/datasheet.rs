@@ -99,9 +99,3 @@ pub mod standard {
     /// T_BUF: 4 700 ns (DS21203 Table 1-2, param. 14, low-voltage column).
     pub const T_BUF_MIN_NS: u64 = 4_700;
 }
-
-/// Default MCU clock φ: 25 MHz, as on the Akizuki AKI-H8/3052F board (docs/design.md §4.1).
-pub const DEFAULT_CLOCK_HZ: u32 = 25_000_000;
-/// Highest φ accepted: 25 MHz, the H8/3052F's maximum operating frequency (H8/3052F hardware
-/// manual, electrical characteristics; docs/design.md §4.1).
-pub const MAX_CLOCK_HZ: u32 = 25_000_000;

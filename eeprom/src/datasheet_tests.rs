@@ -6,20 +6,26 @@ use crate::{
     SimPins,
 };
 
+/// The MCU's φ these tests count in: the robot's 25 MHz (the crate has no clock of its own).
+const CLOCK_HZ: u32 = 25_000_000;
+
 type M = I2cMaster<SimPins>;
 
 fn master_on(bus: I2cBus) -> M {
-    let mut m = I2cMaster::new(SimPins::new(bus), MasterTiming::default());
+    let mut m = I2cMaster::new(
+        SimPins::new(bus),
+        MasterTiming::fast_mode(CLOCK_HZ).unwrap(),
+    );
     m.init();
     m
 }
 
 fn robot(seed: u64) -> M {
-    master_on(I2cBus::robot(seed).unwrap())
+    master_on(I2cBus::robot(seed, CLOCK_HZ).unwrap())
 }
 
 fn with_config(f: impl Fn(&mut DeviceConfig)) -> M {
-    let mut cfg = DeviceConfig::new(0x50, 11);
+    let mut cfg = DeviceConfig::new(0x50, 11, CLOCK_HZ);
     f(&mut cfg);
     master_on(I2cBus::with_chips(&[0x50, 0x51], &cfg).unwrap())
 }
@@ -109,7 +115,7 @@ fn control_byte_selects_only_the_chip_with_matching_a2_a1_a0() {
 
 #[test]
 fn device_pulls_sda_low_during_the_ninth_clock_after_its_output_delay() {
-    let bus = I2cBus::robot(4).unwrap();
+    let bus = I2cBus::robot(4, CLOCK_HZ).unwrap();
     let delay = bus.device(0x50).unwrap().output_delay_states();
     assert_eq!(delay, 22, "900 ns at 25 MHz, rounded down");
     let mut p = SimPins::new(bus);
@@ -573,7 +579,7 @@ fn past_the_endurance_limit_bits_stick() {
 #[test]
 fn wear_is_probabilistic_and_seeded() {
     let run = |seed: u64| {
-        let mut cfg = DeviceConfig::new(0x50, seed);
+        let mut cfg = DeviceConfig::new(0x50, seed, CLOCK_HZ);
         cfg.endurance_cycles = 1;
         cfg.stuck_bit_probability = 0.05;
         let mut m = master_on(I2cBus::with_chips(&[0x50], &cfg).unwrap());
@@ -775,7 +781,7 @@ fn power_cut_while_the_chip_drives_sda_releases_the_line() {
         .unwrap();
     let mut p = m.into_pins();
     // Random read by hand up to the first data bit (0): the chip pulls SDA.
-    let mut tmp = I2cMaster::new(&mut p, MasterTiming::default());
+    let mut tmp = I2cMaster::new(&mut p, MasterTiming::fast_mode(CLOCK_HZ).unwrap());
     let mut b = [0u8; 1];
     tmp.random_read(0x50, 0, &mut b).unwrap();
     // Start a current-address read and stop after the ACK clock, leaving the chip driving 0.
@@ -801,7 +807,7 @@ fn power_cut_while_the_chip_drives_sda_releases_the_line() {
     p.wait_states(50);
     assert!(!p.sda_is_high(), "chip drives the first data bit (0)");
     // MCU reset without power loss: the bus-clear sequence frees the line.
-    let mut fresh = I2cMaster::new(&mut p, MasterTiming::default());
+    let mut fresh = I2cMaster::new(&mut p, MasterTiming::fast_mode(CLOCK_HZ).unwrap());
     let clocks = fresh.bus_clear().unwrap();
     assert!(clocks >= 1);
     assert!(fresh.pins_mut().sda_is_high());
@@ -845,7 +851,7 @@ fn master_meets_every_datasheet_minimum_in_both_modes_and_with_pin_costs() {
         (MasterTiming::standard_mode(25_000_000).unwrap(), 13),
     ] {
         let mut m = I2cMaster::new(
-            SimPins::new(I2cBus::robot(22).unwrap()).with_op_states(op),
+            SimPins::new(I2cBus::robot(22, CLOCK_HZ).unwrap()).with_op_states(op),
             timing,
         );
         m.init();
@@ -891,9 +897,9 @@ fn master_timing_at_25_mhz_is_400_khz_class() {
 fn too_fast_master_is_reported_by_the_timing_monitor() {
     let t = MasterTiming {
         scl_high_states: 10, // 400 ns < 600 ns
-        ..MasterTiming::default()
+        ..MasterTiming::fast_mode(CLOCK_HZ).unwrap()
     };
-    let mut m = I2cMaster::new(SimPins::new(I2cBus::robot(23).unwrap()), t);
+    let mut m = I2cMaster::new(SimPins::new(I2cBus::robot(23, CLOCK_HZ).unwrap()), t);
     m.init();
     let _ = m.byte_write(0x50, 0, 0);
     let v = m.pins().bus().device(0x50).unwrap().timing_violations();
@@ -905,7 +911,7 @@ fn too_fast_master_is_reported_by_the_timing_monitor() {
 
 #[test]
 fn bus_rejects_duplicates_unknown_devices_and_time_going_back() {
-    let cfg = DeviceConfig::new(0x50, 1);
+    let cfg = DeviceConfig::new(0x50, 1, CLOCK_HZ);
     assert!(matches!(
         I2cBus::with_chips(&[0x50, 0x50], &cfg),
         Err(EepromError::DuplicateDeviceAddress { address: 0x50 })
@@ -914,7 +920,7 @@ fn bus_rejects_duplicates_unknown_devices_and_time_going_back() {
         I2cBus::with_chips(&[0x58], &cfg),
         Err(EepromError::InvalidDeviceAddress { address: 0x58 })
     ));
-    let mut bus = I2cBus::robot(1).unwrap();
+    let mut bus = I2cBus::robot(1, CLOCK_HZ).unwrap();
     let e = bus.device(0x53).unwrap_err();
     assert!(e.to_string().contains("0x50, 0x51"), "{e}");
     bus.set_master(100, false, true).unwrap();
@@ -974,7 +980,7 @@ mod properties {
             seed in any::<u64>(),
             ops in proptest::collection::vec((0u8..8, 0u64..200), 0..600),
         ) {
-            let mut p = SimPins::new(I2cBus::robot(seed).unwrap());
+            let mut p = SimPins::new(I2cBus::robot(seed, CLOCK_HZ).unwrap());
             for (op, n) in ops {
                 match op {
                     0 => p.scl_low(),
@@ -995,7 +1001,7 @@ mod properties {
             // Whatever state the chips were left in, wait out any write cycle, clear the bus
             // and use it.
             p.advance(200_000).unwrap();
-            let mut m = I2cMaster::new(p, MasterTiming::default());
+            let mut m = I2cMaster::new(p, MasterTiming::fast_mode(CLOCK_HZ).unwrap());
             m.bus_clear().unwrap();
             m.byte_write(0x50, 0x0123, 0x77).unwrap();
             m.ack_poll(0x50, 1000).unwrap();

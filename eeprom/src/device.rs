@@ -56,12 +56,13 @@ pub struct DeviceConfig {
 }
 
 impl DeviceConfig {
-    /// Datasheet defaults for a chip at `address`, random streams from `seed`.
+    /// Datasheet defaults for a chip at `address` counting in the MCU's `clock_hz`, random
+    /// streams from `seed`.
     #[must_use]
-    pub fn new(address: u8, seed: u64) -> DeviceConfig {
+    pub fn new(address: u8, seed: u64, clock_hz: u32) -> DeviceConfig {
         DeviceConfig {
             address,
-            clock_hz: crate::datasheet::DEFAULT_CLOCK_HZ,
+            clock_hz,
             t_wc_min_ns: T_WC_MODEL_MIN_NS,
             t_wc_max_ns: T_WC_MAX_NS,
             output_delay_ns: T_AA_MAX_NS,
@@ -1027,7 +1028,7 @@ mod tests {
 
     #[test]
     fn bad_configs_are_errors_not_panics() {
-        let ok = DeviceConfig::new(0x50, 1);
+        let ok = DeviceConfig::new(0x50, 1, 25_000_000);
         assert!(Eeprom24lc256::new(ok.clone()).is_ok());
         let bad = |f: fn(&mut DeviceConfig)| {
             let mut c = ok.clone();
@@ -1087,7 +1088,7 @@ mod tests {
 
     #[test]
     fn back_door_reads_check_range_and_power() {
-        let mut d = Eeprom24lc256::new(DeviceConfig::new(0x51, 1)).unwrap();
+        let mut d = Eeprom24lc256::new(DeviceConfig::new(0x51, 1, 25_000_000)).unwrap();
         let mut b = [0u8; 4];
         d.read(0, 0x7FFC, &mut b).unwrap();
         assert_eq!(b, [0xFF; 4]);
@@ -1111,7 +1112,7 @@ mod tests {
 
     #[test]
     fn write_cycle_time_bounds_in_states() {
-        let d = Eeprom24lc256::new(DeviceConfig::new(0x50, 1)).unwrap();
+        let d = Eeprom24lc256::new(DeviceConfig::new(0x50, 1, 25_000_000)).unwrap();
         assert_eq!(d.t_wc_range_states(), (75_000, 125_000));
         assert_eq!(d.output_delay_states(), 22);
     }

@@ -57,9 +57,11 @@
 //! ```
 //! use eeprom::{I2cBus, I2cMaster, MasterTiming, Persistence, Record, SimPins};
 //!
-//! // The robot's bus (chips at 0x50 and 0x51) driven by the bit-banging master.
-//! let bus = I2cBus::robot(1)?;
-//! let mut master = I2cMaster::new(SimPins::new(bus), MasterTiming::default());
+//! // The robot's bus (chips at 0x50 and 0x51) driven by the bit-banging master, every time
+//! // counted in the MCU's φ (the robot's is 25 MHz; the crate has no clock of its own).
+//! let clock_hz = 25_000_000;
+//! let bus = I2cBus::robot(1, clock_hz)?;
+//! let mut master = I2cMaster::new(SimPins::new(bus), MasterTiming::fast_mode(clock_hz)?);
 //! master.init();
 //! let store = Persistence::default();
 //! let boot = store.recover(&mut master);

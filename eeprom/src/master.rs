@@ -142,10 +142,11 @@ impl MasterTiming {
         }
     }
 
-    /// 400 kHz-class timing: the 24LC256's minima at 2.5–5.5 V (DS21203 Table 1-2). The default.
+    /// 400 kHz-class timing: the 24LC256's minima at 2.5–5.5 V (DS21203 Table 1-2), at the
+    /// MCU's `clock_hz`.
     ///
     /// # Errors
-    /// [`EepromError::InvalidClock`] for a zero or too fast clock.
+    /// [`EepromError::InvalidClock`] for a zero clock.
     pub fn fast_mode(clock_hz: u32) -> Result<MasterTiming, EepromError> {
         use datasheet as d;
         Ok(MasterTiming::from_ns(
@@ -165,7 +166,7 @@ impl MasterTiming {
     /// pull-ups.
     ///
     /// # Errors
-    /// [`EepromError::InvalidClock`] for a zero or too fast clock.
+    /// [`EepromError::InvalidClock`] for a zero clock.
     pub fn standard_mode(clock_hz: u32) -> Result<MasterTiming, EepromError> {
         use datasheet::standard as s;
         Ok(MasterTiming::from_ns(
@@ -179,24 +180,6 @@ impl MasterTiming {
             s::T_SU_STO_MIN_NS,
             s::T_BUF_MIN_NS,
         ))
-    }
-}
-
-impl Default for MasterTiming {
-    fn default() -> Self {
-        let clock = Clock::default();
-        use datasheet as d;
-        MasterTiming::from_ns(
-            clock,
-            d::F_CLK_MAX_HZ,
-            d::T_HIGH_MIN_NS,
-            d::T_LOW_MIN_NS,
-            d::T_SU_STA_MIN_NS,
-            d::T_HD_STA_MIN_NS,
-            d::T_SU_DAT_MIN_NS,
-            d::T_SU_STO_MIN_NS,
-            d::T_BUF_MIN_NS,
-        )
     }
 }
 

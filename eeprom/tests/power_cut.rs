@@ -8,6 +8,9 @@ use eeprom::{
     SavePolicy, SimPins, WriteCycleInfo,
 };
 
+/// The MCU's φ these tests count in: the robot's 25 MHz (the crate has no clock of its own).
+const CLOCK_HZ: u32 = 25_000_000;
+
 /// States the robot stays off after a cut (1 ms at 25 MHz).
 const OFF_STATES: u64 = 25_000;
 
@@ -142,7 +145,7 @@ fn cut_and_recover(bus: &I2cBus, t: u64, p: &Persistence) -> (Option<Record>, bo
     let outcomes = b.power_cut(t).unwrap();
     let interrupted = outcomes.iter().any(|o| o.interrupted_write.is_some());
     b.power_on(t + OFF_STATES).unwrap();
-    let mut m = I2cMaster::new(SimPins::new(b), MasterTiming::default());
+    let mut m = I2cMaster::new(SimPins::new(b), MasterTiming::fast_mode(CLOCK_HZ).unwrap());
     m.init();
     (p.recover(&mut m).newest, interrupted)
 }
@@ -165,8 +168,8 @@ fn exhaustive(seed: u64, seq: u32, len: usize) -> (Tally, u64, Vec<WriteCycleInf
     let chip = eeprom::persist::chip_for_sequence(seq);
     // Bring the chips to the state before save `seq`: saves 0..seq all committed.
     let mut m = I2cMaster::new(
-        SimPins::new(I2cBus::robot(seed).unwrap()),
-        MasterTiming::default(),
+        SimPins::new(I2cBus::robot(seed, CLOCK_HZ).unwrap()),
+        MasterTiming::fast_mode(CLOCK_HZ).unwrap(),
     );
     m.init();
     for s in 0..seq {
@@ -189,7 +192,7 @@ fn exhaustive(seed: u64, seq: u32, len: usize) -> (Tally, u64, Vec<WriteCycleInf
         };
         let pins = ProbePins::new(before.clone(), Vec::new(), hook);
         let e0 = pins.bus.edges().total();
-        let mut m = I2cMaster::new(pins, MasterTiming::default());
+        let mut m = I2cMaster::new(pins, MasterTiming::fast_mode(CLOCK_HZ).unwrap());
         p.save(&mut m, &new).unwrap();
         edges_in_save += m.pins().bus.edges().total() - e0;
     }
@@ -235,7 +238,7 @@ fn exhaustive(seed: u64, seq: u32, len: usize) -> (Tally, u64, Vec<WriteCycleInf
             }
         };
         let pins = ProbePins::new(before.clone(), probes, hook);
-        let mut m = I2cMaster::new(pins, MasterTiming::default());
+        let mut m = I2cMaster::new(pins, MasterTiming::fast_mode(CLOCK_HZ).unwrap());
         p.save(&mut m, &new).unwrap();
         // And once more after the save returned: the new record must be there.
         let t = m.pins().now;
@@ -308,8 +311,8 @@ fn writes_per_page_are_counted_exactly_for_a_save_policy() {
     let len = 104;
     let p = persistence(len);
     let mut m = I2cMaster::new(
-        SimPins::new(I2cBus::robot(42).unwrap()),
-        MasterTiming::default(),
+        SimPins::new(I2cBus::robot(42, CLOCK_HZ).unwrap()),
+        MasterTiming::fast_mode(CLOCK_HZ).unwrap(),
     );
     m.init();
     let mut seq = 0u32;
@@ -344,12 +347,15 @@ fn repeated_random_cuts_never_lose_the_last_committed_record() {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
     let len = 150;
     let p = persistence(len);
-    let mut bus = I2cBus::robot(77).unwrap();
+    let mut bus = I2cBus::robot(77, CLOCK_HZ).unwrap();
     let mut committed: Option<Record> = None;
     let mut in_flight: Option<Record> = None;
     let (mut cut_saves, mut whole_saves, mut got_new) = (0, 0, 0);
     for _ in 0..40 {
-        let mut m = I2cMaster::new(SimPins::new(bus), MasterTiming::default());
+        let mut m = I2cMaster::new(
+            SimPins::new(bus),
+            MasterTiming::fast_mode(CLOCK_HZ).unwrap(),
+        );
         m.init();
         let rec = p.recover(&mut m);
         match in_flight.take() {
@@ -370,7 +376,7 @@ fn repeated_random_cuts_never_lose_the_last_committed_record() {
             };
             let mut m = I2cMaster::new(
                 ProbePins::new(start, vec![cut_at], hook),
-                MasterTiming::default(),
+                MasterTiming::fast_mode(CLOCK_HZ).unwrap(),
             );
             p.save(&mut m, &next).unwrap();
             m.into_pins().bus

@@ -3,6 +3,9 @@
 
 use eeprom::{I2cBus, I2cMaster, MasterTiming, SimPins};
 
+/// The MCU's φ these tests count in: the robot's 25 MHz (the crate has no clock of its own).
+const CLOCK_HZ: u32 = 25_000_000;
+
 fn data(n: usize, salt: u8) -> Vec<u8> {
     (0..n).map(|i| (i as u8).wrapping_mul(37) ^ salt).collect()
 }
@@ -10,8 +13,8 @@ fn data(n: usize, salt: u8) -> Vec<u8> {
 #[test]
 fn transaction_writes_match_pin_level_page_writes() {
     let timing = MasterTiming::fast_mode(25_000_000).expect("timing");
-    let mut pins = SimPins::new(I2cBus::robot(42).expect("bus"));
-    let mut fast = I2cBus::robot(42).expect("bus");
+    let mut pins = SimPins::new(I2cBus::robot(42, CLOCK_HZ).expect("bus"));
+    let mut fast = I2cBus::robot(42, CLOCK_HZ).expect("bus");
     // A mix of pages, offsets that wrap inside the page, both chips, repeated pages.
     let writes: [(u8, u16, usize); 7] = [
         (0x50, 0x0000, 64),
@@ -78,7 +81,7 @@ fn transaction_writes_match_pin_level_page_writes() {
 
 #[test]
 fn transactions_refuse_busy_and_unpowered_chips() {
-    let mut bus = I2cBus::robot(1).expect("bus");
+    let mut bus = I2cBus::robot(1, CLOCK_HZ).expect("bus");
     let end = bus
         .write_transaction(1000, 0x50, 0, &[1, 2, 3])
         .expect("write");

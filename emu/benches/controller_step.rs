@@ -12,8 +12,9 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use emu::board::board::{CLOCK_HZ, RobotBoard, RobotConfig, robot_mcu};
 use emu::board::model::{Controller, ControllerConfig};
-use emu::chip::mcu::{DEFAULT_CLOCK_HZ, Mcu, McuConfig};
+use emu::chip::mcu::Mcu;
 use emu::chip::pins::Board;
 use emu::core::bus::Bus;
 
@@ -21,7 +22,7 @@ struct Wave;
 
 impl Board for Wave {
     fn analog_volts(&mut self, channel: u8, now: u64) -> f64 {
-        let t = now as f64 / f64::from(DEFAULT_CLOCK_HZ);
+        let t = now as f64 / f64::from(CLOCK_HZ);
         1.4 + 1.1 * (t * (0.7 + 0.3 * f64::from(channel))).sin()
     }
     fn port2_pins(&mut self, _now: u64) -> u8 {
@@ -29,12 +30,12 @@ impl Board for Wave {
     }
 }
 
-fn setup(save_every_steps: u32, fast_forward: bool) -> (Controller, Mcu<Wave>) {
+fn setup(save_every_steps: u32, fast_forward: bool) -> (Controller, Mcu<RobotBoard<Wave>>) {
     let mut cfg = ControllerConfig::arena(1);
     cfg.save_every_steps = save_every_steps;
     cfg.fast_forward = fast_forward;
     let mut c = Controller::new(cfg).expect("valid controller");
-    let mut m = Mcu::new(McuConfig::default(), Wave).expect("valid MCU");
+    let mut m = robot_mcu(Wave, &RobotConfig::default()).expect("valid MCU");
     c.boot(&mut m).expect("boots");
     (c, m)
 }

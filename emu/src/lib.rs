@@ -10,11 +10,13 @@
 //!    S-record loader for `.mot` images). It knows no chip.
 //! 2. [`chip`] — the H8/3052F: [`chip::periph`] (A/D, ITU, ports, interrupt controller, SCI1,
 //!    each synchronised lazily to the clock), [`chip::mcu`] (the chip as one bus: memories,
-//!    peripherals, the EEPROM bus on port 4, the [`chip::pins::Board`] outside it),
-//!    [`chip::machine`] (the MCU with nothing connected, for `h8swarm emu`), [`chip::run`]
+//!    peripherals, the [`chip::pins::Board`] outside its pins),
+//!    [`chip::machine`] (the MCU with nothing connected), [`chip::run`]
 //!    (running an image to its halt, with console, trace and statistics) and [`chip::power`]
 //!    (what the chip draws from its supply, by state). It knows the core and no robot.
-//! 3. [`board`] — the robot around the chip: [`board::wiring`] (which robot part sits on which
+//! 3. [`board`] — the robot around the chip: [`board::board`] (the robot's clock and the
+//!    board's own parts, the EEPROMs on port 4: what `h8swarm emu` runs images on),
+//!    [`board::wiring`] (which robot part sits on which
 //!    pin; the motor pins read as H-bridge inputs), [`board::ram`] (the on-chip RAM as a budget
 //!    of placed items), the robot's firmware ([`board::firmware`] with its [`board::symbols`],
 //!    [`board::profile`] and [`board::oncore`]) and [`board::model`] (the Rust model of the

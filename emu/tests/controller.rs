@@ -1,8 +1,9 @@
 //! The controller on the emulated MCU: boot, the tick, steps within bounds derived here from
 //! docs/design.md §4.2, saves and their restore, a power cut in the middle of a save, determinism.
 
+use emu::board::board::{CLOCK_HZ, RobotBoard, RobotConfig, robot_mcu};
 use emu::board::model::{Controller, ControllerConfig, ModelBus, StepReport};
-use emu::chip::mcu::{DEFAULT_CLOCK_HZ, Mcu, McuConfig};
+use emu::chip::mcu::Mcu;
 use emu::chip::pins::Board;
 use emu::core::bus::{Bus, FastPathHints};
 use nn_q15::Q15;
@@ -13,7 +14,7 @@ struct Wave;
 
 impl Board for Wave {
     fn analog_volts(&mut self, channel: u8, now: u64) -> f64 {
-        let t = now as f64 / f64::from(DEFAULT_CLOCK_HZ);
+        let t = now as f64 / f64::from(CLOCK_HZ);
         1.4 + 1.1 * (t * (0.7 + 0.3 * f64::from(channel))).sin()
     }
     fn port2_pins(&mut self, _now: u64) -> u8 {
@@ -21,18 +22,18 @@ impl Board for Wave {
     }
 }
 
-fn mcu(seed: u64) -> Mcu<Wave> {
-    Mcu::new(
-        McuConfig {
-            clock_hz: DEFAULT_CLOCK_HZ,
+fn mcu(seed: u64) -> Mcu<RobotBoard<Wave>> {
+    robot_mcu(
+        Wave,
+        &RobotConfig {
+            clock_hz: CLOCK_HZ,
             eeprom_seed: seed,
         },
-        Wave,
     )
     .expect("a valid MCU")
 }
 
-fn run(c: &mut Controller, m: &mut Mcu<Wave>, steps: u32) -> Vec<StepReport> {
+fn run(c: &mut Controller, m: &mut Mcu<RobotBoard<Wave>>, steps: u32) -> Vec<StepReport> {
     (0..steps)
         .map(|_| {
             c.sleep_until_step(m).expect("the tick wakes the CPU");
@@ -148,7 +149,7 @@ fn saves_write_records_that_a_reboot_restores() {
 
 /// Delegates to an MCU and cuts the robot's power once the clock passes `cut_at`.
 struct CutAt<'a> {
-    mcu: &'a mut Mcu<Wave>,
+    mcu: &'a mut Mcu<RobotBoard<Wave>>,
     cut_at: u64,
     cut: bool,
 }
@@ -156,7 +157,7 @@ struct CutAt<'a> {
 impl CutAt<'_> {
     fn check(&mut self) {
         if !self.cut && self.mcu.now() >= self.cut_at {
-            self.mcu.power_cut().expect("power cut");
+            self.mcu.power_cut();
             self.cut = true;
         }
     }
@@ -249,8 +250,7 @@ fn a_power_cut_in_the_middle_of_a_save_leaves_the_last_committed_weights() {
             assert!(bus.cut, "the cut happened at {frac}");
         }
         let now = m.now();
-        m.power_on(now + u64::from(DEFAULT_CLOCK_HZ))
-            .expect("power on");
+        m.power_on(now + u64::from(CLOCK_HZ));
         let mut rebooted = Controller::new(ControllerConfig::arena(12)).expect("valid");
         let boot = rebooted.boot(&mut m).expect("boots");
         assert_eq!(boot.restored, Some(0), "cut at {frac} of the save");
@@ -305,13 +305,13 @@ fn fast_forward_case(corridor: bool, save_every: u32, steps: u32) {
         let chips: Vec<(Vec<u8>, Vec<u32>)> = [0x50u8, 0x51]
             .iter()
             .map(|&a| {
-                let d = m.i2c_mut().device_mut(a).expect("chip");
+                let d = m.board_mut().eeproms_mut().device_mut(a).expect("chip");
                 let mut mem = vec![0u8; 1024];
                 d.read(now, 0, &mut mem).expect("read");
                 (mem, d.write_counts().to_vec())
             })
             .collect();
-        let edges = m.i2c().edges().total();
+        let edges = m.board().eeproms().edges().total();
         (log, chips, edges)
     };
     let ((slow, slow_chips, slow_edges), (fast, fast_chips, fast_edges)) = (go(false), go(true));
@@ -408,12 +408,12 @@ fn rewired_sensors_read_the_same() {
         run(&mut c, &mut m, 30)
     };
     for channels in [[3, 2, 1, 0], [4, 5, 6, 7], [6, 4, 7, 5]] {
-        let mut m = Mcu::new(
-            McuConfig {
-                clock_hz: DEFAULT_CLOCK_HZ,
+        let mut m = robot_mcu(
+            Rewired { channels },
+            &RobotConfig {
+                clock_hz: CLOCK_HZ,
                 eeprom_seed: 2,
             },
-            Rewired { channels },
         )
         .expect("a valid MCU");
         let mut cfg = ControllerConfig::arena(6);

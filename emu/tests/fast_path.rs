@@ -717,7 +717,10 @@ const P4DR: u32 = 0xFF_FFC7;
 #[test]
 fn the_robot_firmware_runs_alike_on_both_paths() {
     let fw = Firmware::robot().expect("the committed firmware");
-    let mut ma = Mcu::new(McuConfig::default(), NullBoard).expect("default MCU");
+    // On the robot's board: its EEPROMs on port 4, nothing else connected.
+    let mut ma =
+        emu::board::board::robot_mcu(NullBoard, &emu::board::board::RobotConfig::default())
+            .expect("default MCU");
     let mut ca = Cpu::new();
     // A step every 10 ticks (0.1 s) and a record saved over I2C every 2 steps, so that a few
     // seconds hold many steps and saves.
@@ -824,7 +827,9 @@ fn run_is_step_in_a_loop() {
     assert!(ca.halted(), "crcmacdiv ran to its halt");
     // The firmware: interrupts, sleep, I/O.
     let fw = Firmware::robot().expect("the committed firmware");
-    let mut ma = Mcu::new(McuConfig::default(), NullBoard).expect("default MCU");
+    let mut ma =
+        emu::board::board::robot_mcu(NullBoard, &emu::board::board::RobotConfig::default())
+            .expect("default MCU");
     let mut ca = Cpu::new();
     let block = ConfigBlock {
         save_every: 2,

@@ -2,11 +2,12 @@
 //! configuration block, boot, steps, motors, EEPROM records, restore after a power cut.
 
 use eeprom::persist::RecordLayout;
+use emu::board::board::{CLOCK_HZ, RobotBoard, RobotConfig, robot_mcu};
 use emu::board::firmware::{
     CONFIG_BLOCK_ADDR, ConfigBlock, ConfigStatus, FLAG_RANDOM_WALK, Firmware, run_until,
 };
 use emu::board::wiring::{Bridge, motor_pins};
-use emu::chip::mcu::{DEFAULT_CLOCK_HZ, Mcu, McuConfig};
+use emu::chip::mcu::{Mcu, McuConfig};
 use emu::chip::pins::{Board, NullBoard};
 use emu::core::bus::Bus;
 use emu::core::cpu::Cpu;
@@ -21,9 +22,11 @@ fn firmware() -> Firmware {
     Firmware::robot().expect("the committed firmware parses")
 }
 
-fn boot<B: Board>(board: B, block: Option<&ConfigBlock>) -> (Firmware, Mcu<B>, Cpu) {
+/// The firmware installed on an MCU on the robot's board (its EEPROMs), `world` on the other
+/// pins.
+fn boot<B: Board>(world: B, block: Option<&ConfigBlock>) -> (Firmware, Mcu<RobotBoard<B>>, Cpu) {
     let fw = firmware();
-    let mut mcu = Mcu::new(McuConfig::default(), board).unwrap();
+    let mut mcu = robot_mcu(world, &RobotConfig::default()).unwrap();
     let mut cpu = Cpu::new();
     fw.install(&mut mcu, &mut cpu, block).unwrap();
     (fw, mcu, cpu)
@@ -207,7 +210,7 @@ fn records_are_eeprom_persist_records_and_survive_a_power_cut() {
     let end = TICK_STATES * (1 + 45 * 23) + 20_000; // 24 steps: saves after steps 5, 10, 15, 20
     run_until(&mut cpu, &mut mcu, end).unwrap();
     assert_eq!(
-        mcu.i2c().timing_violation_count(),
+        mcu.board().eeproms().timing_violation_count(),
         0,
         "the firmware's I2C keeps DS21203's timing"
     );
@@ -218,7 +221,8 @@ fn records_are_eeprom_persist_records_and_survive_a_power_cut() {
     let mut newest = None;
     for chip in [0x50u8, 0x51] {
         let mut image = vec![0u8; 4 * 64];
-        mcu.i2c_mut()
+        mcu.board_mut()
+            .eeproms_mut()
             .device_mut(chip)
             .unwrap()
             .read(now, 0, &mut image)
@@ -232,9 +236,9 @@ fn records_are_eeprom_persist_records_and_survive_a_power_cut() {
     let newest = newest.expect("record 3 on chip 0x51");
     // After step 20 the weights were saved; four more steps have changed them since (maybe).
     // Cut the power, power on, reboot: the firmware restores record 3.
-    mcu.power_cut().unwrap();
-    let t = mcu.now() + u64::from(DEFAULT_CLOCK_HZ);
-    mcu.power_on(t).unwrap();
+    mcu.power_cut();
+    let t = mcu.now() + u64::from(CLOCK_HZ);
+    mcu.power_on(t);
     cpu.reset(&mut mcu);
     run_until(&mut cpu, &mut mcu, t + 2 * TICK_STATES).unwrap();
     assert_eq!(mcu.peek(sym(&fw, "restored")), 1);
@@ -402,7 +406,7 @@ fn controller_trace(fast_forward: bool, steps: usize) -> (Trace, u64, u64) {
     use emu::board::firmware::FirmwareController;
     use emu::core::memmap::{RAM_BYTES, RAM_START};
     let fw = firmware();
-    let mut mcu = Mcu::new(McuConfig::default(), Wandering).unwrap();
+    let mut mcu = robot_mcu(Wandering, &RobotConfig::default()).unwrap();
     let block = ConfigBlock {
         save_every: 3,
         ..ConfigBlock::ARENA
@@ -437,13 +441,15 @@ fn controller_trace(fast_forward: bool, steps: usize) -> (Trace, u64, u64) {
         ram: (0..RAM_BYTES).map(|i| mcu.peek(RAM_START + i)).collect(),
         states,
         write_counts: mcu
-            .i2c()
+            .board()
+            .eeproms()
             .devices()
             .iter()
             .map(|d| d.write_counts().to_vec())
             .collect(),
         violations: mcu
-            .i2c()
+            .board()
+            .eeproms()
             .devices()
             .iter()
             .map(|d| d.timing_violation_count())

@@ -7,9 +7,10 @@ mod gdb_client;
 
 use std::thread::JoinHandle;
 
+use emu::board::board::{RobotBoard, RobotConfig, robot_mcu};
 use emu::board::firmware::Firmware;
 use emu::chip::gdb::GdbListener;
-use emu::chip::mcu::{Mcu, McuConfig};
+use emu::chip::mcu::Mcu;
 use emu::chip::pins::NullBoard;
 use emu::chip::run::{Outcome, Probes, RunOptions, RunReport, run_mcu_probed};
 use emu::core::bus::Bus;
@@ -19,9 +20,12 @@ use gdb_client::Client;
 /// Two seconds of emulated time: the firmware's first steps.
 const BUDGET_STATES: u64 = 50_000_000;
 
+/// The MCU `h8swarm emu` runs images on: the robot's board, nothing connected but its EEPROMs.
+type EmuMcu = Mcu<RobotBoard<NullBoard>>;
+
 /// The firmware on a fresh MCU, reset.
-fn machine(fw: &Firmware) -> (Cpu, Mcu<NullBoard>) {
-    let mut mcu = Mcu::new(McuConfig::default(), NullBoard).unwrap();
+fn machine(fw: &Firmware) -> (Cpu, EmuMcu) {
+    let mut mcu = robot_mcu(NullBoard, &RobotConfig::default()).unwrap();
     let mut cpu = Cpu::new();
     fw.install(&mut mcu, &mut cpu, None).unwrap();
     (cpu, mcu)
@@ -53,7 +57,7 @@ fn debugged(fw: &Firmware) -> (Client, JoinHandle<RunReport>) {
 }
 
 /// The reference: steps `cpu` until its PC is `addr` (before executing it).
-fn run_to(cpu: &mut Cpu, mcu: &mut Mcu<NullBoard>, addr: u32) {
+fn run_to(cpu: &mut Cpu, mcu: &mut EmuMcu, addr: u32) {
     while cpu.pc() != addr {
         assert!(mcu.now() < BUDGET_STATES, "never reached {addr:06x}");
         cpu.step(mcu, BUDGET_STATES).unwrap();
@@ -61,7 +65,7 @@ fn run_to(cpu: &mut Cpu, mcu: &mut Mcu<NullBoard>, addr: u32) {
 }
 
 /// The registers as GDB's h8300h layout gives them: ER0-ER7, CCR, PC, cycles, tick, inst.
-fn expected_registers(cpu: &Cpu, mcu: &Mcu<NullBoard>) -> Vec<u32> {
+fn expected_registers(cpu: &Cpu, mcu: &EmuMcu) -> Vec<u32> {
     let mut r = cpu.regs().to_vec();
     r.push(u32::from(cpu.ccr()));
     r.push(cpu.pc());

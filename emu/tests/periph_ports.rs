@@ -1,7 +1,8 @@
 //! Ports: write-only DDRs, DR reads (latch for outputs, pins for inputs), bumpers on port 2
-//! from the board, and port 4 as the open-drain master of the I²C bus (a START and an address
-//! byte acknowledged by a 24LC256).
+//! from the board, and port 4 as the open-drain master of the I²C bus on the robot's board (a
+//! START and an address byte acknowledged by a 24LC256), and with nothing on port 4.
 
+use emu::board::board::{RobotBoard, RobotConfig, robot_mcu};
 use emu::board::wiring::{P2_BUMPER_FRONT, P2_BUMPER_LEFT, P2_BUMPERS};
 use emu::chip::mcu::{Mcu, McuConfig};
 use emu::chip::periph::ports::{
@@ -80,17 +81,27 @@ fn port2_reads_the_bumpers_through_the_pull_ups() {
 }
 
 /// Bit-banging through the MCU's port 4 exactly as firmware would (DDR = 1 pulls low).
-struct Master {
-    m: Mcu<NullBoard>,
+struct Master<B: Board> {
+    m: Mcu<B>,
     ddr: u8,
 }
 
 /// States between pin changes: 4 µs at 25 MHz, well above every 24LC256 minimum.
 const HALF_BIT: u32 = 100;
 
-impl Master {
+/// An MCU on the robot's board (its EEPROMs on port 4), nothing else connected.
+fn robot() -> Mcu<RobotBoard<NullBoard>> {
+    robot_mcu(NullBoard, &RobotConfig::default()).unwrap()
+}
+
+impl Master<RobotBoard<NullBoard>> {
     fn new() -> Self {
-        let mut m = Mcu::new(McuConfig::default(), NullBoard).unwrap();
+        Self::on(robot())
+    }
+}
+
+impl<B: Board> Master<B> {
+    fn on(mut m: Mcu<B>) -> Self {
         m.write8(P4PCR, P4_SDA | P4_SCL);
         m.write8(P4DR, 0x00);
         m.write8(P4DDR, 0x00);
@@ -128,15 +139,28 @@ impl Master {
 #[test]
 fn port4_bit_banging_reaches_a_24lc256_which_acknowledges_its_address() {
     let mut bus = Master::new();
-    let edges0 = bus.m.i2c().edges();
+    let edges0 = bus.m.board().eeproms().edges();
     bus.start();
     // The START reached the bus at the instant of the write.
-    let e = bus.m.i2c().edges().since(&edges0);
+    let e = bus.m.board().eeproms().edges().since(&edges0);
     assert_eq!((e.sda_falling, e.scl_falling), (1, 1));
-    assert!(bus.m.i2c().now() <= bus.m.now());
+    assert!(bus.m.board().eeproms().now() <= bus.m.now());
     // Control byte 1010 000 0: write to the chip at 0x50; it pulls SDA low on the 9th clock.
     assert!(bus.byte(0xA0), "chip 0x50 acknowledges after a START");
-    assert_eq!(bus.m.i2c().timing_violation_count(), 0);
+    assert_eq!(bus.m.board().eeproms().timing_violation_count(), 0);
+}
+
+#[test]
+fn with_nothing_on_port_4_the_master_reads_its_own_lines_and_gets_no_ack() {
+    let mut bus = Master::on(Mcu::new(McuConfig::default(), NullBoard).unwrap());
+    bus.start();
+    assert!(!bus.sda(), "the master's own pull on SDA reads back low");
+    assert!(
+        !bus.byte(0xA0),
+        "no chip on the lines: SDA stays high on the 9th clock"
+    );
+    bus.set(false, false);
+    assert!(bus.sda(), "released: high through the pull-up");
 }
 
 #[test]
@@ -153,36 +177,38 @@ fn without_a_start_nobody_acknowledges() {
 
 #[test]
 fn released_i2c_lines_need_the_pull_ups_to_read_high() {
-    let mut m = Mcu::new(McuConfig::default(), NullBoard).unwrap();
+    let mut m = robot();
     // Pull-ups off: released lines float and read 0.
     assert_eq!(m.read8(P4DR) & (P4_SDA | P4_SCL), 0);
     m.write8(P4PCR, P4_SDA | P4_SCL);
     assert_eq!(m.read8(P4DR) & (P4_SDA | P4_SCL), P4_SDA | P4_SCL);
     // Pulling SDA low: the line reads low; with DDR = 1 the DR read returns the latch (0).
     m.write8(P4DDR, P4_SDA);
-    assert_eq!(m.i2c().master_pulls(), (false, true));
+    assert_eq!(m.board().eeproms().master_pulls(), (false, true));
     assert_eq!(m.read8(P4DR) & (P4_SDA | P4_SCL), P4_SCL);
     // A 1 in DR with DDR = 1 does not pull the line.
     m.write8(P4DR, P4_SDA);
-    assert_eq!(m.i2c().master_pulls(), (false, false));
+    assert_eq!(m.board().eeproms().master_pulls(), (false, false));
 }
 
 #[test]
 fn power_cut_releases_the_lines_and_forgets_ram() {
-    let mut m = Mcu::new(McuConfig::default(), NullBoard).unwrap();
+    let mut m = robot();
     m.write8(P4DDR, P4_SDA | P4_SCL);
     m.write16(0xFF_E000, 0xBEEF);
-    assert_eq!(m.i2c().master_pulls(), (true, true));
-    let outcomes = m.power_cut().unwrap();
-    assert_eq!(outcomes.len(), 2);
-    assert_eq!(m.i2c().master_pulls(), (false, false));
+    assert_eq!(m.board().eeproms().master_pulls(), (true, true));
+    assert!(m.board().last_power_cut().is_empty());
+    m.power_cut();
+    assert_eq!(m.board().last_power_cut().len(), 2);
+    assert_eq!(m.board().eeproms().master_pulls(), (false, false));
     assert!(!m.has_ram());
     assert_eq!(m.read16(0xFF_E000), 0);
     let t = m.now() + 1_000_000;
-    m.power_on(t).unwrap();
+    m.power_on(t);
     assert_eq!(m.now(), t);
     assert!(
-        m.i2c()
+        m.board()
+            .eeproms()
             .devices()
             .iter()
             .all(eeprom::Eeprom24lc256::is_powered)

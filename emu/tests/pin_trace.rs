@@ -4,8 +4,9 @@
 
 use std::sync::Arc;
 
+use emu::board::board::{RobotBoard, RobotConfig, robot_mcu};
 use emu::board::firmware::{ConfigBlock, FLAG_RANDOM_WALK, Firmware, FirmwareController};
-use emu::chip::mcu::{Mcu, McuConfig};
+use emu::chip::mcu::Mcu;
 use emu::chip::periph::itu::PwmWave;
 use emu::chip::pins::NullBoard;
 use emu::chip::run::{Probes, RunOptions, run_mcu_probed};
@@ -41,7 +42,7 @@ struct Window {
 /// comes up) and traces steps `from..from + steps`.
 fn traced(fast_forward: bool, from: usize, steps: usize) -> Window {
     let fw = Firmware::robot().unwrap();
-    let mut mcu = Mcu::new(McuConfig::default(), Wandering).unwrap();
+    let mut mcu = robot_mcu(Wandering, &RobotConfig::default()).unwrap();
     let block = ConfigBlock {
         save_every: 3,
         flags: FLAG_RANDOM_WALK,
@@ -55,7 +56,7 @@ fn traced(fast_forward: bool, from: usize, steps: usize) -> Window {
     }
     mcu.start_trace(c.cpu().sleeping());
     c.record_phases(Arc::new(fw.symbols.clone()), mcu.now());
-    let edges0 = mcu.i2c().edges();
+    let edges0 = mcu.board().eeproms().edges();
     let behaviour = fw.symbols.addr("behaviour").unwrap();
     let (mut sensing, mut behaviours) = (Vec::new(), Vec::new());
     let (mut sleeping, mut waves) = (Vec::new(), Vec::new());
@@ -64,14 +65,14 @@ fn traced(fast_forward: bool, from: usize, steps: usize) -> Window {
         c.run_to_sleep(&mut mcu).unwrap();
         behaviours.push(mcu.peek(behaviour));
         sleeping.push(mcu.now());
-        let wave = |mcu: &mut Mcu<Wandering>, ch| mcu.tioca(ch).wave.unwrap();
+        let wave = |mcu: &mut Mcu<RobotBoard<Wandering>>, ch| mcu.tioca(ch).wave.unwrap();
         waves.push((wave(&mut mcu, 1), wave(&mut mcu, 2)));
     }
     // A little past the last step's work, so its PWM shows.
     mcu.advance_to(mcu.now() + 5 * PWM_PERIOD_STATES);
     let phases = c.take_phases();
     let trace = mcu.finish_trace().unwrap();
-    let edges = mcu.i2c().edges().since(&edges0);
+    let edges = mcu.board().eeproms().edges().since(&edges0);
     Window {
         trace,
         phases,
@@ -310,9 +311,10 @@ fn the_vcd_file_reads_back_with_the_states_as_timestamps() {
 
 #[test]
 fn the_instruction_trace_and_the_phase_signal_name_the_same_code() {
-    // `h8swarm emu` on the robot firmware with nothing connected: 30 ms, boot and ticks.
+    // `h8swarm emu` on the robot firmware, the robot's board with nothing connected but its
+    // EEPROMs: 30 ms, boot and ticks.
     let fw = Firmware::robot().unwrap();
-    let mut mcu = Mcu::new(McuConfig::default(), NullBoard).unwrap();
+    let mut mcu = robot_mcu(NullBoard, &RobotConfig::default()).unwrap();
     let mut cpu = Cpu::new();
     fw.install(&mut mcu, &mut cpu, None).unwrap();
     mcu.start_trace(false);

@@ -1,7 +1,7 @@
 //! The run API: halting and exit status, console output through SCI1, the state budget, core
 //! errors as outcomes, load errors as errors, traces and statistics.
 
-use emu::chip::run::{Outcome, PHI_HZ, RunError, RunOptions, run_image};
+use emu::chip::run::{Outcome, RunError, RunOptions, run_image};
 use emu::core::cpu::CpuError;
 use emu::core::srec::{self, Chunk, SrecImage};
 
@@ -64,7 +64,9 @@ fn a_program_prints_through_sci1_and_halts_with_its_status() {
     // The third byte can only be written once the second has moved into the shift register,
     // one frame (10 bits × 32 × (19 + 1) states) after the first.
     assert!(r.stats.states > 6400, "{}", r.stats.states);
-    assert!((r.stats.emulated_seconds - r.stats.states as f64 / PHI_HZ as f64).abs() < 1e-12);
+    assert_eq!(r.stats.clock_hz, 25_000_000);
+    let phi = f64::from(r.stats.clock_hz);
+    assert!((r.stats.emulated_seconds - r.stats.states as f64 / phi).abs() < 1e-12);
     let json = r.to_json();
     assert!(json.contains("\"outcome\":\"halted\""), "{json}");
     assert!(json.contains("\"exit_status\":3"), "{json}");

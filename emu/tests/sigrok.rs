@@ -9,8 +9,9 @@ use std::collections::BTreeMap;
 use std::process::Command;
 use std::sync::Arc;
 
+use emu::board::board::{RobotBoard, RobotConfig, robot_mcu};
 use emu::board::firmware::{ConfigBlock, FLAG_RANDOM_WALK, Firmware, FirmwareController};
-use emu::chip::mcu::{Mcu, McuConfig};
+use emu::chip::mcu::Mcu;
 use emu::chip::periph::itu::PwmWave;
 use emu::chip::trace::{PinTrace, Signal};
 use emu::chip::vcd::{VcdInfo, write_vcd};
@@ -47,7 +48,7 @@ const PAGE: usize = 64;
 /// Firmware with a save every second step and random behaviours; steps 1 to 10 traced.
 fn traced() -> Traced {
     let fw = Firmware::robot().unwrap();
-    let mut mcu = Mcu::new(McuConfig::default(), Wandering).unwrap();
+    let mut mcu = robot_mcu(Wandering, &RobotConfig::default()).unwrap();
     let block = ConfigBlock {
         save_every: 2,
         flags: FLAG_RANDOM_WALK,
@@ -61,8 +62,9 @@ fn traced() -> Traced {
     let net_w = fw.symbols.addr("net_w").unwrap();
     let n_in = fw.symbols.addr("net_n_in").unwrap();
     let n_out = fw.symbols.addr("net_n_out").unwrap();
-    let counts = |mcu: &Mcu<Wandering>| -> Vec<(u8, Vec<u32>)> {
-        mcu.i2c()
+    let counts = |mcu: &Mcu<RobotBoard<Wandering>>| -> Vec<(u8, Vec<u32>)> {
+        mcu.board()
+            .eeproms()
             .devices()
             .iter()
             .map(|d| (d.address(), d.write_counts().to_vec()))
@@ -79,7 +81,8 @@ fn traced() -> Traced {
             for (page, (x, y)) in b.iter().zip(&a).enumerate() {
                 if x != y {
                     let mut buf = vec![0u8; PAGE];
-                    mcu.i2c_mut()
+                    mcu.board_mut()
+                        .eeproms_mut()
                         .device_mut(*dev)
                         .unwrap()
                         .read(asleep, (page * PAGE) as u16, &mut buf)
@@ -92,7 +95,7 @@ fn traced() -> Traced {
         let n =
             emu::board::firmware::peek_be::<_, 2>(&mcu, n_in) as u32 * u32::from(mcu.peek(n_out));
         let weights = (0..2 * n).map(|i| mcu.peek(w + i)).collect();
-        let wave = |mcu: &mut Mcu<Wandering>, ch| mcu.tioca(ch).wave.unwrap();
+        let wave = |mcu: &mut Mcu<RobotBoard<Wandering>>, ch| mcu.tioca(ch).wave.unwrap();
         let waves = (wave(&mut mcu, 1), wave(&mut mcu, 2));
         steps.push(Step {
             sensing,

@@ -495,11 +495,12 @@ fn the_differential_programs_run_under_the_guard_untouched() {
 
 #[test]
 fn the_robot_firmware_s_room_takes_in_its_boot_sized_arrays_and_is_never_left() {
+    use emu::board::board::{RobotConfig, robot_mcu};
     use emu::board::firmware::{ConfigBlock, Firmware, FirmwareController, peek_be};
-    use emu::chip::mcu::{Mcu, McuConfig};
     use emu::chip::pins::NullBoard;
     let fw = Firmware::robot().unwrap();
-    let mut mcu = Mcu::new(McuConfig::default(), NullBoard).unwrap();
+    // On the robot's board: the saves reach the EEPROMs.
+    let mut mcu = robot_mcu(NullBoard, &RobotConfig::default()).unwrap();
     let mut c = FirmwareController::start(&fw, &mut mcu, Some(&ConfigBlock::ARENA)).unwrap();
     let before = c.cpu().stack_guard().unwrap().room;
     assert_eq!(Some(before.low), fw.symbols.addr("_bss_end"));
@@ -508,7 +509,7 @@ fn the_robot_firmware_s_room_takes_in_its_boot_sized_arrays_and_is_never_left() 
         c.run_to_sleep(&mut mcu).unwrap();
     }
     let room = c.cpu().stack_guard().unwrap().room;
-    let heap_end = peek_be::<NullBoard, 4>(&mcu, fw.symbols.addr("heap_end").unwrap()) as u32;
+    let heap_end = peek_be::<_, 4>(&mcu, fw.symbols.addr("heap_end").unwrap()) as u32;
     assert!(heap_end > before.low, "the firmware carved its arrays");
     assert_eq!(
         room,

@@ -13,8 +13,6 @@ use crate::curve::{
 use crate::error::SensorError;
 use crate::rng::{StreamRng, counter_unit_f64, stream, uniform_f64, unit_f64};
 
-/// Default MCU clock φ = 25 MHz, 1 state = 40 ns (docs/design.md §4.1, AKI-H8/3052F board).
-pub const DEFAULT_CLOCK_HZ: u32 = 25_000_000;
 /// Typical output at 80 cm, 0.4 V (GP2Y0A21YK / GP2D12 datasheets, electro-optical table).
 pub const DATASHEET_V_80CM_TYP_VOLTS: f64 = 0.4;
 /// Unit-to-unit spread of the output at 80 cm, ±0.15 V (docs/design.md §3.1: datasheet 0.25–0.55 V).
@@ -48,8 +46,9 @@ pub const SUPPLY_VOLTS: f64 = 5.0;
 /// GP2Y0A21YK gives 30 mA typical).
 pub const SUPPLY_CURRENT_MA: f64 = 33.0;
 
-/// Parameters of one IR sensor model. [`Default`] gives the datasheet figures; [`IrParams::ideal`]
-/// a noiseless nominal sensor for tests.
+/// Parameters of one IR sensor model. [`IrParams::datasheet`] gives the datasheet figures;
+/// [`IrParams::ideal`] a noiseless nominal sensor for tests. Both take the MCU's clock, which
+/// the crate has none of its own of (the robot's is the board's, docs/design.md §4.1).
 ///
 /// Valid ranges (checked by [`IrParams::validate`] and [`IrSensor::new`]):
 ///
@@ -92,10 +91,12 @@ pub struct IrParams {
     pub spike_max_volts: f64,
 }
 
-impl Default for IrParams {
-    fn default() -> Self {
+impl IrParams {
+    /// The datasheet figures, time counted in states of the MCU's `clock_hz`.
+    #[must_use]
+    pub fn datasheet(clock_hz: u32) -> Self {
         Self {
-            clock_hz: DEFAULT_CLOCK_HZ,
+            clock_hz,
             v_80cm_min_volts: DATASHEET_V_80CM_TYP_VOLTS - DATASHEET_V_80CM_SPREAD_VOLTS,
             v_80cm_max_volts: DATASHEET_V_80CM_TYP_VOLTS + DATASHEET_V_80CM_SPREAD_VOLTS,
             dv_80_to_10cm_min_volts: DATASHEET_DV_80_TO_10CM_MIN_VOLTS,
@@ -129,9 +130,10 @@ fn check(
 impl IrParams {
     /// A nominal, noiseless sensor: no unit-to-unit spread (gain 1, offset 0, so it follows
     /// [`nominal_volts`](crate::nominal_volts) exactly), a fixed 38.3 ms period without jitter,
-    /// no noise and no spikes. Its random phase remains.
+    /// no noise and no spikes. Its random phase remains. Time is counted in states of the
+    /// MCU's `clock_hz`.
     #[must_use]
-    pub fn ideal() -> Self {
+    pub fn ideal(clock_hz: u32) -> Self {
         Self {
             v_80cm_min_volts: NOMINAL_V_80CM_VOLTS,
             v_80cm_max_volts: NOMINAL_V_80CM_VOLTS,
@@ -141,7 +143,7 @@ impl IrParams {
             period_jitter_ms: 0.0,
             noise_sigma_volts: 0.0,
             spike_probability: 0.0,
-            ..Self::default()
+            ..Self::datasheet(clock_hz)
         }
     }
 
@@ -480,6 +482,9 @@ impl IrSensor {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The MCU's φ these tests count in: the robot's 25 MHz (the crate has no clock of its own).
+    const CLOCK_HZ: u32 = 25_000_000;
     use crate::curve::{FAR_BRANCH_MIN_MM, far_branch_cm_at_volts, nominal_volts};
     use proptest::prelude::*;
 
@@ -494,7 +499,7 @@ mod tests {
 
     #[test]
     fn ideal_sensor_follows_the_nominal_curve() {
-        let mut s = IrSensor::new(IrParams::ideal(), 7).unwrap();
+        let mut s = IrSensor::new(IrParams::ideal(CLOCK_HZ), 7).unwrap();
         assert_eq!(s.gain(), 1.0);
         assert!(s.offset_volts().abs() < 1e-15);
         for d in [0.0, 10.0, 50.0, 80.0, 100.0, 333.3, 800.0, 5000.0] {
@@ -510,7 +515,7 @@ mod tests {
 
     #[test]
     fn hold_is_constant_between_refreshes() {
-        let mut s = IrSensor::new(IrParams::ideal(), 11).unwrap();
+        let mut s = IrSensor::new(IrParams::ideal(CLOCK_HZ), 11).unwrap();
         let near = s.curve_volts(Some(150.0)).unwrap();
         let far = s.curve_volts(Some(600.0)).unwrap();
         assert_eq!(s.sample(0, Some(150.0)).unwrap(), near);
@@ -536,7 +541,7 @@ mod tests {
         let n = 2000;
         let (mut v80s, mut dvs) = (Vec::new(), Vec::new());
         for seed in 0..n {
-            let s = IrSensor::new(IrParams::default(), seed).unwrap();
+            let s = IrSensor::new(IrParams::datasheet(CLOCK_HZ), seed).unwrap();
             let v80 = s.curve_volts(Some(800.0)).unwrap();
             let dv = s.curve_volts(Some(100.0)).unwrap() - v80;
             assert!(
@@ -569,7 +574,7 @@ mod tests {
     /// Tolerances are 4 standard errors of each estimate at this sample size.
     #[test]
     fn noise_statistics_over_100k_reads() {
-        let mut s = IrSensor::new(IrParams::default(), 2024).unwrap();
+        let mut s = IrSensor::new(IrParams::datasheet(CLOCK_HZ), 2024).unwrap();
         s.update(0, Some(300.0)).unwrap();
         let held = s.held_volts().unwrap();
         assert!(held > 0.5 && held < 4.0, "far from the clamps: {held}");
@@ -620,7 +625,7 @@ mod tests {
     fn spike_heights_are_uniform_in_range() {
         let params = IrParams {
             noise_sigma_volts: 0.0,
-            ..IrParams::default()
+            ..IrParams::datasheet(CLOCK_HZ)
         };
         let mut s = IrSensor::new(params, 99).unwrap();
         let mut heights = Vec::new();
@@ -654,7 +659,7 @@ mod tests {
         let n = 2000;
         let (mut periods, mut phases) = (Vec::new(), Vec::new());
         for seed in 0..n {
-            let s = IrSensor::new(IrParams::default(), seed).unwrap();
+            let s = IrSensor::new(IrParams::datasheet(CLOCK_HZ), seed).unwrap();
             let p = s.period_ms();
             assert!(
                 (29.5 - 1e-9..=47.1 + 1e-9).contains(&p),
@@ -692,7 +697,7 @@ mod tests {
     #[test]
     fn refresh_intervals_match_the_model() {
         for seed in [3u64, 4, 5] {
-            let mut s = IrSensor::new(IrParams::default(), seed).unwrap();
+            let mut s = IrSensor::new(IrParams::datasheet(CLOCK_HZ), seed).unwrap();
             let p_states = s.period_ms() * 25_000.0;
             let j_states = DEFAULT_PERIOD_JITTER_MS * 25_000.0;
             let n = 10_000;
@@ -745,7 +750,7 @@ mod tests {
     fn pooled_refresh_intervals_match_the_datasheet() {
         let mut all = Vec::new();
         for seed in 1000..1500u64 {
-            let mut s = IrSensor::new(IrParams::default(), seed).unwrap();
+            let mut s = IrSensor::new(IrParams::datasheet(CLOCK_HZ), seed).unwrap();
             let mut t = s.next_refresh_states();
             s.update(t, None).unwrap();
             for _ in 0..200 {
@@ -771,7 +776,7 @@ mod tests {
 
     #[test]
     fn schedule_does_not_depend_on_when_the_caller_looks() {
-        let mut often = IrSensor::new(IrParams::default(), 17).unwrap();
+        let mut often = IrSensor::new(IrParams::datasheet(CLOCK_HZ), 17).unwrap();
         let mut rarely = often.clone();
         let end = 25_000_000u64 * 60; // one minute
         let mut t = 0;
@@ -790,7 +795,7 @@ mod tests {
     #[test]
     fn same_seed_same_readings_different_seed_different() {
         let run = |seed: u64| {
-            let mut s = IrSensor::new(IrParams::default(), seed).unwrap();
+            let mut s = IrSensor::new(IrParams::datasheet(CLOCK_HZ), seed).unwrap();
             (0..2000u64)
                 .map(|i| s.sample(i * 6_650, Some(100.0 + (i % 700) as f64)).unwrap())
                 .collect::<Vec<f64>>()
@@ -837,7 +842,7 @@ mod tests {
             ("spike_max_volts", |p| p.spike_max_volts = f64::NAN),
         ];
         for (name, edit) in cases {
-            let mut p = IrParams::default();
+            let mut p = IrParams::datasheet(CLOCK_HZ);
             edit(&mut p);
             match IrSensor::new(p, 0) {
                 Err(e @ SensorError::ParamOutOfRange { name: got, .. }) => {
@@ -848,13 +853,13 @@ mod tests {
                 other => panic!("{name}: expected an error, got {other:?}"),
             }
         }
-        assert!(IrParams::default().validate().is_ok());
-        assert!(IrParams::ideal().validate().is_ok());
+        assert!(IrParams::datasheet(CLOCK_HZ).validate().is_ok());
+        assert!(IrParams::ideal(CLOCK_HZ).validate().is_ok());
     }
 
     #[test]
     fn bad_calls_are_errors_and_change_nothing() {
-        let mut s = IrSensor::new(IrParams::default(), 5).unwrap();
+        let mut s = IrSensor::new(IrParams::datasheet(CLOCK_HZ), 5).unwrap();
         s.sample(1_000, Some(200.0)).unwrap();
         let before = s.clone();
         let err = s.sample(999, Some(200.0)).unwrap_err();
@@ -884,7 +889,7 @@ mod tests {
     #[test]
     fn fold_back_ambiguity_holds_for_every_sensor() {
         for seed in 0..50 {
-            let s = IrSensor::new(IrParams::default(), seed).unwrap();
+            let s = IrSensor::new(IrParams::datasheet(CLOCK_HZ), seed).unwrap();
             let v5 = s.curve_volts(Some(50.0)).unwrap();
             // The same affine map on both branches keeps the nominal twin at 12.17 cm.
             let twin_mm = far_branch_cm_at_volts(nominal_volts(Some(50.0)).unwrap()) * 10.0;
@@ -897,7 +902,7 @@ mod tests {
         #[test]
         fn every_sensor_far_branch_is_decreasing(seed: u64, a in 80.0f64..10_000.0, b in 80.0f64..10_000.0) {
             prop_assume!(a != b);
-            let s = IrSensor::new(IrParams::default(), seed).unwrap();
+            let s = IrSensor::new(IrParams::datasheet(CLOCK_HZ), seed).unwrap();
             let (near, far) = if a < b { (a, b) } else { (b, a) };
             let (vn, vf) = (s.curve_volts(Some(near)).unwrap(), s.curve_volts(Some(far)).unwrap());
             // Strict unless both clamp at 0 V (a low-offset sensor, far away).
@@ -910,7 +915,7 @@ mod tests {
             seed: u64,
             steps in proptest::collection::vec((0u64..2_000_000, proptest::option::of(0.0f64..1e6)), 1..50),
         ) {
-            let mut s = IrSensor::new(IrParams::default(), seed).unwrap();
+            let mut s = IrSensor::new(IrParams::datasheet(CLOCK_HZ), seed).unwrap();
             let mut t = 0u64;
             for (dt, d) in steps {
                 t += dt;

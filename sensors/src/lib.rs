@@ -11,7 +11,8 @@
 //! ```
 //! use sensors::{IrParams, IrSensor, DU_TABLE, adc10_code, code8_from_adc10};
 //!
-//! let mut front = IrSensor::new(IrParams::default(), 7)?;
+//! let clock_hz = 25_000_000; // the MCU's φ (the robot's; the crate has no clock of its own)
+//! let mut front = IrSensor::new(IrParams::datasheet(clock_hz), 7)?;
 //! let now_states = 1_000_000; // 40 ms at φ = 25 MHz
 //! let volts = front.sample(now_states, Some(300.0))?; // a wall 30 cm away
 //! let c = code8_from_adc10(adc10_code(volts));
@@ -114,4 +115,4 @@ pub use bumpers::{
 pub use curve::{FOLDBACK_CONTACT_VOLTS, NOTHING_HIT_MM, PEAK_VOLTS, nominal_volts};
 pub use du::{DU_TABLE, STEEP_CODES, du_for_code};
 pub use error::SensorError;
-pub use ir::{DEFAULT_CLOCK_HZ, DEFAULT_PERIOD_JITTER_MS, IrParams, IrSensor, SUPPLY_CURRENT_MA};
+pub use ir::{DEFAULT_PERIOD_JITTER_MS, IrParams, IrSensor, SUPPLY_CURRENT_MA};

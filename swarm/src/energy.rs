@@ -21,6 +21,7 @@
 //!   wheels up more, and a robot pressed against a wall (its wheels slipping at the floor's
 //!   traction) the current that holds the slipping wheel's friction torque.
 
+use emu::board::board::RobotBoard;
 use emu::board::wiring::Bridge;
 use emu::chip::mcu::Mcu;
 use emu::chip::pins::Board;
@@ -192,6 +193,12 @@ impl Charge {
     }
 }
 
+/// Each EEPROM's counters on `mcu`'s board (0x50, then 0x51).
+fn eeprom_stats<W: Board>(mcu: &Mcu<RobotBoard<W>>) -> Vec<eeprom::DeviceStats> {
+    let chips = mcu.board().eeproms().devices();
+    chips.iter().map(|d| d.stats()).collect()
+}
+
 /// The electronics of one robot (the MCU, its A/D converter, the IR sensors, the EEPROMs, the
 /// regulator), metered from the MCU's own counters between two calls.
 #[derive(Clone, Debug)]
@@ -202,20 +209,21 @@ pub struct ElectronicsMeter {
 }
 
 impl ElectronicsMeter {
-    /// A meter that counts from `mcu`'s present state.
+    /// A meter that counts from `mcu`'s present state (the chip's counters, the EEPROMs' on
+    /// its board).
     #[must_use]
-    pub fn new<B: Board>(mcu: &Mcu<B>) -> Self {
+    pub fn new<W: Board>(mcu: &Mcu<RobotBoard<W>>) -> Self {
         let now = mcu.now();
         ElectronicsMeter {
             last_states: now,
             last_converting: mcu.adc().converting_states(now),
-            last_eeproms: mcu.i2c().devices().iter().map(|d| d.stats()).collect(),
+            last_eeproms: eeprom_stats(mcu),
         }
     }
 
     /// The charge since the last call (or since [`Self::new`]), of which the CPU was busy for
     /// `busy_states`.
-    pub fn take<B: Board>(&mut self, mcu: &Mcu<B>, busy_states: u64) -> Charge {
+    pub fn take<W: Board>(&mut self, mcu: &Mcu<RobotBoard<W>>, busy_states: u64) -> Charge {
         let now = mcu.now();
         let clock_hz = mcu.clock_hz();
         let interval = now.saturating_sub(self.last_states);
@@ -235,8 +243,7 @@ impl ElectronicsMeter {
             IR_SENSORS * sensors::SUPPLY_CURRENT_MA * seconds * 1e3,
         );
         c.add_to(Part::Regulator, REGULATOR_QUIESCENT_MA * seconds * 1e3);
-        let stats: Vec<eeprom::DeviceStats> =
-            mcu.i2c().devices().iter().map(|d| d.stats()).collect();
+        let stats = eeprom_stats(mcu);
         let eeproms: f64 = stats
             .iter()
             .zip(&self.last_eeproms)
@@ -473,7 +480,7 @@ mod tests {
 
     /// One drive wheel's traction with the world's defaults, μ_floor · m·g/2 = 1.4710 N.
     fn traction_n() -> f64 {
-        WorldParams::default().wheel_traction_n()
+        WorldParams::with_clock(u64::from(emu::board::board::CLOCK_HZ)).wheel_traction_n()
     }
 
     #[test]
@@ -551,7 +558,7 @@ mod tests {
     fn free_wheels_settle_to_the_no_load_current_and_held_ones_to_the_friction_current() {
         let params = WorldParams {
             motor_gain_spread: 0.0,
-            ..WorldParams::default()
+            ..WorldParams::with_clock(u64::from(emu::board::board::CLOCK_HZ))
         };
         let mut d = DriveMeter::new(0.15, [1.0, 1.0]);
         d.set_commands(WheelCommand::forward(1.0), WheelCommand::forward(0.3));

@@ -347,7 +347,6 @@ pub fn world_params(s: &Scenario) -> WorldParams {
         motor_gain_spread: s.world.motor_gain_spread,
         wheel_track_m: s.world.wheel_track_m,
         max_substep_s: s.world.substep_s,
-        clock_hz: u64::from(s.timing.clock_hz),
         sensor_max_range_m: s.world.sensor_range_m,
         mu_wall: s.world.mu_wall,
         sensor_mounts: SensorMount::default_mounts(
@@ -364,7 +363,7 @@ pub fn world_params(s: &Scenario) -> WorldParams {
             }
         })
         .collect(),
-        ..WorldParams::default()
+        ..WorldParams::with_clock(u64::from(s.timing.clock_hz))
     }
 }
 
@@ -1363,7 +1362,7 @@ mod tests {
             for i in 0..s.robots {
                 let b = swarm.world().bumpers(i).unwrap();
                 pressed += usize::from(b.iter().any(|&x| x));
-                let board = swarm.robot_mut(i).unwrap().mcu.board_mut();
+                let board = &mut swarm.robot_mut(i).unwrap().mcu.board_mut().world;
                 assert_eq!(board.bumpers, b);
                 let [front, rear, left, right] = b;
                 let want =

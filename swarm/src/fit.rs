@@ -30,12 +30,13 @@ use rand_chacha::ChaCha8Rng;
 use seeding::Purpose;
 use serde::Serialize;
 
+use emu::board::board::{BoardError, RobotBoard, RobotConfig, robot_mcu};
 use emu::board::firmware::{
     BlockError, ConfigBlock, ConfigStatus, Firmware, FirmwareError, RunError, halted,
 };
 use emu::board::model::{Controller, ControllerConfig, ControllerError, PhaseStates};
 use emu::board::profile::{PhaseDef, Profiler, UnknownFunction};
-use emu::chip::mcu::{Mcu, McuConfig, McuError};
+use emu::chip::mcu::Mcu;
 use emu::chip::pins::Board;
 use emu::core::bus::Bus;
 use emu::core::cpu::{Cpu, CpuError, Event, StackFault, StackGuard};
@@ -173,7 +174,7 @@ pub enum FitError {
     },
     /// The MCU could not be built.
     #[error("building the MCU")]
-    Mcu(#[from] McuError),
+    Mcu(#[from] BoardError),
     /// A what-if on an image without a configuration block.
     #[error(
         "`{image}` has no configuration block (symbol config_block at H'000400), so the settings cannot reach it; measure it without what-ifs"
@@ -447,7 +448,8 @@ pub struct FitReport {
     pub verdict: String,
 }
 
-/// The board of the fit runs: four IR sensors whose distances the driver sets; bumpers open.
+/// What the fit's world drives on the robot's board: four IR sensors whose distances the driver
+/// sets; bumpers open.
 pub struct FitBoard {
     sensors: Vec<sensors::IrSensor>,
     distance_mm: [f64; 4],
@@ -476,7 +478,7 @@ pub const fn fit_weight_seed(seed: u64) -> u64 {
 
 /// The fit's robot: its MCU (sensors, EEPROMs) and the walk of its sensors' distances.
 struct Rig {
-    mcu: Mcu<FitBoard>,
+    mcu: Mcu<RobotBoard<FitBoard>>,
     walk: ChaCha8Rng,
 }
 
@@ -486,10 +488,7 @@ impl Rig {
         let stream = |k: u64, purpose: Purpose| robot_stream(cfg.seed, 0, 0, k, purpose);
         let mut sensors_v = Vec::with_capacity(4);
         for k in 0..4 {
-            let params = sensors::IrParams {
-                clock_hz,
-                ..sensors::IrParams::default()
-            };
+            let params = sensors::IrParams::datasheet(clock_hz);
             sensors_v.push(
                 sensors::IrSensor::new(params, stream(k, Purpose::IrSensor)).map_err(|e| {
                     FitError::Sensor {
@@ -504,12 +503,12 @@ impl Rig {
             distance_mm: [300.0, 500.0, 150.0, 800.0],
             channels: cfg.controller.sensor_channels,
         };
-        let mcu = Mcu::new(
-            McuConfig {
+        let mcu = robot_mcu(
+            board,
+            &RobotConfig {
                 clock_hz,
                 eeprom_seed: stream(0, Purpose::Eeproms),
             },
-            board,
         )?;
         Ok(Rig {
             mcu,
@@ -519,7 +518,7 @@ impl Rig {
 
     /// The world moves before each step: each distance takes a bounded random step.
     fn move_world(&mut self) {
-        for d in &mut self.mcu.board_mut().distance_mm {
+        for d in &mut self.mcu.board_mut().world.distance_mm {
             let delta: f64 = self.walk.random_range(-60.0..60.0);
             *d = (*d + delta).clamp(30.0, 1000.0);
         }
@@ -568,8 +567,8 @@ struct FitMeter {
 }
 
 impl FitMeter {
-    fn new<B: Board>(mcu: &Mcu<B>) -> FitMeter {
-        let params = world::WorldParams::default();
+    fn new<W: Board>(mcu: &Mcu<RobotBoard<W>>) -> FitMeter {
+        let params = world::WorldParams::with_clock(u64::from(emu::board::board::CLOCK_HZ));
         let top = params.top_speed_m_per_s;
         let wheels = || FreeWheels::new(&params);
         FitMeter {
@@ -597,7 +596,7 @@ impl FitMeter {
         }
     }
 
-    fn finish<B: Board>(mut self, mcu: &Mcu<B>, busy_states: u64) -> Metered {
+    fn finish<W: Board>(mut self, mcu: &Mcu<RobotBoard<W>>, busy_states: u64) -> Metered {
         Metered {
             electronics: self.electronics.take(mcu, busy_states),
             free: self.free.0.take(),

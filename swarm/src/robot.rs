@@ -1,5 +1,5 @@
-//! One robot: the emulated H8/3052F with its controller, four IR sensors, two EEPROMs (on the
-//! MCU's port 4) and, in the world, its body.
+//! One robot: the emulated H8/3052F on the robot's board (its two EEPROMs on the MCU's port 4,
+//! `emu::board::board`) with its controller, four IR sensors and, in the world, its body.
 //!
 //! Every random draw comes from its own stream: the sensors (one each), the EEPROMs, the
 //! initial weights and the random-walk control each get a seed from the run's seed, the
@@ -9,13 +9,14 @@
 use std::sync::Arc;
 
 use anyhow::{Context, Result};
+use emu::board::board::{RobotBoard, RobotConfig, robot_mcu};
 use emu::board::firmware::{
     ConfigBlock, ConfigStatus, FLAG_RANDOM_WALK, Firmware, FirmwareController,
 };
 use emu::board::model::{Controller, ControllerConfig};
 use emu::board::wiring::{Bridge, MotorDrive};
 use emu::chip::gdb::Debugger;
-use emu::chip::mcu::{Mcu, McuConfig};
+use emu::chip::mcu::Mcu;
 use emu::chip::pins::Board;
 use emu::chip::trace::CodeNames;
 use emu::chip::vcd::{VcdInfo, VcdStream};
@@ -31,8 +32,9 @@ use crate::scenario::Scenario;
 
 use crate::seeds::robot_stream;
 
-/// The robot's hardware outside the chip: what the sensors see and the bumpers feel.
-pub struct RobotBoard {
+/// The robot's hardware that the world drives: what the sensors see and the bumpers feel (the
+/// analog inputs and port 2; the board's EEPROMs are [`RobotBoard`]'s own).
+pub struct Senses {
     sensors: [IrSensor; 4],
     /// The true distance each sensor's ray finds (mm), as of the step being run.
     pub distance_mm: [Option<f64>; 4],
@@ -43,7 +45,7 @@ pub struct RobotBoard {
     channels: [u8; 4],
 }
 
-impl Board for RobotBoard {
+impl Board for Senses {
     fn analog_volts(&mut self, channel: u8, now_states: u64) -> f64 {
         emu::board::wiring::sensor_volts(
             &mut self.sensors,
@@ -110,8 +112,8 @@ pub struct StepResult {
 
 /// One robot.
 pub struct Robot {
-    /// The MCU with its board.
-    pub mcu: Mcu<RobotBoard>,
+    /// The MCU on its board.
+    pub mcu: Mcu<RobotBoard<Senses>>,
     /// The controller running on it.
     pub brain: Brain,
     walk: Option<ChaCha8Rng>,
@@ -143,7 +145,7 @@ pub struct Robot {
 
 /// Ends the MCU's pin trace and writes the rest of it (and of the phases) into `vcd`.
 fn finish_stream(
-    mcu: &mut Mcu<RobotBoard>,
+    mcu: &mut Mcu<RobotBoard<Senses>>,
     c: &mut FirmwareController,
     vcd: Option<VcdStream<'static>>,
 ) -> Option<std::io::Result<()>> {
@@ -240,17 +242,14 @@ impl Robot {
         images: Option<&Images>,
     ) -> Result<Self> {
         let stream = |k: u64, purpose: Purpose| robot_stream(s.seed, repeat, index, k, purpose);
+        let clock_hz = s.timing.clock_hz;
         let ir = IrParams {
-            clock_hz: s.timing.clock_hz,
             noise_sigma_volts: s.sensors.noise_sigma_v,
             spike_probability: s.sensors.spike_probability,
             ..if s.sensors.spread {
-                IrParams::default()
+                IrParams::datasheet(clock_hz)
             } else {
-                IrParams {
-                    clock_hz: s.timing.clock_hz,
-                    ..IrParams::ideal()
-                }
+                IrParams::ideal(clock_hz)
             }
         };
         let mut sensors_v = Vec::with_capacity(4);
@@ -261,18 +260,18 @@ impl Robot {
         let sensors: [IrSensor; 4] = sensors_v
             .try_into()
             .map_err(|_| anyhow::anyhow!("four sensors"))?;
-        let board = RobotBoard {
+        let senses = Senses {
             sensors,
             distance_mm: [None; 4],
             bumpers: [false; 4],
             channels: s.sensors.channels,
         };
-        let mut mcu = Mcu::new(
-            McuConfig {
+        let mut mcu = robot_mcu(
+            senses,
+            &RobotConfig {
                 clock_hz: s.timing.clock_hz,
                 eeprom_seed: stream(0, Purpose::Eeproms),
             },
-            board,
         )
         .context("timing.clock_hz")?;
         let electronics = crate::energy::ElectronicsMeter::new(&mcu);
@@ -331,7 +330,8 @@ impl Robot {
     /// either chip (docs/design.md §3.6's A/B records).
     fn records_written(&self) -> u64 {
         self.mcu
-            .i2c()
+            .board()
+            .eeproms()
             .devices()
             .iter()
             .map(|d| u64::from(d.write_counts().first().copied().unwrap_or(0)))
@@ -470,7 +470,7 @@ impl Robot {
     /// Sets the bumper switches the board shows on port 2 (front, rear, left, right; `true` =
     /// pressed), as they stand for the coming step.
     pub fn set_bumpers(&mut self, bumpers: [bool; 4]) {
-        self.mcu.board_mut().bumpers = bumpers;
+        self.mcu.board_mut().world.bumpers = bumpers;
     }
 
     /// Runs the step with the distances the world's rays found.
@@ -496,7 +496,7 @@ impl Robot {
 
     /// [`Robot::step`] without the charge meter.
     fn run_step(&mut self, distance_mm: [Option<f64>; 4]) -> Result<StepResult> {
-        self.mcu.board_mut().distance_mm = distance_mm;
+        self.mcu.board_mut().world.distance_mm = distance_mm;
         match &mut self.brain {
             Brain::Model(c) => {
                 let forced = self
@@ -535,7 +535,7 @@ impl Robot {
     /// controller made them: the du table of the upper byte of each sensor's A/D result.
     #[must_use]
     pub fn readings_du(&self) -> [u8; 4] {
-        self.mcu.board().channels.map(|ch| {
+        self.mcu.board().world.channels.map(|ch| {
             let code8 = (self.mcu.adc().data(usize::from(ch & 3)) >> 8) as usize;
             sensors::DU_TABLE[code8]
         })

@@ -388,7 +388,7 @@ impl Scenario {
             },
             timing: TimingSpec {
                 step_period_s: 0.45,
-                clock_hz: 25_000_000,
+                clock_hz: emu::board::board::CLOCK_HZ,
             },
             world: WorldSpec {
                 mu_wall: ARENA_MU_WALL,

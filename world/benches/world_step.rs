@@ -16,6 +16,10 @@ use rand_pcg::Pcg64;
 use world::geometry::{Obb, obb_overlap, ray_obb};
 use world::{Arena, Behaviour, World, WorldParams};
 
+/// The robots' MCU clock the world counts in here: the robot's φ, 25 MHz (the world crate has
+/// no clock of its own, and does not depend on the emulator that defines the robot's).
+const CLOCK_HZ: u64 = 25_000_000;
+
 const SIZES: [usize; 4] = [3, 100, 1_000, 10_000];
 const SUBSTEP_S: f64 = 0.010;
 const SUBSTEPS_PER_BEHAVIOUR: u64 = 45;
@@ -24,7 +28,7 @@ const SUBSTEPS_PER_BEHAVIOUR: u64 = 45;
 fn moving_world(n: usize, rng: &mut Pcg64) -> World {
     let mut w = World::new(
         Arena::scaled_square(n).unwrap(),
-        WorldParams::default(),
+        WorldParams::with_clock(CLOCK_HZ),
         n,
         2008,
     )

@@ -25,7 +25,9 @@ use world::geometry::{Obb, obb_overlap};
 use world::{Arena, Behaviour, World, WorldParams};
 
 const STEP_STATES: u64 = 11_250_000;
-const CLOCK_HZ: f64 = 25_000_000.0;
+/// The robots' MCU clock the world counts in here: the robot's φ, 25 MHz (the world crate has
+/// no clock of its own, and does not depend on the emulator that defines the robot's).
+const CLOCK_HZ: u64 = 25_000_000;
 const SUBSTEPS: u32 = 23;
 const HX: f64 = 0.115;
 const HY: f64 = 0.09;
@@ -67,7 +69,7 @@ fn fingerprint(poses: impl Iterator<Item = (f64, f64, f64)>) -> u64 {
 fn own(n: usize, plan: &[Vec<Behaviour>], parallel: bool) -> Outcome {
     let mut w = World::new(
         Arena::scaled_square(n).unwrap(),
-        WorldParams::default(),
+        WorldParams::with_clock(CLOCK_HZ),
         n,
         2008,
     )
@@ -111,13 +113,13 @@ fn rapier(n: usize, plan: &[Vec<Behaviour>]) -> Outcome {
     // The same placement and motor gains as ours.
     let start = World::new(
         Arena::scaled_square(n).unwrap(),
-        WorldParams::default(),
+        WorldParams::with_clock(CLOCK_HZ),
         n,
         2008,
     )
     .unwrap();
     let side = start.arena().width_m();
-    let h = STEP_STATES as f64 / CLOCK_HZ / f64::from(SUBSTEPS);
+    let h = STEP_STATES as f64 / CLOCK_HZ as f64 / f64::from(SUBSTEPS);
     let mut pw = rapier_scene::walled_world(side, side, MU_CONTACT, h);
     let mut handles = Vec::with_capacity(n);
     let mut gains = Vec::with_capacity(n);

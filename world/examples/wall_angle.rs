@@ -27,6 +27,10 @@ mod rapier_scene;
 use rapier2d::prelude::*;
 use world::{Arena, Pose, World, WorldParams};
 
+/// The robots' MCU clock the world counts in here: the robot's φ, 25 MHz (the world crate has
+/// no clock of its own, and does not depend on the emulator that defines the robot's).
+const CLOCK_HZ: u64 = 25_000_000;
+
 const HX: f64 = 0.115;
 const HY: f64 = 0.09;
 const MASS: f64 = 0.5;
@@ -57,7 +61,7 @@ fn inertia() -> f64 {
 fn own(theta: f64, duty: [f64; 2]) -> Track {
     let params = WorldParams {
         motor_gain_spread: 0.0,
-        ..WorldParams::default()
+        ..WorldParams::with_clock(CLOCK_HZ)
     };
     let (x, y) = start(theta);
     let pose = Pose {

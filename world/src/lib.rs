@@ -8,7 +8,8 @@
 //! ```
 //! use world::{Arena, Behaviour, World, WorldParams, FRONT};
 //!
-//! let mut w = World::new(Arena::square(), WorldParams::default(), 3, 42)?;
+//! // Time counted in the robots' MCU clock: 25 MHz (the world has no clock of its own).
+//! let mut w = World::new(Arena::square(), WorldParams::with_clock(25_000_000), 3, 42)?;
 //! let (l, r) = Behaviour::TurnLeftForward.wheels();
 //! w.set_wheels(0, l, r)?;
 //! for _ in 0..45 {
@@ -46,7 +47,7 @@
 //!   arc for the sub-step's *mean* wheel speeds (the exact integral of the lag) when it touches
 //!   nothing, so the heading change is exact, straight-line distance is exact, and constant
 //!   wheel speeds give the same path whatever the sub-step length (to rounding).
-//! - **Time** is counted in whole clock states (`clock_hz`, default the MCU's 25 MHz: one clock
+//! - **Time** is counted in whole clock states (`clock_hz`, the robots' MCU clock: one clock
 //!   rules it all, the world counts the states the robots' MCUs count). [`World::advance_states`]
 //!   cuts an interval into [`World::substep_plan`]'s fewest equal sub-steps of at most
 //!   `max_substep_s` (default 20 ms; lengths differing by one state at most, adding up exactly),

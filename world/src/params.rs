@@ -73,9 +73,10 @@ pub const BUMPER_FORCE_N: f64 = 0.1;
 /// D2F-01 at 0.74 N / 0.05 N (Omron D2F datasheet, "Operating Characteristics"). We keep the
 /// data sheet's release force with our lower operating force.
 pub const BUMPER_RELEASE_FORCE_N: f64 = 0.02;
-/// Default clock that counts the world's time: φ = 25 MHz, one state = 40 ns (docs/design.md §4.1): the
-/// world advances in whole MCU states, the clock the robots' MCUs count.
-pub const CLOCK_HZ: u64 = 25_000_000;
+/// The clock the world's unit tests count in: the robot's φ, 25 MHz (docs/design.md §4.1).
+/// The crate itself has no clock: [`WorldParams::with_clock`] takes the robots' MCU clock.
+#[cfg(test)]
+pub(crate) const TEST_CLOCK_HZ: u64 = 25_000_000;
 /// Most rays a sensor cone may use (our limit).
 pub const MAX_RAYS_PER_SENSOR: u32 = 16;
 /// Widest accepted sensor cone half-angle: 0.5 rad (our limit; the Sharp beam is a few degrees).
@@ -124,7 +125,8 @@ impl SensorMount {
     }
 }
 
-/// All parameters of the physical world. [`WorldParams::default`] gives the design values.
+/// All parameters of the physical world. [`WorldParams::with_clock`] gives the design values,
+/// time counted in the robots' MCU clock.
 #[derive(Debug, Clone, PartialEq)]
 pub struct WorldParams {
     /// Body length along the heading, metres.
@@ -173,12 +175,17 @@ pub struct WorldParams {
     pub solver_iterations: u32,
     /// Position-correction sweeps per sub-step.
     pub position_iterations: u32,
-    /// The clock the world's time is counted in (MCU states per second).
+    /// The clock the world's time is counted in (MCU states per second): the world advances
+    /// in whole states of the clock the robots' MCUs count.
     pub clock_hz: u64,
 }
 
-impl Default for WorldParams {
-    fn default() -> Self {
+impl WorldParams {
+    /// The design values, the world's time counted in states of the robots' MCU clock
+    /// `clock_hz` (the robot's φ is the board's, docs/design.md §4.1; the world has none of its
+    /// own).
+    #[must_use]
+    pub fn with_clock(clock_hz: u64) -> Self {
         WorldParams {
             body_length_m: BODY_LENGTH_M,
             body_width_m: BODY_WIDTH_M,
@@ -202,7 +209,7 @@ impl Default for WorldParams {
             bumper_release_force_n: BUMPER_RELEASE_FORCE_N,
             solver_iterations: SOLVER_ITERATIONS,
             position_iterations: POSITION_ITERATIONS,
-            clock_hz: CLOCK_HZ,
+            clock_hz,
         }
     }
 }

@@ -201,7 +201,7 @@ mod tests {
 
     #[test]
     fn placement_is_non_overlapping_and_deterministic() {
-        let params = WorldParams::default();
+        let params = WorldParams::with_clock(crate::params::TEST_CLOCK_HZ);
         for (arena, n) in [
             (Arena::square(), 3),
             (Arena::square(), 15),
@@ -235,7 +235,7 @@ mod tests {
 
     #[test]
     fn crowded_placement_is_an_error_that_says_how_many_fit() {
-        let params = WorldParams::default();
+        let params = WorldParams::with_clock(crate::params::TEST_CLOCK_HZ);
         // Corridor: 3.0 m holds floor((3.0 − 0.05) / 0.28) = 10 robots at 5 cm.
         assert!(place(&Arena::paper_corridor(), &params, 10, 1).is_ok());
         let e = place(&Arena::paper_corridor(), &params, 11, 1).unwrap_err();
@@ -275,7 +275,7 @@ mod tests {
         // A body wider than the corridor.
         let wide = WorldParams {
             body_width_m: 0.25,
-            ..WorldParams::default()
+            ..WorldParams::with_clock(crate::params::TEST_CLOCK_HZ)
         };
         assert!(place(&Arena::paper_corridor(), &wide, 1, 1).is_err());
         // Zero robots: nothing placed.

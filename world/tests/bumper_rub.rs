@@ -9,6 +9,10 @@
 use world::params::{BODY_WIDTH_M, BUMPER_FORCE_N, BUMPER_RELEASE_FORCE_N};
 use world::{Arena, Pose, WheelCommand, World, WorldParams};
 
+/// The robots' MCU clock the world counts in here: the robot's φ, 25 MHz (the world crate has
+/// no clock of its own, and does not depend on the emulator that defines the robot's).
+const CLOCK_HZ: u64 = 25_000_000;
+
 /// Runs the robot along the wall y = 0 for `n` sub-steps of 20 ms with the left wheel at full
 /// duty and the right at `right_duty` (turning it into the wall), and returns per sub-step
 /// whether any switch was pressed and the body's distance from the wall.
@@ -16,7 +20,7 @@ fn rub(right_duty: f64, n: usize, release_n: f64) -> Vec<(bool, f64)> {
     let params = WorldParams {
         motor_gain_spread: 0.0,
         bumper_release_force_n: release_n,
-        ..WorldParams::default()
+        ..WorldParams::with_clock(CLOCK_HZ)
     };
     let pose = Pose {
         x_m: 0.4,

@@ -12,6 +12,10 @@ use coulomb_reference::{Sample, Scene};
 use world::params::{BODY_LENGTH_M, BODY_WIDTH_M};
 use world::{Arena, Pose, WheelCommand, World, WorldParams};
 
+/// The robots' MCU clock the world counts in here: the robot's φ, 25 MHz (the world crate has
+/// no clock of its own, and does not depend on the emulator that defines the robot's).
+const CLOCK_HZ: u64 = 25_000_000;
+
 const WALL_X: f64 = 3.0;
 const EVERY_S: f64 = 0.02;
 
@@ -36,7 +40,7 @@ fn own(s: &Scene) -> Vec<Sample> {
     let params = WorldParams {
         motor_gain_spread: 0.0,
         mu_wall: s.mu_wall,
-        ..WorldParams::default()
+        ..WorldParams::with_clock(CLOCK_HZ)
     };
     let pose = Pose {
         x_m: s.x,

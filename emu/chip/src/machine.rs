@@ -1,6 +1,8 @@
-//! The system `h8swarm emu` runs machine code on: the same [`Mcu`] as the robot's controller
-//! (flash, RAM, SCI1 as console, ITU, A/D, ports, interrupt controller, the EEPROMs on port
-//! 4), with a [`NullBoard`] outside it (all analog inputs at 0 V, port-2 pins released).
+//! The chip alone, for running machine code: the same [`Mcu`] as the robot's controller
+//! (flash, RAM, SCI1 as console, ITU, A/D, ports, interrupt controller) with a [`NullBoard`]
+//! outside it (all analog inputs at 0 V, port-2 and port-4 pins released: no EEPROMs).
+//! `h8swarm emu` runs images on the robot's board instead (`robot_board::board`), so that
+//! programs that use the EEPROMs find them.
 //!
 //! [`Machine`] is a thin wrapper that keeps the constructors the core's tests and the runner
 //! use; it dereferences to [`Mcu<NullBoard>`] for everything else.
@@ -13,7 +15,8 @@ use crate::pins::NullBoard;
 use h8300h::bus::{Bus, FastPathHints};
 use h8300h::srec::SrecImage;
 
-/// The MCU with nothing connected outside it, at φ = 25 MHz.
+/// The MCU with nothing connected outside it, at its highest φ
+/// ([`crate::mcu::MAX_CLOCK_HZ`]).
 #[derive(Clone, Debug)]
 pub struct Machine(Mcu<NullBoard>);
 
@@ -30,7 +33,7 @@ impl Machine {
     pub fn new() -> Self {
         match Mcu::new(McuConfig::default(), NullBoard) {
             Ok(m) => Machine(m),
-            // The default configuration is valid: φ = 25 MHz and the robot's two chips.
+            // The default configuration is valid: φ = the chip's highest.
             Err(e) => unreachable!("default MCU configuration rejected: {e}"),
         }
     }

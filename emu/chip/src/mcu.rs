@@ -1,6 +1,6 @@
-//! The H8/3052F as one chip: clock, flash, RAM, the peripherals and the robot's I²C EEPROMs on
-//! port 4, behind the [`Bus`] every program (the Rust controller or machine code on the
-//! H8/300H core) talks through.
+//! The H8/3052F as one chip: clock, flash, RAM and the peripherals, with the board outside its
+//! pins, behind the [`Bus`] every program (the Rust controller or machine code on the H8/300H
+//! core) talks through.
 //!
 //! # Memory
 //! A swarm holds thousands of MCUs and the Rust controller never touches ROM or RAM contents,
@@ -10,7 +10,7 @@
 //! - the 8 KB RAM is allocated on the first write (bus or [`Mcu::poke`]); reads of untouched
 //!   RAM return 0.
 //!
-//! An `Mcu` without image and RAM holds a few hundred bytes plus its two EEPROM chips.
+//! An `Mcu` without image and RAM holds a few hundred bytes plus its board.
 //!
 //! # Peripherals and time
 //! The clock counts states since reset; every bus access advances it by the states of the
@@ -36,11 +36,14 @@
 //! at each P2DR read. A board must answer for any instant not earlier than one it was already
 //! asked about and not later than the MCU clock.
 //!
-//! # I²C on port 4
-//! The chip model carries the robot's EEPROM bus (two 24LC256 at 0x50 and 0x51, docs/design.md §3.6) on
-//! P4.7 (SDA) and P4.6 (SCL), as the ports module describes ([`crate::periph::ports`]),
-//! so that the chips' own events (the end of a write cycle) are synchronised with the chip's
-//! clock; they are applied lazily by the bus.
+//! # Port 4 and the board's own events
+//! Port 4 is open-drain ([`crate::periph::ports`]): the board is told what the port pulls low
+//! at every write to P4DDR or P4DR and asked for the line levels at every P4DR read. On the
+//! robot the lines are its EEPROM bus (two 24LC256 at 0x50 and 0x51 on P4.7/P4.6,
+//! docs/design.md §3.6), which the board holds (`robot_board::board`). The board's own events
+//! (an EEPROM's write cycle ending, [`Board::next_event_states`]) count among the chip's
+//! events, so that they are synchronised with the chip's clock, and the board is brought up to
+//! the clock whenever the chip is ([`Mcu::sync`]); the board applies them lazily.
 //!
 //! # Other registers
 //! Registers of modules not modelled (DMAC, watchdog, SCI0, TPC, ports 1, 3, 5, 6, 7, 8, 9,
@@ -48,10 +51,7 @@
 
 use std::cell::Cell;
 
-use eeprom::{DeviceConfig, EepromError, I2cBus, PowerCutOutcome};
-
 use crate::flash::Flash;
-
 use crate::periph::Peripheral;
 use crate::periph::adc::{ADCR, ADDRA, Adc};
 use crate::periph::intc::Intc;
@@ -69,12 +69,9 @@ use h8300h::srec::SrecImage;
 /// Lowest φ accepted: 2 MHz (H8/3052F hardware manual, electrical characteristics: operating
 /// frequency 2–25 MHz).
 pub const MIN_CLOCK_HZ: u32 = 2_000_000;
-/// Highest φ accepted: 25 MHz (same table; also the top of the EEPROM model's clock range).
+/// Highest φ accepted: 25 MHz (same table). The one definition of the chip's top speed; the
+/// robot's board runs the chip at it (`robot_board::board::CLOCK_HZ`).
 pub const MAX_CLOCK_HZ: u32 = 25_000_000;
-/// The clock φ of the AKI-H8/3052F board, the chip's highest: 25 MHz, 1 state = 40 ns
-/// (docs/design.md §4.1). The one definition of the robot's clock; everything else that
-/// needs it refers here.
-pub const DEFAULT_CLOCK_HZ: u32 = MAX_CLOCK_HZ;
 
 /// Index masks of the flash and RAM arrays (both sizes are powers of two).
 const ROM_INDEX_MASK: usize = ROM_BYTES as usize - 1;
@@ -83,24 +80,36 @@ const RAM_INDEX_MASK: usize = RAM_BYTES as usize - 1;
 /// How to build an [`Mcu`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct McuConfig {
-    /// The system clock φ in Hz ([`MIN_CLOCK_HZ`]..=[`MAX_CLOCK_HZ`]; default 25 MHz). The MCU
-    /// counts states; φ converts them to seconds and sets the EEPROMs' timing.
+    /// The system clock φ in Hz ([`MIN_CLOCK_HZ`]..=[`MAX_CLOCK_HZ`]; default the chip's
+    /// highest, [`MAX_CLOCK_HZ`]). The MCU counts states; φ converts them to seconds.
     pub clock_hz: u32,
-    /// Seed of the two EEPROMs' random streams (write-cycle times, power-cut corruption,
-    /// wear).
-    pub eeprom_seed: u64,
 }
 
 impl Default for McuConfig {
     fn default() -> Self {
         McuConfig {
-            clock_hz: DEFAULT_CLOCK_HZ,
-            eeprom_seed: 0,
+            clock_hz: MAX_CLOCK_HZ,
         }
     }
 }
 
-/// Why an MCU cannot be built or its EEPROMs cannot be switched.
+impl McuConfig {
+    /// Checks the configuration as [`Mcu::new`] does.
+    ///
+    /// # Errors
+    /// [`McuError::InvalidClock`] if `clock_hz` is outside [`MIN_CLOCK_HZ`]..=[`MAX_CLOCK_HZ`].
+    pub fn validate(&self) -> Result<(), McuError> {
+        if (MIN_CLOCK_HZ..=MAX_CLOCK_HZ).contains(&self.clock_hz) {
+            Ok(())
+        } else {
+            Err(McuError::InvalidClock {
+                clock_hz: self.clock_hz,
+            })
+        }
+    }
+}
+
+/// Why an MCU cannot be built.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum McuError {
     /// φ outside what the chip runs at.
@@ -113,9 +122,6 @@ pub enum McuError {
         /// The rejected value.
         clock_hz: u32,
     },
-    /// The EEPROM bus refused an operation.
-    #[error("EEPROM bus on port 4")]
-    Eeprom(#[from] EepromError),
 }
 
 /// Why an image cannot be loaded into the flash.
@@ -151,7 +157,7 @@ pub struct TiocaOutput {
     pub wave: Option<PwmWave>,
 }
 
-/// The H8/3052F with its board and the robot's EEPROM bus.
+/// The H8/3052F with its board.
 #[derive(Clone, Debug)]
 pub struct Mcu<B: Board> {
     now: u64,
@@ -165,7 +171,6 @@ pub struct Mcu<B: Board> {
     adc: Adc,
     intc: Intc,
     ports: Ports,
-    i2c: I2cBus,
     board: B,
     /// The winning interrupt request as of the last computation.
     irq_cached: Cell<Option<u8>>,
@@ -227,7 +232,7 @@ impl Module {
 
 /// Evaluates `$body` with `$p` bound to module `$m` of the MCU `$mcu` and `$outside` to what
 /// that module sees outside itself (the board's analog inputs for the A/D converter; the
-/// port-2 pins, the EEPROM bus and the ITU for the ports; nothing for the others), or `$none`
+/// port-2 and port-4 pins and the ITU for the ports; nothing for the others), or `$none`
 /// for [`Module::Unmodelled`]. The one place that says which field holds which module.
 macro_rules! on_module {
     ($mcu:ident, $m:expr, |$p:ident, $outside:ident| $body:expr, $none:expr) => {
@@ -244,7 +249,6 @@ macro_rules! on_module {
                 let $p = &mut $mcu.ports;
                 let $outside = PortPins {
                     board: &mut $mcu.board,
-                    i2c: &mut $mcu.i2c,
                     itu: &mut $mcu.itu,
                 };
                 $body
@@ -302,24 +306,13 @@ fn earliest(a: Option<u64>, b: Option<u64>) -> Option<u64> {
 }
 
 impl<B: Board> Mcu<B> {
-    /// An MCU after reset with `board` outside it and the robot's two 24LC256 (0x50, 0x51) on
-    /// port 4, their streams seeded from `config.eeprom_seed`.
+    /// An MCU after reset with `board` outside it.
     ///
     /// # Errors
     /// [`McuError::InvalidClock`] if `config.clock_hz` is outside
-    /// [`MIN_CLOCK_HZ`]..=[`MAX_CLOCK_HZ`]; [`McuError::Eeprom`] if the EEPROM model refuses.
+    /// [`MIN_CLOCK_HZ`]..=[`MAX_CLOCK_HZ`].
     pub fn new(config: McuConfig, board: B) -> Result<Self, McuError> {
-        if !(MIN_CLOCK_HZ..=MAX_CLOCK_HZ).contains(&config.clock_hz) {
-            return Err(McuError::InvalidClock {
-                clock_hz: config.clock_hz,
-            });
-        }
-        // I2cBus::robot(seed) with the chips counting in this MCU's φ.
-        let chip = DeviceConfig {
-            clock_hz: config.clock_hz,
-            ..DeviceConfig::new(eeprom::CHIP_A, config.eeprom_seed)
-        };
-        let i2c = I2cBus::with_chips(&[eeprom::CHIP_A, eeprom::CHIP_B], &chip)?;
+        config.validate()?;
         Ok(Mcu {
             now: 0,
             clock_hz: config.clock_hz,
@@ -331,7 +324,6 @@ impl<B: Board> Mcu<B> {
             adc: Adc::new(),
             intc: Intc::new(),
             ports: Ports::new(),
-            i2c,
             board,
             irq_cached: Cell::new(None),
             irq_valid_until: Cell::new(0),
@@ -348,18 +340,6 @@ impl<B: Board> Mcu<B> {
     /// The board, mutably (the world updates what the sensors see).
     pub fn board_mut(&mut self) -> &mut B {
         &mut self.board
-    }
-
-    /// The I²C bus with the two EEPROMs.
-    #[must_use]
-    pub fn i2c(&self) -> &I2cBus {
-        &self.i2c
-    }
-
-    /// The I²C bus, mutably (back-door loads and reads of the chips). Keep its time calls at
-    /// or after [`Bus::now`].
-    pub fn i2c_mut(&mut self) -> &mut I2cBus {
-        &mut self.i2c
     }
 
     /// φ in Hz.
@@ -489,7 +469,7 @@ impl<B: Board> Mcu<B> {
         self.sync();
     }
 
-    /// Brings every peripheral and the EEPROM bus up to the current clock.
+    /// Brings every peripheral and the board ([`Board::sync`]) up to the current clock.
     pub fn sync(&mut self) {
         let now = self.now;
         for m in Module::ALL {
@@ -500,20 +480,19 @@ impl<B: Board> Mcu<B> {
                 ()
             );
         }
-        // Time never goes back here (max), so the bus cannot refuse.
-        let _ = self.i2c.advance_to(now.max(self.i2c.now()));
+        self.board.sync(now);
         self.invalidate_irq();
     }
 
     /// The earliest state after now at which a peripheral next needs attention (an ITU compare
-    /// match or overflow, an A/D sampling instant or conversion end, an SCI frame end, an
-    /// EEPROM write cycle end), if any.
+    /// match or overflow, an A/D sampling instant or conversion end, an SCI frame end) or the
+    /// board's own parts do ([`Board::next_event_states`]: an EEPROM's write cycle end), if any.
     #[must_use]
     pub fn next_event(&self) -> Option<u64> {
         let now = self.now;
         earliest(
             fold_modules!(self, |p| Peripheral::next_event(p, now), earliest),
-            self.i2c.next_event_states().filter(|&t| t > now),
+            self.board.next_event_states(now),
         )
     }
 
@@ -563,7 +542,7 @@ impl<B: Board> Mcu<B> {
             &self.adc,
             ChipView {
                 ports: &self.ports,
-                i2c: &mut self.i2c,
+                board: &mut self.board,
             },
             cpu_sleeping,
         );
@@ -611,18 +590,18 @@ impl<B: Board> Mcu<B> {
             let Some(t) = self.tracer.as_mut() else {
                 return Ok(());
             };
-            // A slice never ends before the EEPROM bus's own clock (its logged changes up to
-            // there are taken whole).
+            // A slice never ends before the board's own clock (its logged changes up to there
+            // are taken whole).
             let to = t
                 .caught_up()
                 .saturating_add(slice.max(1))
-                .max(self.i2c.now())
+                .max(self.board.now_states())
                 .min(now);
             t.catch_up(
                 to,
                 ChipView {
                     ports: &self.ports,
-                    i2c: &mut self.i2c,
+                    board: &mut self.board,
                 },
             );
             let changes = t.drain_before(to);
@@ -641,10 +620,10 @@ impl<B: Board> Mcu<B> {
             now,
             ChipView {
                 ports: &self.ports,
-                i2c: &mut self.i2c,
+                board: &mut self.board,
             },
         );
-        Some(tracer.finish(now, self.clock_hz, &mut self.i2c))
+        Some(tracer.finish(now, self.clock_hz, &mut self.board))
     }
 
     /// A CPU signal for the trace under way.
@@ -670,7 +649,7 @@ impl<B: Board> Mcu<B> {
                 now,
                 ChipView {
                     ports: &self.ports,
-                    i2c: &mut self.i2c,
+                    board: &mut self.board,
                 },
             );
         }
@@ -687,39 +666,29 @@ impl<B: Board> Mcu<B> {
                 (module == Module::Adc).then_some(&self.adc),
                 ChipView {
                     ports: &self.ports,
-                    i2c: &mut self.i2c,
+                    board: &mut self.board,
                 },
             );
         }
     }
 
-    /// Cuts the robot's power now: the EEPROMs lose power (a write cycle under way is
-    /// corrupted as the `eeprom` crate models it), the RAM loses its contents and every
-    /// peripheral returns to its reset state (ports released). The flash keeps its image. The
-    /// clock keeps running. Returns each chip's outcome (0x50, then 0x51).
-    ///
-    /// # Errors
-    /// [`McuError::Eeprom`] if the bus refuses (it cannot, as time never goes back here).
-    pub fn power_cut(&mut self) -> Result<Vec<PowerCutOutcome>, McuError> {
-        let t = self.now.max(self.i2c.now());
-        let outcomes = self.i2c.power_cut(t)?;
+    /// Cuts the robot's power now: the board's parts lose power ([`Board::power_cut`]; on the
+    /// robot, an EEPROM write cycle under way is corrupted as the `eeprom` crate models it),
+    /// the RAM loses its contents and every peripheral returns to its reset state (ports
+    /// released). The flash keeps its image. The clock keeps running.
+    pub fn power_cut(&mut self) {
+        self.board.power_cut(self.now);
         self.reset_peripherals();
         self.ram = None;
-        Ok(outcomes)
     }
 
-    /// Powers the robot on at `at_states` (the clock jumps there if it is later): the
-    /// EEPROMs power up, the peripherals are in their reset state. The caller resets the CPU
-    /// (or restarts the controller program).
-    ///
-    /// # Errors
-    /// [`McuError::Eeprom`] if the bus refuses (it cannot, as time never goes back here).
-    pub fn power_on(&mut self, at_states: u64) -> Result<(), McuError> {
+    /// Powers the robot on at `at_states` (the clock jumps there if it is later): the board's
+    /// parts power up ([`Board::power_on`]), the peripherals are in their reset state. The
+    /// caller resets the CPU (or restarts the controller program).
+    pub fn power_on(&mut self, at_states: u64) {
         self.now = self.now.max(at_states);
-        let t = self.now.max(self.i2c.now());
-        self.i2c.power_on(t)?;
+        self.board.power_on(self.now);
         self.reset_peripherals();
-        Ok(())
     }
 
     fn reset_peripherals(&mut self) {
@@ -1016,9 +985,10 @@ impl<B: Board> FastPathHints for Mcu<B> {
     }
 
     /// The ITU's state relative to now ([`Itu::idle_signature`]), when every other module is
-    /// quiet: the A/D converter, SCI1 and the EEPROMs have nothing under way (no event to
-    /// come), so that without accesses their state stays as it is and they request nothing
-    /// new. `None` while a pin trace is recorded (it must see every cycle) or a module is busy.
+    /// quiet: the A/D converter, SCI1 and the board's parts (the EEPROMs) have nothing under
+    /// way (no event to come), so that without accesses their state stays as it is and they
+    /// request nothing new. `None` while a pin trace is recorded (it must see every cycle) or a
+    /// module or the board is busy.
     fn idle_signature(&mut self) -> Option<Vec<u64>> {
         let now = self.now;
         if self.tracer.is_some()
@@ -1026,7 +996,7 @@ impl<B: Board> FastPathHints for Mcu<B> {
             || Peripheral::next_event(&self.sci, now).is_some()
             || Peripheral::next_event(&self.ports, now).is_some()
             || Peripheral::next_event(&self.intc, now).is_some()
-            || self.i2c.next_event_states().is_some_and(|t| t > now)
+            || self.board.next_event_states(now).is_some()
         {
             return None;
         }
@@ -1074,27 +1044,18 @@ mod tests {
     #[test]
     fn clock_out_of_range_is_an_error() {
         for hz in [0, MIN_CLOCK_HZ - 1, MAX_CLOCK_HZ + 1] {
-            let e = Mcu::new(
-                McuConfig {
-                    clock_hz: hz,
-                    eeprom_seed: 1,
-                },
-                NullBoard,
-            )
-            .unwrap_err();
+            let e = Mcu::new(McuConfig { clock_hz: hz }, NullBoard).unwrap_err();
             assert_eq!(e, McuError::InvalidClock { clock_hz: hz });
             assert!(e.to_string().contains("2000000..=25000000"), "{e}");
         }
         let m = Mcu::new(
             McuConfig {
                 clock_hz: 16_000_000,
-                eeprom_seed: 1,
             },
             NullBoard,
         )
         .unwrap();
         assert_eq!(m.clock_hz(), 16_000_000);
-        assert_eq!(m.i2c().devices()[0].clock().hz(), 16_000_000);
     }
 
     #[test]

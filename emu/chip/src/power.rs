@@ -59,24 +59,24 @@ pub struct McuCharge {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mcu::DEFAULT_CLOCK_HZ;
+    use crate::mcu::MAX_CLOCK_HZ;
 
-    /// One second of states at the board's clock.
-    const SECOND: u64 = DEFAULT_CLOCK_HZ as u64;
+    /// One second of states at the chip's highest clock, the robot's (25 MHz).
+    const SECOND: u64 = MAX_CLOCK_HZ as u64;
 
     #[test]
     fn a_sleeping_chip_draws_its_sleep_current() {
         // One second at 25 MHz, never awake: 35 mA for 1 s is 35 000 µC.
-        let q = mcu_charge_uc(SECOND, 0, 0, DEFAULT_CLOCK_HZ);
+        let q = mcu_charge_uc(SECOND, 0, 0, MAX_CLOCK_HZ);
         assert!((q.core_uc - 35_000.0).abs() < 1e-6, "{q:?}");
         assert_eq!(q.adc_uc, 0.0);
         // Busy all the time: the active current.
-        let q = mcu_charge_uc(SECOND, SECOND, 0, DEFAULT_CLOCK_HZ);
+        let q = mcu_charge_uc(SECOND, SECOND, 0, MAX_CLOCK_HZ);
         assert!((q.core_uc - 50_000.0).abs() < 1e-6, "{q:?}");
         // A scan of four conversions (266 + 3 × 256 states = 41.36 µs) at 1.45 mA: 0.06 µC.
-        let q = mcu_charge_uc(1034, 1034, 1034, DEFAULT_CLOCK_HZ);
+        let q = mcu_charge_uc(1034, 1034, 1034, MAX_CLOCK_HZ);
         assert!(
-            (q.adc_uc - 1034.0 / f64::from(DEFAULT_CLOCK_HZ) * 1.45e3).abs() < 1e-9,
+            (q.adc_uc - 1034.0 / f64::from(MAX_CLOCK_HZ) * 1.45e3).abs() < 1e-9,
             "{q:?}"
         );
     }

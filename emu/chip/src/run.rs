@@ -2,7 +2,9 @@
 //!
 //! [`run_image`] parses a `.mot` image, loads it into a [`Machine`] — the same [`Mcu`] the
 //! robot's controller runs on (flash, RAM, SCI1 as console, ITU, A/D, ports, interrupt
-//! controller, EEPROMs on port 4) with a [`NullBoard`](crate::pins::NullBoard) outside it — resets the CPU through vector 0 and runs it until the program halts
+//! controller) with a [`NullBoard`](crate::pins::NullBoard) outside it (no EEPROMs; `h8swarm
+//! emu` runs [`run_mcu_probed`] on the robot's board instead) — resets the CPU through vector
+//! 0 and runs it until the program halts
 //! (SLEEP with CCR.I = 1 and no NMI pending; exit status = low byte of R0, docs/design.md §7), the state
 //! budget runs out, or the core stops on an error (undefined opcode, fetch outside ROM/RAM).
 //! Bytes the program transmits on SCI1 go to the console writer as they leave TDR; the
@@ -21,16 +23,13 @@ use std::io::Write;
 
 use crate::gdb::DebugAction;
 use crate::machine::{LoadError, Machine};
-use crate::mcu::{DEFAULT_CLOCK_HZ, Mcu};
+use crate::mcu::Mcu;
 use crate::pins::Board;
 use crate::trace::{CodeNames, PhaseRecorder, phase_name};
 use h8300h::bus::Bus;
 use h8300h::cpu::disasm::format_instr;
 use h8300h::cpu::{Cpu, CpuError, Event, StackFault, StackGuard, StackRoom};
 use h8300h::srec::{self, SrecError};
-
-/// The clock φ the runner counts seconds in: the board's, [`DEFAULT_CLOCK_HZ`].
-pub const PHI_HZ: u64 = DEFAULT_CLOCK_HZ as u64;
 
 /// Options of a run.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -70,8 +69,10 @@ pub struct RunStats {
     pub instructions: u64,
     /// States elapsed (the MCU clock at the end).
     pub states: u64,
-    /// `states / φ` in seconds at φ = 25 MHz.
+    /// `states / φ` in seconds, at the MCU's φ.
     pub emulated_seconds: f64,
+    /// The MCU's φ in Hz.
+    pub clock_hz: u32,
     /// Interrupts accepted.
     pub interrupts: u64,
     /// Bytes transmitted on SCI1.
@@ -111,7 +112,7 @@ impl RunReport {
             instructions: self.stats.instructions,
             states: self.stats.states,
             emulated_seconds: self.stats.emulated_seconds,
-            phi_hz: PHI_HZ,
+            phi_hz: u64::from(self.stats.clock_hz),
             interrupts: self.stats.interrupts,
             console_bytes: self.stats.console_bytes,
         };
@@ -192,8 +193,9 @@ pub fn run_machine(
     run_mcu(cpu, machine.mcu_mut(), options, console, trace)
 }
 
-/// [`run_machine`] on any [`Mcu`], whatever board is outside it (a [`NullBoard`](crate::pins::NullBoard) for
-/// `h8swarm emu`, the robot for machine-code controllers). `emulated_seconds` uses the MCU's φ.
+/// [`run_machine`] on any [`Mcu`], whatever board is outside it (a
+/// [`NullBoard`](crate::pins::NullBoard), the robot's board for `h8swarm emu` and machine-code
+/// controllers). `emulated_seconds` uses the MCU's φ.
 ///
 /// # Errors
 /// Only I/O errors of the writers.
@@ -476,6 +478,7 @@ fn report<B: Board>(
             instructions: cpu.instructions() - start_instructions,
             states,
             emulated_seconds: states as f64 / f64::from(machine.clock_hz()),
+            clock_hz: machine.clock_hz(),
             interrupts,
             console_bytes: machine.sci().bytes_sent(),
         },

@@ -10,9 +10,10 @@
 //! CPU in sleep mode).
 //!
 //! A line of the EEPROM bus is the wired AND of everything on it: low while the master (port
-//! 4) or a chip pulls it low; otherwise high only through port 4's on-chip pull-up (P4PCR) or
-//! when the port drives it high; a released line without pull-up floats and is traced 0, as a
-//! read of P4DR returns it ([`crate::periph::ports`]).
+//! 4) or a part on the board pulls it low ([`Board::port4_pins`]); otherwise high only through
+//! port 4's on-chip pull-up (P4PCR) or when the port drives it high; a released line without
+//! pull-up floats and is traced 0, as a read of P4DR returns it ([`crate::periph::ports`]).
+//! With nothing on port 4 ([`crate::pins::NullBoard`]) the lines are the port's own levels.
 //!
 //! # How changes are found at their instant
 //! Nothing is stepped per state. Levels change for three reasons, and each is caught where
@@ -25,8 +26,8 @@
 //!   SDA output): the tracer keeps copies of the ITU and the A/D converter taken after their
 //!   last write, which evolve exactly as the real ones do until the next write, and walks
 //!   their event instants ([`crate::periph::itu::Itu::next_event`],
-//!   [`crate::periph::adc::Adc::next_event`]); the EEPROM bus logs its own line changes
-//!   with their instants ([`eeprom::I2cBus::set_line_log`]);
+//!   [`crate::periph::adc::Adc::next_event`]); the board logs the port-4 line changes its
+//!   parts make with their instants ([`Board::set_pin_log`]);
 //! - the CPU entering or leaving sleep mode ([`h8300h::bus::CpuSignal`]).
 //!
 //! The MCU calls the tracer only on I/O writes and CPU signals, so with no trace running the
@@ -35,13 +36,12 @@
 //! replaces register accesses (the model's transaction-level save, its charged ticks) would
 //! not, so trace the model with its shortcuts off.
 
-use eeprom::{I2cBus, LineLevels};
-
 use crate::periph::adc::Adc;
 use crate::periph::itu::{IMFA, Itu};
 use crate::periph::ports::{
     P4_SCL, P4_SDA, PA_TIOCA1, PA_TIOCA2, PB_TIOCA3, PB_TIOCA4, Port, Ports,
 };
+use crate::pins::Board;
 
 /// A traced pin or status line.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -202,37 +202,32 @@ pub(crate) struct Tracer {
     itu: Itu,
     /// The A/D converter as of its last write.
     adc: Adc,
-    /// The EEPROM bus's levels as of the last logged change taken.
-    lines: LineLevels,
+    /// The port-4 line levels as the board leaves them ([`Board::port4_pins`]), as of the last
+    /// logged change taken.
+    lines: u8,
     sleeping: bool,
     /// Changes up to this instant are recorded.
     caught_up: u64,
 }
 
 /// What the tracer reads off the chip to work out the levels.
-pub(crate) struct ChipView<'a> {
+pub(crate) struct ChipView<'a, B: Board> {
     pub(crate) ports: &'a Ports,
-    pub(crate) i2c: &'a mut I2cBus,
+    pub(crate) board: &'a mut B,
 }
 
 impl Tracer {
     /// Starts a trace at `now` from the chip's present state (`sleeping`: whether the CPU is in
     /// sleep mode now).
-    pub(crate) fn start(
+    pub(crate) fn start<B: Board>(
         now: u64,
         itu: &Itu,
         adc: &Adc,
-        chip: ChipView<'_>,
+        chip: ChipView<'_, B>,
         sleeping: bool,
     ) -> Tracer {
-        chip.i2c.set_line_log(true);
-        let lines = chip
-            .i2c
-            .lines(now.max(chip.i2c.now()))
-            .unwrap_or(LineLevels {
-                scl: true,
-                sda: true,
-            });
+        chip.board.set_pin_log(true);
+        let lines = chip.board.port4_pins(now);
         let mut t = Tracer {
             start: now,
             initial: [false; 12],
@@ -250,7 +245,7 @@ impl Tracer {
         t
     }
 
-    /// Every signal's level at `t` from the copies, the bus levels taken so far and the ports.
+    /// Every signal's level at `t` from the copies, the port-4 line levels taken so far and the ports.
     fn compute(&self, t: u64, ports: &Ports) -> [bool; 12] {
         let mut v = [false; 12];
         let pa = ports.port_a();
@@ -278,8 +273,8 @@ impl Tracer {
             v[s.index()] = pb & (1 << k) != 0;
         }
         let p4 = ports.port4();
-        v[Signal::Sda.index()] = line_level(self.lines.sda, &p4, P4_SDA);
-        v[Signal::Scl.index()] = line_level(self.lines.scl, &p4, P4_SCL);
+        v[Signal::Sda.index()] = line_level(self.lines, &p4, P4_SDA);
+        v[Signal::Scl.index()] = line_level(self.lines, &p4, P4_SCL);
         let (adst, adf) = self.adc.status_at(t);
         v[Signal::Adst.index()] = adst;
         v[Signal::Adf.index()] = adf;
@@ -305,11 +300,11 @@ impl Tracer {
     }
 
     /// Records every change up to `now` that happened without a write: the peripherals'
-    /// events and the EEPROM bus's logged changes, in time order. The bus is brought to `now`
-    /// first (as the next access would; it changes nothing it would not).
-    pub(crate) fn catch_up(&mut self, now: u64, chip: ChipView<'_>) {
-        let _ = chip.i2c.advance_to(now.max(chip.i2c.now()));
-        let log = chip.i2c.take_line_log();
+    /// events and the board's logged port-4 changes, in time order. The board is brought to
+    /// `now` first (as the next access would; it changes nothing it would not).
+    pub(crate) fn catch_up<B: Board>(&mut self, now: u64, chip: ChipView<'_, B>) {
+        chip.board.sync(now);
+        let log = chip.board.take_pin_log();
         let mut log = log.into_iter().peekable();
         let mut t = self.caught_up;
         loop {
@@ -329,7 +324,7 @@ impl Tracer {
                 self.lines = levels;
                 log.next();
             }
-            // The modules' next events lie strictly after `t`; a logged bus change is never
+            // The modules' next events lie strictly after `t`; a logged line change is never
             // before the instant the trace last caught up to.
             t = e.max(t);
             self.sample(t, chip.ports);
@@ -339,12 +334,12 @@ impl Tracer {
 
     /// After a write at `now`: takes fresh copies of the modules written to and records the
     /// write's effect.
-    pub(crate) fn after_write(
+    pub(crate) fn after_write<B: Board>(
         &mut self,
         now: u64,
         itu: Option<&Itu>,
         adc: Option<&Adc>,
-        chip: ChipView<'_>,
+        chip: ChipView<'_, B>,
     ) {
         if let Some(itu) = itu {
             self.itu = itu.clone();
@@ -352,8 +347,8 @@ impl Tracer {
         if let Some(adc) = adc {
             self.adc = adc.clone();
         }
-        // The write may have moved the bus's lines (port 4): take them.
-        for (_, levels) in chip.i2c.take_line_log() {
+        // The write may have moved the board's lines (port 4): take them.
+        for (_, levels) in chip.board.take_pin_log() {
             self.lines = levels;
         }
         self.sample(now, chip.ports);
@@ -403,9 +398,9 @@ impl Tracer {
     }
 
     /// Ends the trace at `now` (after [`Tracer::catch_up`]).
-    pub(crate) fn finish(mut self, now: u64, clock_hz: u32, i2c: &mut I2cBus) -> PinTrace {
-        i2c.set_line_log(false);
-        // Changes at one instant stay in the order they were made; the bus's log may deliver
+    pub(crate) fn finish<B: Board>(mut self, now: u64, clock_hz: u32, board: &mut B) -> PinTrace {
+        board.set_pin_log(false);
+        // Changes at one instant stay in the order they were made; the board's log may deliver
         // a change late (with its own instant), so sort by instant, stably.
         self.changes.sort_by_key(|c| c.t);
         PinTrace {
@@ -419,11 +414,11 @@ impl Tracer {
     }
 }
 
-/// A line of the EEPROM bus as the pin sees it: low when the bus is low (someone pulls it);
-/// else high through the pull-up of an input pin or when the port drives a 1; else floating,
-/// traced as 0.
-fn line_level(bus_high: bool, p4: &Port, bit: u8) -> bool {
-    bus_high && (p4.pulled_up() & bit != 0 || p4.output_levels() & bit != 0)
+/// A line of port 4 (bit `bit`) as the pin sees it: low when the board holds it low (someone
+/// pulls it; `lines` as [`Board::port4_pins`] reads them); else high through the pull-up of an
+/// input pin or when the port drives a 1; else floating, traced as 0.
+fn line_level(lines: u8, p4: &Port, bit: u8) -> bool {
+    lines & bit != 0 && (p4.pulled_up() & bit != 0 || p4.output_levels() & bit != 0)
 }
 
 /// Names the code a program counter is in (a firmware's functions, from its symbol table:

@@ -316,7 +316,7 @@ mod tests {
     #[test]
     fn timescales_divide_the_state_exactly() {
         assert_eq!(
-            timescale_for(crate::mcu::DEFAULT_CLOCK_HZ),
+            timescale_for(crate::mcu::MAX_CLOCK_HZ),
             ((10, TimescaleUnit::NS), Some(4))
         );
         assert_eq!(

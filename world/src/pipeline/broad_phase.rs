@@ -232,7 +232,7 @@ pub(crate) mod tests {
             xs in proptest::collection::vec((0.0f64..1.0, 0.0f64..1.0, -PI..PI), 1..80),
         ) {
             let n = xs.len();
-            let (pose, body, broad) = scene(&WorldParams::default(), side, &xs);
+            let (pose, body, broad) = scene(&WorldParams::with_clock(crate::params::TEST_CLOCK_HZ), side, &xs);
             let obb = |i: usize| body.obb(pose[i]);
             let mut via_grid = std::collections::BTreeSet::new();
             for &[i, j] in &broad.candidates().pairs {
@@ -265,7 +265,11 @@ pub(crate) mod tests {
                 ((f * 0.618_034).fract(), (f * 0.414_214).fract(), f)
             })
             .collect();
-        let (pose, body, serial) = scene(&WorldParams::default(), 12.0, &xs);
+        let (pose, body, serial) = scene(
+            &WorldParams::with_clock(crate::params::TEST_CLOCK_HZ),
+            12.0,
+            &xs,
+        );
         let mut parallel = serial.clone();
         parallel.rebuild(&pose, body.radius_m, 12.0, 8.4, true);
         assert!(!serial.candidates().pairs.is_empty());

@@ -251,7 +251,7 @@ mod tests {
             let params = WorldParams {
                 rays_per_sensor: 3,
                 cone_half_angle_rad: 0.05,
-                ..WorldParams::default()
+                ..WorldParams::with_clock(crate::params::TEST_CLOCK_HZ)
             };
             let (pose, body, broad) = scene(&params, side, &xs);
             let (w, h) = (side, side * 0.7);

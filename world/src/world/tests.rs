@@ -20,7 +20,7 @@ const TAU: f64 = 0.060;
 fn exact_params() -> WorldParams {
     WorldParams {
         motor_gain_spread: 0.0,
-        ..WorldParams::default()
+        ..WorldParams::with_clock(crate::params::TEST_CLOCK_HZ)
     }
 }
 
@@ -227,21 +227,21 @@ fn arc_with_lag_transient_converges_with_substep_length() {
 fn motor_gains_are_seeded_per_robot_and_within_spread() {
     let a = World::new(
         Arena::scaled_square(20).unwrap(),
-        WorldParams::default(),
+        WorldParams::with_clock(crate::params::TEST_CLOCK_HZ),
         20,
         99,
     )
     .unwrap();
     let b = World::new(
         Arena::scaled_square(5).unwrap(),
-        WorldParams::default(),
+        WorldParams::with_clock(crate::params::TEST_CLOCK_HZ),
         5,
         99,
     )
     .unwrap();
     let c = World::new(
         Arena::scaled_square(5).unwrap(),
-        WorldParams::default(),
+        WorldParams::with_clock(crate::params::TEST_CLOCK_HZ),
         5,
         100,
     )
@@ -564,7 +564,7 @@ fn veering_robot_in_the_corridor_slides_along_without_penetrating() {
     // or stick, and it reaches the far end.
     let params = WorldParams {
         motor_gain_spread: 0.0,
-        ..WorldParams::default()
+        ..WorldParams::with_clock(crate::params::TEST_CLOCK_HZ)
     };
     let arena = Arena::paper_corridor();
     let mut w = world_at(arena, params, &[pose(0.3, 0.11, 0.0)]);
@@ -613,7 +613,7 @@ proptest! {
     /// behaviours: no body ever penetrates a wall or another body after a sub-step.
     #[test]
     fn crowded_swarm_never_penetrates(seed in any::<u64>(), dt in 0.002f64..0.1) {
-        let params = WorldParams { max_substep_s: 0.1, ..WorldParams::default() };
+        let params = WorldParams { max_substep_s: 0.1, ..WorldParams::with_clock(crate::params::TEST_CLOCK_HZ) };
         let mut w = dense_swarm(seed, 20, params);
         let mut rng = walk_rng(seed, 2);
         let steps = (12.0 / dt) as usize;
@@ -637,7 +637,7 @@ proptest! {
             top_speed_m_per_s: 1.0,
             max_substep_s: 0.1,
             motor_time_constant_s: 0.02,
-            ..WorldParams::default()
+            ..WorldParams::with_clock(crate::params::TEST_CLOCK_HZ)
         };
         let mut w = dense_swarm(seed, 20, params);
         let mut rng = walk_rng(seed, 2);
@@ -767,7 +767,7 @@ fn a_robot_accelerating_from_rest_takes_m_a_from_its_wheels() {
 
 #[test]
 fn wheel_forces_never_exceed_the_traction_in_a_crowd() {
-    let mut w = dense_swarm(5, 20, WorldParams::default());
+    let mut w = dense_swarm(5, 20, WorldParams::with_clock(crate::params::TEST_CLOCK_HZ));
     let mut rng = walk_rng(5, 2);
     let f = traction_n();
     let mut at_traction = 0;
@@ -928,7 +928,7 @@ proptest! {
     /// brute force.
     #[test]
     fn rays_equal_brute_force_after_motion(seed in any::<u64>(), n in 1usize..60, steps in 0usize..200) {
-        let params = WorldParams { rays_per_sensor: 2, cone_half_angle_rad: 0.03, ..WorldParams::default() };
+        let params = WorldParams { rays_per_sensor: 2, cone_half_angle_rad: 0.03, ..WorldParams::with_clock(crate::params::TEST_CLOCK_HZ) };
         let mut w = World::new(Arena::scaled_square(n).unwrap(), params, n, seed).unwrap();
         let mut rng = walk_rng(seed, 3);
         for k in 0..steps {
@@ -950,7 +950,13 @@ proptest! {
 /// A world of no robots is a world, and advances.
 #[test]
 fn an_empty_world_advances() {
-    let mut w = World::new(Arena::square(), WorldParams::default(), 0, 1).unwrap();
+    let mut w = World::new(
+        Arena::square(),
+        WorldParams::with_clock(crate::params::TEST_CLOCK_HZ),
+        0,
+        1,
+    )
+    .unwrap();
     assert_eq!(w.robot_count(), 0);
     w.advance(0.01).unwrap();
 }
@@ -959,7 +965,7 @@ fn an_empty_world_advances() {
 fn from_poses_rejects_overlaps_and_bodies_outside() {
     let e = World::from_poses(
         Arena::square(),
-        WorldParams::default(),
+        WorldParams::with_clock(crate::params::TEST_CLOCK_HZ),
         &[pose(0.1, 0.9, 0.0)],
         1,
     )
@@ -970,7 +976,7 @@ fn from_poses_rejects_overlaps_and_bodies_outside() {
     );
     let e = World::from_poses(
         Arena::square(),
-        WorldParams::default(),
+        WorldParams::with_clock(crate::params::TEST_CLOCK_HZ),
         &[
             pose(0.9, 0.9, 0.0),
             pose(0.5, 0.9, 0.0),
@@ -985,7 +991,7 @@ fn from_poses_rejects_overlaps_and_bodies_outside() {
     );
     let e = World::from_poses(
         Arena::square(),
-        WorldParams::default(),
+        WorldParams::with_clock(crate::params::TEST_CLOCK_HZ),
         &[pose(f64::NAN, 0.9, 0.0)],
         1,
     )
@@ -993,7 +999,7 @@ fn from_poses_rejects_overlaps_and_bodies_outside() {
     assert!(matches!(e, WorldError::PoseOutsideArena { .. }));
     let mut w = World::from_poses(
         Arena::square(),
-        WorldParams::default(),
+        WorldParams::with_clock(crate::params::TEST_CLOCK_HZ),
         &[pose(0.5, 0.9, 0.0), pose(1.2, 0.9, 0.0)],
         1,
     )
@@ -1039,7 +1045,7 @@ fn same_seed_gives_identical_state_after_10000_substeps() {
     let mk = || {
         World::new(
             Arena::scaled_square(n).unwrap(),
-            WorldParams::default(),
+            WorldParams::with_clock(crate::params::TEST_CLOCK_HZ),
             n,
             2024,
         )
@@ -1064,7 +1070,15 @@ fn thread_count_does_not_change_the_result() {
     let n = 3000;
     let side = Arena::scaled_square(n).unwrap().width_m() / 6f64.sqrt();
     let arena = Arena::rectangle(side, side).unwrap();
-    let mk = || World::new(arena, WorldParams::default(), n, 77).unwrap();
+    let mk = || {
+        World::new(
+            arena,
+            WorldParams::with_clock(crate::params::TEST_CLOCK_HZ),
+            n,
+            77,
+        )
+        .unwrap()
+    };
     let mut seq = mk();
     drive_run(&mut seq, 300, 9, false);
     let reference = state_bits(&seq);
@@ -1096,7 +1110,7 @@ fn thread_count_does_not_change_the_result() {
 #[test]
 fn bad_parameters_and_indices_are_errors() {
     let bad = |f: fn(&mut WorldParams)| {
-        let mut p = WorldParams::default();
+        let mut p = WorldParams::with_clock(crate::params::TEST_CLOCK_HZ);
         f(&mut p);
         World::new(Arena::square(), p, 3, 1).unwrap_err()
     };
@@ -1167,7 +1181,13 @@ fn bad_parameters_and_indices_are_errors() {
         WorldError::Parameter { .. }
     ));
 
-    let mut w = World::new(Arena::square(), WorldParams::default(), 3, 1).unwrap();
+    let mut w = World::new(
+        Arena::square(),
+        WorldParams::with_clock(crate::params::TEST_CLOCK_HZ),
+        3,
+        1,
+    )
+    .unwrap();
     for dt in [0.0, -0.01, f64::NAN, f64::INFINITY, 1e9] {
         let e = w.advance(dt).unwrap_err();
         assert!(matches!(e, WorldError::TimeStep { .. }), "{e}");
@@ -1290,7 +1310,7 @@ proptest! {
         n in 0usize..60,
         seed in any::<u64>(),
     ) {
-        let mut p = WorldParams::default();
+        let mut p = WorldParams::with_clock(crate::params::TEST_CLOCK_HZ);
         match field {
             0 => p.body_length_m = value,
             1 => p.body_width_m = value,
@@ -1316,7 +1336,7 @@ proptest! {
             let ps: Vec<Pose> = poses.iter().map(|&(x, y, h)| pose(x, y, h)).collect();
             let _ = World::from_poses(arena, p.clone(), &ps, seed);
         }
-        let mut w = World::new(Arena::square(), WorldParams::default(), 3, seed).unwrap();
+        let mut w = World::new(Arena::square(), WorldParams::with_clock(crate::params::TEST_CLOCK_HZ), 3, seed).unwrap();
         let _ = w.set_wheels(robot, WheelCommand::forward(duty), WheelCommand::reverse(duty));
         let _ = w.set_wheels(robot, WheelCommand::brake(), WheelCommand::coast());
         let _ = w.advance(dt);
@@ -1340,7 +1360,7 @@ proptest! {
     /// 220 mm, so the order along the corridor is kept.
     #[test]
     fn corridor_robots_keep_their_order(seed in any::<u64>(), n in 2usize..9) {
-        let mut w = World::new(Arena::paper_corridor(), WorldParams::default(), n, seed).unwrap();
+        let mut w = World::new(Arena::paper_corridor(), WorldParams::with_clock(crate::params::TEST_CLOCK_HZ), n, seed).unwrap();
         let order = |w: &World| {
             let mut o: Vec<usize> = (0..w.robot_count()).collect();
             o.sort_by(|&a, &b| w.pose[a].x.total_cmp(&w.pose[b].x));

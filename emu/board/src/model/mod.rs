@@ -51,6 +51,7 @@ use nn_q15::{
     UpdateKind, ram_items,
 };
 
+use crate::board::RobotBoard;
 use crate::ram::{RamMap, RamOverflow};
 use fast::SaveTimelines;
 use fw::{FETCH_STATES, Fw, FwPins, SLEEP_STATES};
@@ -62,9 +63,10 @@ use regs::*;
 /// What the model asks of the MCU besides the bus: the EEPROM bus for its transaction-level
 /// save ([`ControllerConfig::fast_forward`]), which no program on the chip could reach and
 /// the core's [`h8300h::bus::Bus`] therefore does not carry (the ADF poll's shortcut uses
-/// [`FastPathHints::reads_stable_until`], as the core's loop fast-forwarding does). Implemented for
-/// [`Mcu`]; a bus that answers neither (the defaults, as a test's wrapper around an MCU may)
-/// runs the model register by register and I²C pin by pin, with the same results.
+/// [`FastPathHints::reads_stable_until`], as the core's loop fast-forwarding does). Implemented
+/// for an [`Mcu`] on the robot's board ([`RobotBoard`], which holds the EEPROMs); a bus that
+/// answers neither (the defaults, as a test's wrapper around an MCU may) runs the model
+/// register by register and I²C pin by pin, with the same results.
 pub trait ModelBus: FastPathHints {
     /// The EEPROM bus behind port 4, for the fast save that acts on the chips at transaction
     /// level with exactly the pin-level outcome ([`fast`]). `None`: pin-level access only.
@@ -73,9 +75,9 @@ pub trait ModelBus: FastPathHints {
     }
 }
 
-impl<B: Board> ModelBus for Mcu<B> {
+impl<W: Board> ModelBus for Mcu<RobotBoard<W>> {
     fn eeprom_bus(&mut self) -> Option<&mut eeprom::I2cBus> {
-        Some(self.i2c_mut())
+        Some(self.board_mut().eeproms_mut())
     }
 }
 
@@ -187,7 +189,7 @@ impl ControllerConfig {
     #[must_use]
     pub fn arena(weight_seed: u64) -> Self {
         Self {
-            clock_hz: h8_3052f::mcu::DEFAULT_CLOCK_HZ,
+            clock_hz: crate::board::CLOCK_HZ,
             behaviours: 4,
             layout: InputLayout::DEFAULT,
             params: Params::ARENA,

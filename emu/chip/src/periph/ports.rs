@@ -17,16 +17,16 @@
 //!   robot. The pull-up is off for output bits, as on the chip. Ports A and B have no
 //!   pull-ups.
 //! - Pins driven by a peripheral (TIOCA outputs of the ITU) read their peripheral level.
-//! - Port 4's P4.7/P4.6 carry the robot's I²C bus to its EEPROMs ([`P4_SDA`], [`P4_SCL`]): a
-//!   line is pulled low while its DDR bit is 1 with DR = 0 and released otherwise (a 1 in DR
-//!   with DDR = 1 would drive the line high; it is treated as a release, since only the master
-//!   could then pull it). Every write to P4DDR or P4DR passes the new pulls to the bus at the
-//!   instant of the write; P4DR reads return the bus lines at the instant of the read.
+//! - Port 4 is used open-drain (on the robot, P4.7/P4.6 carry its bit-banged I²C bus,
+//!   [`P4_SDA`], [`P4_SCL`]): a pin is pulled low while its DDR bit is 1 with DR = 0 and
+//!   released otherwise (a 1 in DR with DDR = 1 would drive the line high; it is treated as a
+//!   release, since only the port could then pull it). Every write to P4DDR or P4DR tells the
+//!   board the new pulls at the instant of the write ([`Board::port4_drive`]); P4DR reads
+//!   return the lines as the board leaves them at the instant of the read
+//!   ([`Board::port4_pins`]).
 //!
 //! [`Ports`] is the four ports as one [`Peripheral`] owning the port block H'FFFFC0–H'FFFFDB;
 //! the registers of the ports not modelled (1, 3, 5, 6, 7, 8, 9) read 0 and ignore writes.
-
-use eeprom::I2cBus;
 
 use super::Peripheral;
 use super::itu::Itu;
@@ -65,11 +65,12 @@ pub const PB_TIOCA3: u8 = 0x01;
 /// Port-B bit of TIOCA4 (PB2).
 pub const PB_TIOCA4: u8 = 0x04;
 
-/// Port-4 bit of the EEPROM bus's data line SDA (P4.7, docs/design.md §3.6). The H8/3052F has no I²C
-/// module: the chip model carries the robot's I²C bus on these two pins, bit-banged by
-/// firmware through P4DDR (see [`crate::mcu`]).
+/// Port-4 bit of P4.7, the pin the robot's EEPROM bus has its data line SDA on
+/// (docs/design.md §3.6). The H8/3052F has no I²C module: firmware bit-bangs the bus through
+/// P4DDR; the parts on the lines are the board's ([`Board::port4_pins`]). A pin trace records
+/// this pin's line level ([`crate::trace`]).
 pub const P4_SDA: u8 = 0x80;
-/// Port-4 bit of the EEPROM bus's clock line SCL (P4.6, docs/design.md §3.6).
+/// Port-4 bit of P4.6, the pin of the EEPROM bus's clock line SCL (docs/design.md §3.6).
 pub const P4_SCL: u8 = 0x40;
 
 /// What a read of a write-only DDR returns: every bit 1 (H8/3052F manual, port sections: "DDR
@@ -148,10 +149,9 @@ pub const PORTS_LAST: u32 = 0xFF_FFDB;
 
 /// What the ports see around them during an access.
 pub struct PortPins<'a, B: Board> {
-    /// The board, for the levels of the port-2 pins ([`Board::port2_pins`]: the bumpers).
+    /// The board, for the levels of the port-2 pins ([`Board::port2_pins`]: the bumpers) and
+    /// the port-4 lines ([`Board::port4_pins`], [`Board::port4_drive`]: the EEPROM bus).
     pub board: &'a mut B,
-    /// The EEPROM bus on P4.7 (SDA) and P4.6 (SCL).
-    pub i2c: &'a mut I2cBus,
     /// The ITU, whose TIOCA outputs share pins with ports A and B.
     pub itu: &'a mut Itu,
 }
@@ -221,30 +221,10 @@ impl Ports {
         pins
     }
 
-    /// Levels of port 4's input pins: SDA/SCL from the bus, the rest unconnected; a released
-    /// pin reads high only through its pull-up.
-    fn p4_inputs(&self, i2c: &mut I2cBus, now: u64) -> u8 {
-        let t = now.max(i2c.now());
-        let released = match i2c.lines(t) {
-            Ok(l) => {
-                !(P4_SDA | P4_SCL) | if l.sda { P4_SDA } else { 0 } | if l.scl { P4_SCL } else { 0 }
-            }
-            // Cannot happen (time never goes back here); read the lines as released.
-            Err(_) => 0xFF,
-        };
-        self.p4.open_drain_levels(released)
-    }
-
-    /// Passes port 4's pulls on SDA/SCL to the bus at `now`.
-    fn update_i2c(&self, i2c: &mut I2cBus, now: u64) {
-        let low = self.p4.driven_low();
-        let scl_low = low & P4_SCL != 0;
-        let sda_low = low & P4_SDA != 0;
-        if i2c.master_pulls() != (scl_low, sda_low) {
-            let t = now.max(i2c.now());
-            // Cannot fail: time never goes back here.
-            let _ = i2c.set_master(t, scl_low, sda_low);
-        }
+    /// Levels of port 4's input pins as the board leaves the lines; a released pin reads high
+    /// only through its pull-up.
+    fn p4_inputs<B: Board>(&self, board: &mut B, now: u64) -> u8 {
+        self.p4.open_drain_levels(board.port4_pins(now))
     }
 }
 
@@ -264,7 +244,7 @@ impl Peripheral for Ports {
                 self.p2.read_dr(self.p2.open_drain_levels(released))
             }
             P4DR => {
-                let inputs = self.p4_inputs(pins.i2c, now);
+                let inputs = self.p4_inputs(pins.board, now);
                 self.p4.read_dr(inputs)
             }
             PADR => {
@@ -289,11 +269,11 @@ impl Peripheral for Ports {
             P2PCR => self.p2.pcr = value,
             P4DDR => {
                 self.p4.ddr = value;
-                self.update_i2c(pins.i2c, now);
+                pins.board.port4_drive(self.p4.driven_low(), now);
             }
             P4DR => {
                 self.p4.dr = value;
-                self.update_i2c(pins.i2c, now);
+                pins.board.port4_drive(self.p4.driven_low(), now);
             }
             P4PCR => self.p4.pcr = value,
             PADDR => self.pa.ddr = value,
