@@ -308,8 +308,8 @@ fn temp_dir(name: &str) -> std::path::PathBuf {
 
 #[test]
 fn run_writes_identical_metrics_for_any_thread_count() {
-    // Runs spread over the threads (3 and 80 robots, six runs), and one run of 1 200 robots
-    // whose stages run in parallel inside it.
+    // Runs spread over the threads (3 and 80 robots, six runs), and one run of 4 200 robots
+    // whose stages (the per-robot meters too) run in parallel inside it.
     let learning_only = concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/scenarios/arena-learning-only.toml"
@@ -317,7 +317,7 @@ fn run_writes_identical_metrics_for_any_thread_count() {
     for (scenario, robots, repeats) in [
         ("arena", "3", "2"),
         ("arena", "80", "2"),
-        (learning_only, "1200", "1"),
+        (learning_only, "4200", "1"),
     ] {
         let mut files = Vec::new();
         for threads in ["1", "2"] {

@@ -8,8 +8,7 @@
 //! page without storage gives what the fresh chip holds. What the array holds is the same
 //! either way: the store changes where bytes live, never their values.
 
-use crate::datasheet::{ARRAY_BYTES, PAGE_BYTES, PAGES};
-use crate::device::ERASED_BYTE;
+use crate::datasheet::{ARRAY_BYTES, ERASED_BYTE, PAGE_BYTES, PAGES};
 
 /// One page's bytes and stuck-bit masks (bit set: the cell keeps its value whatever is
 /// written).

@@ -14,6 +14,8 @@ pub const MAX_MEMORY_ADDRESS: u16 = 0x7FFF;
 pub const PAGE_BYTES: usize = 64;
 /// Number of 64-byte pages in the array (32 768 / 64).
 pub const PAGES: usize = ARRAY_BYTES / PAGE_BYTES;
+/// Value of an erased EEPROM byte; a new chip reads all 0xFF (DS21203: "erased" state).
+pub const ERASED_BYTE: u8 = 0xFF;
 /// Control code in the four high bits of the control byte: `1010` (DS21203 §5.0, Figure 5-1).
 pub const CONTROL_CODE: u8 = 0b1010;
 /// Lowest 7-bit bus address a 24LC256 can take: control code 1010 with A2..A0 = 000.

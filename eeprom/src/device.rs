@@ -23,8 +23,7 @@ use crate::error::EepromError;
 /// one new stuck bit every two writes, so wear shows up quickly in a simulation.
 pub const DEFAULT_STUCK_BIT_PROBABILITY: f64 = 1.0 / 1024.0;
 
-/// Value of an erased EEPROM byte; a new chip reads all 0xFF (DS21203: "erased" state).
-pub const ERASED_BYTE: u8 = 0xFF;
+pub use crate::datasheet::ERASED_BYTE;
 
 /// Most timing violations kept in detail (all are counted).
 const VIOLATION_LOG_LEN: usize = 64;

@@ -1161,12 +1161,16 @@ fn advance_world(
         let dt_s = len as f64 / clock_hz;
         let w: &World = world;
         // Each robot's meters take its own wheels and bumpers: robot by robot, in any order
-        // (the sums are of integers).
-        let drive = |(i, d): (usize, &mut crate::energy::DriveMeter)| -> Result<()> {
-            d.add_substep(dt_s, w.wheel_mean_speeds(i)?, w.wheel_forces(i)?);
-            Ok(())
-        };
-        let meter = |(i, (m, c)): (usize, (&mut ContactMeter, &mut u64))| -> Result<(u64, u64)> {
+        // (the sums are of integers), in one pass.
+        let metered = drives.len() == meters.len();
+        let meter = |i: usize,
+                     m: &mut ContactMeter,
+                     c: &mut u64,
+                     d: Option<&mut crate::energy::DriveMeter>|
+         -> Result<(u64, u64)> {
+            if let Some(d) = d {
+                d.add_substep(dt_s, w.wheel_mean_speeds(i)?, w.wheel_forces(i)?);
+            }
             let pressed = w.bumpers(i)?.iter().any(|&b| b);
             m.sample(pressed, len);
             let (n, t) = m.take();
@@ -1174,22 +1178,27 @@ fn advance_world(
             Ok((n, t))
         };
         let add = |a: (u64, u64), b: (u64, u64)| (a.0 + b.0, a.1 + b.1);
-        let (c, t) = if par && meters.len() > PAR_ROBOTS {
-            drives.par_iter_mut().enumerate().try_for_each(drive)?;
-            meters
+        let (c, t) = if par && meters.len() >= PAR_ROBOTS {
+            let it = meters
                 .par_iter_mut()
                 .zip(per_robot.par_iter_mut())
-                .enumerate()
-                .map(meter)
-                .try_reduce(|| (0, 0), |a, b| Ok(add(a, b)))?
+                .enumerate();
+            if metered {
+                it.zip(drives.par_iter_mut())
+                    .map(|((i, (m, c)), d)| meter(i, m, c, Some(d)))
+                    .try_reduce(|| (0, 0), |a, b| Ok(add(a, b)))?
+            } else {
+                it.map(|(i, (m, c))| meter(i, m, c, None))
+                    .try_reduce(|| (0, 0), |a, b| Ok(add(a, b)))?
+            }
         } else {
-            drives.iter_mut().enumerate().try_for_each(drive)?;
-            meters
-                .iter_mut()
-                .zip(per_robot.iter_mut())
-                .enumerate()
-                .map(meter)
-                .try_fold((0, 0), |a, b| b.map(|b| add(a, b)))?
+            let mut drives = drives.iter_mut();
+            let mut sum = (0, 0);
+            for (i, (m, c)) in meters.iter_mut().zip(per_robot.iter_mut()).enumerate() {
+                let d = if metered { drives.next() } else { None };
+                sum = add(sum, meter(i, m, c, d)?);
+            }
+            sum
         };
         collisions += c;
         contact += t;
@@ -1197,9 +1206,11 @@ fn advance_world(
     Ok((collisions, contact))
 }
 
-/// Robots above which the per-robot meters of a sub-step run on rayon's pool (below, the
-/// pool's overhead is larger than the work).
-const PAR_ROBOTS: usize = 256;
+/// Robots from which the per-robot meters of a sub-step run on rayon's pool: below a few
+/// thousand robots, waking the pool's other threads for each sub-step costs more than the
+/// meters (1 000 robots x 2 000 steps on two threads: 11.7-14.4 s with them on the pool from
+/// 256 robots, 11.0-11.8 s without; docs/performance.md).
+const PAR_ROBOTS: usize = 4096;
 
 /// Records the tracked robots' centres in the early and/or late paths, and their outlines at a
 /// snapshot instant.
