@@ -252,13 +252,10 @@ impl Cpu {
         deadline: u64,
         stop: &mut F,
     ) -> Result<Outcome, CpuError> {
-        if self.loops.len() <= edge {
-            self.loops.resize(edge + 1, Loop::Unseen);
-        }
-        match self.loops[edge] {
+        match *self.loop_at(edge) {
             Loop::Never => Ok(Outcome::Continue),
             Loop::Unseen => {
-                self.loops[edge] = self.classify(edge);
+                *self.loop_at(edge) = self.classify(edge);
                 self.loop_back(bus, edge, deadline, stop)
             }
             Loop::Countdown {
@@ -280,7 +277,7 @@ impl Cpu {
             Loop::Watch { fails } => {
                 let (outcome, failed) = self.watch(bus, edge, deadline, stop)?;
                 if failed {
-                    self.loops[edge] = if fails + 1 >= MAX_FAILS {
+                    *self.loop_at(edge) = if fails + 1 >= MAX_FAILS {
                         Loop::Never
                     } else {
                         Loop::Watch { fails: fails + 1 }
@@ -289,6 +286,21 @@ impl Cpu {
                 Ok(outcome)
             }
         }
+    }
+
+    /// What is known of the back edge in slot `edge` ([`Loop::Unseen`] the first time). The
+    /// back edges are kept in a short list sorted by slot (a program has tens of them, so a
+    /// table indexed like the decode caches would be mostly empty).
+    fn loop_at(&mut self, edge: usize) -> &mut Loop {
+        let key = edge as u32;
+        let k = match self.loops.binary_search_by_key(&key, |&(e, _)| e) {
+            Ok(k) => k,
+            Err(k) => {
+                self.loops.insert(k, (key, Loop::Unseen));
+                k
+            }
+        };
+        &mut self.loops[k].1
     }
 
     /// What kind of loop the back edge in slot `edge` closes (PC at its target).

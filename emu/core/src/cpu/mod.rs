@@ -221,8 +221,9 @@ pub struct Cpu {
     fast_path: bool,
     /// Whether [`Cpu::run_until`] fast-forwards loops ([`ffwd`]).
     fast_forward: bool,
-    /// What [`ffwd`] knows about each back edge, same index as `fast`.
-    loops: Vec<ffwd::Loop>,
+    /// What [`ffwd`] knows about each back edge taken so far, by its slot index in `fast`
+    /// (sorted by it).
+    loops: Vec<(u32, ffwd::Loop)>,
     /// Instructions fast-forwarded so far.
     skipped: u64,
     /// Idle cycles advanced in closed form so far ([`Cpu::run_idle`]).
