@@ -50,7 +50,10 @@ const MAX_FAILS: u8 = 4;
 /// The condition code of BNE.
 const COND_NE: u8 = 6;
 
-/// What is known about one back edge (indexed like the fast path's slots).
+/// `Cpu::loop_slots` of a slot whose back edge has no entry yet.
+pub(super) const NO_LOOP: u32 = u32::MAX;
+
+/// What is known about one back edge (`Cpu::loops`, reached through `Cpu::loop_slots`).
 #[derive(Clone, Copy, Debug, Default)]
 pub(super) enum Loop {
     /// Not classified yet.
@@ -288,19 +291,20 @@ impl Cpu {
         }
     }
 
-    /// What is known of the back edge in slot `edge` ([`Loop::Unseen`] the first time). The
-    /// back edges are kept in a short list sorted by slot (a program has tens of them, so a
-    /// table indexed like the decode caches would be mostly empty).
+    /// What is known of the back edge in slot `edge` ([`Loop::Unseen`] the first time). A
+    /// program has tens of back edges, so the table indexed like the decode caches holds only
+    /// their places in a short list (4 bytes a slot rather than a `Loop`'s 16).
     fn loop_at(&mut self, edge: usize) -> &mut Loop {
-        let key = edge as u32;
-        let k = match self.loops.binary_search_by_key(&key, |&(e, _)| e) {
-            Ok(k) => k,
-            Err(k) => {
-                self.loops.insert(k, (key, Loop::Unseen));
-                k
-            }
-        };
-        &mut self.loops[k].1
+        if self.loop_slots.len() <= edge {
+            self.loop_slots.resize(edge + 1, NO_LOOP);
+        }
+        if self.loop_slots[edge] == NO_LOOP {
+            // Fewer entries than slots, and slots (halfwords of the 16 MB address space) fit
+            // a u32 below NO_LOOP.
+            self.loop_slots[edge] = self.loops.len() as u32;
+            self.loops.push(Loop::Unseen);
+        }
+        &mut self.loops[self.loop_slots[edge] as usize]
     }
 
     /// What kind of loop the back edge in slot `edge` closes (PC at its target).

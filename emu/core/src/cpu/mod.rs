@@ -221,9 +221,11 @@ pub struct Cpu {
     fast_path: bool,
     /// Whether [`Cpu::run_until`] fast-forwards loops ([`ffwd`]).
     fast_forward: bool,
-    /// What [`ffwd`] knows about each back edge taken so far, by its slot index in `fast`
-    /// (sorted by it).
-    loops: Vec<(u32, ffwd::Loop)>,
+    /// What [`ffwd`] knows about each back edge taken so far, in the order they were first
+    /// taken.
+    loops: Vec<ffwd::Loop>,
+    /// Per slot of `fast`, its back edge's place in `loops` ([`ffwd::NO_LOOP`]: none yet).
+    loop_slots: Vec<u32>,
     /// Instructions fast-forwarded so far.
     skipped: u64,
     /// Idle cycles advanced in closed form so far ([`Cpu::run_idle`]).
@@ -286,6 +288,7 @@ impl Cpu {
             fast_path: true,
             fast_forward: true,
             loops: Vec::new(),
+            loop_slots: Vec::new(),
             skipped: 0,
             idle_skipped: 0,
             idle_fails: Vec::new(),
@@ -498,6 +501,7 @@ impl Cpu {
         self.cache.clear();
         self.fast.clear();
         self.loops.clear();
+        self.loop_slots.clear();
         self.idle_fails.clear();
     }
 
