@@ -408,7 +408,7 @@ fn unconfigured_image(
 
 /// Host memory one robot takes while its run is going, with a margin (measured, see
 /// docs/performance.md: the peak resident size of `h8swarm run --robots 10000` less that of
-/// 1 000 robots, per robot: model robots 16 KB; firmware robots 208 KB, most of it the CPU's
+/// 1 000 robots, per robot: model robots 16 KB; firmware robots 185 KB, most of it the CPU's
 /// decode caches, the flash being shared).
 pub const MODEL_ROBOT_BYTES: u64 = 24 << 10;
 /// See [`MODEL_ROBOT_BYTES`].
