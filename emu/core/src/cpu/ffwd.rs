@@ -294,17 +294,27 @@ impl Cpu {
     /// What is known of the back edge in slot `edge` ([`Loop::Unseen`] the first time). A
     /// program has tens of back edges, so the table indexed like the decode caches holds only
     /// their places in a short list (4 bytes a slot rather than a `Loop`'s 16).
+    #[inline]
     fn loop_at(&mut self, edge: usize) -> &mut Loop {
+        let k = match self.loop_slots.get(edge) {
+            Some(&k) if k != NO_LOOP => k as usize,
+            _ => self.new_loop(edge),
+        };
+        &mut self.loops[k]
+    }
+
+    /// Gives the back edge in slot `edge` an entry ([`Loop::Unseen`]); returns its place.
+    #[cold]
+    fn new_loop(&mut self, edge: usize) -> usize {
         if self.loop_slots.len() <= edge {
             self.loop_slots.resize(edge + 1, NO_LOOP);
         }
-        if self.loop_slots[edge] == NO_LOOP {
-            // Fewer entries than slots, and slots (halfwords of the 16 MB address space) fit
-            // a u32 below NO_LOOP.
-            self.loop_slots[edge] = self.loops.len() as u32;
-            self.loops.push(Loop::Unseen);
-        }
-        &mut self.loops[self.loop_slots[edge] as usize]
+        // Fewer entries than slots, and slots (halfwords of the 16 MB address space) fit a
+        // u32 below NO_LOOP.
+        let k = self.loops.len();
+        self.loop_slots[edge] = k as u32;
+        self.loops.push(Loop::Unseen);
+        k
     }
 
     /// What kind of loop the back edge in slot `edge` closes (PC at its target).
