@@ -3,9 +3,9 @@
 //!
 //! A fresh chip reads erased (H'FF) everywhere and has no stuck bit. A robot's firmware uses a
 //! few pages of the 512, so a swarm of thousands of robots would otherwise hold 64 KB per chip
-//! of H'FF and zero masks (docs/performance.md, "Memory"). A page gets storage of its own at its first
-//! write (a programmer's load, a completed or cut write cycle, a bit stuck by wear); reading a
-//! page without storage gives what the fresh chip holds. What the array holds is the same
+//! of H'FF and zero masks (docs/performance.md, "Memory"). A page gets storage of its own at
+//! its first write (a programmer's load, a completed or cut write cycle, a bit stuck by wear);
+//! reading a page without storage gives what the fresh chip holds. What the array holds is the same
 //! either way: the store changes where bytes live, never their values.
 
 use crate::datasheet::{ARRAY_BYTES, ERASED_BYTE, PAGE_BYTES, PAGES};
