@@ -66,7 +66,7 @@ use gdbstub::target::{Target, TargetError, TargetResult};
 
 use crate::mcu::Mcu;
 use crate::pins::Board;
-use h8300h::bus::{Bus, CpuSignal, FastPathHints};
+use h8300h::bus::{Bus, FastPathHints};
 use h8300h::cpu::{Cpu, CpuError, Event};
 use h8300h::memmap::{ADDRESS_MASK, Area};
 
@@ -1336,9 +1336,7 @@ impl<B: FastPathHints> WatchBus<'_, B> {
 }
 
 impl<B: FastPathHints> Bus for WatchBus<'_, B> {
-    fn now(&self) -> u64 {
-        self.bus.now()
-    }
+    h8300h::forward_bus_timing!(bus);
     fn read8(&mut self, addr: u32) -> u8 {
         self.note(addr, 1, false);
         self.bus.read8(addr)
@@ -1355,30 +1353,10 @@ impl<B: FastPathHints> Bus for WatchBus<'_, B> {
         self.note(addr & !1, 2, true);
         self.bus.write16(addr, value);
     }
-    fn internal(&mut self, states: u32) {
-        self.bus.internal(states);
-    }
-    fn pending_irq(&self) -> Option<u8> {
-        self.bus.pending_irq()
-    }
-    fn sleep_until_irq(&mut self, deadline: u64) -> bool {
-        self.bus.sleep_until_irq(deadline)
-    }
-    fn cpu_signal(&mut self, signal: CpuSignal) {
-        self.bus.cpu_signal(signal);
-    }
 }
 
 impl<B: FastPathHints> FastPathHints for WatchBus<'_, B> {
-    fn code_generation(&self) -> Option<u64> {
-        self.bus.code_generation()
-    }
-    fn irq_stable_until(&self) -> u64 {
-        self.bus.irq_stable_until()
-    }
-    fn reads_stable_until(&self, addr: u32) -> Option<u64> {
-        self.bus.reads_stable_until(addr)
-    }
+    h8300h::forward_fast_path_hints!(bus);
 }
 
 #[cfg(test)]

@@ -89,64 +89,10 @@ impl DerefMut for Machine {
 }
 
 impl Bus for Machine {
-    #[inline]
-    fn now(&self) -> u64 {
-        self.0.now()
-    }
-
-    #[inline]
-    fn read8(&mut self, addr: u32) -> u8 {
-        self.0.read8(addr)
-    }
-
-    #[inline]
-    fn read16(&mut self, addr: u32) -> u16 {
-        self.0.read16(addr)
-    }
-
-    #[inline]
-    fn write8(&mut self, addr: u32, value: u8) {
-        self.0.write8(addr, value);
-    }
-
-    #[inline]
-    fn write16(&mut self, addr: u32, value: u16) {
-        self.0.write16(addr, value);
-    }
-
-    #[inline]
-    fn internal(&mut self, states: u32) {
-        self.0.internal(states);
-    }
-
-    #[inline]
-    fn pending_irq(&self) -> Option<u8> {
-        self.0.pending_irq()
-    }
-
-    fn sleep_until_irq(&mut self, deadline: u64) -> bool {
-        self.0.sleep_until_irq(deadline)
-    }
-
-    #[inline]
-    fn cpu_signal(&mut self, signal: h8300h::bus::CpuSignal) {
-        self.0.cpu_signal(signal);
-    }
+    h8300h::forward_bus_timing!(0);
+    h8300h::forward_bus_accesses!(0);
 }
 
 impl FastPathHints for Machine {
-    #[inline]
-    fn code_generation(&self) -> Option<u64> {
-        self.0.code_generation()
-    }
-
-    #[inline]
-    fn irq_stable_until(&self) -> u64 {
-        self.0.irq_stable_until()
-    }
-
-    #[inline]
-    fn reads_stable_until(&self, addr: u32) -> Option<u64> {
-        self.0.reads_stable_until(addr)
-    }
+    h8300h::forward_fast_path_hints!(0);
 }

@@ -129,47 +129,88 @@ pub trait FastPathHints: Bus {
     }
 }
 
+/// The [`Bus`] methods that make no memory access (time, internal states, interrupts, CPU
+/// signals), forwarded to the bus in field `$f` of `self`: for wrappers of a bus that watch or
+/// change only its accesses. Used inside an `impl Bus for …` block.
+#[macro_export]
+macro_rules! forward_bus_timing {
+    ($f:tt) => {
+        #[inline]
+        fn now(&self) -> u64 {
+            self.$f.now()
+        }
+        #[inline]
+        fn internal(&mut self, states: u32) {
+            self.$f.internal(states);
+        }
+        #[inline]
+        fn pending_irq(&self) -> Option<u8> {
+            self.$f.pending_irq()
+        }
+        fn sleep_until_irq(&mut self, deadline: u64) -> bool {
+            self.$f.sleep_until_irq(deadline)
+        }
+        #[inline]
+        fn cpu_signal(&mut self, signal: $crate::bus::CpuSignal) {
+            self.$f.cpu_signal(signal);
+        }
+    };
+}
+
+/// The [`Bus`] accesses (reads and writes of bytes and words), forwarded to the bus in field
+/// `$f` of `self`; with [`forward_bus_timing!`], a whole forwarding `impl Bus`.
+#[macro_export]
+macro_rules! forward_bus_accesses {
+    ($f:tt) => {
+        #[inline]
+        fn read8(&mut self, addr: u32) -> u8 {
+            self.$f.read8(addr)
+        }
+        #[inline]
+        fn read16(&mut self, addr: u32) -> u16 {
+            self.$f.read16(addr)
+        }
+        #[inline]
+        fn write8(&mut self, addr: u32, value: u8) {
+            self.$f.write8(addr, value);
+        }
+        #[inline]
+        fn write16(&mut self, addr: u32, value: u16) {
+            self.$f.write16(addr, value);
+        }
+    };
+}
+
+/// The fast path's promises about code, interrupts and reads ([`FastPathHints`]'s
+/// `code_generation`, `irq_stable_until`, `reads_stable_until`) forwarded to the bus in field
+/// `$f` of `self`; the idle-cycle methods keep their defaults (no promise). Used inside an
+/// `impl FastPathHints for …` block.
+#[macro_export]
+macro_rules! forward_fast_path_hints {
+    ($f:tt) => {
+        #[inline]
+        fn code_generation(&self) -> Option<u64> {
+            self.$f.code_generation()
+        }
+        #[inline]
+        fn irq_stable_until(&self) -> u64 {
+            self.$f.irq_stable_until()
+        }
+        #[inline]
+        fn reads_stable_until(&self, addr: u32) -> Option<u64> {
+            self.$f.reads_stable_until(addr)
+        }
+    };
+}
+
 /// A [`Bus`] with no fast-path promises: every [`FastPathHints`] method at its default. For a
 /// bus that implements only [`Bus`] (a flat memory, a probe), to run the CPU on it.
 #[derive(Debug)]
 pub struct NoHints<'b, B: Bus>(pub &'b mut B);
 
 impl<B: Bus> Bus for NoHints<'_, B> {
-    #[inline]
-    fn now(&self) -> u64 {
-        self.0.now()
-    }
-    #[inline]
-    fn read8(&mut self, addr: u32) -> u8 {
-        self.0.read8(addr)
-    }
-    #[inline]
-    fn read16(&mut self, addr: u32) -> u16 {
-        self.0.read16(addr)
-    }
-    #[inline]
-    fn write8(&mut self, addr: u32, value: u8) {
-        self.0.write8(addr, value);
-    }
-    #[inline]
-    fn write16(&mut self, addr: u32, value: u16) {
-        self.0.write16(addr, value);
-    }
-    #[inline]
-    fn internal(&mut self, states: u32) {
-        self.0.internal(states);
-    }
-    #[inline]
-    fn pending_irq(&self) -> Option<u8> {
-        self.0.pending_irq()
-    }
-    fn sleep_until_irq(&mut self, deadline: u64) -> bool {
-        self.0.sleep_until_irq(deadline)
-    }
-    #[inline]
-    fn cpu_signal(&mut self, signal: CpuSignal) {
-        self.0.cpu_signal(signal);
-    }
+    crate::forward_bus_timing!(0);
+    crate::forward_bus_accesses!(0);
 }
 
 impl<B: Bus> FastPathHints for NoHints<'_, B> {}

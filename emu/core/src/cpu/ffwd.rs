@@ -109,10 +109,7 @@ impl<B: FastPathHints> Recorder<'_, B> {
 }
 
 impl<B: FastPathHints> Bus for Recorder<'_, B> {
-    #[inline]
-    fn now(&self) -> u64 {
-        self.bus.now()
-    }
+    crate::forward_bus_timing!(bus);
     #[inline]
     fn read8(&mut self, addr: u32) -> u8 {
         let v = self.bus.read8(addr);
@@ -135,36 +132,10 @@ impl<B: FastPathHints> Bus for Recorder<'_, B> {
         self.wrote = true;
         self.bus.write16(addr, value);
     }
-    #[inline]
-    fn internal(&mut self, states: u32) {
-        self.bus.internal(states);
-    }
-    #[inline]
-    fn pending_irq(&self) -> Option<u8> {
-        self.bus.pending_irq()
-    }
-    fn sleep_until_irq(&mut self, deadline: u64) -> bool {
-        self.bus.sleep_until_irq(deadline)
-    }
-    #[inline]
-    fn cpu_signal(&mut self, signal: crate::bus::CpuSignal) {
-        self.bus.cpu_signal(signal);
-    }
 }
 
 impl<B: FastPathHints> FastPathHints for Recorder<'_, B> {
-    #[inline]
-    fn code_generation(&self) -> Option<u64> {
-        self.bus.code_generation()
-    }
-    #[inline]
-    fn irq_stable_until(&self) -> u64 {
-        self.bus.irq_stable_until()
-    }
-    #[inline]
-    fn reads_stable_until(&self, addr: u32) -> Option<u64> {
-        self.bus.reads_stable_until(addr)
-    }
+    crate::forward_fast_path_hints!(bus);
 }
 
 /// The smallest `i >= 1` with `v + i·d ≡ 0 (mod 2^bits)`: the iterations until a counter of

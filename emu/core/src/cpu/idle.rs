@@ -38,7 +38,7 @@
 
 use super::decode::{AluOp, BitNum, BitTarget, Instr, Operand, Size};
 use super::{Cpu, CpuError, Event, RunState};
-use crate::bus::{Bus, CpuSignal, FastPathHints};
+use crate::bus::{Bus, FastPathHints};
 use crate::memmap::{ADDRESS_MASK, Area};
 
 /// Most steps (instructions and accepted interrupts) one recorded idle cycle may take.
@@ -128,9 +128,7 @@ impl<B: FastPathHints> Log<'_, B> {
 }
 
 impl<B: FastPathHints> Bus for Log<'_, B> {
-    fn now(&self) -> u64 {
-        self.bus.now()
-    }
+    crate::forward_bus_timing!(bus);
     fn read8(&mut self, addr: u32) -> u8 {
         let v = self.bus.read8(addr);
         self.note(addr, false, false, u16::from(v));
@@ -149,30 +147,10 @@ impl<B: FastPathHints> Bus for Log<'_, B> {
         self.bus.write16(addr, value);
         self.note(addr & !1, true, true, value);
     }
-    fn internal(&mut self, states: u32) {
-        self.bus.internal(states);
-    }
-    fn pending_irq(&self) -> Option<u8> {
-        self.bus.pending_irq()
-    }
-    fn sleep_until_irq(&mut self, deadline: u64) -> bool {
-        self.bus.sleep_until_irq(deadline)
-    }
-    fn cpu_signal(&mut self, signal: CpuSignal) {
-        self.bus.cpu_signal(signal);
-    }
 }
 
 impl<B: FastPathHints> FastPathHints for Log<'_, B> {
-    fn code_generation(&self) -> Option<u64> {
-        self.bus.code_generation()
-    }
-    fn irq_stable_until(&self) -> u64 {
-        self.bus.irq_stable_until()
-    }
-    fn reads_stable_until(&self, addr: u32) -> Option<u64> {
-        self.bus.reads_stable_until(addr)
-    }
+    crate::forward_fast_path_hints!(bus);
 }
 
 /// How a recording ended.
