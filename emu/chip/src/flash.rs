@@ -93,6 +93,16 @@ impl Flash {
         self.pages[a / FLASH_PAGE_BYTES][a % FLASH_PAGE_BYTES]
     }
 
+    /// The big-endian word at the even flash offset `a` (below 512 K); both bytes lie in one
+    /// page.
+    #[inline]
+    #[must_use]
+    pub fn word(&self, a: usize) -> u16 {
+        let page = &self.pages[a / FLASH_PAGE_BYTES];
+        let i = (a % FLASH_PAGE_BYTES) & !1;
+        u16::from_be_bytes([page[i], page[i | 1]])
+    }
+
     /// Sets the byte at flash offset `a` (below 512 K), copying its page first if another
     /// flash shares it.
     pub fn set(&mut self, a: usize, value: u8) {
@@ -136,6 +146,8 @@ mod tests {
             [0xFF, 0xFF, 1, 2, 3, 4, 5, 0xFF, 0xFF]
         );
         assert_eq!(base.own_pages(), 2);
+        assert_eq!(base.word(0x3FE), 0x0102);
+        assert_eq!(base.word(0x400), 0x0304);
         let mut robot = base.clone();
         assert_eq!(robot.own_pages(), 0);
         robot.set(0x400, 9);

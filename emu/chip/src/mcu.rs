@@ -820,10 +820,7 @@ impl<B: Board> Bus for Mcu<B> {
             Area::Rom => {
                 self.now += u64::from(Area::Rom.word_states());
                 match &self.rom {
-                    Some(r) => {
-                        let i = a as usize & ROM_INDEX_MASK & !1;
-                        u16::from_be_bytes([r.byte(i), r.byte(i | 1)])
-                    }
+                    Some(r) => r.word(a as usize & ROM_INDEX_MASK),
                     None => 0xffff,
                 }
             }
