@@ -440,7 +440,12 @@ mod tests {
                 let ours = obb_overlap(&a, &b, 0.0);
                 match (ours, pc) {
                     (Some(o), Some(c)) if c.dist < 0.0 => {
-                        prop_assert!((o.depth_m + f64::from(c.dist)).abs() < 1e-5, "{o:?} {c:?}");
+                        // parry2d computes in f32: its depth is off by up to ~4e-6 m at
+                        // shallow depths and by up to ~2e-4 of the depth where the boxes overlap
+                        // deeply (a scan of 2 million random pairs); the bound keeps 1e-5 m at
+                        // the depths the world sees and twice that relative error beyond.
+                        let bound = 1e-5 + 4e-4 * o.depth_m;
+                        prop_assert!((o.depth_m + f64::from(c.dist)).abs() < bound, "{o:?} {c:?}");
                         if o.depth_m > 1e-4 {
                             let (px, py) = (f64::from(c.normal1.x), f64::from(c.normal1.y));
                             let dot = o.nx * px + o.ny * py;
