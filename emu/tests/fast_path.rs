@@ -764,6 +764,64 @@ fn the_robot_firmware_runs_alike_on_both_paths() {
 
 // ----- run, the switch, the caches ---------------------------------------------------------
 
+/// Robots installed from one firmware share its decoded code (each with its own configuration
+/// block, which the shared tables leave out) and run exactly as a robot whose CPU fills tables
+/// of its own; a write to the flash outside the block gives that robot its own tables again and
+/// leaves the others' alone.
+#[test]
+fn robots_sharing_decoded_firmware_run_as_with_tables_of_their_own() {
+    let fw = Firmware::robot().expect("the committed firmware");
+    let robot = || {
+        emu::board::board::robot_mcu(NullBoard, &emu::board::board::RobotConfig::default())
+            .expect("default MCU")
+    };
+    let block = ConfigBlock {
+        save_every: 2,
+        ticks_per_step: 10,
+        ..ConfigBlock::ARENA
+    };
+    let (mut ma, mut ca) = (robot(), Cpu::new());
+    fw.install(&mut ma, &mut ca, Some(&block))
+        .expect("installs");
+    let code = fw.shared_code().expect("built by the install").clone();
+    assert!(ca.shares_code(&code));
+    assert!(code.filled() > 1_000, "{} slots", code.filled());
+    let (mut mb, mut cb) = (robot(), Cpu::new());
+    fw.install(&mut mb, &mut cb, Some(&block))
+        .expect("installs");
+    cb.flush_decode_cache();
+    assert!(!cb.shares_code(&code), "cb decodes for itself");
+    // Another block: another page of flash, the same shared code.
+    let (mut mc, mut cc) = (robot(), Cpu::new());
+    let other = ConfigBlock {
+        save_every: 3,
+        ..block
+    };
+    fw.install(&mut mc, &mut cc, Some(&other))
+        .expect("installs");
+    assert!(cc.shares_code(&code));
+    let until = FIRMWARE_S * u64::from(ma.clock_hz());
+    run_vs_steps((&mut ca, &mut ma), (&mut cb, &mut mb), 12_345, until)
+        .unwrap_or_else(|e| panic!("shared vs own tables: {e}"));
+    assert!(ca.instructions() > 1_000_000, "{}", ca.instructions());
+    assert!(
+        ca.shares_code(&code),
+        "every instruction run was in the shared tables: none copied"
+    );
+    cc.run(&mut mc, until).expect("runs");
+    assert!(cc.shares_code(&code));
+    // A flash write outside the block: a new token, and cc's tables are its own from the next
+    // step on; the shared tables and ca's are untouched.
+    mc.poke(0x7_0000, &[0x12]);
+    cc.run(&mut mc, until + 1_000).expect("runs");
+    assert!(!cc.shares_code(&code));
+    assert!(ca.shares_code(&code));
+    assert!(
+        fw.shared_code()
+            .is_some_and(|c| c.filled() == code.filled())
+    );
+}
+
 fn crcmacdiv() -> srec::SrecImage {
     let path =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/programs/crcmacdiv.mot");

@@ -11,7 +11,10 @@ use h8_3052f::gdb::{DebugAction, Debugger};
 use h8_3052f::mcu::{LoadError, Mcu, check_image};
 use h8_3052f::pins::Board;
 use h8_3052f::trace::{CodeNames, PhaseRecorder};
-use h8300h::cpu::{Cpu, CpuError, Event, StackFault, StackGuard, StackGuardMode, StackRoom};
+use h8300h::bus::FastPathHints;
+use h8300h::cpu::{
+    Cpu, CpuError, Event, SharedCode, StackFault, StackGuard, StackGuardMode, StackRoom,
+};
 use h8300h::srec::{self, SrecError, SrecImage};
 
 /// Where the configuration block sits in the flash (docs/design.md §8: "say H'000400, after the
@@ -282,10 +285,39 @@ pub struct Firmware {
     pub symbols: SymbolTable,
     /// Where it came from (for messages).
     pub name: String,
-    /// The flash with the image programmed, built at the first install and shared by every
-    /// MCU the firmware is installed on, with the image it was built from (so that a changed
-    /// `image` is never served from an old flash).
-    flash: OnceLock<(SrecImage, Result<Flash, LoadError>)>,
+    /// The flash with the image programmed and its decoded code, built at the first install
+    /// and shared by every MCU (and CPU) the firmware is installed on, with the image it was
+    /// built from (so that a changed `image` is never served from an old flash).
+    flash: OnceLock<(SrecImage, Result<SharedImage, LoadError>)>,
+}
+
+/// An image programmed into a flash and decoded, for every robot running it.
+#[derive(Clone, Debug)]
+struct SharedImage {
+    flash: Flash,
+    code: SharedCode,
+}
+
+/// The flash bytes that differ from robot to robot: the configuration block. The shared
+/// decode tables leave every instruction that covers one of them to each CPU.
+const VARYING_BYTES: std::ops::Range<u32> =
+    CONFIG_BLOCK_ADDR..CONFIG_BLOCK_ADDR + CONFIG_BLOCK_BYTES as u32;
+
+impl SharedImage {
+    /// `image` programmed into an erased flash, and the code from its lowest to its highest
+    /// byte decoded.
+    fn build(image: &SrecImage) -> SharedImage {
+        let flash = Flash::with_image(image);
+        let start = image.chunks.iter().map(|c| c.address).min().unwrap_or(0);
+        let end = image
+            .chunks
+            .iter()
+            .map(|c| c.address.saturating_add(c.data.len() as u32))
+            .max()
+            .unwrap_or(0);
+        let code = SharedCode::decode_rom(|a| flash.word(a as usize), start..end, VARYING_BYTES);
+        SharedImage { flash, code }
+    }
 }
 
 /// The committed robot firmware (`firmware/robot.mot`, `firmware/robot.sym`), built into the
@@ -370,21 +402,34 @@ impl Firmware {
     }
 
     /// Programs the image into `mcu`'s flash: an MCU without flash takes the firmware's shared
-    /// flash (its pages copied only where the MCU writes), one with flash has the image
-    /// programmed over it.
-    fn program<B: Board>(&self, mcu: &mut Mcu<B>) -> Result<(), LoadError> {
+    /// flash (its pages copied only where the MCU writes) and gets the image's shared decoded
+    /// code back, one with flash has the image programmed over it (and gets `None`: bytes
+    /// outside the image may differ from the shared flash's).
+    fn program<B: Board>(&self, mcu: &mut Mcu<B>) -> Result<Option<&SharedCode>, LoadError> {
         if mcu.has_flash() {
-            return mcu.load_image(&self.image);
+            return mcu.load_image(&self.image).map(|()| None);
         }
-        let (source, flash) = self.flash.get_or_init(|| {
-            let built = check_image(&self.image).map(|()| Flash::with_image(&self.image));
+        let (source, shared) = self.flash.get_or_init(|| {
+            let built = check_image(&self.image).map(|()| SharedImage::build(&self.image));
             (self.image.clone(), built)
         });
         if *source != self.image {
-            return mcu.load_image(&self.image);
+            return mcu.load_image(&self.image).map(|()| None);
         }
-        mcu.load_flash(flash.as_ref().map_err(Clone::clone)?);
-        Ok(())
+        let shared = shared.as_ref().map_err(Clone::clone)?;
+        mcu.load_flash(&shared.flash);
+        Ok(Some(&shared.code))
+    }
+
+    /// The image's decoded code that CPUs of MCUs installed without flash of their own share
+    /// ([`SharedCode`]), once an install has built it (and while the image is the one it was
+    /// built from).
+    #[must_use]
+    pub fn shared_code(&self) -> Option<&SharedCode> {
+        match self.flash.get()? {
+            (source, Ok(shared)) if *source == self.image => Some(&shared.code),
+            _ => None,
+        }
     }
 
     /// Bytes of the image (its ROM).
@@ -437,11 +482,15 @@ impl Firmware {
         cpu: &mut Cpu,
         block: Option<&ConfigBlock>,
     ) -> Result<(), FirmwareError> {
-        self.program(mcu)?;
+        let code = self.program(mcu)?;
         if let Some(b) = block {
+            // Inside VARYING_BYTES: the shared code holds nothing decoded from these bytes.
             mcu.poke(CONFIG_BLOCK_ADDR, &b.encode());
         }
         cpu.flush_decode_cache();
+        if let (Some(code), Some(token)) = (code, mcu.code_generation()) {
+            cpu.adopt_shared_code(code, token);
+        }
         cpu.reset(mcu);
         Ok(())
     }

@@ -89,11 +89,15 @@ mod exec;
 mod fast;
 mod ffwd;
 mod idle;
+mod shared;
 pub mod stack;
 pub mod timing;
 
 pub use idle::{IdleRun, MAX_CYCLE};
+pub use shared::SharedCode;
 pub use stack::{StackAccess, StackFault, StackGuard, StackGuardMode, StackRoom};
+
+use std::sync::Arc;
 
 use crate::bus::{Bus, CpuSignal, FastPathHints};
 use crate::memmap::Area;
@@ -210,10 +214,11 @@ pub struct Cpu {
     state: RunState,
     /// Set by LDC/ANDC/ORC/XORC: no interrupt is accepted before the next instruction.
     irq_inhibit: bool,
-    /// Decoded ROM instructions, indexed by address / 2; grows on demand.
-    cache: Vec<Decoded>,
-    /// The fast path's handlers of the same instructions, same index; grows on demand.
-    fast: Vec<fast::Slot>,
+    /// Decoded ROM instructions, indexed by address / 2; grows on demand, and may be shared
+    /// with other CPUs running the same image ([`SharedCode`]; copied before a write).
+    cache: Arc<[Decoded]>,
+    /// The fast path's handlers of the same instructions, same index, grown and shared alike.
+    fast: Arc<[fast::Slot]>,
     /// The bus's [`FastPathHints::code_generation`] token the caches were filled under (0: none; the
     /// tokens of [`crate::bus::fresh_code_generation`] start at 1).
     code_generation: u64,
@@ -282,8 +287,8 @@ impl Cpu {
             ccr: CCR_I,
             state: RunState::Running,
             irq_inhibit: false,
-            cache: Vec::new(),
-            fast: Vec::new(),
+            cache: Arc::new([]),
+            fast: Arc::new([]),
             code_generation: 0,
             fast_path: true,
             fast_forward: true,
@@ -498,8 +503,8 @@ impl Cpu {
     pub fn flush_decode_cache(&mut self) {
         self.last_copy = self.last_executed();
         self.last_index = LAST_IN_COPY;
-        self.cache.clear();
-        self.fast.clear();
+        self.cache = Arc::new([]);
+        self.fast = Arc::new([]);
         self.loops.clear();
         self.loop_slots.clear();
         self.idle_fails.clear();
@@ -538,10 +543,7 @@ impl Cpu {
             }
             let d = self.decode_through_bus(bus)?;
             if Area::of(pc + d.len_bytes() - 1) == Area::Rom {
-                if self.cache.len() <= idx {
-                    self.cache.resize(idx + 1, EMPTY_SLOT);
-                }
-                self.cache[idx] = d;
+                *shared::own_slot(&mut self.cache, idx, EMPTY_SLOT) = d;
             }
             return Ok(d);
         }
@@ -780,15 +782,9 @@ impl Cpu {
     fn fast_miss<B: Bus>(&mut self, bus: &mut B, pc: u32, idx: usize) -> Result<Event, CpuError> {
         let d = self.decode_through_bus(bus)?;
         if Area::of(pc) == Area::Rom && Area::of(pc + d.len_bytes() - 1) == Area::Rom {
-            if self.cache.len() <= idx {
-                self.cache.resize(idx + 1, EMPTY_SLOT);
-            }
-            if self.fast.len() <= idx {
-                self.fast.resize(idx + 1, fast::Slot::EMPTY);
-            }
             let slot = fast::Slot::new(d, pc);
-            self.cache[idx] = d;
-            self.fast[idx] = slot;
+            *shared::own_slot(&mut self.cache, idx, EMPTY_SLOT) = d;
+            *shared::own_slot(&mut self.fast, idx, fast::Slot::EMPTY) = slot;
             return self.exec_fast(bus, pc, idx, slot.next);
         }
         self.execute(bus, d)
