@@ -418,6 +418,8 @@ pub struct Swarm {
     recorder: Option<(crate::recording::Recorder, usize)>,
     /// Each robot's motors and bridges, metered over the world's sub-steps.
     drives: Vec<crate::energy::DriveMeter>,
+    /// The sub-steps' readings gathered for the meters.
+    readings: Readings,
     /// The electronics' charge of the step being completed, summed over the live robots, and
     /// how many robots were live.
     pending_charge: (f64, usize),
@@ -500,6 +502,7 @@ impl Swarm {
             dead: vec![None; n],
             recorder: None,
             drives,
+            readings: Readings::default(),
             pending_charge: (0.0, 0),
             energy: crate::energy::Charge::default(),
         })
@@ -822,10 +825,10 @@ impl Swarm {
         let (collided, contact_states) = advance_world(
             &mut self.world,
             t_states,
-            &mut self.meters,
-            &mut self.collided,
+            (&mut self.meters, &mut self.collided),
             self.parallel,
             &mut self.drives,
+            &mut self.readings,
         )?;
         let mut drive_uc = 0.0;
         for d in &mut self.drives {
@@ -1137,19 +1140,123 @@ pub fn nominal_substep_states(s: &Scenario) -> u64 {
     period / plan.substeps().max(1)
 }
 
+/// Sub-steps whose readings are gathered before the meters take them, robot by robot, in one
+/// pass: one pass a step at the arena's 23 sub-steps (a pass on the pool costs about as much
+/// as 1 000 robots' meters of one sub-step; docs/performance.md), and a bound on the readings
+/// kept (32 × 41 bytes a robot) whatever the sub-step.
+const METER_BATCH: usize = 32;
+
+/// What a robot's meters take from one sub-step: its wheels' mean speeds and transmitted
+/// forces, and whether a bumper was pressed.
+#[derive(Clone, Copy, Debug, Default)]
+struct Reading {
+    speeds: [f64; 2],
+    forces: [f64; 2],
+    pressed: bool,
+}
+
+/// The readings of up to [`METER_BATCH`] sub-steps, every robot's (sub-step major), and the
+/// sub-steps' lengths.
+#[derive(Clone, Debug, Default)]
+struct Readings {
+    lens: Vec<u64>,
+    of: Vec<Reading>,
+}
+
+impl Readings {
+    /// Appends every robot's reading of the sub-step of `len` states the world just made.
+    fn gather(&mut self, world: &World, len: u64) -> Result<()> {
+        self.lens.push(len);
+        for i in 0..world.robot_count() {
+            self.of.push(Reading {
+                speeds: world.wheel_mean_speeds(i)?,
+                forces: world.wheel_forces(i)?,
+                pressed: world.bumpers(i)?.iter().any(|&b| b),
+            });
+        }
+        Ok(())
+    }
+
+    /// Feeds the gathered sub-steps to every robot's meters, sub-step by sub-step in order for
+    /// each robot (robots in any order, on the pool with `par`: the sums are of integers), and
+    /// empties the batch; returns the collisions counted and the robot-states in contact.
+    fn feed(
+        &mut self,
+        meters: &mut [ContactMeter],
+        per_robot: &mut [u64],
+        par: bool,
+        drives: &mut [crate::energy::DriveMeter],
+        clock_hz: f64,
+    ) -> (u64, u64) {
+        let n = meters.len();
+        let (lens, of) = (&self.lens, &self.of);
+        let metered = drives.len() == n;
+        let meter = |i: usize,
+                     m: &mut ContactMeter,
+                     c: &mut u64,
+                     mut d: Option<&mut crate::energy::DriveMeter>|
+         -> (u64, u64) {
+            let mut sum = (0, 0);
+            for (k, &len) in lens.iter().enumerate() {
+                let r = of[k * n + i];
+                if let Some(d) = d.as_deref_mut() {
+                    d.add_substep(len as f64 / clock_hz, r.speeds, r.forces);
+                }
+                m.sample(r.pressed, len);
+                let (collided, touching) = m.take();
+                *c += collided;
+                sum = add(sum, (collided, touching));
+            }
+            sum
+        };
+        let sum = if par {
+            let it = meters
+                .par_iter_mut()
+                .zip(per_robot.par_iter_mut())
+                .enumerate();
+            if metered {
+                it.zip(drives.par_iter_mut())
+                    .map(|((i, (m, c)), d)| meter(i, m, c, Some(d)))
+                    .reduce(|| (0, 0), add)
+            } else {
+                it.map(|(i, (m, c))| meter(i, m, c, None))
+                    .reduce(|| (0, 0), add)
+            }
+        } else {
+            let mut drives = drives.iter_mut();
+            let mut sum = (0, 0);
+            for (i, (m, c)) in meters.iter_mut().zip(per_robot.iter_mut()).enumerate() {
+                let d = if metered { drives.next() } else { None };
+                sum = add(sum, meter(i, m, c, d));
+            }
+            sum
+        };
+        self.lens.clear();
+        self.of.clear();
+        sum
+    }
+}
+
+/// Two (collisions, robot-states in contact) sums added.
+fn add(a: (u64, u64), b: (u64, u64)) -> (u64, u64) {
+    (a.0 + b.0, a.1 + b.1)
+}
+
 /// Advances the world to `target_states` in its sub-steps, feeding every robot's bumpers
 /// after each to its meter and its wheels' mean speeds and the forces they transmitted to its
 /// drive meter (when `drives` has one per robot); adds each robot's collisions to `per_robot`
-/// and returns the collisions counted and the robot-states in contact.
+/// and returns the collisions counted and the robot-states in contact. The readings are
+/// gathered after each sub-step and fed to the meters in batches ([`Readings`]): each meter
+/// sees its robot's sub-steps in order, as if fed after each.
 fn advance_world(
     world: &mut World,
     target_states: u64,
-    meters: &mut [ContactMeter],
-    per_robot: &mut [u64],
+    (meters, per_robot): (&mut [ContactMeter], &mut [u64]),
     par: bool,
     drives: &mut [crate::energy::DriveMeter],
+    readings: &mut Readings,
 ) -> Result<(u64, u64)> {
-    let (mut collisions, mut contact) = (0u64, 0u64);
+    let mut sum = (0u64, 0u64);
     let dt = target_states.saturating_sub(world.elapsed_states());
     let clock_hz = world.params().clock_hz as f64;
     for len in world.substep_plan(dt) {
@@ -1158,59 +1265,16 @@ fn advance_world(
         } else {
             world.advance_states(len);
         }
-        let dt_s = len as f64 / clock_hz;
-        let w: &World = world;
-        // Each robot's meters take its own wheels and bumpers: robot by robot, in any order
-        // (the sums are of integers), in one pass.
-        let metered = drives.len() == meters.len();
-        let meter = |i: usize,
-                     m: &mut ContactMeter,
-                     c: &mut u64,
-                     d: Option<&mut crate::energy::DriveMeter>|
-         -> Result<(u64, u64)> {
-            if let Some(d) = d {
-                d.add_substep(dt_s, w.wheel_mean_speeds(i)?, w.wheel_forces(i)?);
-            }
-            let pressed = w.bumpers(i)?.iter().any(|&b| b);
-            m.sample(pressed, len);
-            let (n, t) = m.take();
-            *c += n;
-            Ok((n, t))
-        };
-        let add = |a: (u64, u64), b: (u64, u64)| (a.0 + b.0, a.1 + b.1);
-        let (c, t) = if par && meters.len() >= PAR_ROBOTS {
-            let it = meters
-                .par_iter_mut()
-                .zip(per_robot.par_iter_mut())
-                .enumerate();
-            if metered {
-                it.zip(drives.par_iter_mut())
-                    .map(|((i, (m, c)), d)| meter(i, m, c, Some(d)))
-                    .try_reduce(|| (0, 0), |a, b| Ok(add(a, b)))?
-            } else {
-                it.map(|(i, (m, c))| meter(i, m, c, None))
-                    .try_reduce(|| (0, 0), |a, b| Ok(add(a, b)))?
-            }
-        } else {
-            let mut drives = drives.iter_mut();
-            let mut sum = (0, 0);
-            for (i, (m, c)) in meters.iter_mut().zip(per_robot.iter_mut()).enumerate() {
-                let d = if metered { drives.next() } else { None };
-                sum = add(sum, meter(i, m, c, d)?);
-            }
-            sum
-        };
-        collisions += c;
-        contact += t;
+        readings.gather(world, len)?;
+        if readings.lens.len() == METER_BATCH {
+            sum = add(sum, readings.feed(meters, per_robot, par, drives, clock_hz));
+        }
     }
-    Ok((collisions, contact))
+    if !readings.lens.is_empty() {
+        sum = add(sum, readings.feed(meters, per_robot, par, drives, clock_hz));
+    }
+    Ok(sum)
 }
-
-/// Robots from which the per-robot meters of a sub-step run on rayon's pool: below a few
-/// thousand robots, waking the pool's other threads for each sub-step costs more than the
-/// meters (1 000 robots x 2 000 steps on two threads: 11.7-14.4 s with them on the pool from
-/// 256 robots, 11.0-11.8 s without; docs/performance.md).
-const PAR_ROBOTS: usize = 4096;
 
 /// Records the tracked robots' centres in the early and/or late paths, and their outlines at a
 /// snapshot instant.
@@ -1280,8 +1344,15 @@ mod tests {
             for len in w.substep_plan(t - w.elapsed_states()) {
                 assert_eq!(len, nominal, "no sliver of a sub-step");
             }
-            let (c, contact) =
-                advance_world(&mut w, t, &mut meters, &mut per_robot, false, &mut []).unwrap();
+            let (c, contact) = advance_world(
+                &mut w,
+                t,
+                (&mut meters, &mut per_robot),
+                false,
+                &mut [],
+                &mut Readings::default(),
+            )
+            .unwrap();
             collisions.push((c, contact));
         }
         assert_eq!(w.elapsed_states(), 500 * period, "no drift");
@@ -1291,6 +1362,94 @@ mod tests {
         // From the step it arrives (2.5 m → 2.885 m at 0.15 m/s: about 4 steps) it is in
         // contact the whole step.
         assert!(collisions[10..].iter().all(|&(_, c)| c == period));
+    }
+
+    /// The meters fed in batches (more than [`METER_BATCH`] sub-steps a step, so full batches
+    /// and a remainder) count what they count fed after every sub-step, on one thread and on
+    /// the pool: three robots in the corridor, one pushing the end wall, two meeting head on.
+    #[test]
+    fn meters_fed_in_batches_count_as_fed_after_every_substep() {
+        let mut s = Scenario::corridor();
+        s.world.substep_s = 0.008;
+        let poses = [
+            (2.7, 0.11, 0.0),
+            (1.0, 0.11, 0.0),
+            (1.3, 0.12, std::f64::consts::PI),
+        ];
+        let poses: Vec<Pose> = poses
+            .iter()
+            .map(|&(x_m, y_m, heading_rad)| Pose {
+                x_m,
+                y_m,
+                heading_rad,
+            })
+            .collect();
+        let mut w =
+            World::from_poses(Arena::paper_corridor(), world_params(&s), &poses, 1).unwrap();
+        let (l, r) = Behaviour::Forward.wheels();
+        let mut drive = crate::energy::DriveMeter::new(s.world.top_speed_m_per_s, [1.0, 1.0]);
+        drive.set_commands(l, r);
+        for i in 0..poses.len() {
+            w.set_wheels(i, l, r).unwrap();
+        }
+        let period = period_states(&s);
+        assert!(w.substep_plan(period).substeps() > 2 * METER_BATCH as u64);
+        let nominal = nominal_substep_states(&s);
+        let fresh = || {
+            (
+                vec![ContactMeter::new(nominal); 3],
+                vec![0u64; 3],
+                vec![drive.clone(); 3],
+            )
+        };
+        // The reference: every meter fed after every sub-step.
+        let mut plain = w.clone();
+        let (mut m0, mut c0, mut d0) = fresh();
+        let mut sums0 = Vec::new();
+        for k in 1..=40u64 {
+            let mut sum = (0, 0);
+            for len in plain.substep_plan(k * period - plain.elapsed_states()) {
+                plain.advance_states(len);
+                for i in 0..3 {
+                    d0[i].add_substep(
+                        len as f64 / f64::from(s.timing.clock_hz),
+                        plain.wheel_mean_speeds(i).unwrap(),
+                        plain.wheel_forces(i).unwrap(),
+                    );
+                    m0[i].sample(plain.bumpers(i).unwrap().iter().any(|&b| b), len);
+                    let (n, t) = m0[i].take();
+                    c0[i] += n;
+                    sum = add(sum, (n, t));
+                }
+            }
+            sums0.push(sum);
+        }
+        assert!(c0.iter().all(|&c| c >= 1), "every robot collided: {c0:?}");
+        for par in [false, true] {
+            let mut w = w.clone();
+            let (mut m, mut c, mut d) = fresh();
+            let mut readings = Readings::default();
+            let sums: Vec<_> = (1..=40u64)
+                .map(|k| {
+                    advance_world(
+                        &mut w,
+                        k * period,
+                        (&mut m, &mut c),
+                        par,
+                        &mut d,
+                        &mut readings,
+                    )
+                    .unwrap()
+                })
+                .collect();
+            assert_eq!(sums, sums0, "par {par}");
+            assert_eq!(c, c0);
+            assert_eq!(m, m0);
+            for (a, b) in d.iter_mut().zip(d0.iter_mut()) {
+                assert_eq!(a.take(), b.clone().take());
+                assert_eq!(a.cap(), b.cap());
+            }
+        }
     }
 
     #[test]

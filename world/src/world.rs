@@ -15,7 +15,7 @@ use crate::pipeline::corrections::{Corrections, Scene};
 use crate::pipeline::drive::{Drive, Motion};
 use crate::pipeline::islands::Islands;
 use crate::pipeline::narrow_phase::{NarrowPhase, Probe, speculative_m};
-use crate::pipeline::par::PAR_CHUNK;
+use crate::pipeline::par::{PAR_CHUNK, PAR_STAGE_ROBOTS};
 use crate::pipeline::sensing::{Bumpers, MountRays, RayScene};
 use crate::pipeline::solver::IslandBody;
 use crate::pipeline::warm_start::WarmStart;
@@ -561,9 +561,12 @@ impl World {
     }
 
     /// One sub-step of `len` clock states: the pipeline's stages in order (see
-    /// [`crate::pipeline`]); with `parallel`, the per-robot stages and the islands on rayon's
-    /// pool, with the same result.
+    /// [`crate::pipeline`]); with `parallel`, the islands on rayon's pool, and the per-robot
+    /// stages too from [`PAR_STAGE_ROBOTS`] robots, with the same result.
     fn substep(&mut self, len: u64, parallel: bool) {
+        // The islands' solve on the pool with `parallel`; the short per-robot stages only in
+        // large swarms.
+        let stages = parallel && self.pose.len() >= PAR_STAGE_ROBOTS;
         let h = len as f64 / self.params.clock_hz as f64;
         let drive = Drive {
             lag: self.lag_for(len),
@@ -573,7 +576,7 @@ impl World {
             body: self.body,
         };
         // 1. Motors: the wheel speeds over the sub-step.
-        self.run_motors(&drive, parallel);
+        self.run_motors(&drive, stages);
         self.bumpers.begin_substep();
         // 2. Contacts at the start of the sub-step, gaps up to the speculative distance.
         let spec = speculative_m(&self.params, self.body.radius_m, h);
@@ -590,12 +593,12 @@ impl World {
             &self.wmean,
             drive.inv_track,
             h,
-            parallel,
+            stages,
         );
         // 3. Robots touching nothing follow their wheels exactly; the others are solved.
-        self.move_free(&drive, parallel);
+        self.move_free(&drive, stages);
         if !self.narrow.active.is_empty() {
-            self.solve(h, parallel);
+            self.solve(h, (parallel, stages));
         }
         self.warm.keep(&self.narrow.contacts);
         if !self.narrow.checked.is_empty() {
@@ -617,7 +620,7 @@ impl World {
         }
         // 6. The broad phase is rebuilt once some robot has drifted too far.
         if self.broad.is_stale(&self.pose) {
-            self.rebuild_broad_phase(parallel);
+            self.rebuild_broad_phase(stages);
         }
         self.elapsed_states += len;
         self.substeps += 1;
@@ -669,14 +672,14 @@ impl World {
     /// The solved robots of a sub-step of `h` seconds: warm-started from the previous
     /// sub-step's impulses of the same contacts and wheels, split into islands and solved;
     /// they then move by the exact motion of their solved velocities.
-    fn solve(&mut self, h: f64, parallel: bool) {
+    fn solve(&mut self, h: f64, (parallel, stages): (bool, bool)) {
         self.warm.apply(
             &mut self.narrow.contacts,
             &self.narrow.active,
             &self.motion,
             &mut self.wheel_imp,
             self.substeps,
-            parallel,
+            stages,
         );
         self.islands.build(
             &mut self.narrow.active,
@@ -698,7 +701,7 @@ impl World {
         let pose = &self.pose;
         let moved = |(&i, b): (&u32, &IslandBody)| solved_motion(pose[i as usize], b, h);
         self.solved.clear();
-        if parallel && self.narrow.active.len() > PAR_CHUNK {
+        if stages && self.narrow.active.len() > PAR_CHUNK {
             self.narrow
                 .active
                 .par_iter()

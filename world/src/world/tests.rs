@@ -1065,9 +1065,10 @@ fn same_seed_gives_identical_state_after_10000_substeps() {
 
 #[test]
 fn thread_count_does_not_change_the_result() {
-    // 3 000 robots: six parallel chunks; dense enough (6× paper density) for contacts in
-    // chunks too.
-    let n = 3000;
+    // 4 500 robots: the per-robot stages on the pool too (from PAR_STAGE_ROBOTS), nine
+    // parallel chunks; dense enough (6× paper density) for contacts in chunks too.
+    let n = 4500;
+    assert!(n >= crate::pipeline::par::PAR_STAGE_ROBOTS);
     let side = Arena::scaled_square(n).unwrap().width_m() / 6f64.sqrt();
     let arena = Arena::rectangle(side, side).unwrap();
     let mk = || {
