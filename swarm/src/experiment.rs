@@ -441,12 +441,17 @@ impl Swarm {
     ) -> Result<Self> {
         let n = s.robots;
         let world = build_world(s, repeat)?;
-        let robots: Vec<Robot> = (0..n)
-            .map(|i| {
-                Robot::new(s, condition, repeat, i as u32, images)
-                    .with_context(|| format!("robot {i}"))
-            })
-            .collect::<Result<_>>()?;
+        // Each robot is built from its own seeds: on the pool for a large swarm, the first
+        // failure in index order reported whatever the threads.
+        let build = |i: usize| {
+            Robot::new(s, condition, repeat, i as u32, images).with_context(|| format!("robot {i}"))
+        };
+        let built: Vec<Result<Robot>> = if n >= PARALLEL_ROBOTS {
+            (0..n).into_par_iter().map(build).collect()
+        } else {
+            (0..n).map(build).collect()
+        };
+        let robots: Vec<Robot> = built.into_iter().collect::<Result<_>>()?;
         let tracked = if record_track {
             n.min(TRACKED_ROBOTS)
         } else {
