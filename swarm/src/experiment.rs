@@ -1151,9 +1151,15 @@ pub fn nominal_substep_states(s: &Scenario) -> u64 {
 /// kept (32 × 41 bytes a robot) whatever the sub-step.
 const METER_BATCH: usize = 32;
 
+/// Robots from which a sub-step's readings are gathered on the pool (as the world's per-robot
+/// stages: below it a parallel region costs more than the copying).
+const GATHER_PAR_ROBOTS: usize = 4096;
+/// Robots per chunk of the parallel gathering.
+const GATHER_CHUNK: usize = 1024;
+
 /// What a robot's meters take from one sub-step: its wheels' mean speeds and transmitted
 /// forces, and whether a bumper was pressed.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 struct Reading {
     speeds: [f64; 2],
     forces: [f64; 2],
@@ -1169,17 +1175,32 @@ struct Readings {
 }
 
 impl Readings {
-    /// Appends every robot's reading of the sub-step of `len` states the world just made.
-    fn gather(&mut self, world: &World, len: u64) -> Result<()> {
+    /// Appends every robot's reading of the sub-step of `len` states the world just made, in
+    /// chunks on the pool with `par` from [`GATHER_PAR_ROBOTS`] robots.
+    fn gather(&mut self, world: &World, len: u64, par: bool) -> Result<()> {
         self.lens.push(len);
-        for i in 0..world.robot_count() {
-            self.of.push(Reading {
-                speeds: world.wheel_mean_speeds(i)?,
-                forces: world.wheel_forces(i)?,
-                pressed: world.bumpers(i)?.iter().any(|&b| b),
-            });
+        let n = world.robot_count();
+        let start = self.of.len();
+        self.of.resize(start + n, Reading::default());
+        let fill = |first: usize, out: &mut [Reading]| -> Result<()> {
+            for (k, r) in out.iter_mut().enumerate() {
+                let i = first + k;
+                *r = Reading {
+                    speeds: world.wheel_mean_speeds(i)?,
+                    forces: world.wheel_forces(i)?,
+                    pressed: world.bumpers(i)?.iter().any(|&b| b),
+                };
+            }
+            Ok(())
+        };
+        if par && n >= GATHER_PAR_ROBOTS {
+            self.of[start..]
+                .par_chunks_mut(GATHER_CHUNK)
+                .enumerate()
+                .try_for_each(|(k, out)| fill(k * GATHER_CHUNK, out))
+        } else {
+            fill(0, &mut self.of[start..])
         }
-        Ok(())
     }
 
     /// Feeds the gathered sub-steps to every robot's meters, sub-step by sub-step in order for
@@ -1270,7 +1291,7 @@ fn advance_world(
         } else {
             world.advance_states(len);
         }
-        readings.gather(world, len)?;
+        readings.gather(world, len, par)?;
         if readings.lens.len() == METER_BATCH {
             sum = add(sum, readings.feed(meters, per_robot, par, drives, clock_hz));
         }
@@ -1455,6 +1476,33 @@ mod tests {
                 assert_eq!(a.cap(), b.cap());
             }
         }
+    }
+
+    /// A large swarm's readings gathered on the pool are the ones gathered in order.
+    #[test]
+    fn readings_gathered_on_the_pool_are_those_gathered_in_order() {
+        let s = Scenario::arena();
+        let n = GATHER_PAR_ROBOTS + GATHER_CHUNK / 2;
+        let arena = Arena::scaled_square(n).unwrap();
+        let mut w = World::new(arena, world_params(&s), n, 5).unwrap();
+        for i in 0..n {
+            let (l, r) = Behaviour::TurnLeftForward.wheels();
+            w.set_wheels(i, l, r).unwrap();
+        }
+        w.advance_states(50 * nominal_substep_states(&s));
+        let (mut plain, mut pooled) = (Readings::default(), Readings::default());
+        for len in [7, 9] {
+            plain.gather(&w, len, false).unwrap();
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(3)
+                .build()
+                .unwrap();
+            pool.install(|| pooled.gather(&w, len, true)).unwrap();
+        }
+        assert_eq!(plain.lens, pooled.lens);
+        assert_eq!(plain.of.len(), 2 * n);
+        assert!(plain.of.iter().any(|r| r.pressed), "some bumper pressed");
+        assert_eq!(plain.of, pooled.of);
     }
 
     #[test]
