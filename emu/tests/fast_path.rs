@@ -1073,6 +1073,42 @@ fn code_adding(v: u32) -> Vec<u8> {
     halting_code(&[0x7a, 0x00, a, b, c, d, 0x0a, 0x81])
 }
 
+/// More back edges than the fast-forward keeps entries for (65 534): 65 600 countdown loops
+/// one after the other, each taken 63 times. Those with entries are advanced in closed form,
+/// the rest simply run; `run` reaches the state stepping reaches at every deadline.
+#[test]
+fn more_loops_than_the_fast_forward_indexes_run_to_the_same_state() {
+    let loops = 65_600;
+    let mut code = Vec::with_capacity(loops * 6);
+    for _ in 0..loops {
+        // mov.b #64,r0l; L: dec.b r0l; bne L
+        code.extend_from_slice(&[0xF8, 0x40, 0x1A, 0x08, 0x46, 0xFC]);
+    }
+    let mut m = Machine::new();
+    m.poke(0x1000, &halting_code(&code));
+    let mut ma = m.into_mcu();
+    let mut mb = ma.clone();
+    let (mut ca, mut cb) = (Cpu::new(), Cpu::new());
+    for c in [&mut ca, &mut cb] {
+        c.set_pc(0x1000);
+        c.set_ccr(0x80);
+    }
+    run_vs_steps(
+        (&mut ca, &mut ma),
+        (&mut cb, &mut mb),
+        1_000_003,
+        200_000_000,
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert!(ca.halted(), "ran to the end");
+    assert!(
+        ca.skipped_instructions() > 1_000_000,
+        "{}",
+        ca.skipped_instructions()
+    );
+    assert_eq!(ca.instructions(), cb.instructions());
+}
+
 #[test]
 fn a_poke_into_the_flash_empties_the_decode_caches() {
     let mut m = Machine::new();
