@@ -298,15 +298,15 @@ struct SharedImage {
     code: SharedCode,
 }
 
-/// The flash bytes that differ from robot to robot: the configuration block. The shared
-/// decode tables leave every instruction that covers one of them to each CPU.
+/// The flash bytes that differ from robot to robot in an image with a configuration block: the
+/// block. The shared decode tables leave every instruction that covers one of them to each CPU.
 const VARYING_BYTES: std::ops::Range<u32> =
     CONFIG_BLOCK_ADDR..CONFIG_BLOCK_ADDR + CONFIG_BLOCK_BYTES as u32;
 
 impl SharedImage {
     /// `image` programmed into an erased flash, and the code from its lowest to its highest
-    /// byte decoded.
-    fn build(image: &SrecImage) -> SharedImage {
+    /// byte decoded, but for instructions covering a byte of `varies`.
+    fn build(image: &SrecImage, varies: std::ops::Range<u32>) -> SharedImage {
         let flash = Flash::with_image(image);
         let start = image.chunks.iter().map(|c| c.address).min().unwrap_or(0);
         let end = image
@@ -315,7 +315,7 @@ impl SharedImage {
             .map(|c| c.address.saturating_add(c.data.len() as u32))
             .max()
             .unwrap_or(0);
-        let code = SharedCode::decode_rom(|a| flash.word(a as usize), start..end, VARYING_BYTES);
+        let code = SharedCode::decode_rom(|a| flash.word(a as usize), start..end, varies);
         SharedImage { flash, code }
     }
 }
@@ -410,7 +410,15 @@ impl Firmware {
             return mcu.load_image(&self.image).map(|()| None);
         }
         let (source, shared) = self.flash.get_or_init(|| {
-            let built = check_image(&self.image).map(|()| SharedImage::build(&self.image));
+            // An image without a configuration block gets none poked over it (a block given
+            // anyway makes the CPU decode for itself, see `install`), so all its code is
+            // shared, whatever lies at H'000400.
+            let varies = if self.has_config_block() {
+                VARYING_BYTES
+            } else {
+                0..0
+            };
+            let built = check_image(&self.image).map(|()| SharedImage::build(&self.image, varies));
             (self.image.clone(), built)
         });
         if *source != self.image {
@@ -482,9 +490,13 @@ impl Firmware {
         cpu: &mut Cpu,
         block: Option<&ConfigBlock>,
     ) -> Result<(), FirmwareError> {
-        let code = self.program(mcu)?;
+        let mut code = self.program(mcu)?;
         if let Some(b) = block {
-            // Inside VARYING_BYTES: the shared code holds nothing decoded from these bytes.
+            // With a configuration block these are VARYING_BYTES, of which the shared code
+            // holds nothing; without one they may be code the shared tables decoded.
+            if !self.has_config_block() {
+                code = None;
+            }
             mcu.poke(CONFIG_BLOCK_ADDR, &b.encode());
         }
         cpu.flush_decode_cache();
@@ -943,6 +955,73 @@ mod tests {
             .flat_map(|c| (0..c.data.len()).map(move |i| c.address + i as u32))
             .map(|a| mcu.peek(a))
             .collect()
+    }
+
+    /// An image without a configuration block whose code runs through H'000400 (a user's
+    /// image): its robots share all of its decoded code, run it as a CPU decoding for itself
+    /// does, and one given a block anyway (poked over that code) decodes for itself.
+    #[test]
+    fn code_at_the_block_address_is_shared_when_no_block_lands_there() {
+        // Reset vector -> H'000100; NOPs up to H'000500, then mov.b #7,r0l and SLEEP (with
+        // CCR.I set after reset: the program halts).
+        let mut code = vec![0u8; 0x400];
+        code.extend_from_slice(&[0xF8, 0x07, 0x01, 0x80]);
+        let image = SrecImage {
+            header: None,
+            chunks: vec![
+                h8300h::srec::Chunk {
+                    address: 0,
+                    data: vec![0, 0, 0x01, 0x00],
+                },
+                h8300h::srec::Chunk {
+                    address: 0x100,
+                    data: code,
+                },
+            ],
+            start: None,
+        };
+        let fw = Firmware {
+            image,
+            symbols: SymbolTable::default(),
+            name: "user.mot".to_string(),
+            flash: OnceLock::new(),
+        };
+        assert!(!fw.has_config_block());
+        let run = |block: Option<&ConfigBlock>, own: bool| {
+            let mut mcu = Mcu::new(McuConfig::default(), NullBoard).expect("mcu");
+            let mut cpu = Cpu::new();
+            fw.install(&mut mcu, &mut cpu, block).expect("install");
+            if own {
+                cpu.flush_decode_cache();
+            }
+            let shares = cpu.shares_code(fw.shared_code().expect("built"));
+            let _ = run_until(&mut cpu, &mut mcu, 1_000_000);
+            let shares_after = cpu.shares_code(fw.shared_code().expect("built"));
+            (
+                cpu.regs(),
+                cpu.halted(),
+                h8300h::bus::Bus::now(&mcu),
+                shares,
+                shares_after,
+            )
+        };
+        let shared = run(None, false);
+        let own = run(None, true);
+        assert!(shared.3 && shared.4, "shared before and after the run");
+        assert!(!own.3);
+        assert!(shared.1, "halted");
+        assert_eq!(shared.0[0] & 0xFF, 7);
+        assert_eq!((shared.0, shared.1, shared.2), (own.0, own.1, own.2));
+        let code = fw.shared_code().expect("built");
+        assert!(code.filled() >= 0x200, "{} slots", code.filled());
+        // A block poked over the code: that CPU decodes for itself, and runs the bytes it has.
+        let blocked = run(Some(&ConfigBlock::ARENA), false);
+        let blocked_own = run(Some(&ConfigBlock::ARENA), true);
+        assert!(!blocked.3);
+        assert_eq!(
+            (blocked.0, blocked.1, blocked.2),
+            (blocked_own.0, blocked_own.1, blocked_own.2)
+        );
     }
 
     /// MCUs sharing the firmware's flash read the image, each keeps its own configuration
