@@ -1285,11 +1285,26 @@ fn advance_world(
     let mut sum = (0u64, 0u64);
     let dt = target_states.saturating_sub(world.elapsed_states());
     let clock_hz = world.params().clock_hz as f64;
-    for len in world.substep_plan(dt) {
+    // With more than one thread, each sub-step's readings are fed while the world makes the
+    // next sub-step (the other thread has the meters to do during the world's one-thread
+    // stages); on one thread they wait for a batch, which keeps each robot's meters in cache.
+    let pipelined = par && rayon::current_num_threads() > 1;
+    let advance = |world: &mut World, len: u64| {
         if par {
             world.advance_states_par(len);
         } else {
             world.advance_states(len);
+        }
+    };
+    for len in world.substep_plan(dt) {
+        if pipelined && !readings.lens.is_empty() {
+            let ((), fed) = rayon::join(
+                || advance(world, len),
+                || readings.feed(meters, per_robot, par, drives, clock_hz),
+            );
+            sum = add(sum, fed);
+        } else {
+            advance(world, len);
         }
         readings.gather(world, len, par)?;
         if readings.lens.len() == METER_BATCH {
@@ -1391,8 +1406,9 @@ mod tests {
     }
 
     /// The meters fed in batches (more than [`METER_BATCH`] sub-steps a step, so full batches
-    /// and a remainder) count what they count fed after every sub-step, on one thread and on
-    /// the pool: three robots in the corridor, one pushing the end wall, two meeting head on.
+    /// and a remainder) or pipelined with the world's sub-steps (two threads) count what they
+    /// count fed after every sub-step: three robots in the corridor, one pushing the end wall,
+    /// two meeting head on.
     #[test]
     fn meters_fed_in_batches_count_as_fed_after_every_substep() {
         let mut s = Scenario::corridor();
@@ -1451,24 +1467,32 @@ mod tests {
             sums0.push(sum);
         }
         assert!(c0.iter().all(|&c| c >= 1), "every robot collided: {c0:?}");
-        for par in [false, true] {
+        // One thread in order, one thread with the pool's stages (batched), two threads
+        // (each sub-step fed while the world makes the next).
+        for (par, threads) in [(false, 1), (true, 1), (true, 2)] {
             let mut w = w.clone();
             let (mut m, mut c, mut d) = fresh();
             let mut readings = Readings::default();
-            let sums: Vec<_> = (1..=40u64)
-                .map(|k| {
-                    advance_world(
-                        &mut w,
-                        k * period,
-                        (&mut m, &mut c),
-                        par,
-                        &mut d,
-                        &mut readings,
-                    )
-                    .unwrap()
-                })
-                .collect();
-            assert_eq!(sums, sums0, "par {par}");
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let sums: Vec<_> = pool.install(|| {
+                (1..=40u64)
+                    .map(|k| {
+                        advance_world(
+                            &mut w,
+                            k * period,
+                            (&mut m, &mut c),
+                            par,
+                            &mut d,
+                            &mut readings,
+                        )
+                        .unwrap()
+                    })
+                    .collect()
+            });
+            assert_eq!(sums, sums0, "par {par}, {threads} threads");
             assert_eq!(c, c0);
             assert_eq!(m, m0);
             for (a, b) in d.iter_mut().zip(d0.iter_mut()) {
