@@ -408,11 +408,11 @@ fn unconfigured_image(
 
 /// Host memory one robot takes while its run is going, with a margin (measured, see
 /// docs/performance.md: the peak resident size of `h8swarm run --robots 10000` less that of
-/// 1 000 robots, per robot: model robots 16 KB; firmware robots 34 KB, the flash and the
+/// 1 000 robots, per robot: model robots 16 KB; firmware robots 39 KB, the flash and the
 /// CPU's decoded code being shared).
 pub const MODEL_ROBOT_BYTES: u64 = 24 << 10;
 /// See [`MODEL_ROBOT_BYTES`].
-pub const FIRMWARE_ROBOT_BYTES: u64 = 48 << 10;
+pub const FIRMWARE_ROBOT_BYTES: u64 = 56 << 10;
 /// Host memory per window of a run kept for the summary and the plots (the window's sums;
 /// the steps themselves are written as they complete and not kept), with a margin.
 pub const WINDOW_BYTES: u64 = 128;

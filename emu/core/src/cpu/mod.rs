@@ -230,7 +230,7 @@ pub struct Cpu {
     /// taken.
     loops: Vec<ffwd::Loop>,
     /// Per slot of `fast`, its back edge's place in `loops` ([`ffwd::NO_LOOP`]: none yet).
-    loop_slots: Vec<u16>,
+    loop_slots: Vec<u32>,
     /// Instructions fast-forwarded so far.
     skipped: u64,
     /// Idle cycles advanced in closed form so far ([`Cpu::run_idle`]).
