@@ -1235,6 +1235,7 @@ impl Readings {
     ) -> (u64, u64) {
         let n = meters.len();
         let (lens, of) = (&self.lens, &self.of);
+        debug_assert_eq!(of.len(), lens.len() * n, "a reading per robot per sub-step");
         let metered = drives.len() == n;
         let meter = |i: usize,
                      m: &mut ContactMeter,
