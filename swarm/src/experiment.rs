@@ -1157,9 +1157,9 @@ const METER_BATCH: usize = 32;
 /// batched; 1 000 robots × 600 steps: 3.28–4.07 s against 3.55–4.29 s).
 const PIPELINE_ROBOTS: usize = 512;
 
-/// Robots from which a sub-step's readings are gathered on the pool (as the world's per-robot
-/// stages: below it a parallel region costs more than the copying).
-const GATHER_PAR_ROBOTS: usize = 4096;
+/// Robots from which a sub-step's readings are gathered on the pool: the world's own threshold
+/// for its per-robot stages (below it a parallel region costs more than the copying).
+const GATHER_PAR_ROBOTS: usize = world::PAR_STAGE_ROBOTS;
 /// Robots per chunk of the parallel gathering.
 const GATHER_CHUNK: usize = 1024;
 

@@ -157,6 +157,7 @@ pub use error::WorldError;
 pub use motor::{Behaviour, Direction, WheelCommand};
 pub use params::{SensorMount, WorldParams};
 pub use pipeline::broad_phase::BROAD_PHASE_MARGIN_M;
+pub use pipeline::par::PAR_STAGE_ROBOTS;
 pub use pipeline::solver::CONTACT_SKIN_M;
 pub use world::{
     FRONT, LEFT, MAX_ROBOTS, Pose, REAR, RIGHT, SolverStats, SubstepPlan, World,

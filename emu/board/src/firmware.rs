@@ -499,9 +499,10 @@ impl Firmware {
             }
             mcu.poke(CONFIG_BLOCK_ADDR, &b.encode());
         }
-        cpu.flush_decode_cache();
-        if let (Some(code), Some(token)) = (code, mcu.code_generation()) {
-            cpu.adopt_shared_code(code, token);
+        // Either way the CPU forgets what it decoded before (adopting does that too).
+        match (code, mcu.code_generation()) {
+            (Some(code), Some(token)) => cpu.adopt_shared_code(code, token),
+            _ => cpu.flush_decode_cache(),
         }
         cpu.reset(mcu);
         Ok(())

@@ -16,7 +16,7 @@ pub(crate) mod corrections;
 pub(crate) mod drive;
 pub(crate) mod islands;
 pub(crate) mod narrow_phase;
-pub(crate) mod par;
+pub mod par;
 pub(crate) mod sensing;
 pub(crate) mod solver;
 pub(crate) mod warm_start;

@@ -10,5 +10,5 @@ pub(crate) const PAR_ISLAND_ROBOTS: usize = 64;
 /// 2 µs for 100 robots' motors), and a parallel region costs about 10-15 µs of waking and
 /// joining on this machine: at 1 000 robots on two threads the motors took 120-159 ms on the
 /// pool against 21 ms on one thread over a 400-step run (docs/performance.md). The islands'
-/// solve, hundreds of µs a sub-step, goes on the pool from [`PAR_ISLAND_ROBOTS`].
-pub(crate) const PAR_STAGE_ROBOTS: usize = 4096;
+/// solve, about 127 µs a sub-step at 1 000 robots, goes on the pool from 64 solved robots.
+pub const PAR_STAGE_ROBOTS: usize = 4096;

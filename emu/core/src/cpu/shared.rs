@@ -88,12 +88,6 @@ impl SharedCode {
     pub fn filled(&self) -> usize {
         self.cache.iter().filter(|d| d.words != 0).count()
     }
-
-    /// Bytes the tables take (once, however many CPUs share them).
-    #[must_use]
-    pub fn bytes(&self) -> usize {
-        std::mem::size_of_val(&*self.cache) + std::mem::size_of_val(&*self.fast)
-    }
 }
 
 impl Cpu {
