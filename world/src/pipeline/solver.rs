@@ -234,35 +234,23 @@ pub(crate) fn solve_island(
                 b.vel[2] -= d_long * y_w * body.inv_i;
             }
         }
+        // Each contact works on copies of its robots' velocities (a wall's stays zero), written
+        // back after its rows: the same arithmetic as on the island's bodies in place.
         for ct in contacts.iter_mut() {
-            let (la, lb) = (ct.la, ct.lb);
-            let mu = if lb == WALL {
-                body.mu_wall
+            let la = ct.la as usize;
+            if ct.lb == WALL {
+                let mut va = bodies[la].vel;
+                let d = contact_rows::<true>(&mut va, &mut [0.0; 3], ct, body.mu_wall, body, inv_h);
+                change = change.max(d);
+                bodies[la].vel = va;
             } else {
-                body.mu_robot
-            };
-            let (nx, ny) = (ct.nx, ct.ny);
-            let (tx, ty) = (-ny, nx);
-            for p in ct.pts[..usize::from(ct.count)].iter_mut() {
-                let (rvx, rvy) = relative_velocity(bodies, la, lb, p);
-                let vn = rvx * nx + rvy * ny;
-                // Allowed approach: close the gap down to the skin (sep > 0), or open an overlap
-                // to it (sep < 0).
-                let target = -(p.sep - CONTACT_SKIN_M) * inv_h;
-                let new = (p.ln + p.mass_n * (target - vn)).max(0.0);
-                let d = new - p.ln;
-                p.ln = new;
-                change = change.max(d.abs());
-                apply(bodies, la, lb, p, d * nx, d * ny, body);
-                // Friction against the updated velocities.
-                let (rvx, rvy) = relative_velocity(bodies, la, lb, p);
-                let vt = rvx * tx + rvy * ty;
-                let bound = mu * p.ln;
-                let new_t = (p.lt - p.mass_t * vt).clamp(-bound, bound);
-                let dt = new_t - p.lt;
-                p.lt = new_t;
-                change = change.max(dt.abs());
-                apply(bodies, la, lb, p, dt * tx, dt * ty, body);
+                let lb = ct.lb as usize;
+                debug_assert_ne!(la, lb, "a contact joins two robots");
+                let (mut va, mut vb) = (bodies[la].vel, bodies[lb].vel);
+                let d = contact_rows::<false>(&mut va, &mut vb, ct, body.mu_robot, body, inv_h);
+                change = change.max(d);
+                bodies[la].vel = va;
+                bodies[lb].vel = vb;
             }
         }
         if change < CONVERGED_N_S {
@@ -272,19 +260,73 @@ pub(crate) fn solve_island(
     sweeps
 }
 
-/// Velocity of b's contact point relative to a's (a wall does not move).
-#[inline]
-fn relative_velocity(bodies: &[IslandBody], la: u32, lb: u32, p: &ContactRow) -> (f64, f64) {
-    let va = bodies[la as usize].vel;
-    let vb = if lb == WALL {
-        [0.0; 3]
-    } else {
-        bodies[lb as usize].vel
-    };
+/// One sweep's rows of contact `ct` between velocities `va` and `vb` (`TO_WALL`: b is a wall,
+/// `vb` is zero and stays so), friction coefficient `mu`: each point's normal row (push,
+/// never pull, towards the speculative target), then its friction row against the updated
+/// velocities. Returns the largest impulse change.
+#[inline(always)]
+fn contact_rows<const TO_WALL: bool>(
+    va: &mut [f64; 3],
+    vb: &mut [f64; 3],
+    ct: &mut Contact,
+    mu: f64,
+    body: &BodyConst,
+    inv_h: f64,
+) -> f64 {
+    let mut change: f64 = 0.0;
+    let (nx, ny) = (ct.nx, ct.ny);
+    let (tx, ty) = (-ny, nx);
+    for p in ct.pts[..usize::from(ct.count)].iter_mut() {
+        let (rvx, rvy) = point_velocity(va, vb, p);
+        let vn = rvx * nx + rvy * ny;
+        // Allowed approach: close the gap down to the skin (sep > 0), or open an overlap to it
+        // (sep < 0).
+        let target = -(p.sep - CONTACT_SKIN_M) * inv_h;
+        let new = (p.ln + p.mass_n * (target - vn)).max(0.0);
+        let d = new - p.ln;
+        p.ln = new;
+        change = change.max(d.abs());
+        push::<TO_WALL>(va, vb, p, d * nx, d * ny, body);
+        // Friction against the updated velocities.
+        let (rvx, rvy) = point_velocity(va, vb, p);
+        let vt = rvx * tx + rvy * ty;
+        let bound = mu * p.ln;
+        let new_t = (p.lt - p.mass_t * vt).clamp(-bound, bound);
+        let dt = new_t - p.lt;
+        p.lt = new_t;
+        change = change.max(dt.abs());
+        push::<TO_WALL>(va, vb, p, dt * tx, dt * ty, body);
+    }
+    change
+}
+
+/// Velocity of b's contact point relative to a's, from their velocities.
+#[inline(always)]
+fn point_velocity(va: &[f64; 3], vb: &[f64; 3], p: &ContactRow) -> (f64, f64) {
     (
         (vb[0] - vb[2] * p.rb[1]) - (va[0] - va[2] * p.ra[1]),
         (vb[1] + vb[2] * p.rb[0]) - (va[1] + va[2] * p.ra[0]),
     )
+}
+
+/// Applies the impulse (px, py) to b at its lever arm (unless `TO_WALL`) and (−px, −py) to a.
+#[inline(always)]
+fn push<const TO_WALL: bool>(
+    va: &mut [f64; 3],
+    vb: &mut [f64; 3],
+    p: &ContactRow,
+    px: f64,
+    py: f64,
+    body: &BodyConst,
+) {
+    va[0] -= px * body.inv_m;
+    va[1] -= py * body.inv_m;
+    va[2] -= (p.ra[0] * py - p.ra[1] * px) * body.inv_i;
+    if !TO_WALL {
+        vb[0] += px * body.inv_m;
+        vb[1] += py * body.inv_m;
+        vb[2] += (p.rb[0] * py - p.rb[1] * px) * body.inv_i;
+    }
 }
 
 /// An impulse change small enough to call a sweep converged: 1e-6 N·s, a velocity change of
@@ -292,7 +334,8 @@ fn relative_velocity(bodies: &[IslandBody], la: u32, lb: u32, p: &ContactRow) ->
 /// position sweeps remove).
 const CONVERGED_N_S: f64 = 1e-6;
 
-/// Applies the impulse (px, py) to b at its lever arm and (−px, −py) to a.
+/// Applies the impulse (px, py) to robot `lb` of the island at its lever arm (unless it is a
+/// wall) and (−px, −py) to robot `la`.
 #[inline]
 fn apply(
     bodies: &mut [IslandBody],
@@ -303,14 +346,14 @@ fn apply(
     py: f64,
     body: &BodyConst,
 ) {
-    let va = &mut bodies[la as usize].vel;
-    va[0] -= px * body.inv_m;
-    va[1] -= py * body.inv_m;
-    va[2] -= (p.ra[0] * py - p.ra[1] * px) * body.inv_i;
-    if lb != WALL {
-        let vb = &mut bodies[lb as usize].vel;
-        vb[0] += px * body.inv_m;
-        vb[1] += py * body.inv_m;
-        vb[2] += (p.rb[0] * py - p.rb[1] * px) * body.inv_i;
+    let la = la as usize;
+    if lb == WALL {
+        push::<true>(&mut bodies[la].vel, &mut [0.0; 3], p, px, py, body);
+    } else {
+        let lb = lb as usize;
+        let (mut va, mut vb) = (bodies[la].vel, bodies[lb].vel);
+        push::<false>(&mut va, &mut vb, p, px, py, body);
+        bodies[la].vel = va;
+        bodies[lb].vel = vb;
     }
 }
