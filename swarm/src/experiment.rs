@@ -591,6 +591,13 @@ impl Swarm {
         self.parallel = parallel;
     }
 
+    /// Whether this step's per-robot work goes on rayon's pool: [`Swarm::set_parallel`], on a
+    /// pool of more than one thread (on one thread the parallel paths would only cost their
+    /// chunking; the results are the same either way).
+    fn par(&self) -> bool {
+        self.parallel && rayon::current_num_threads() > 1
+    }
+
     /// Runs the next step: every MCU sleeps to the step instant, the world catches up (its
     /// collisions are the previous step's), the robots sense, step and drive.
     ///
@@ -636,7 +643,7 @@ impl Swarm {
         let sleep = |(i, r): (usize, &mut Robot)| -> Option<Result<u64>> {
             dead[i].is_none().then(|| r.sleep())
         };
-        let times: Vec<Option<Result<u64>>> = if self.parallel {
+        let times: Vec<Option<Result<u64>>> = if self.par() {
             self.robots.par_iter_mut().enumerate().map(sleep).collect()
         } else {
             self.robots.iter_mut().enumerate().map(sleep).collect()
@@ -697,7 +704,7 @@ impl Swarm {
             Ok((d, world.bumpers(i)?))
         };
         let n = self.robots.len();
-        if self.parallel {
+        if self.par() {
             (0..n).into_par_iter().map(sense).collect()
         } else {
             (0..n).map(sense).collect()
@@ -714,7 +721,7 @@ impl Swarm {
                 r.step(*d).map(|rep| (rep, r.take_busy_states()))
             })
         };
-        let results: Vec<_> = if self.parallel {
+        let results: Vec<_> = if self.par() {
             self.robots
                 .par_iter_mut()
                 .zip(senses.par_iter())
@@ -827,11 +834,12 @@ impl Swarm {
     /// robots.
     fn close_step(&mut self, t_states: u64) -> Result<()> {
         let dt = t_states.saturating_sub(self.world.elapsed_states());
+        let par = self.par();
         let (collided, contact_states) = advance_world(
             &mut self.world,
             t_states,
             (&mut self.meters, &mut self.collided),
-            self.parallel,
+            par,
             &mut self.drives,
             &mut self.readings,
         )?;

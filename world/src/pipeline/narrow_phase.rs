@@ -48,6 +48,26 @@ pub(crate) struct NarrowPhase {
     pub(crate) checked: Vec<u32>,
     /// Per robot, [`ACTIVE`] and the search's own marks; all zero between sub-steps.
     pub(crate) flags: Vec<u8>,
+    /// Per contact, whether it binds (scratch).
+    binds: Vec<bool>,
+}
+
+/// Puts `list`, the robots whose `flags` have `bit` (each once), in index order: sorted when
+/// few robots are listed, read off the flags when many (the same list, in less time than a
+/// sort of thousands).
+fn in_index_order(list: &mut Vec<u32>, flags: &[u8], bit: u8) {
+    if list.len() * 16 < flags.len() {
+        list.sort_unstable();
+    } else {
+        list.clear();
+        list.extend(
+            flags
+                .iter()
+                .enumerate()
+                .filter(|&(_, &f)| f & bit != 0)
+                .map(|(i, _)| i as u32),
+        );
+    }
 }
 
 /// What the contact search reads.
@@ -123,6 +143,7 @@ impl NarrowPhase {
             active: Vec::new(),
             checked: Vec::new(),
             flags: vec![0; n],
+            binds: Vec::new(),
         }
     }
 
@@ -175,7 +196,7 @@ impl NarrowPhase {
             probe.walls(&cand.walls, &mut self.contacts);
             probe.pairs(&cand.pairs, &mut self.contacts);
         }
-        self.bind(probe.pose, wmean, inv_track, h);
+        self.bind(probe.pose, wmean, (inv_track, h), parallel);
     }
 
     /// Which contacts bind: those that the robots' own wheels would close (to within
@@ -184,7 +205,16 @@ impl NarrowPhase {
     /// (its motion is no longer its wheels'); the rest follow their wheels exactly, and
     /// their contacts are checked for overlap after the move. Keeps the contacts of solved
     /// robots only, and lists the solved robots and the checked ones in index order.
-    fn bind(&mut self, pose: &[BodyPose], wmean: &[[f64; 2]], inv_track: f64, h: f64) {
+    ///
+    /// With `parallel`, whether each contact binds is decided on rayon's pool (each on its
+    /// own, so the same answers).
+    fn bind(
+        &mut self,
+        pose: &[BodyPose],
+        wmean: &[[f64; 2]],
+        (inv_track, h): (f64, f64),
+        parallel: bool,
+    ) {
         self.active.clear();
         self.checked.clear();
         let twist = |i: usize| -> [f64; 3] {
@@ -193,16 +223,30 @@ impl NarrowPhase {
             let p = pose[i];
             [v * p.c, v * p.s, (w[1] - w[0]) * inv_track]
         };
-        for ct in &self.contacts {
-            let a = ct.a as usize;
-            let wall = ct.b == WALL;
-            let ua = twist(a);
-            let ub = if wall { [0.0; 3] } else { twist(ct.b as usize) };
-            let binds = ct.pts[..usize::from(ct.count)].iter().any(|p| {
+        let binds = |ct: &Contact| -> bool {
+            let ua = twist(ct.a as usize);
+            let ub = if ct.b == WALL {
+                [0.0; 3]
+            } else {
+                twist(ct.b as usize)
+            };
+            ct.pts[..usize::from(ct.count)].iter().any(|p| {
                 let rvx = (ub[0] - ub[2] * p.rb[1]) - (ua[0] - ua[2] * p.ra[1]);
                 let rvy = (ub[1] + ub[2] * p.rb[0]) - (ua[1] + ua[2] * p.ra[0]);
                 p.sep + (rvx * ct.nx + rvy * ct.ny) * h < BIND_MARGIN_M
-            });
+            })
+        };
+        self.binds.clear();
+        if parallel && self.contacts.len() > PAR_CHUNK {
+            self.contacts
+                .par_iter()
+                .with_min_len(PAR_CHUNK / 4)
+                .map(binds)
+                .collect_into_vec(&mut self.binds);
+        } else {
+            self.binds.extend(self.contacts.iter().map(binds));
+        }
+        for (ct, &binds) in self.contacts.iter().zip(&self.binds) {
             for i in [ct.a, ct.b] {
                 if i != WALL && self.flags[i as usize] & CHECK == 0 {
                     self.flags[i as usize] |= CHECK;
@@ -245,14 +289,39 @@ impl NarrowPhase {
                 }
             }
         }
-        self.active.sort_unstable();
-        self.checked.sort_unstable();
+        in_index_order(&mut self.active, &self.flags, LISTED);
+        in_index_order(&mut self.checked, &self.flags, CHECK);
     }
 
     /// Clears the flags of the checked robots (the only ones set) for the next sub-step.
     pub(crate) fn clear_flags(&mut self) {
         for &i in &self.checked {
             self.flags[i as usize] = 0;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Read off the flags or sorted, the listed robots come out the same, in index order.
+    #[test]
+    fn listed_robots_come_out_in_index_order_either_way() {
+        // Pushed in the order a contact list would meet them.
+        let pushed: Vec<u32> = vec![40, 3, 17, 63, 0, 22, 5];
+        let mut sorted = pushed.clone();
+        sorted.sort_unstable();
+        // 7 of 256 robots: sorted; 7 of 64: read off the flags.
+        for n in [256, 64] {
+            let mut flags = vec![0u8; n];
+            for &i in &pushed {
+                flags[i as usize] |= CHECK;
+            }
+            flags[9] |= ACTIVE; // another bit: not listed
+            let mut list = pushed.clone();
+            in_index_order(&mut list, &flags, CHECK);
+            assert_eq!(list, sorted, "{n} robots");
         }
     }
 }

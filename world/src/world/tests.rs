@@ -1095,6 +1095,8 @@ fn thread_count_does_not_change_the_result() {
         st.active_robot_substeps,
         st.substeps
     );
+    // The position corrections ran (their checks for overlaps go on the pool at this size).
+    assert!(st.overlap_substeps > 0 && st.position_sweeps > 0, "{st:?}");
     for threads in [1, 2, 3, 4] {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
@@ -1103,6 +1105,7 @@ fn thread_count_does_not_change_the_result() {
         let mut w = mk();
         pool.install(|| drive_run(&mut w, 300, 9, true));
         assert_eq!(state_bits(&w), reference, "{threads} threads");
+        assert_eq!(w.solver_stats(), st, "{threads} threads");
     }
 }
 
