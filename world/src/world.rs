@@ -603,7 +603,7 @@ impl World {
         self.warm.keep(&self.narrow.contacts);
         if !self.narrow.checked.is_empty() {
             // 4. What the linearised solve left of an overlap is corrected.
-            self.correct(h, stages);
+            self.correct(h);
             // 5. A bumper is pressed when the contacts on its face carried force: the solver's
             // impulses and the corrections' pushes (as impulses) summed over the sub-step.
             // A switch operates at `bumper_force_n` and, once pressed, releases only below
@@ -726,9 +726,8 @@ impl World {
         }
     }
 
-    /// The position corrections of a sub-step of `h` seconds, counted in the statistics; with
-    /// `parallel`, the checks for overlaps on rayon's pool.
-    fn correct(&mut self, h: f64, parallel: bool) {
+    /// The position corrections of a sub-step of `h` seconds, counted in the statistics.
+    fn correct(&mut self, h: f64) {
         let mut scene = Scene {
             pose: &mut self.pose,
             prev: &self.prev,
@@ -742,8 +741,8 @@ impl World {
         let done = self.corrections.clear_overlaps(
             &mut scene,
             &self.narrow.checked,
-            (self.params.position_iterations, h),
-            parallel,
+            self.params.position_iterations,
+            h,
         );
         self.stats.overlap_substeps += u64::from(done.overlapped);
         self.stats.position_sweeps += done.sweeps;

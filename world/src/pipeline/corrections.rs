@@ -2,13 +2,10 @@
 //! corner, a cluster that did not converge) is pushed apart by position sweeps; what they do
 //! not clear stops early in the sub-step, at a time of impact.
 
-use rayon::prelude::*;
-
 use crate::body::{BodyConst, BodyPose};
 use crate::contact::{Manifold, box_box, box_walls};
 use crate::geometry::obb_overlap;
 use crate::pipeline::broad_phase::Candidates;
-use crate::pipeline::par::PAR_CHUNK;
 use crate::pipeline::sensing::Bumpers;
 
 /// The gap a position correction opens (10 µm): more than the contact skin (the solver's
@@ -58,8 +55,6 @@ pub(crate) struct Corrections {
     last_move: Vec<u64>,
     /// Overlaps found by the latest check.
     overlaps: Candidates,
-    /// Per chunk of candidates, its overlaps (the parallel check's scratch).
-    chunks: Vec<Candidates>,
 }
 
 impl Corrections {
@@ -69,7 +64,6 @@ impl Corrections {
             epoch: 1,
             last_move: vec![0; n],
             overlaps: Candidates::default(),
-            chunks: Vec::new(),
         }
     }
 
@@ -81,15 +75,12 @@ impl Corrections {
     /// early: its robots move only the largest fraction (1/2, 1/4, …, 0) of this sub-step's
     /// motion at which nothing overlaps (a time of impact: no body jumps anywhere, it is only
     /// kept from going on), and so do robots whose motion ends in those robots.
-    ///
-    /// With `parallel`, each check for overlaps runs in chunks of candidates on rayon's pool,
-    /// merged in order (the same list as in order).
     pub(crate) fn clear_overlaps(
         &mut self,
         s: &mut Scene<'_>,
         checked: &[u32],
-        (iterations, h): (u32, f64),
-        parallel: bool,
+        iterations: u32,
+        h: f64,
     ) -> Corrected {
         let mut done = Corrected::default();
         self.epoch += 1;
@@ -98,7 +89,7 @@ impl Corrections {
             self.last_move[i as usize] = self.epoch;
         }
         for _ in 0..iterations {
-            self.collect_overlaps(s, since, parallel);
+            self.collect_overlaps(s, since);
             if self.overlaps.is_empty() {
                 return done;
             }
@@ -115,51 +106,36 @@ impl Corrections {
             }
             self.overlaps = list;
         }
-        self.collect_overlaps(s, since, parallel);
+        self.collect_overlaps(s, since);
         if !self.overlaps.is_empty() {
-            done.stopped = self.stop_early(s, parallel);
+            done.stopped = self.stop_early(s);
         }
         done
     }
 
     /// The candidates with a robot moved at or after epoch `since` that overlap now, into
-    /// `overlaps` in candidate order (walls, then pairs); with `parallel` and enough
-    /// candidates, in chunks on rayon's pool.
-    fn collect_overlaps(&mut self, s: &Scene<'_>, since: u64, parallel: bool) {
-        let Corrections {
-            last_move,
-            overlaps,
-            chunks,
-            ..
-        } = self;
-        overlaps.clear();
-        let check = OverlapCheck {
-            moved: last_move,
-            since,
-            s,
-            reach2: 4.0 * s.body.radius_m * s.body.radius_m,
-        };
-        let (walls, pairs) = (&s.cand.walls, &s.cand.pairs);
-        if parallel && walls.len() + pairs.len() > PAR_CHUNK {
-            let n = walls.len().max(pairs.len()).div_ceil(PAR_CHUNK);
-            if chunks.len() < n {
-                chunks.resize_with(n, Candidates::default);
+    /// `overlaps`.
+    fn collect_overlaps(&mut self, s: &Scene<'_>, since: u64) {
+        self.overlaps.clear();
+        let moved = &self.last_move;
+        let (hx, hy) = (s.body.hx, s.body.hy);
+        for &i in &s.cand.walls {
+            if moved[i as usize] >= since && s.pose[i as usize].crosses_walls(hx, hy, s.w, s.h) {
+                self.overlaps.walls.push(i);
             }
-            let part = |v: usize, k: usize| (k * PAR_CHUNK).min(v)..((k + 1) * PAR_CHUNK).min(v);
-            chunks[..n].par_iter_mut().enumerate().for_each(|(k, out)| {
-                out.clear();
-                check.walls(&walls[part(walls.len(), k)], &mut out.walls);
-                check.pairs(&pairs[part(pairs.len(), k)], &mut out.pairs);
-            });
-            for c in &chunks[..n] {
-                overlaps.walls.extend_from_slice(&c.walls);
+        }
+        let reach2 = 4.0 * s.body.radius_m * s.body.radius_m;
+        for &[i, j] in &s.cand.pairs {
+            if moved[i as usize] < since && moved[j as usize] < since {
+                continue;
             }
-            for c in &chunks[..n] {
-                overlaps.pairs.extend_from_slice(&c.pairs);
+            let (a, b) = (s.pose[i as usize], s.pose[j as usize]);
+            if (b.x - a.x) * (b.x - a.x) + (b.y - a.y) * (b.y - a.y) >= reach2 {
+                continue;
             }
-        } else {
-            check.walls(walls, &mut overlaps.walls);
-            check.pairs(pairs, &mut overlaps.pairs);
+            if obb_overlap(&s.body.obb(a), &s.body.obb(b), 0.0).is_some() {
+                self.overlaps.pairs.push([i, j]);
+            }
         }
     }
 
@@ -253,7 +229,7 @@ impl Corrections {
     /// this sub-step's motion, the largest of 1, 1/2, …, 1/1024, 0 at which nothing they touch
     /// overlaps, and lose their velocity. Their start poses were free of overlaps, so this
     /// ends. Returns how many robots stopped.
-    fn stop_early(&mut self, s: &mut Scene<'_>, parallel: bool) -> u64 {
+    fn stop_early(&mut self, s: &mut Scene<'_>) -> u64 {
         let mut group: Vec<u32> = Vec::new();
         let mut ends: Vec<BodyPose> = Vec::new();
         let add = |i: u32, group: &mut Vec<u32>, ends: &mut Vec<BodyPose>, pose: &[BodyPose]| {
@@ -270,7 +246,7 @@ impl Corrections {
             add(j, &mut group, &mut ends, s.pose);
         }
         loop {
-            if self.back_off(s, (&group, &ends), parallel) {
+            if self.back_off(s, &group, &ends) {
                 break;
             }
             // At fraction 0 the group is where it started, free of overlaps among itself: what
@@ -297,12 +273,7 @@ impl Corrections {
     /// Moves the robots `group` a fraction 1/2, 1/4, …, 1/1024, 0 of the way from their start
     /// poses to `ends`, until nothing overlaps; whether that was reached (if not, the group is
     /// at its start poses and `overlaps` holds what still overlaps).
-    fn back_off(
-        &mut self,
-        s: &mut Scene<'_>,
-        (group, ends): (&[u32], &[BodyPose]),
-        parallel: bool,
-    ) -> bool {
+    fn back_off(&mut self, s: &mut Scene<'_>, group: &[u32], ends: &[BodyPose]) -> bool {
         let mut fraction = 1.0;
         for _ in 0..=11 {
             fraction = if fraction > 1.0 / 1024.0 {
@@ -316,7 +287,7 @@ impl Corrections {
                 s.pose[i] = interpolate(s.prev[i], ends[k], fraction);
                 self.last_move[i] = self.epoch;
             }
-            self.collect_overlaps(s, self.epoch, parallel);
+            self.collect_overlaps(s, self.epoch);
             if self.overlaps.is_empty() {
                 return true;
             }
@@ -325,48 +296,6 @@ impl Corrections {
             }
         }
         false
-    }
-}
-
-/// What a check for overlaps reads: the robots moved at or after epoch `since` (by
-/// `moved`) and the scene.
-struct OverlapCheck<'a, 's> {
-    moved: &'a [u64],
-    since: u64,
-    s: &'a Scene<'s>,
-    /// Squared distance between centres from which two bodies cannot overlap.
-    reach2: f64,
-}
-
-impl OverlapCheck<'_, '_> {
-    /// Appends the robots of `walls` that moved and cross a wall, in order.
-    fn walls(&self, walls: &[u32], out: &mut Vec<u32>) {
-        let s = self.s;
-        let (hx, hy) = (s.body.hx, s.body.hy);
-        for &i in walls {
-            if self.moved[i as usize] >= self.since
-                && s.pose[i as usize].crosses_walls(hx, hy, s.w, s.h)
-            {
-                out.push(i);
-            }
-        }
-    }
-
-    /// Appends the pairs of `pairs` with a robot that moved that overlap, in order.
-    fn pairs(&self, pairs: &[[u32; 2]], out: &mut Vec<[u32; 2]>) {
-        let s = self.s;
-        for &[i, j] in pairs {
-            if self.moved[i as usize] < self.since && self.moved[j as usize] < self.since {
-                continue;
-            }
-            let (a, b) = (s.pose[i as usize], s.pose[j as usize]);
-            if (b.x - a.x) * (b.x - a.x) + (b.y - a.y) * (b.y - a.y) >= self.reach2 {
-                continue;
-            }
-            if obb_overlap(&s.body.obb(a), &s.body.obb(b), 0.0).is_some() {
-                out.push([i, j]);
-            }
-        }
     }
 }
 

@@ -48,8 +48,6 @@ pub(crate) struct NarrowPhase {
     pub(crate) checked: Vec<u32>,
     /// Per robot, [`ACTIVE`] and the search's own marks; all zero between sub-steps.
     pub(crate) flags: Vec<u8>,
-    /// Per contact, whether it binds (scratch).
-    binds: Vec<bool>,
 }
 
 /// Puts `list`, the robots whose `flags` have `bit` (each once), in index order: sorted when
@@ -143,7 +141,6 @@ impl NarrowPhase {
             active: Vec::new(),
             checked: Vec::new(),
             flags: vec![0; n],
-            binds: Vec::new(),
         }
     }
 
@@ -196,7 +193,7 @@ impl NarrowPhase {
             probe.walls(&cand.walls, &mut self.contacts);
             probe.pairs(&cand.pairs, &mut self.contacts);
         }
-        self.bind(probe.pose, wmean, (inv_track, h), parallel);
+        self.bind(probe.pose, wmean, inv_track, h);
     }
 
     /// Which contacts bind: those that the robots' own wheels would close (to within
@@ -205,16 +202,7 @@ impl NarrowPhase {
     /// (its motion is no longer its wheels'); the rest follow their wheels exactly, and
     /// their contacts are checked for overlap after the move. Keeps the contacts of solved
     /// robots only, and lists the solved robots and the checked ones in index order.
-    ///
-    /// With `parallel`, whether each contact binds is decided on rayon's pool (each on its
-    /// own, so the same answers).
-    fn bind(
-        &mut self,
-        pose: &[BodyPose],
-        wmean: &[[f64; 2]],
-        (inv_track, h): (f64, f64),
-        parallel: bool,
-    ) {
+    fn bind(&mut self, pose: &[BodyPose], wmean: &[[f64; 2]], inv_track: f64, h: f64) {
         self.active.clear();
         self.checked.clear();
         let twist = |i: usize| -> [f64; 3] {
@@ -223,30 +211,16 @@ impl NarrowPhase {
             let p = pose[i];
             [v * p.c, v * p.s, (w[1] - w[0]) * inv_track]
         };
-        let binds = |ct: &Contact| -> bool {
-            let ua = twist(ct.a as usize);
-            let ub = if ct.b == WALL {
-                [0.0; 3]
-            } else {
-                twist(ct.b as usize)
-            };
-            ct.pts[..usize::from(ct.count)].iter().any(|p| {
+        for ct in &self.contacts {
+            let a = ct.a as usize;
+            let wall = ct.b == WALL;
+            let ua = twist(a);
+            let ub = if wall { [0.0; 3] } else { twist(ct.b as usize) };
+            let binds = ct.pts[..usize::from(ct.count)].iter().any(|p| {
                 let rvx = (ub[0] - ub[2] * p.rb[1]) - (ua[0] - ua[2] * p.ra[1]);
                 let rvy = (ub[1] + ub[2] * p.rb[0]) - (ua[1] + ua[2] * p.ra[0]);
                 p.sep + (rvx * ct.nx + rvy * ct.ny) * h < BIND_MARGIN_M
-            })
-        };
-        self.binds.clear();
-        if parallel && self.contacts.len() > PAR_CHUNK {
-            self.contacts
-                .par_iter()
-                .with_min_len(PAR_CHUNK / 4)
-                .map(binds)
-                .collect_into_vec(&mut self.binds);
-        } else {
-            self.binds.extend(self.contacts.iter().map(binds));
-        }
-        for (ct, &binds) in self.contacts.iter().zip(&self.binds) {
+            });
             for i in [ct.a, ct.b] {
                 if i != WALL && self.flags[i as usize] & CHECK == 0 {
                     self.flags[i as usize] |= CHECK;
