@@ -237,21 +237,14 @@ pub(crate) fn solve_island(
         // Each contact works on copies of its robots' velocities (a wall's stays zero), written
         // back after its rows: the same arithmetic as on the island's bodies in place.
         for ct in contacts.iter_mut() {
-            let la = ct.la as usize;
-            if ct.lb == WALL {
-                let mut va = bodies[la].vel;
-                let d = contact_rows::<true>(&mut va, &mut [0.0; 3], ct, body.mu_wall, body, inv_h);
-                change = change.max(d);
-                bodies[la].vel = va;
+            let (mut va, mut vb) = velocities(bodies, ct.la, ct.lb);
+            let d = if ct.lb == WALL {
+                contact_rows::<true>(&mut va, &mut vb, ct, body.mu_wall, body, inv_h)
             } else {
-                let lb = ct.lb as usize;
-                debug_assert_ne!(la, lb, "a contact joins two robots");
-                let (mut va, mut vb) = (bodies[la].vel, bodies[lb].vel);
-                let d = contact_rows::<false>(&mut va, &mut vb, ct, body.mu_robot, body, inv_h);
-                change = change.max(d);
-                bodies[la].vel = va;
-                bodies[lb].vel = vb;
-            }
+                contact_rows::<false>(&mut va, &mut vb, ct, body.mu_robot, body, inv_h)
+            };
+            change = change.max(d);
+            store(bodies, ct.la, ct.lb, va, vb);
         }
         if change < CONVERGED_N_S {
             break;
@@ -346,14 +339,32 @@ fn apply(
     py: f64,
     body: &BodyConst,
 ) {
-    let la = la as usize;
+    let (mut va, mut vb) = velocities(bodies, la, lb);
     if lb == WALL {
-        push::<true>(&mut bodies[la].vel, &mut [0.0; 3], p, px, py, body);
+        push::<true>(&mut va, &mut vb, p, px, py, body);
     } else {
-        let lb = lb as usize;
-        let (mut va, mut vb) = (bodies[la].vel, bodies[lb].vel);
         push::<false>(&mut va, &mut vb, p, px, py, body);
-        bodies[la].vel = va;
-        bodies[lb].vel = vb;
+    }
+    store(bodies, la, lb, va, vb);
+}
+
+/// Copies of the velocities of robots `la` and `lb` of the island (a wall's: zero).
+#[inline(always)]
+fn velocities(bodies: &[IslandBody], la: u32, lb: u32) -> ([f64; 3], [f64; 3]) {
+    let va = bodies[la as usize].vel;
+    if lb == WALL {
+        (va, [0.0; 3])
+    } else {
+        debug_assert_ne!(la, lb, "a contact joins two robots");
+        (va, bodies[lb as usize].vel)
+    }
+}
+
+/// Writes [`velocities`]' copies back (a wall's is dropped).
+#[inline(always)]
+fn store(bodies: &mut [IslandBody], la: u32, lb: u32, va: [f64; 3], vb: [f64; 3]) {
+    bodies[la as usize].vel = va;
+    if lb != WALL {
+        bodies[lb as usize].vel = vb;
     }
 }

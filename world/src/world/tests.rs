@@ -1095,7 +1095,7 @@ fn thread_count_does_not_change_the_result() {
         st.active_robot_substeps,
         st.substeps
     );
-    // The position corrections ran (their checks for overlaps go on the pool at this size).
+    // The position corrections ran, so their statistics below are compared where they count.
     assert!(st.overlap_substeps > 0 && st.position_sweeps > 0, "{st:?}");
     for threads in [1, 2, 3, 4] {
         let pool = rayon::ThreadPoolBuilder::new()
