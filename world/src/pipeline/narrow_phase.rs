@@ -51,8 +51,8 @@ pub(crate) struct NarrowPhase {
 }
 
 /// Puts `list`, the robots whose `flags` have `bit` (each once), in index order: sorted when
-/// few robots are listed, read off the flags when many (the same list, in less time than a
-/// sort of thousands).
+/// fewer than one robot in 16 is listed, otherwise read off the flags in one pass over the
+/// robots (the same list either way; the cut-off is a choice, not a measured crossover).
 fn in_index_order(list: &mut Vec<u32>, flags: &[u8], bit: u8) {
     if list.len() * 16 < flags.len() {
         list.sort_unstable();
