@@ -356,7 +356,19 @@ fn run_failure(e: anyhow::Error) -> Failure {
 }
 
 fn run(args: &run_cmd::RunArgs) -> Result<(), Failure> {
-    let text = run_cmd::run(args).map_err(run_failure)?;
+    let text = match run_cmd::run(args) {
+        Ok(text) => text,
+        Err(e) => {
+            // A run that wrote its outputs but failed as a whole: its report first.
+            if let Some(f) = e.downcast_ref::<run_cmd::FailedRun>() {
+                io::stdout()
+                    .lock()
+                    .write_all(f.report.as_bytes())
+                    .or_else(write_failure)?;
+            }
+            return Err(run_failure(e));
+        }
+    };
     io::stdout()
         .lock()
         .write_all(text.as_bytes())
