@@ -1,0 +1,224 @@
+//! Hostile input, round three (docs/limits-and-failures.md): a full disk during a merge, a
+//! trace file of a run that never ran, two sweep tasks on one plan, plans edited by hand,
+//! Unicode format characters, a reader that closes the pipe early. Each test failed on the
+//! build before its fix (`H8SWARM_BIN=… cargo test --release --test hostile3` runs them
+//! against another build).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+
+mod common;
+use common::*;
+
+/// A sweep of two points (learner.threshold 10 and 20) with master seed `seed`, 20-step
+/// arena runs of 2 robots, planned and run in `root/name`.
+fn sweep(root: &Path, name: &str, seed: u64) -> PathBuf {
+    let dir = root.join(name);
+    let file = root.join(format!("{name}.toml"));
+    std::fs::write(
+        &file,
+        format!(
+            "seeds = [{seed}]\n[set]\nsteps = 20\nwindow = 10\nrepeats = 1\nrobots = 2\ncontrols.random_walk = false\n[grid]\n\"learner.threshold\" = [10, 20]\n"
+        ),
+    )
+    .unwrap();
+    ok(&["sweep", "plan", s(&file), "--out", s(&dir)]);
+    ok(&["sweep", "run", s(&dir), "--threads", "1"]);
+    dir
+}
+
+/// A tmpfs of `kib` KiB mounted at a fresh folder, unmounted when dropped; `None` (the test
+/// says SKIPPED) where this process cannot mount (not root, no tmpfs).
+struct Tmpfs(PathBuf);
+
+impl Tmpfs {
+    fn mount(at: &Path, kib: u64) -> Option<Tmpfs> {
+        std::fs::create_dir_all(at).ok()?;
+        let ok = Command::new("mount")
+            .args(["-t", "tmpfs", "-o", &format!("size={kib}k"), "tmpfs"])
+            .arg(at)
+            .stderr(Stdio::null())
+            .status()
+            .is_ok_and(|s| s.success());
+        ok.then(|| Tmpfs(at.to_path_buf()))
+    }
+
+    /// Bytes free on it.
+    fn free(&self) -> u64 {
+        let out = Command::new("df")
+            .args(["-B1", "--output=avail"])
+            .arg(&self.0)
+            .output()
+            .unwrap();
+        text(&out.stdout)
+            .lines()
+            .nth(1)
+            .and_then(|l| l.trim().parse().ok())
+            .unwrap()
+    }
+
+    /// Fills it with a file until `leave` bytes are free.
+    fn fill_leaving(&self, leave: u64) {
+        let filler = self.0.join("filler");
+        let _ = std::fs::remove_file(&filler);
+        let n = self.free().saturating_sub(leave);
+        std::fs::write(&filler, vec![0u8; n as usize]).unwrap();
+    }
+}
+
+impl Drop for Tmpfs {
+    fn drop(&mut self) {
+        let _ = Command::new("umount").arg(&self.0).status();
+    }
+}
+
+fn bytes_under(dir: &Path) -> u64 {
+    tree(dir)
+        .iter()
+        .filter_map(|(_, b)| b.as_ref().map(|b| b.len() as u64))
+        .sum()
+}
+
+#[test]
+fn a_merge_that_fills_the_disk_leaves_the_earlier_merge_whole() {
+    let root = fresh("r3-full-disk");
+    let a = sweep(&root, "a", 1);
+    let b = sweep(&root, "b", 2);
+    // B's merge on a roomy disk: how much it writes, and how much of it is sweep.csv.
+    let roomy = root.join("roomy");
+    ok(&["sweep", "merge", s(&b), "--out", s(&roomy)]);
+    let all = bytes_under(&roomy);
+    let csv = std::fs::metadata(roomy.join("sweep.csv")).unwrap().len();
+    let Some(disk) = Tmpfs::mount(&root.join("disk"), 16 * 1024) else {
+        eprintln!("SKIPPED: cannot mount a tmpfs here (needs root)");
+        return;
+    };
+    let out = disk.0.join("report");
+    ok(&["sweep", "merge", s(&a), "--out", s(&out)]);
+    std::fs::write(out.join("notes.txt"), b"the user's notes").unwrap();
+    let before = tree(&out);
+    // Room for B's sweep.csv and a little more, not for all of B's files.
+    let leave = csv + 8192;
+    assert!(leave + 16384 < all, "the figures take more than a few pages");
+    disk.fill_leaving(leave);
+    let (code, _, err) = status(&["sweep", "merge", s(&b), "--out", s(&out)]);
+    assert_eq!(code, 1, "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.contains("No space left"), "{err}");
+    let diff = tree_diff(&tree(&out), &before);
+    assert!(diff.is_empty(), "the earlier merge whole, nothing of B's: {diff:?}");
+    let leftovers: Vec<String> = std::fs::read_dir(&disk.0)
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n != "filler" && n != "report")
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+    // With room again, B's merge replaces A's and keeps the user's file.
+    std::fs::remove_file(disk.0.join("filler")).unwrap();
+    ok(&["sweep", "merge", s(&b), "--out", s(&out)]);
+    assert_eq!(
+        std::fs::read(out.join("sweep.csv")).unwrap(),
+        std::fs::read(roomy.join("sweep.csv")).unwrap()
+    );
+    assert_eq!(
+        std::fs::read(out.join("notes.txt")).unwrap(),
+        b"the user's notes"
+    );
+    drop(disk);
+    let _ = std::fs::remove_dir_all(&root);
+}
+
+#[test]
+fn a_trace_file_is_untouched_by_a_run_that_never_ran_or_failed() {
+    let root = fresh("r3-vcd");
+    let vcd = root.join("trace.vcd");
+    std::fs::write(&vcd, b"an earlier trace").unwrap();
+    // --out is a file: refused before anything runs.
+    let file = root.join("x");
+    std::fs::write(&file, b"a file").unwrap();
+    let args = |out: &Path| {
+        vec![
+            "run".to_string(),
+            "--controller".into(),
+            "firmware".into(),
+            "--steps".into(),
+            "20".into(),
+            "--repeats".into(),
+            "1".into(),
+            "--vcd".into(),
+            s(&vcd).into(),
+            "--out".into(),
+            s(out).into(),
+        ]
+    };
+    let a = args(&file);
+    let (code, _, err) = status(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    assert_eq!(code, 1, "{err}");
+    assert_eq!(std::fs::read(&vcd).unwrap(), b"an earlier trace");
+    // A run that fails after its trace began (the robots run an image that spins at boot, and
+    // the step watchdog stops it): status 2, the trace untouched.
+    let spin = root.join("spin.mot");
+    std::fs::write(&spin, spin_image()).unwrap();
+    let scenario = root.join("spin.toml");
+    std::fs::write(
+        &scenario,
+        format!(
+            "[controls]\nlearning_off = false\nrandom_walk = false\n[controller]\nkind = \"firmware\"\nimage = \"{}\"\n",
+            spin.display()
+        ),
+    )
+    .unwrap();
+    let out = root.join("o");
+    let (code, _, err) = status(&[
+        "run",
+        s(&scenario),
+        "--steps",
+        "5",
+        "--repeats",
+        "1",
+        "--vcd",
+        s(&vcd),
+        "--out",
+        s(&out),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("nothing was written"), "{err}");
+    assert_eq!(std::fs::read(&vcd).unwrap(), b"an earlier trace");
+    assert!(!out.exists());
+    // A run that succeeds replaces it, and leaves no staging file beside it.
+    let out = root.join("good");
+    let a = args(&out);
+    let o = ok(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    let trace = std::fs::read_to_string(&vcd).unwrap();
+    assert!(trace.starts_with("$version"), "{o}");
+    let names: Vec<String> = std::fs::read_dir(&root)
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with('.'))
+        .collect();
+    assert!(names.is_empty(), "{names:?}");
+    let _ = std::fs::remove_dir_all(&root);
+}
+
+/// An S-record image whose reset vector points at `BRA .` at H'000100 (it never starts the
+/// A/D converter, so the robot's step watchdog stops it).
+fn spin_image() -> String {
+    use emu::core::srec::{Chunk, SrecImage, write_s3};
+    let img = SrecImage {
+        header: None,
+        chunks: vec![
+            Chunk {
+                address: 0,
+                data: 0x100u32.to_be_bytes().to_vec(),
+            },
+            Chunk {
+                address: 0x100,
+                data: vec![0x40, 0xFE],
+            },
+        ],
+        start: Some(0x100),
+    };
+    write_s3(&img, 16)
+}
