@@ -222,3 +222,79 @@ fn spin_image() -> String {
     };
     write_s3(&img, 16)
 }
+
+/// Runs `sweep merge` and `sweep run` on `dir`: both refuse it with status 2 and one line
+/// naming `words`.
+fn refused_by_merge_and_run(dir: &Path, words: &[&str]) {
+    for args in [
+        vec!["sweep", "merge", s(dir)],
+        vec!["sweep", "run", s(dir), "--threads", "1"],
+    ] {
+        let (code, _, err) = status(&args);
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert_eq!(err.lines().count(), 1, "{args:?}: {err}");
+        for w in words {
+            assert!(err.contains(w), "{args:?}: {w}: {err}");
+        }
+    }
+}
+
+/// Rewrites `dir/file` (JSON, or JSON Lines with `lines`) through `edit`.
+fn edit_json(dir: &Path, file: &str, edit: &dyn Fn(&mut serde_json::Value)) {
+    let path = dir.join(file);
+    let text = std::fs::read_to_string(&path).unwrap();
+    let out: Vec<String> = if file.ends_with(".jsonl") {
+        text.lines()
+            .map(|l| {
+                let mut v: serde_json::Value = serde_json::from_str(l).unwrap();
+                edit(&mut v);
+                v.to_string()
+            })
+            .collect()
+    } else {
+        let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        edit(&mut v);
+        vec![v.to_string()]
+    };
+    std::fs::write(&path, out.join("\n") + "\n").unwrap();
+}
+
+#[test]
+fn plans_edited_by_hand_are_refused_in_one_line_not_a_panic_or_an_abort() {
+    let root = fresh("r3-edited");
+    let pristine = sweep(&root, "p", 3);
+    let copy = |name: &str| {
+        let d = root.join(name);
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        for f in ["plan.json", "points.jsonl", "sweep.toml", "sweep.sbatch"] {
+            std::fs::copy(pristine.join(f), d.join(f)).unwrap();
+        }
+        d
+    };
+    // A point whose coords lie outside the axes (it was an index out of bounds, exit 101).
+    let d = copy("coords");
+    edit_json(&d, "points.jsonl", &|v| v["coords"] = serde_json::json!([7]));
+    refused_by_merge_and_run(&d, &["points.jsonl line 1", "outside the plan's axes"]);
+    // An axis shortened by hand.
+    let d = copy("shortened");
+    edit_json(&d, "plan.json", &|v| {
+        v["axes"][0]["values"].as_array_mut().unwrap().pop();
+    });
+    refused_by_merge_and_run(&d, &["plan.json", "2 points, but its axes and seeds make 1"]);
+    // Two axes of 100 000 values each (it asked for 560 GB and aborted).
+    let d = copy("huge");
+    edit_json(&d, "plan.json", &|v| {
+        let axis = serde_json::json!({
+            "keys": ["learner.threshold"],
+            "values": (0..100_000).map(|i| vec![i]).collect::<Vec<_>>(),
+        });
+        v["axes"] = serde_json::json!([axis.clone(), axis]);
+    });
+    refused_by_merge_and_run(&d, &["plan.json", "cells"]);
+    // Two points with one id: two tasks would share a folder.
+    let d = copy("twins");
+    edit_json(&d, "points.jsonl", &|v| v["id"] = serde_json::json!("twin"));
+    refused_by_merge_and_run(&d, &["points.jsonl line 2", "`twin` is another point's too"]);
+    let _ = std::fs::remove_dir_all(&root);
+}
