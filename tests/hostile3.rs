@@ -99,14 +99,20 @@ fn a_merge_that_fills_the_disk_leaves_the_earlier_merge_whole() {
     let before = tree(&out);
     // Room for B's sweep.csv and a little more, not for all of B's files.
     let leave = csv + 8192;
-    assert!(leave + 16384 < all, "the figures take more than a few pages");
+    assert!(
+        leave + 16384 < all,
+        "the figures take more than a few pages"
+    );
     disk.fill_leaving(leave);
     let (code, _, err) = status(&["sweep", "merge", s(&b), "--out", s(&out)]);
     assert_eq!(code, 1, "{err}");
     assert_eq!(err.lines().count(), 1, "{err}");
     assert!(err.contains("No space left"), "{err}");
     let diff = tree_diff(&tree(&out), &before);
-    assert!(diff.is_empty(), "the earlier merge whole, nothing of B's: {diff:?}");
+    assert!(
+        diff.is_empty(),
+        "the earlier merge whole, nothing of B's: {diff:?}"
+    );
     let leftovers: Vec<String> = std::fs::read_dir(&disk.0)
         .unwrap()
         .flatten()
@@ -274,14 +280,19 @@ fn plans_edited_by_hand_are_refused_in_one_line_not_a_panic_or_an_abort() {
     };
     // A point whose coords lie outside the axes (it was an index out of bounds, exit 101).
     let d = copy("coords");
-    edit_json(&d, "points.jsonl", &|v| v["coords"] = serde_json::json!([7]));
+    edit_json(&d, "points.jsonl", &|v| {
+        v["coords"] = serde_json::json!([7])
+    });
     refused_by_merge_and_run(&d, &["points.jsonl line 1", "outside the plan's axes"]);
     // An axis shortened by hand.
     let d = copy("shortened");
     edit_json(&d, "plan.json", &|v| {
         v["axes"][0]["values"].as_array_mut().unwrap().pop();
     });
-    refused_by_merge_and_run(&d, &["plan.json", "2 points, but its axes and seeds make 1"]);
+    refused_by_merge_and_run(
+        &d,
+        &["plan.json", "2 points, but its axes and seeds make 1"],
+    );
     // Two axes of 100 000 values each (it asked for 560 GB and aborted).
     let d = copy("huge");
     edit_json(&d, "plan.json", &|v| {
@@ -295,6 +306,123 @@ fn plans_edited_by_hand_are_refused_in_one_line_not_a_panic_or_an_abort() {
     // Two points with one id: two tasks would share a folder.
     let d = copy("twins");
     edit_json(&d, "points.jsonl", &|v| v["id"] = serde_json::json!("twin"));
-    refused_by_merge_and_run(&d, &["points.jsonl line 2", "`twin` is another point's too"]);
+    refused_by_merge_and_run(
+        &d,
+        &["points.jsonl line 2", "`twin` is another point's too"],
+    );
+    let _ = std::fs::remove_dir_all(&root);
+}
+
+/// Plans a sweep of `n` threshold values (one seed) of 30-step runs in `root/name`.
+fn plan_only(root: &Path, name: &str, n: usize) -> PathBuf {
+    let dir = root.join(name);
+    let file = root.join(format!("{name}.toml"));
+    let values: Vec<String> = (0..n).map(|i| (10 + 5 * i).to_string()).collect();
+    std::fs::write(
+        &file,
+        format!(
+            "seeds = [4]\n[set]\nsteps = 30\nwindow = 10\nrepeats = 1\nrobots = 2\ncontrols.random_walk = false\n[grid]\n\"learner.threshold\" = [{}]\n",
+            values.join(", ")
+        ),
+    )
+    .unwrap();
+    ok(&["sweep", "plan", s(&file), "--out", s(&dir)]);
+    dir
+}
+
+/// Every point's summary.json under `dir/points`, by id.
+fn summaries(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut out: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir.join("points"))
+        .unwrap()
+        .flatten()
+        .filter(|e| !e.file_name().to_string_lossy().starts_with('.'))
+        .map(|e| {
+            (
+                e.file_name().to_string_lossy().into_owned(),
+                std::fs::read(e.path().join("summary.json")).unwrap(),
+            )
+        })
+        .collect();
+    out.sort();
+    out
+}
+
+#[test]
+fn two_sweep_runs_on_one_plan_share_its_points_and_lose_none() {
+    let root = fresh("r3-two-writers");
+    let alone = plan_only(&root, "alone", 6);
+    ok(&["sweep", "run", s(&alone), "--threads", "1"]);
+    let reference = summaries(&alone);
+    assert_eq!(reference.len(), 6);
+    for trial in 0..3 {
+        let dir = plan_only(&root, &format!("both{trial}"), 6);
+        let spawn = || {
+            Command::new(bin())
+                .args(["sweep", "run", s(&dir), "--threads", "1"])
+                .current_dir(env!("CARGO_MANIFEST_DIR"))
+                .env_remove("SLURM_ARRAY_TASK_ID")
+                .stdin(Stdio::null())
+                .stdout(Stdio::piped())
+                .stderr(Stdio::piped())
+                .spawn()
+                .unwrap()
+        };
+        let (a, b) = (spawn(), spawn());
+        for c in [a, b] {
+            let o = c.wait_with_output().unwrap();
+            assert!(
+                o.status.success(),
+                "trial {trial}: {}{}",
+                text(&o.stdout),
+                text(&o.stderr)
+            );
+        }
+        let merged = ok(&["sweep", "merge", s(&dir), "--require-complete"]);
+        assert!(
+            merged.contains("6 ok, 0 failed, 0 missing, 0 broken"),
+            "{merged}"
+        );
+        assert_eq!(summaries(&dir), reference, "trial {trial}");
+        let hidden: Vec<String> = std::fs::read_dir(dir.join("points"))
+            .unwrap()
+            .flatten()
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .filter(|n| n.starts_with('.'))
+            .collect();
+        assert!(hidden.is_empty(), "trial {trial}: {hidden:?}");
+    }
+    let _ = std::fs::remove_dir_all(&root);
+}
+
+#[test]
+fn a_point_a_live_task_holds_is_left_to_it_and_taken_over_when_it_dies() {
+    let root = fresh("r3-claims");
+    let dir = plan_only(&root, "d", 2);
+    let lines = std::fs::read_to_string(dir.join("points.jsonl")).unwrap();
+    let first: serde_json::Value = serde_json::from_str(lines.lines().next().unwrap()).unwrap();
+    let id = first["id"].as_str().unwrap().to_string();
+    std::fs::create_dir_all(dir.join("points")).unwrap();
+    // This test holds the first point's claim, as a live task would.
+    let lock = std::fs::OpenOptions::new()
+        .create(true)
+        .truncate(false)
+        .write(true)
+        .open(dir.join("points").join(format!(".lock-{id}")))
+        .unwrap();
+    lock.lock().unwrap();
+    let printed = ok(&["sweep", "run", s(&dir), "--threads", "1"]);
+    assert!(
+        printed.contains("1 run, 0 skipped (finished before), 0 failed, 1 left to another task"),
+        "{printed}"
+    );
+    assert!(!dir.join("points").join(&id).exists());
+    // The holder ends (its lock goes with it): the next run takes the point over.
+    drop(lock);
+    let printed = ok(&["sweep", "run", s(&dir), "--threads", "1"]);
+    assert!(
+        printed.contains("1 run, 1 skipped (finished before), 0 failed\n"),
+        "{printed}"
+    );
+    ok(&["sweep", "merge", s(&dir), "--require-complete"]);
     let _ = std::fs::remove_dir_all(&root);
 }

@@ -27,6 +27,8 @@ pub enum Outcome {
     Done,
     /// Run now, and it failed (the reason is in its `status.json`).
     Failed(String),
+    /// Another task that is alive holds it (two sweeps on one plan): left to that task.
+    Held,
 }
 
 fn io_err(what: &str, p: &Path, e: &std::io::Error) -> SweepError {
@@ -46,6 +48,60 @@ pub fn run_point(
     if point_state(points, line) == PointState::Ok {
         return Ok(Outcome::Skipped);
     }
+    // The point is claimed before anything of it is touched: an exclusive lock on
+    // `points/.lock-ID`, which the kernel releases when the holder ends however it ends (so
+    // a killed task's points are taken over by the next). A point another live task holds is
+    // left to it.
+    let Some(claim) = Claim::take(points, &line.id)? else {
+        return Ok(Outcome::Held);
+    };
+    // Checked again under the claim: the holder before may have finished it.
+    let outcome = if point_state(points, line) == PointState::Ok {
+        Ok(Outcome::Skipped)
+    } else {
+        run_claimed(points, line, threads)
+    };
+    claim.release();
+    outcome
+}
+
+/// An exclusive claim on a point (see [`run_point`]).
+struct Claim {
+    path: PathBuf,
+    file: std::fs::File,
+}
+
+impl Claim {
+    /// Takes the claim on point `id`, or `None` when another live task holds it.
+    fn take(points: &Path, id: &str) -> Result<Option<Claim>, SweepError> {
+        let path = points.join(format!(".lock-{id}"));
+        let file = std::fs::OpenOptions::new()
+            .create(true)
+            .truncate(false)
+            .write(true)
+            .open(&path)
+            .map_err(|e| io_err("open the claim", &path, &e))?;
+        match file.try_lock() {
+            Ok(()) => Ok(Some(Claim { path, file })),
+            Err(std::fs::TryLockError::WouldBlock) => Ok(None),
+            Err(std::fs::TryLockError::Error(e)) => Err(io_err("lock the claim", &path, &e)),
+        }
+    }
+
+    /// Gives the claim up, removing its file (a task that opened it meanwhile finds the point
+    /// finished when it checks again under the lock).
+    fn release(self) {
+        let _ = std::fs::remove_file(&self.path);
+        let _ = self.file.unlock();
+    }
+}
+
+/// Runs a point this task has claimed.
+fn run_claimed(
+    points: &Path,
+    line: &PlanLine,
+    threads: Option<usize>,
+) -> Result<Outcome, SweepError> {
     let final_dir = points.join(&line.id);
     // Leftovers of this point: a broken or failed folder, temporary folders of killed tasks
     // (`.tmp-ID-…`) and the staging folders of their runs (`..tmp-ID-….partial-PID`).
@@ -221,7 +277,7 @@ pub fn run_task(
         ),
         share.len()
     );
-    let (mut done, mut skipped, mut failed) = (0, 0, 0);
+    let (mut done, mut skipped, mut failed, mut held) = (0, 0, 0, 0);
     for line in share {
         let started = Instant::now();
         let outcome = run_point(&points, line, threads)?;
@@ -242,13 +298,22 @@ pub fn run_task(
                 failed += 1;
                 format!("{} FAILED: {why}", line.id)
             }
+            Outcome::Held => {
+                held += 1;
+                format!("{} is being run by another task: left to it", line.id)
+            }
         };
         // One line per point as it ends, for Slurm's log (standard output holds the totals).
         eprintln!("{}", swarm::text::printable(&line_text));
     }
     let _ = writeln!(
         t,
-        "{done} run, {skipped} skipped (finished before), {failed} failed"
+        "{done} run, {skipped} skipped (finished before), {failed} failed{}",
+        if held > 0 {
+            format!(", {held} left to another task running them now")
+        } else {
+            String::new()
+        }
     );
     Ok((t, failed == 0))
 }

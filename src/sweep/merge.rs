@@ -294,9 +294,8 @@ pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepErro
     let text = serde_json::to_string_pretty(&doc)
         .map_err(|e| SweepError::tool(format!("writing sweep.json: {e}")))?
         + "\n";
-    std::fs::write(stage.path("sweep.json"), text.as_bytes()).map_err(|e| {
-        SweepError::tool(format!("cannot write `{}`: {e}", json_path.display()))
-    })?;
+    std::fs::write(stage.path("sweep.json"), text.as_bytes())
+        .map_err(|e| SweepError::tool(format!("cannot write `{}`: {e}", json_path.display())))?;
     let mut files = vec!["sweep.csv".to_string(), "sweep.json".to_string()];
     files.extend(figure_names.iter().cloned());
     stage

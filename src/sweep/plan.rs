@@ -750,18 +750,19 @@ fn check_plan_sizes(plan: &Plan) -> Result<(), String> {
     }
     let mut cells: usize = 1;
     for a in &plan.axes {
-        if a.keys.is_empty() || a.values.is_empty() || a.values.iter().any(|v| v.len() != a.keys.len()) {
+        if a.keys.is_empty()
+            || a.values.is_empty()
+            || a.values.iter().any(|v| v.len() != a.keys.len())
+        {
             return Err(format!(
                 "the axis `{}` needs values, one per key",
                 super::text_of(&a.name())
             ));
         }
-        cells = cells.checked_mul(a.values.len()).filter(|&c| c <= super::spec::MAX_POINTS).ok_or_else(|| {
-            format!(
-                "its axes make more than {} cells",
-                super::spec::MAX_POINTS
-            )
-        })?;
+        cells = cells
+            .checked_mul(a.values.len())
+            .filter(|&c| c <= super::spec::MAX_POINTS)
+            .ok_or_else(|| format!("its axes make more than {} cells", super::spec::MAX_POINTS))?;
     }
     let want = cells.checked_mul(plan.seeds.len());
     if want != Some(plan.points) {

@@ -95,12 +95,8 @@ pub fn small_sweep(root: &Path) -> PathBuf {
     dir
 }
 
-
 /// The entries in which two trees of [`tree`] differ, by name (for a readable failure).
-pub fn tree_diff(
-    a: &[(String, Option<Vec<u8>>)],
-    b: &[(String, Option<Vec<u8>>)],
-) -> Vec<String> {
+pub fn tree_diff(a: &[(String, Option<Vec<u8>>)], b: &[(String, Option<Vec<u8>>)]) -> Vec<String> {
     let mut names: Vec<&String> = a.iter().chain(b).map(|(n, _)| n).collect();
     names.sort();
     names.dedup();
