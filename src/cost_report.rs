@@ -173,10 +173,11 @@ pub fn measure(cfg: &CostConfig) -> Result<CostReport> {
             cfg.steps
         );
     }
-    if !(cfg.step_period_s.is_finite() && cfg.step_period_s > 0.0) {
+    if !emu::board::model::step_period_ok(cfg.step_period_s) {
         bail!(
-            "--step-period-s must be a positive number of seconds, got {}",
-            cfg.step_period_s
+            "--step-period-s {}: valid is {}",
+            swarm::text::number(cfg.step_period_s),
+            emu::board::model::STEP_PERIOD_VALID
         );
     }
     let layout = InputLayout::new(cfg.history, cfg.bias).context("--history")?;

@@ -165,6 +165,13 @@ fn apply_what_ifs(mut cfg: ControllerConfig, a: &FitArgs) -> Result<ControllerCo
         cfg.save_every_steps = s;
     }
     if let Some(p) = a.step_period_s {
+        if !emu::board::model::step_period_ok(p) {
+            bail!(
+                "--step-period-s {}: valid is {}",
+                swarm::text::number(p),
+                emu::board::model::STEP_PERIOD_VALID
+            );
+        }
         cfg.step_period_s = p;
     }
     if let Some(hz) = a.clock_hz {
