@@ -1194,6 +1194,7 @@ fn write_replay(
             .collect(),
         du_m: sensors::du::MM_PER_DU / 1000.0,
         robots: plan.robots,
+        run_robots: s.robots,
         steps: s.steps,
         stride: plan.opts.stride,
         step_period_s: s.timing.step_period_s,
