@@ -426,3 +426,53 @@ fn a_point_a_live_task_holds_is_left_to_it_and_taken_over_when_it_dies() {
     ok(&["sweep", "merge", s(&dir), "--require-complete"]);
     let _ = std::fs::remove_dir_all(&root);
 }
+
+#[test]
+fn every_command_that_writes_to_standard_output_ends_quietly_when_the_reader_goes() {
+    let root = fresh("r3-pipe");
+    let sweep_dir = root.join("sw");
+    let sweep_file = root.join("sw.toml");
+    std::fs::write(
+        &sweep_file,
+        "seeds = [5]\n[set]\nsteps = 20\nwindow = 10\nrepeats = 1\nrobots = 2\ncontrols.random_walk = false\n",
+    )
+    .unwrap();
+    let out = root.join("run");
+    let replay = "examples/replay-arena.jsonl";
+    let q15 = "emu/tests/programs/q15learn.mot";
+    let commands: Vec<Vec<&str>> = vec![
+        vec!["--version"],
+        vec!["--help"],
+        vec!["run", "--help"],
+        vec!["cost"],
+        vec!["cost", "--json"],
+        vec!["fit"],
+        vec!["learn", "--replay", replay],
+        vec!["learn", "--replay", replay, "--states"],
+        vec!["learn", "--replay", replay, "--on-core", "--states"],
+        vec!["emu", q15],
+        vec!["emu", q15, "--stats"],
+        vec!["run", "--steps", "20", "--repeats", "1", "--out", s(&out)],
+        vec!["sweep", "plan", s(&sweep_file), "--out", s(&sweep_dir)],
+        vec!["sweep", "run", s(&sweep_dir), "--threads", "1"],
+        vec!["sweep", "merge", s(&sweep_dir)],
+    ];
+    for args in &commands {
+        // The reader is gone before the command writes a byte: every write fails with EPIPE.
+        let mut child = Command::new(bin())
+            .args(args)
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .env_remove("SLURM_ARRAY_TASK_ID")
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        drop(child.stdout.take());
+        let o = child.wait_with_output().unwrap();
+        let err = text(&o.stderr);
+        assert_eq!(o.status.code(), Some(0), "{args:?}: {err}");
+        assert!(!err.contains("Broken pipe") && !err.contains("error"), "{args:?}: {err}");
+    }
+    let _ = std::fs::remove_dir_all(&root);
+}
