@@ -259,7 +259,8 @@ pub fn parse_capacity(given: Option<f64>) -> Result<f64> {
         None => Ok(swarm::energy::DEFAULT_CAPACITY_MAH),
         Some(c) if c.is_finite() && (1.0..=100_000.0).contains(&c) => Ok(c),
         Some(c) => bail!(
-            "--capacity-mah {c}: give a cell's capacity from 1 to 100000 mAh (AA NiMH cells hold 1 900-2 700 mAh)"
+            "--capacity-mah {}: give a cell's capacity from 1 to 100000 mAh (AA NiMH cells hold 1 900-2 700 mAh)",
+            swarm::text::number(c)
         ),
     }
 }

@@ -206,11 +206,17 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(Failure::Program(status)) => ExitCode::from(status),
         Err(Failure::Input(e)) => {
-            eprintln!("error: {}", printable(&format!("{e:#}")));
+            eprintln!(
+                "error: {}",
+                printable(&swarm::text::short_numbers(&format!("{e:#}")))
+            );
             ExitCode::from(2)
         }
         Err(Failure::Tool(e)) => {
-            eprintln!("error: {}", printable(&format!("{e:#}")));
+            eprintln!(
+                "error: {}",
+                printable(&swarm::text::short_numbers(&format!("{e:#}")))
+            );
             ExitCode::from(1)
         }
     }

@@ -687,8 +687,14 @@ mod tests {
             assert!(e.contains("is not an integer"), "{bad}: {e}");
         }
         // A string may hold what looks like a number.
-        assert_eq!(negative_zero_not_an_integer(r#"{"a": "-0.0", "b": [1, -0]}"#), None);
-        assert_eq!(negative_zero_not_an_integer(r#"{"a": "x\"-0.0", "b": -0e3}"#), Some("-0e3"));
+        assert_eq!(
+            negative_zero_not_an_integer(r#"{"a": "-0.0", "b": [1, -0]}"#),
+            None
+        );
+        assert_eq!(
+            negative_zero_not_an_integer(r#"{"a": "x\"-0.0", "b": -0e3}"#),
+            Some("-0e3")
+        );
     }
 
     #[test]

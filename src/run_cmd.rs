@@ -1239,6 +1239,19 @@ fn warnings(s: &Scenario) -> Vec<String> {
             s.repeats
         ));
     }
+    if let Some(sym) = &s.controller.symbols
+        && s.controller.image.is_none()
+    {
+        w.push(format!(
+            "`controller.symbols` = {} is not used: it is the symbol table of `controller.image`, and {}",
+            swarm::text::printable(sym),
+            if s.controller.kind == swarm::scenario::ControllerKind::Model {
+                "the robots run the Rust model (controller.kind = \"model\")"
+            } else {
+                "the robots run the built-in firmware"
+            }
+        ));
+    }
     w
 }
 

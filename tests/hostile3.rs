@@ -472,7 +472,154 @@ fn every_command_that_writes_to_standard_output_ends_quietly_when_the_reader_goe
         let o = child.wait_with_output().unwrap();
         let err = text(&o.stderr);
         assert_eq!(o.status.code(), Some(0), "{args:?}: {err}");
-        assert!(!err.contains("Broken pipe") && !err.contains("error"), "{args:?}: {err}");
+        assert!(
+            !err.contains("Broken pipe") && !err.contains("error"),
+            "{args:?}: {err}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&root);
+}
+
+/// Status 2 and one error line holding every one of `words`.
+fn refused(args: &[&str], words: &[&str]) {
+    let (code, _, err) = status(args);
+    assert_eq!(code, 2, "{args:?}: {err}");
+    let errors: Vec<&str> = err.lines().filter(|l| l.starts_with("error:")).collect();
+    assert_eq!(errors.len(), 1, "{args:?}: {err}");
+    for w in words {
+        assert!(errors[0].contains(w), "{args:?}: {w}: {err}");
+    }
+    assert!(err.len() < 600, "{args:?}: a short message: {err}");
+}
+
+#[test]
+fn numbers_step_periods_and_learning_rates_follow_one_rule_in_short_messages() {
+    let root = fresh("r3-numbers");
+    // Extreme values in exponent form, never hundreds of digits.
+    refused(
+        &["cost", "--step-period-s", "1e-320"],
+        &["1e-320", "10 ms ticks"],
+    );
+    refused(&["fit", "--step-period-s", "1e308"], &["1e308"]);
+    refused(
+        &["fit", "--capacity-mah", "1e308"],
+        &["--capacity-mah 1e308"],
+    );
+    refused(
+        &["run", "--capacity-mah", "1e-320", "--steps", "5"],
+        &["--capacity-mah 1e-320"],
+    );
+    let file = root.join("tiny.toml");
+    std::fs::write(&file, "[world]\nsubstep_s = 1e-320\n").unwrap();
+    refused(&["run", s(&file)], &["`world.substep_s` = 1e-320"]);
+    let file = root.join("huge.toml");
+    std::fs::write(&file, "steps = 1e308\n").unwrap();
+    refused(&["run", s(&file)], &["`1e308`"]);
+    // One rule for the step period: cost refuses what fit and scenarios refuse.
+    refused(
+        &["cost", "--step-period-s", "0.005"],
+        &["--step-period-s 0.005"],
+    );
+    refused(
+        &["fit", "--step-period-s", "0.005"],
+        &["--step-period-s 0.005"],
+    );
+    let file = root.join("period.toml");
+    std::fs::write(&file, "[timing]\nstep_period_s = 0.005\n").unwrap();
+    refused(&["run", s(&file)], &["`timing.step_period_s` = 0.005"]);
+    ok(&["cost", "--step-period-s", "0.6", "--steps", "10"]);
+    // The largest learning rate the message offers is taken.
+    let (code, _, err) = status(&["cost", "--eta", "0.99997", "--steps", "10"]);
+    assert_eq!(code, 0, "{err}");
+    refused(&["cost", "--eta", "0.99999"], &["0.99997"]);
+    let _ = std::fs::remove_dir_all(&root);
+}
+
+#[test]
+fn output_folders_follow_one_rule_and_misplaced_keys_are_named() {
+    let root = fresh("r3-folders");
+    let dir = sweep(&root, "d", 6);
+    let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/sweep-example.toml");
+    // Run from deep inside the test's own folder, so that even a build without the rule
+    // writes nothing outside it; the root itself is tried only on this build (an older one
+    // would write a plan into /).
+    let cwd = root.join("a/b");
+    std::fs::create_dir_all(&cwd).unwrap();
+    let mut bad = vec!["..", ".", "x/.."];
+    if std::env::var_os("H8SWARM_BIN").is_none() {
+        bad.push("/");
+    }
+    for bad in bad {
+        let (code, _, err) = status_in(&cwd, &["sweep", "plan", s(&example), "--out", bad]);
+        assert_eq!(code, 1, "plan --out {bad}: {err}");
+        assert!(err.contains("give a folder name"), "{err}");
+        let (code, _, err) = status_in(&cwd, &["sweep", "merge", s(&dir), "--out", bad]);
+        assert_eq!(code, 1, "merge --out {bad}: {err}");
+        assert!(err.contains("give a folder name"), "{err}");
+        let (code, _, err) = status_in(&cwd, &["run", "--steps", "5", "--out", bad]);
+        assert_eq!(code, 1, "run --out {bad}: {err}");
+    }
+    // A top-level key written after [set] lands in [set]: the message says where it belongs.
+    let file = root.join("late-seeds.toml");
+    std::fs::write(&file, "[set]\nsteps = 10\nseeds = [1, 2]\n").unwrap();
+    refused(
+        &["sweep", "plan", s(&file), "--out", s(&root.join("x"))],
+        &[
+            "`seeds` is a key of the sweep file itself",
+            "before the first [table]",
+        ],
+    );
+    // controller.symbols with nothing to name is said, not silently dropped.
+    let file = root.join("symbols.toml");
+    std::fs::write(&file, "[controller]\nsymbols = \"x.sym\"\n").unwrap();
+    let printed = ok(&[
+        "run",
+        s(&file),
+        "--steps",
+        "10",
+        "--repeats",
+        "1",
+        "--out",
+        s(&root.join("o")),
+    ]);
+    assert!(
+        printed.contains("WARNING `controller.symbols` = x.sym is not used"),
+        "{printed}"
+    );
+    let _ = std::fs::remove_dir_all(&root);
+}
+
+#[test]
+fn format_characters_and_split_values_never_reach_the_terminal_raw() {
+    let root = fresh("r3-format-chars");
+    // A scenario name with a right-to-left override: refused, the character escaped.
+    let file = root.join("rlo.toml");
+    std::fs::write(&file, "name = \"abc\u{202e}def\"\n").unwrap();
+    refused(&["run", s(&file)], &["U+202E"]);
+    // A symbol name with one: the symbol table is refused, its line shown escaped.
+    let image = root.join("p.mot");
+    std::fs::copy("emu/tests/programs/q15learn.mot", &image).unwrap();
+    let sym = root.join("p.sym");
+    std::fs::write(&sym, "00000100 T _ma\u{202e}in\n").unwrap();
+    for args in [
+        vec!["emu", s(&image), "--symbols", s(&sym)],
+        vec!["fit", "--firmware", s(&image), "--symbols", s(&sym)],
+    ] {
+        let (code, _, err) = status(&args);
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert!(!err.contains('\u{202e}'), "{args:?}: {err}");
+        assert!(err.contains("\\u{202e}"), "{args:?}: {err}");
+    }
+    // A value with a newline or an ESC: one error line, the value escaped (not stripped).
+    for (value, shown) in [("1\n2", "'1\\n2'"), ("\u{1b}[31mx", "'\\e[31mx'")] {
+        let (code, _, err) = status(&["run", "--replay-stride", value]);
+        assert_eq!(code, 2, "{err}");
+        let first = err.lines().next().unwrap();
+        assert!(
+            first.starts_with("error: invalid value") && first.contains(shown),
+            "{err}"
+        );
+        assert!(!err.contains('\u{1b}'), "{err}");
     }
     let _ = std::fs::remove_dir_all(&root);
 }

@@ -536,6 +536,8 @@ fn plan_of(sweep: &Sweep) -> Result<Plan, SweepError> {
 
 /// The sweep folder `dir`, created if need be, as an absolute path.
 fn plan_folder(dir: &Path) -> Result<PathBuf, SweepError> {
+    // One rule for output folders (as `run`'s and `merge`'s): a folder with a name of its own.
+    crate::stage::check_out_folder("--out", dir).map_err(|e| SweepError::tool(e.0))?;
     std::fs::create_dir_all(dir).map_err(|e| {
         SweepError::tool(format!(
             "cannot create the sweep folder `{}`: {e}",

@@ -360,7 +360,10 @@ fn finite(key: &str, v: f64, lo: f64, hi: f64) -> Result<()> {
     if v.is_finite() && v >= lo && v <= hi {
         Ok(())
     } else {
-        bail!("`{key}` = {v} is out of range: valid is {lo} to {hi}")
+        bail!(
+            "`{key}` = {} is out of range: valid is {lo} to {hi}",
+            crate::text::number(v)
+        )
     }
 }
 

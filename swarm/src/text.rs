@@ -89,7 +89,30 @@ pub fn one_line(text: &str) -> String {
         })
         .collect::<Vec<_>>()
         .join(": ");
-    printable(&joined)
+    printable(&short_numbers(&joined))
+}
+
+/// `text` with every written-out number of more than 20 characters (a parser's `1e308` as
+/// 309 digits) put in [`number`]'s exponent form.
+#[must_use]
+pub fn short_numbers(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text;
+    while let Some(start) = rest.find(|c: char| c.is_ascii_digit()) {
+        out.push_str(&rest[..start]);
+        let tail = &rest[start..];
+        let len = tail
+            .find(|c: char| !(c.is_ascii_digit() || c == '.'))
+            .unwrap_or(tail.len());
+        let token = &tail[..len];
+        match token.parse::<f64>() {
+            Ok(v) if len > 20 => out.push_str(&number(v)),
+            _ => out.push_str(token),
+        }
+        rest = &tail[len..];
+    }
+    out.push_str(rest);
+    out
 }
 
 #[cfg(test)]
@@ -136,5 +159,19 @@ mod tests {
         assert_eq!(number(0.0), "0");
         assert_eq!(number(f64::NAN), "NaN");
         assert_eq!(number(123_456.0), "123456");
+        let long = format!(
+            "invalid type: floating point `1{}`, expected u32",
+            "0".repeat(308)
+        );
+        assert_eq!(
+            short_numbers(&long),
+            "invalid type: floating point `1e308`, expected u32"
+        );
+        let tiny = format!("`x` = 0.{}1 at line 12", "0".repeat(319));
+        assert_eq!(short_numbers(&tiny), "`x` = 1e-320 at line 12");
+        assert_eq!(
+            short_numbers("line 3, column 7: 1.5 and 20"),
+            "line 3, column 7: 1.5 and 20"
+        );
     }
 }

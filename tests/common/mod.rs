@@ -109,3 +109,20 @@ pub fn tree_diff(a: &[(String, Option<Vec<u8>>)], b: &[(String, Option<Vec<u8>>)
         .cloned()
         .collect()
 }
+
+/// Exit status, standard output and standard error of the binary run in the folder `dir`.
+pub fn status_in(dir: &Path, args: &[&str]) -> (i32, String, String) {
+    let o = Command::new(bin())
+        .args(args)
+        .current_dir(dir)
+        .env_remove("SLURM_ARRAY_TASK_ID")
+        .env_remove("SLURM_CPUS_PER_TASK")
+        .stdin(Stdio::null())
+        .output()
+        .expect("the binary runs");
+    (
+        o.status.code().unwrap_or(-1),
+        text(&o.stdout),
+        text(&o.stderr),
+    )
+}
