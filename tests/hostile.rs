@@ -4,7 +4,7 @@
 //! line on standard error with the exit status docs/limits-and-failures.md gives, and nothing a file or an
 //! argument holds reaches the terminal as a control sequence.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output, Stdio};
 
 mod common;

@@ -2,6 +2,8 @@
 //! (`tests/hostile.rs`, `tests/hostile3.rs`).
 #![allow(dead_code)]
 
+pub mod fuzzing;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 

@@ -106,10 +106,7 @@ pub const STEP_PERIOD_VALID: &str =
 #[must_use]
 pub fn step_period_ok(step_period_s: f64) -> bool {
     let ticks = step_period_s / TICK_S;
-    step_period_s.is_finite()
-        && step_period_s >= TICK_S
-        && step_period_s <= MAX_STEP_PERIOD_S
-        && (ticks - ticks.round()).abs() < 1e-9
+    (TICK_S..=MAX_STEP_PERIOD_S).contains(&step_period_s) && (ticks - ticks.round()).abs() < 1e-9
 }
 /// Amplitude of the fresh random weights: uniform in ±0.5 (±16384 in Q15).
 pub const INITIAL_WEIGHT_AMPLITUDE: i16 = 16384;
