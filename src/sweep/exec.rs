@@ -6,7 +6,9 @@
 //! not exist or is complete. A point whose folder holds `status.json` with `"status": "ok"`
 //! and the planned `scenario.toml` is finished and skipped; anything else (no folder, a failed
 //! point, a folder of another scenario, a temporary folder left by a task that was killed) is
-//! removed and run again. A point depends only on its scenario, so its files are the same byte
+//! removed and run again. A task claims a point before it touches anything of it (an exclusive
+//! lock on `points/.lock-ID`, which the kernel frees when its holder ends), so two tasks on one
+//! plan never work on one point, and a killed task's points are taken over. A point depends only on its scenario, so its files are the same byte
 //! for byte whichever task runs it and with how many threads (`run.txt`, the console text with
 //! its wall time, is the exception).
 
