@@ -67,31 +67,58 @@ pub fn run_point(
     outcome
 }
 
-/// An exclusive claim on a point (see [`run_point`]).
+/// An exclusive claim on a point (see [`run_point`]): a lock on `points/.lock-ID`.
 struct Claim {
     path: PathBuf,
     file: std::fs::File,
+    _registered: crate::cleanup::Staged,
+}
+
+/// The prefix of a claim's file under `points/`.
+pub const CLAIM_PREFIX: &str = ".lock-";
+
+/// Locks the file at `path` if no one holds it: `Ok(None)` when another process holds its
+/// lock. The lock holds only if the file locked is still the one at `path` (a holder may have
+/// removed it between the open and the lock): otherwise it is tried again.
+fn lock_file(path: &Path) -> Result<Option<std::fs::File>, SweepError> {
+    use std::os::unix::fs::MetadataExt;
+    loop {
+        let file = std::fs::OpenOptions::new()
+            .create(true)
+            .truncate(false)
+            .write(true)
+            .open(path)
+            .map_err(|e| io_err("open the claim", path, &e))?;
+        match file.try_lock() {
+            Ok(()) => {}
+            Err(std::fs::TryLockError::WouldBlock) => return Ok(None),
+            Err(std::fs::TryLockError::Error(e)) => {
+                return Err(io_err("lock the claim", path, &e));
+            }
+        }
+        let held = file.metadata().map(|m| (m.dev(), m.ino())).ok();
+        let there = std::fs::metadata(path).map(|m| (m.dev(), m.ino())).ok();
+        if held.is_some() && held == there {
+            return Ok(Some(file));
+        }
+    }
 }
 
 impl Claim {
     /// Takes the claim on point `id`, or `None` when another live task holds it.
     fn take(points: &Path, id: &str) -> Result<Option<Claim>, SweepError> {
-        let path = points.join(format!(".lock-{id}"));
-        let file = std::fs::OpenOptions::new()
-            .create(true)
-            .truncate(false)
-            .write(true)
-            .open(&path)
-            .map_err(|e| io_err("open the claim", &path, &e))?;
-        match file.try_lock() {
-            Ok(()) => Ok(Some(Claim { path, file })),
-            Err(std::fs::TryLockError::WouldBlock) => Ok(None),
-            Err(std::fs::TryLockError::Error(e)) => Err(io_err("lock the claim", &path, &e)),
-        }
+        let path = points.join(format!("{CLAIM_PREFIX}{id}"));
+        // Removed if a signal stops the task (the lock itself goes with the process).
+        let registered = crate::cleanup::Staged::register(&path);
+        Ok(lock_file(&path)?.map(|file| Claim {
+            path,
+            file,
+            _registered: registered,
+        }))
     }
 
-    /// Gives the claim up, removing its file (a task that opened it meanwhile finds the point
-    /// finished when it checks again under the lock).
+    /// Gives the claim up, removing its file (a task that opened it meanwhile finds it gone
+    /// once it holds the lock, and tries again).
     fn release(self) {
         let _ = std::fs::remove_file(&self.path);
         let _ = self.file.unlock();
@@ -188,6 +215,15 @@ pub fn remove_dead_leftovers(points: &Path) -> Result<Vec<String>, SweepError> {
     let mut removed = Vec::new();
     for e in std::fs::read_dir(points).into_iter().flatten().flatten() {
         let name = e.file_name().to_string_lossy().into_owned();
+        // A claim no one holds (its task was killed): removed under its lock.
+        if name.starts_with(CLAIM_PREFIX) {
+            let p = e.path();
+            if let Some(file) = lock_file(&p)? {
+                let _ = std::fs::remove_file(&p);
+                drop(file);
+            }
+            continue;
+        }
         if is_dead_leftover(&name, &host) {
             let p = e.path();
             std::fs::remove_dir_all(&p).map_err(|e| io_err("remove", &p, &e))?;
