@@ -386,6 +386,7 @@ pub fn run(a: &RunArgs) -> Result<String> {
             let commit = crate::stage::Commit {
                 files: names.clone(),
                 ours: OUTPUT_FILES.iter().map(|n| (*n).to_string()).collect(),
+                folders: Vec::new(),
             };
             stage.commit(&commit).map_err(|e| {
                 anyhow::Error::new(OutputError(e.0)).context(format!(

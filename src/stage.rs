@@ -98,6 +98,9 @@ pub struct Commit {
     pub files: Vec<String>,
     /// This tool's files that are removed when not among `files` (relative paths).
     pub ours: Vec<String>,
+    /// Sub-folders of the output folder that exist after the commit even when no file goes
+    /// into them (relative paths).
+    pub folders: Vec<String>,
 }
 
 /// One move of a commit, for the way back.
@@ -223,6 +226,7 @@ impl Stage {
         // removed again on the way back.
         let mut made: Vec<PathBuf> = Vec::new();
         let mut need: Vec<PathBuf> = vec![self.out.clone()];
+        need.extend(c.folders.iter().map(|f| self.out.join(f)));
         for rel in &new {
             if let Some(p) = Path::new(rel)
                 .parent()
@@ -231,6 +235,7 @@ impl Stage {
                 need.push(self.out.join(p));
             }
         }
+        need.sort();
         need.dedup();
         for d in &need {
             if !d.exists() {
@@ -402,6 +407,7 @@ mod tests {
         s.commit(&Commit {
             files: vec!["a.csv".into(), "plots/new.png".into()],
             ours: vec!["plots/old.png".into()],
+            folders: vec!["plots".into(), "empty".into()],
         })
         .unwrap();
         let read = |p: &str| std::fs::read_to_string(out.join(p)).ok();
@@ -410,6 +416,7 @@ mod tests {
         assert_eq!(read("plots/old.png"), None);
         assert_eq!(read("plots/mine.png").as_deref(), Some("user's"));
         assert_eq!(read("notes.txt").as_deref(), Some("user's"));
+        assert!(out.join("empty").is_dir());
         assert_eq!(std::fs::read_to_string(&vcd).unwrap(), "new trace");
         assert!(!stage_dir.exists() && !staged.exists());
         let left: Vec<_> = std::fs::read_dir(&d)
@@ -440,6 +447,7 @@ mod tests {
             .commit(&Commit {
                 files: vec!["a.csv".into(), "b.json".into()],
                 ours: vec![],
+                folders: vec!["new".into()],
             })
             .unwrap_err();
         assert!(e.0.contains("b.json"), "{e}");
@@ -449,6 +457,7 @@ mod tests {
             "old b"
         );
         assert_eq!(std::fs::read_to_string(&vcd).unwrap(), "old trace");
+        assert!(!out.join("new").exists());
         let left: Vec<_> = std::fs::read_dir(&d)
             .unwrap()
             .flatten()
@@ -471,6 +480,7 @@ mod tests {
             .commit(&Commit {
                 files: vec!["b.json".into(), "a.csv".into()],
                 ours: vec![],
+                folders: vec![],
             })
             .unwrap_err();
         assert!(e.0.contains("is a folder"), "{e}");

@@ -302,6 +302,7 @@ pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepErro
         .commit(&crate::stage::Commit {
             files,
             ours: earlier,
+            folders: vec!["plots".into()],
         })
         .map_err(|e| {
             SweepError::tool(format!(
