@@ -165,6 +165,13 @@ fn apply_what_ifs(mut cfg: ControllerConfig, a: &FitArgs) -> Result<ControllerCo
         cfg.save_every_steps = s;
     }
     if let Some(p) = a.step_period_s {
+        if !emu::board::model::step_period_ok(p) {
+            bail!(
+                "--step-period-s {}: valid is {}",
+                swarm::text::number(p),
+                emu::board::model::STEP_PERIOD_VALID
+            );
+        }
         cfg.step_period_s = p;
     }
     if let Some(hz) = a.clock_hz {
@@ -252,7 +259,8 @@ pub fn parse_capacity(given: Option<f64>) -> Result<f64> {
         None => Ok(swarm::energy::DEFAULT_CAPACITY_MAH),
         Some(c) if c.is_finite() && (1.0..=100_000.0).contains(&c) => Ok(c),
         Some(c) => bail!(
-            "--capacity-mah {c}: give a cell's capacity from 1 to 100000 mAh (AA NiMH cells hold 1 900-2 700 mAh)"
+            "--capacity-mah {}: give a cell's capacity from 1 to 100000 mAh (AA NiMH cells hold 1 900-2 700 mAh)",
+            swarm::text::number(c)
         ),
     }
 }

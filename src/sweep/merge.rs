@@ -245,14 +245,20 @@ pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepErro
     let (plan, lines, m) = collect(dir)?;
     let out: PathBuf = out.map_or_else(|| dir.join("merged"), Path::to_path_buf);
     let plots = out.join("plots");
-    // Only merge's own files are replaced: the figures of an earlier merge into `out` (its
-    // sweep.json lists them) that this one does not draw again are removed; anything else in
-    // `out` or `out/plots` is the user's and stays.
+    // Every file is written into a staging folder beside `out` and moved into place in one
+    // commit (crate::stage): a failure (a full disk) leaves `out` as it was. Only merge's own
+    // files are replaced: the figures of an earlier merge into `out` (its sweep.json lists
+    // them) that this one does not draw again are removed; anything else in `out` or
+    // `out/plots` is the user's and stays.
     let earlier = earlier_figures(&out);
-    std::fs::create_dir_all(&plots)
-        .map_err(|e| SweepError::tool(format!("cannot create `{}`: {e}", plots.display())))?;
+    let stage = crate::stage::Stage::new("--out", &out).map_err(|e| SweepError::tool(e.0))?;
+    let staged_plots = stage.path("plots");
+    std::fs::create_dir_all(&staged_plots).map_err(|e| {
+        SweepError::tool(format!("cannot create `{}`: {e}", staged_plots.display()))
+    })?;
 
-    let csv_path = write_csv(&m, &out)?;
+    write_csv(&m, &stage.path("sweep.csv"))?;
+    let csv_path = out.join("sweep.csv");
 
     let series = claim_series(&m);
     let coords: Vec<Vec<usize>> = lines.iter().map(|l| l.coords.clone()).collect();
@@ -276,20 +282,34 @@ pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepErro
         "columns": m.columns,
         "rows": m.rows,
     });
-    let figures = claim_figures(&plan.axes, &coords, &series, &plots)?;
+    let figures = claim_figures(&plan.axes, &coords, &series, &staged_plots)?;
     let figure_names: Vec<String> = figures
         .iter()
         .filter_map(|p| p.file_name())
         .map(|n| format!("plots/{}", n.to_string_lossy()))
         .collect();
-    remove_stale_figures(&out, &earlier, &figure_names)?;
     let mut doc = doc;
     doc["figures"] = json!(figure_names);
     let json_path = out.join("sweep.json");
     let text = serde_json::to_string_pretty(&doc)
         .map_err(|e| SweepError::tool(format!("writing sweep.json: {e}")))?
         + "\n";
-    super::write_atomic(&json_path, text.as_bytes())?;
+    std::fs::write(stage.path("sweep.json"), text.as_bytes())
+        .map_err(|e| SweepError::tool(format!("cannot write `{}`: {e}", json_path.display())))?;
+    let mut files = vec!["sweep.csv".to_string(), "sweep.json".to_string()];
+    files.extend(figure_names.iter().cloned());
+    stage
+        .commit(&crate::stage::Commit {
+            files,
+            ours: earlier,
+            folders: vec!["plots".into()],
+        })
+        .map_err(|e| {
+            SweepError::tool(format!(
+                "the merge into `{}` could not be moved into place: {e}",
+                out.display()
+            ))
+        })?;
 
     let mut t = String::new();
     let _ = writeln!(
@@ -353,9 +373,8 @@ pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepErro
     Ok((t, complete))
 }
 
-/// Writes the merged table as `out/sweep.csv` (rendered in memory, then written in one step);
-/// returns its path.
-fn write_csv(m: &Merged, out: &Path) -> Result<PathBuf, SweepError> {
+/// Writes the merged table to `path` (rendered in memory, then written in one step).
+fn write_csv(m: &Merged, path: &Path) -> Result<(), SweepError> {
     let mut w = csv::Writer::from_writer(Vec::new());
     let csv_err = |e: csv::Error| SweepError::tool(format!("writing sweep.csv: {e}"));
     w.write_record(&m.columns).map_err(csv_err)?;
@@ -366,10 +385,8 @@ fn write_csv(m: &Merged, out: &Path) -> Result<PathBuf, SweepError> {
     let bytes = w
         .into_inner()
         .map_err(|e| SweepError::tool(format!("writing sweep.csv: {e}")))?;
-    let csv_path = out.join("sweep.csv");
-    super::write_atomic(&csv_path, &bytes)?;
-
-    Ok(csv_path)
+    std::fs::write(path, &bytes)
+        .map_err(|e| SweepError::tool(format!("cannot write `sweep.csv`: {e}")))
 }
 
 /// Each claim's result per point (its repeats for, against and tied, and its effect), for the
@@ -403,27 +420,6 @@ fn claim_series(m: &Merged) -> Vec<ClaimSeries> {
                 .collect(),
         })
         .collect()
-}
-
-/// Removes the figures an earlier merge into `out` drew (`earlier`, as its sweep.json lists
-/// them) that this one did not draw again (`drawn`).
-fn remove_stale_figures(
-    out: &Path,
-    earlier: &[String],
-    drawn: &[String],
-) -> Result<(), SweepError> {
-    for old in earlier.iter().filter(|n| !drawn.contains(n)) {
-        let p = out.join(old);
-        if p.is_file() {
-            std::fs::remove_file(&p).map_err(|e| {
-                SweepError::tool(format!(
-                    "cannot remove the earlier figure `{}`: {e}",
-                    p.display()
-                ))
-            })?;
-        }
-    }
-    Ok(())
 }
 
 /// The report's lines on the points that did not finish: failed, missing, broken, and the

@@ -73,6 +73,14 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), SweepError> {
         })
 }
 
+/// A name read from a file, as an error message shows it (control and format characters
+/// escaped, at most 80 characters).
+#[must_use]
+pub fn text_of(name: &str) -> String {
+    let shown: String = name.chars().take(80).collect();
+    swarm::text::printable(&shown)
+}
+
 /// Options of `h8swarm sweep`.
 #[derive(Args, Debug, Clone)]
 pub struct SweepArgs {

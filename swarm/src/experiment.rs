@@ -138,8 +138,8 @@ pub struct RunOutput {
     pub track: Option<Track>,
     /// EEPROM records written over the run (all robots).
     pub saves: u64,
-    /// Robots that died (with `--keep-going`), with why.
-    pub dead: Vec<(usize, String)>,
+    /// Robots that died (with `--keep-going`): which, in which step, why.
+    pub dead: Vec<DeadRobot>,
     /// Each robot's record over the run (distance, collisions, stuck spells), by index.
     pub robots: Vec<RobotTally>,
     /// With a recorder: the frames recorded and the frames with weights.
@@ -150,6 +150,18 @@ pub struct RunOutput {
     pub energy: crate::energy::Charge,
     /// How often the drive voltage's bound cut a motor's current, summed over the robots.
     pub motor_cap: crate::energy::CurrentCap,
+}
+
+/// A robot whose controller failed in a run with `--keep-going`: it is dead from then on (its
+/// motors coast), and the run's claims leave its repeat out.
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize)]
+pub struct DeadRobot {
+    /// Its index.
+    pub robot: usize,
+    /// The step in which it died.
+    pub step: u32,
+    /// Why.
+    pub why: String,
 }
 
 /// Sums of a run's per-step metrics over a span of steps: the summary's and the figure's
@@ -281,7 +293,7 @@ impl RunMetrics {
 }
 
 /// The columns of `metrics.csv`, one row per step of every run.
-pub const METRICS_HEADER: [&str; 12] = [
+pub const METRICS_HEADER: [&str; 13] = [
     "condition",
     "repeat",
     "step",
@@ -294,11 +306,19 @@ pub const METRICS_HEADER: [&str; 12] = [
     "gap_cv",
     "cpu_load_percent",
     "energy_per_robot_mj",
+    "dead_robots",
 ];
 
-/// Step `k`'s row of `metrics.csv` (see [`METRICS_HEADER`]).
+/// Step `k`'s row of `metrics.csv` (see [`METRICS_HEADER`]); `dead` robots had died by its
+/// end (`--keep-going`).
 #[must_use]
-pub fn metrics_row(condition: Condition, repeat: u32, k: u32, m: &StepMetrics) -> [String; 12] {
+pub fn metrics_row(
+    condition: Condition,
+    repeat: u32,
+    k: u32,
+    m: &StepMetrics,
+    dead: usize,
+) -> [String; 13] {
     [
         condition.name().to_string(),
         repeat.to_string(),
@@ -312,6 +332,7 @@ pub fn metrics_row(condition: Condition, repeat: u32, k: u32, m: &StepMetrics) -
         m.gap_cv.map(|v| format!("{v}")).unwrap_or_default(),
         format!("{}", m.cpu_load_percent),
         format!("{}", m.energy_per_robot_mj),
+        dead.to_string(),
     ]
 }
 
@@ -412,8 +433,8 @@ pub struct Swarm {
     /// Go on when a robot's controller fails: the robot is dead from then on (its motors
     /// coast; it is left out of the means).
     keep_going: bool,
-    /// Why each dead robot died.
-    dead: Vec<Option<String>>,
+    /// The step in which each dead robot died, and why.
+    dead: Vec<Option<(u32, String)>>,
     /// The replay recorder and how many robots it records, when the run is recorded.
     recorder: Option<(crate::recording::Recorder, usize)>,
     /// Each robot's motors and bridges, metered over the world's sub-steps.
@@ -553,13 +574,19 @@ impl Swarm {
         self.keep_going = keep_going;
     }
 
-    /// The robots that died, with why.
+    /// The robots that died, with the step and why.
     #[must_use]
-    pub fn dead(&self) -> Vec<(usize, String)> {
+    pub fn dead(&self) -> Vec<DeadRobot> {
         self.dead
             .iter()
             .enumerate()
-            .filter_map(|(i, d)| d.clone().map(|d| (i, d)))
+            .filter_map(|(i, d)| {
+                d.clone().map(|(step, why)| DeadRobot {
+                    robot: i,
+                    step,
+                    why,
+                })
+            })
             .collect()
     }
 
@@ -567,7 +594,7 @@ impl Swarm {
     fn fail(&mut self, i: usize, e: anyhow::Error) -> Result<()> {
         let e = e.context(format!("robot {i}"));
         if self.keep_going {
-            self.dead[i] = Some(format!("{e:#}"));
+            self.dead[i] = Some((self.started, format!("{e:#}")));
             Ok(())
         } else {
             Err(e)
@@ -881,7 +908,13 @@ impl Swarm {
             self.metrics.add(k, &last);
             if let Some(rows) = self.rows.as_mut() {
                 rows.w
-                    .write_record(metrics_row(self.condition, self.repeat, k, &last))
+                    .write_record(metrics_row(
+                        self.condition,
+                        self.repeat,
+                        k,
+                        &last,
+                        self.dead.iter().flatten().filter(|d| d.0 <= k).count(),
+                    ))
                     .map_err(anyhow::Error::new)
                     .with_context(|| {
                         crate::output_error::OutputError(format!(
@@ -982,8 +1015,10 @@ pub struct VcdProbe {
     /// Traced steps: the trace ends when the step after the last one begins sensing (so the
     /// last step's behaviour shows to its end), or with the run.
     pub steps: u32,
-    /// The VCD file.
+    /// The file the trace is written to (a staging file, moved into place by the caller).
     pub path: std::path::PathBuf,
+    /// The file as the user named it, for messages.
+    pub shown: std::path::PathBuf,
 }
 
 /// What to look at inside one robot of a run: its pins, its firmware under GDB.
@@ -1065,7 +1100,7 @@ pub fn run_one(
                         format!("--vcd-robot {}: the robots run no firmware", v.robot)
                     })?;
                 let file = std::fs::File::create(&v.path)
-                    .with_context(|| format!("--vcd: cannot create `{}`", v.path.display()))?;
+                    .with_context(|| format!("--vcd: cannot create `{}`", v.shown.display()))?;
                 robot
                     .start_pin_trace(names, Box::new(file), &vcd_info(v, s, condition, repeat))
                     .with_context(|| format!("--vcd-robot {}", v.robot))?;
@@ -1079,7 +1114,7 @@ pub fn run_one(
         if let Some(v) = &probes.vcd
             && let Some(written) = swarm.robot_mut(v.robot).and_then(Robot::take_pin_trace)
         {
-            written.with_context(|| format!("--vcd: cannot write `{}`", v.path.display()))?;
+            written.with_context(|| format!("--vcd: cannot write `{}`", v.shown.display()))?;
             tracing = false;
         }
         progress(1);
@@ -1088,7 +1123,7 @@ pub fn run_one(
         && tracing
         && let Some(written) = swarm.robot_mut(v.robot).and_then(Robot::finish_pin_trace)
     {
-        written.with_context(|| format!("--vcd: cannot write `{}`", v.path.display()))?;
+        written.with_context(|| format!("--vcd: cannot write `{}`", v.shown.display()))?;
     }
     if let Some(robot) = debugged.and_then(|k| swarm.robot_mut(k)) {
         robot.detach_debugger();

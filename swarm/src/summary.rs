@@ -514,7 +514,17 @@ fn per_repeat(
     robots: usize,
     win: fn(&RunOutput) -> &WindowSums,
 ) -> Vec<Option<f64>> {
-    runs.iter().map(|r| q.of(win(r), robots)).collect()
+    // A run in which a robot died (`--keep-going`) has no value: its dead robots would count
+    // as robots that neither collide nor get stuck.
+    runs.iter()
+        .map(|r| {
+            if r.dead.is_empty() {
+                q.of(win(r), robots)
+            } else {
+                None
+            }
+        })
+        .collect()
 }
 
 /// Window statistics over runs of one condition (in repeat order), from each run's sums over
@@ -709,7 +719,12 @@ fn pairing(learning: &[&RunOutput], other: &[&RunOutput], c: Condition) -> Optio
         let Some(o) = other.iter().find(|o| o.repeat == l.repeat) else {
             continue;
         };
-        for (a, b) in l.robots.iter().zip(&o.robots) {
+        let dead = |r: &RunOutput, i: usize| r.dead.iter().any(|d| d.robot == i);
+        for (i, (a, b)) in l.robots.iter().zip(&o.robots).enumerate() {
+            // A robot dead in either run is compared with nothing.
+            if dead(l, i) || dead(o, i) {
+                continue;
+            }
             p.robots += 1;
             match (a.ends_stuck, b.ends_stuck) {
                 (true, true) => p.both_stuck += 1,
