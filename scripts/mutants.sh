@@ -18,7 +18,7 @@
 #   MUTANTS_CAP        wall-clock cap in seconds (default: none). When it is reached the run
 #                      stops, the mutants tested so far are judged, and the report says the
 #                      check was partial.
-#   MUTANTS_OUT        folder for mutants.out (default target/mutants)
+#   MUTANTS_OUT        folder for mutants.out (default target/mutants-out)
 #
 # Exit status: 0 no missed mutant other than the listed equivalent ones (or nothing to test),
 # 1 a tool failure (cargo-mutants itself, or the tests failing on the unmutated tree),
@@ -65,7 +65,7 @@ fi
 export PROPTEST_CASES="${PROPTEST_CASES:-1000}"
 export PROPTEST_RNG_SEED="${PROPTEST_RNG_SEED:-1}"
 jobs="${MUTANTS_JOBS:-1}"
-out="${MUTANTS_OUT:-target/mutants}"
+out="${MUTANTS_OUT:-target/mutants-out}"
 mkdir -p "$out"
 out="$(cd "$out" && pwd)"
 
