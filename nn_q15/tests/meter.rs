@@ -73,7 +73,8 @@ fn forward_states_match_the_firmware_on_every_path() {
         32767, 32767, 32767, -32768, -32768, -32768, 32767, 32767, 32766, 1000, -2000, 3000,
     ];
     // (what it exercises, N, M, weights, x, states on the firmware)
-    let cases: [(&str, usize, usize, &[i16], &[i8], u64); 6] = [
+    type Case<'a> = (&'a str, usize, usize, &'a [i16], &'a [i8], u64);
+    let cases: [Case; 6] = [
         (
             "plain, one output clamped at the bottom, a new maximum",
             2,

@@ -405,7 +405,7 @@ fn the_largest_shape_works_and_one_input_more_is_refused() {
     );
     let small = InputLayout::DEFAULT;
     assert_eq!(
-        DynLearner::new(5, small, Params::CORRIDOR, &vec![Q15::ZERO; 14 * 5]).unwrap_err(),
+        DynLearner::new(5, small, Params::CORRIDOR, &[Q15::ZERO; 14 * 5]).unwrap_err(),
         ShapeError::Behaviours { got: 5 }
     );
     let mut longer = w.clone();
