@@ -87,8 +87,10 @@ if [ "$mode" = last ]; then
   echo "mutants.sh: the last change to nn_q15/src is $(git log -1 --format='%h %s' "$rev" | cut -c1-100)"
 fi
 
+# A test run takes a few seconds on an idle machine; cargo-mutants would time a mutant out at
+# 20 s, which a machine shared with other builds exceeds: at least 120 s before a timeout.
 args=(mutants -p nn_q15 --test-package nn_q15,proptests --profile mutants --jobs "$jobs"
-  --no-shuffle --colors never --output "$out")
+  --no-shuffle --colors never --output "$out" --minimum-test-timeout 120)
 if [ -n "$diff_file" ]; then
   if ! grep -q '^+++ b/nn_q15/src/' "$diff_file"; then
     echo "mutants.sh: the diff adds nothing to nn_q15/src: nothing to test"
