@@ -326,6 +326,7 @@ fn the_instruction_trace_and_the_phase_signal_name_the_same_code() {
         &mut mcu,
         &RunOptions {
             max_states: Some(3 * TICK_STATES),
+            ..RunOptions::default()
         },
         &mut std::io::sink(),
         Probes {
@@ -334,6 +335,7 @@ fn the_instruction_trace_and_the_phase_signal_name_the_same_code() {
             phases: Some(&mut phases),
             debugger: None,
             vcd: None,
+            profile: None,
         },
     )
     .unwrap();
