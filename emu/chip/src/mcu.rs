@@ -901,6 +901,9 @@ impl<B: Board> Mcu<B> {
     /// reset state but the WDT's RSTCSR, port 4's lines released, the clock to the reset's end.
     #[cold]
     fn internal_reset(&mut self) {
+        // Everything up to the reset happens first (a byte SCI1 has finished sending is out;
+        // the WDT has set WRST).
+        self.sync();
         let now = self.now;
         let end = self.wdt.reset_end().unwrap_or(now).max(now);
         let wdt = self.wdt.clone();
@@ -1301,22 +1304,27 @@ impl<B: Board> Bus for Mcu<B> {
         }
     }
 
+    /// Moves the clock to the next instant a request can appear, again while none does (a pin
+    /// the board drives may change without requesting: a rising edge, a disabled IRQ), up to
+    /// `deadline`.
     fn sleep_until_irq(&mut self, deadline: u64) -> bool {
-        if self.pending_irq().is_some() {
-            return true;
-        }
-        match self.next_irq_time() {
-            Some(t) if t <= deadline => {
-                self.now = self.now.max(t);
-                self.sync();
-                self.pending_irq().is_some()
+        loop {
+            if self.pending_irq().is_some() {
+                return true;
             }
-            _ => {
-                if deadline != u64::MAX {
-                    self.now = self.now.max(deadline);
+            match self.next_irq_time() {
+                Some(t) if t <= deadline && t > self.now => {
+                    self.now = t;
                     self.sync();
                 }
-                false
+                Some(t) if t <= self.now => return false,
+                _ => {
+                    if deadline != u64::MAX {
+                        self.now = self.now.max(deadline);
+                        self.sync();
+                    }
+                    return false;
+                }
             }
         }
     }

@@ -16,8 +16,11 @@ static volatile u32 irqs;
 void isr_irq0(void) __attribute__((interrupt_handler));
 void isr_irq0(void)
 {
+    u8 isr;
     irqs++;
     P8DR = 0x01u; /* the pin high: a low level no longer requests */
+    isr = ISR;    /* ... and the flag, read as 1, cleared (a level-sensed flag is not cleared */
+    ISR = (u8)(isr & 0xFEu); /* by the exception handling while the pin was still low) */
 }
 
 int main(void)
