@@ -317,7 +317,9 @@ fn start_vcd(
         phase_at_start = p.drain_before(mcu.now() + 1).pop().map(|(_, name)| name);
         phases = Some(p);
     }
-    let (start, initial) = mcu.trace_beginning().unwrap_or_default();
+    let (start, initial) = mcu
+        .trace_beginning()
+        .unwrap_or((0, [false; emu::chip::trace::SIGNAL_COUNT]));
     let stream = VcdStream::start(
         Box::new(file),
         mcu.clock_hz(),

@@ -110,6 +110,20 @@ pub struct RunArgs {
     /// top): `stop` the run with an error, or `warn` after the run and go on.
     #[arg(long, value_enum, value_name = "ACTION")]
     pub stack_guard: Option<StackGuardArg>,
+    /// Write a profile of where one firmware robot's states go by call stack (the learning
+    /// run, repeat 0) to FILE as folded stacks, for speedscope, inferno-flamegraph or
+    /// flamegraph.pl. The robot then runs instruction by instruction (the same results, more
+    /// slowly).
+    #[arg(long, value_name = "FILE")]
+    pub profile: Option<PathBuf>,
+    /// The robot --profile profiles (default 0).
+    #[arg(long, value_name = "K", requires = "profile")]
+    pub profile_robot: Option<usize>,
+    /// Stop a firmware robot (an error, or a dead robot with --keep-going) at its first access
+    /// to a register the emulated chip does not model or to a reserved address, instead of
+    /// warning about each after the run.
+    #[arg(long)]
+    pub strict_io: bool,
 }
 
 /// What the stack guard does (`--stack-guard`).
@@ -243,6 +257,17 @@ fn probes(a: &RunArgs, s: &Scenario) -> Result<swarm::experiment::RobotProbes> {
             steps: steps.min(s.steps - from),
             path: path.clone(),
         });
+    }
+    if let Some(path) = &a.profile {
+        let robot = probed_robot("--profile-robot", a.profile_robot.unwrap_or(0), s)?;
+        // Fail now, not after the runs, if the file cannot be written.
+        std::fs::write(path, b"")
+            .map_err(anyhow::Error::new)
+            .context(OutputError(format!(
+                "--profile: cannot create `{}`",
+                path.display()
+            )))?;
+        p.profile = Some((robot, path.clone()));
     }
     if let Some(addr) = &a.gdb {
         let robot = probed_robot("--gdb-robot", a.gdb_robot.unwrap_or(0), s)?;
@@ -1073,6 +1098,7 @@ fn run_all(
                         probes: probes.unwrap_or_default(),
                         replay,
                         stack_guard: a.stack_guard.unwrap_or_default().into(),
+                        strict_io: a.strict_io,
                     },
                 )
             })
@@ -1099,6 +1125,7 @@ fn measure_fit(s: &Scenario) -> Result<swarm::fit::FitReport> {
         kind: swarm::scenario::ControllerKind::Firmware,
         firmware: swarm::fit::FirmwareUnderTest::robot()?,
         compare: true,
+        strict_io: false,
     })?)
 }
 
@@ -1186,9 +1213,21 @@ fn factor_text(f: f64) -> String {
     }
 }
 
-/// One line per robot that died and per stack warning, run by run.
+/// One line per robot that died and per stack warning, run by run; one per robot and
+/// address its chip does not model, for the first run that touched it.
 fn render_failures(t: &mut String, runs: &[RunOutput]) {
+    let mut io_seen = std::collections::BTreeSet::new();
     for r in runs {
+        for (i, what) in &r.io_warnings {
+            if io_seen.insert((*i, what.clone())) {
+                let _ = writeln!(
+                    t,
+                    "IO    robot {i} in {} repeat {}: {what}",
+                    r.condition.name(),
+                    r.repeat
+                );
+            }
+        }
         for (i, why) in &r.dead {
             let _ = writeln!(
                 t,

@@ -739,7 +739,7 @@ impl<B: Board> Mcu<B> {
 
     /// The pin trace under way: its first instant and every signal's level then.
     #[must_use]
-    pub fn trace_beginning(&self) -> Option<(u64, [bool; 12])> {
+    pub fn trace_beginning(&self) -> Option<(u64, [bool; crate::trace::SIGNAL_COUNT])> {
         self.tracer.as_ref().map(|t| t.beginning())
     }
 

@@ -13,9 +13,11 @@
 //! stub's clock.
 //!
 //! # Contents
-//! Scope `h8_3052f` holds one 1-bit wire per [`Signal`] (named by [`Signal::name`]);
+//! Scope `h8_3052f` holds one 1-bit wire per named [`Signal`] (named by [`Signal::name`]);
 //! scope `firmware` holds `phase`, a string variable naming the code that runs
-//! ([`crate::trace::PhaseRecorder`]). The values at the trace's start are given in a
+//! ([`crate::trace::PhaseRecorder`]); scope `ports` holds one 8-bit wire per port, `P1`–`P9`,
+//! `PA`, `PB`, what the port drives ([`Signal::PortOut`]: DR on its output pins, 0 on its
+//! inputs), so a program's port writes show. The values at the trace's start are given in a
 //! `$dumpvars` block; a last timestamp marks its end. At one instant only a signal's final
 //! level is written, and only if it changed.
 
@@ -23,7 +25,8 @@ use std::io::{self, Write};
 
 use vcd::{IdCode, SimulationCommand, TimescaleUnit, Value, VarType, Writer};
 
-use crate::trace::{PinChange, PinTrace, Signal};
+use crate::periph::ports::PortId;
+use crate::trace::{PinChange, PinTrace, SIGNAL_COUNT, Signal};
 
 /// The VCD time unit for a clock: (count, unit) for `$timescale`, and how many such units one
 /// state lasts, or `None` when a state is no whole number of femtoseconds.
@@ -104,7 +107,9 @@ pub struct VcdStream<'w> {
     clock: Clock,
     ids: Vec<IdCode>,
     phase_id: Option<IdCode>,
-    levels: [bool; 12],
+    /// The ports' 8-bit wires, in [`PortId::ALL`] order.
+    port_ids: Vec<IdCode>,
+    levels: [bool; SIGNAL_COUNT],
     phase_now: Option<String>,
     start: u64,
 }
@@ -128,7 +133,7 @@ impl<'w> VcdStream<'w> {
         out: Box<dyn Write + Send + 'w>,
         clock_hz: u32,
         start: u64,
-        initial: [bool; 12],
+        initial: [bool; SIGNAL_COUNT],
         phase: Option<&str>,
         info: &VcdInfo,
     ) -> io::Result<VcdStream<'w>> {
@@ -154,17 +159,20 @@ impl<'w> VcdStream<'w> {
                 &info.source
             },
         );
-        for s in Signal::ALL {
+        for s in Signal::NAMED {
             comment.push_str(&format!(" {}: {}.", s.name(), s.description()));
         }
         if phase.is_some() {
             comment.push_str(" phase: the function that runs (symbol table).");
         }
+        comment.push_str(
+            " P1-P9, PA, PB: what each port drives (DR on its output pins, 0 on its inputs).",
+        );
         w.comment(&comment)?;
         w.timescale(count, unit)?;
         w.add_module("h8_3052f")?;
-        let mut ids: Vec<IdCode> = Vec::with_capacity(Signal::ALL.len());
-        for s in Signal::ALL {
+        let mut ids: Vec<IdCode> = Vec::with_capacity(Signal::NAMED.len());
+        for s in Signal::NAMED {
             ids.push(w.add_wire(1, s.name())?);
         }
         w.upscope()?;
@@ -177,6 +185,12 @@ impl<'w> VcdStream<'w> {
             }
             None => None,
         };
+        w.add_module("ports")?;
+        let mut port_ids = Vec::with_capacity(PortId::ALL.len());
+        for p in PortId::ALL {
+            port_ids.push(w.add_wire(8, p.name())?);
+        }
+        w.upscope()?;
         w.enddefinitions()?;
         w.timestamp(clock.stamp(start))?;
         w.begin(SimulationCommand::Dumpvars)?;
@@ -186,11 +200,15 @@ impl<'w> VcdStream<'w> {
         if let (Some(id), Some(name)) = (phase_id, phase) {
             w.change_string(id, name)?;
         }
+        for (p, id) in PortId::ALL.into_iter().zip(&port_ids) {
+            w.change_vector(*id, port_bits(&initial, p))?;
+        }
         w.end()?;
         Ok(VcdStream {
             w,
             clock,
             ids,
+            port_ids,
             phase_id,
             levels: initial,
             phase_now: phase.map(str::to_string),
@@ -228,7 +246,7 @@ impl<'w> VcdStream<'w> {
             }
             let mut now = self.levels;
             while let Some(c) = pins.get(i).filter(|c| c.t == t) {
-                now[c.signal as usize] = c.level;
+                now[c.signal.index()] = c.level;
                 i += 1;
             }
             let mut phase_at: Option<&str> = self.phase_now.as_deref();
@@ -246,6 +264,12 @@ impl<'w> VcdStream<'w> {
                 }
                 if let (true, Some(id), Some(name)) = (phase_changed, self.phase_id, phase_at) {
                     self.w.change_string(id, name)?;
+                }
+                for (p, id) in PortId::ALL.into_iter().zip(&self.port_ids) {
+                    let bits = Signal::PortOut(p, 0).index()..Signal::PortOut(p, 7).index() + 1;
+                    if now[bits.clone()] != self.levels[bits] {
+                        self.w.change_vector(*id, port_bits(&now, p))?;
+                    }
                 }
             }
             self.levels = now;
@@ -303,6 +327,14 @@ pub fn write_vcd<'w, W: Write + Send + 'w>(
         trace.end.saturating_add(1),
     )?;
     v.finish(&[], &[], trace.end)
+}
+
+/// Port `p`'s eight pins from `levels`, most significant first (a VCD vector's order).
+fn port_bits(levels: &[bool; SIGNAL_COUNT], p: PortId) -> Vec<Value> {
+    (0..8u8)
+        .rev()
+        .map(|b| bit(levels[Signal::PortOut(p, b).index()]))
+        .collect()
 }
 
 fn bit(level: bool) -> Value {

@@ -41,7 +41,7 @@ cd "$here"
 
 PROGRAMS=(arith shifts muldiv bitops structs recursion funcptr switch q15learn crcmacdiv)
 STACK_PROGRAMS=(stack_deep stack_after stack_close)
-CHIP_PROGRAMS=(wdt idle_wdt unmodelled callstack irq irq_board)
+CHIP_PROGRAMS=(wdt idle_wdt unmodelled callstack irq irq_board minibot)
 SUPPORT_C=(console.c)
 
 H8_PREFIX="${H8_PREFIX:-h8300-hms-}"
