@@ -73,7 +73,7 @@ pub enum Signal {
     /// The CPU in sleep mode.
     Sleep,
     /// Pin `bit` (0–7) of a port as the port drives it: its DR bit while the pin is an output
-    /// (DDR = 1), else 0. A VCD file shows each port's eight as one 8-bit vector.
+    /// (DDR = 1), else 0 (named `P1_0`…`PB_7` in a VCD file).
     PortOut(PortId, u8),
 }
 

@@ -15,9 +15,10 @@
 //! # Contents
 //! Scope `h8_3052f` holds one 1-bit wire per named [`Signal`] (named by [`Signal::name`]);
 //! scope `firmware` holds `phase`, a string variable naming the code that runs
-//! ([`crate::trace::PhaseRecorder`]); scope `ports` holds one 8-bit wire per port, `P1`–`P9`,
-//! `PA`, `PB`, what the port drives ([`Signal::PortOut`]: DR on its output pins, 0 on its
-//! inputs), so a program's port writes show. The values at the trace's start are given in a
+//! ([`crate::trace::PhaseRecorder`]); scope `ports` holds one 1-bit wire per pin of each port,
+//! `P1_0`–`P1_7` to `PB_0`–`PB_7`, what the port drives ([`Signal::PortOut`]: DR on its output
+//! pins, 0 on its inputs), so a program's port writes show (1-bit wires, not 8-bit vectors:
+//! sigrok's VCD input reads only 1-bit wires). The values at the trace's start are given in a
 //! `$dumpvars` block; a last timestamp marks its end. At one instant only a signal's final
 //! level is written, and only if it changed.
 
@@ -105,10 +106,9 @@ pub const DRAIN_SLICE_STATES: u64 = 1 << 20;
 pub struct VcdStream<'w> {
     w: Writer<io::BufWriter<Box<dyn Write + Send + 'w>>>,
     clock: Clock,
+    /// Every signal's wire, in [`Signal::ALL`] order.
     ids: Vec<IdCode>,
     phase_id: Option<IdCode>,
-    /// The ports' 8-bit wires, in [`PortId::ALL`] order.
-    port_ids: Vec<IdCode>,
     levels: [bool; SIGNAL_COUNT],
     phase_now: Option<String>,
     start: u64,
@@ -166,12 +166,12 @@ impl<'w> VcdStream<'w> {
             comment.push_str(" phase: the function that runs (symbol table).");
         }
         comment.push_str(
-            " P1-P9, PA, PB: what each port drives (DR on its output pins, 0 on its inputs).",
+            " P1_0-PB_7: what each port drives on each pin (DR on its output pins, 0 on its inputs).",
         );
         w.comment(&comment)?;
         w.timescale(count, unit)?;
         w.add_module("h8_3052f")?;
-        let mut ids: Vec<IdCode> = Vec::with_capacity(Signal::NAMED.len());
+        let mut ids: Vec<IdCode> = Vec::with_capacity(SIGNAL_COUNT);
         for s in Signal::NAMED {
             ids.push(w.add_wire(1, s.name())?);
         }
@@ -186,29 +186,29 @@ impl<'w> VcdStream<'w> {
             None => None,
         };
         w.add_module("ports")?;
-        let mut port_ids = Vec::with_capacity(PortId::ALL.len());
         for p in PortId::ALL {
-            port_ids.push(w.add_wire(8, p.name())?);
+            for b in 0..8 {
+                ids.push(w.add_wire(1, &format!("{}_{b}", p.name()))?);
+            }
         }
         w.upscope()?;
         w.enddefinitions()?;
         w.timestamp(clock.stamp(start))?;
         w.begin(SimulationCommand::Dumpvars)?;
-        for (i, id) in ids.iter().enumerate() {
+        for (i, id) in ids.iter().enumerate().take(Signal::NAMED.len()) {
             w.change_scalar(*id, bit(initial[i]))?;
         }
         if let (Some(id), Some(name)) = (phase_id, phase) {
             w.change_string(id, name)?;
         }
-        for (p, id) in PortId::ALL.into_iter().zip(&port_ids) {
-            w.change_vector(*id, port_bits(&initial, p))?;
+        for (i, id) in ids.iter().enumerate().skip(Signal::NAMED.len()) {
+            w.change_scalar(*id, bit(initial[i]))?;
         }
         w.end()?;
         Ok(VcdStream {
             w,
             clock,
             ids,
-            port_ids,
             phase_id,
             levels: initial,
             phase_now: phase.map(str::to_string),
@@ -257,7 +257,7 @@ impl<'w> VcdStream<'w> {
             let phase_changed = phase_at != self.phase_now.as_deref();
             if now != self.levels || phase_changed {
                 self.w.timestamp(self.clock.stamp(t))?;
-                for (n, id) in self.ids.iter().enumerate() {
+                for (n, id) in self.ids.iter().enumerate().take(Signal::NAMED.len()) {
                     if now[n] != self.levels[n] {
                         self.w.change_scalar(*id, bit(now[n]))?;
                     }
@@ -265,10 +265,9 @@ impl<'w> VcdStream<'w> {
                 if let (true, Some(id), Some(name)) = (phase_changed, self.phase_id, phase_at) {
                     self.w.change_string(id, name)?;
                 }
-                for (p, id) in PortId::ALL.into_iter().zip(&self.port_ids) {
-                    let bits = Signal::PortOut(p, 0).index()..Signal::PortOut(p, 7).index() + 1;
-                    if now[bits.clone()] != self.levels[bits] {
-                        self.w.change_vector(*id, port_bits(&now, p))?;
+                for (n, id) in self.ids.iter().enumerate().skip(Signal::NAMED.len()) {
+                    if now[n] != self.levels[n] {
+                        self.w.change_scalar(*id, bit(now[n]))?;
                     }
                 }
             }
@@ -327,14 +326,6 @@ pub fn write_vcd<'w, W: Write + Send + 'w>(
         trace.end.saturating_add(1),
     )?;
     v.finish(&[], &[], trace.end)
-}
-
-/// Port `p`'s eight pins from `levels`, most significant first (a VCD vector's order).
-fn port_bits(levels: &[bool; SIGNAL_COUNT], p: PortId) -> Vec<Value> {
-    (0..8u8)
-        .rev()
-        .map(|b| bit(levels[Signal::PortOut(p, b).index()]))
-        .collect()
 }
 
 fn bit(level: bool) -> Value {
