@@ -102,6 +102,10 @@ pub struct FitArgs {
     /// life (default: 2 000 mAh, a typical AA NiMH cell of 2008).
     #[arg(long, value_name = "MAH")]
     pub capacity_mah: Option<f64>,
+    /// Stop with an error at the image's first access to a register the emulated chip does
+    /// not model or to a reserved address, instead of naming them in the verdict.
+    #[arg(long)]
+    pub strict_io: bool,
 }
 
 impl FitArgs {
@@ -301,6 +305,7 @@ pub fn run(a: &FitArgs) -> Result<String> {
         kind,
         firmware: firmware.clone(),
         compare,
+        strict_io: a.strict_io,
     };
     let mut reports = Vec::new();
     for setting in &settings {
@@ -392,6 +397,9 @@ fn render(s: &mut String, name: &str, r: &FitReport) {
     render_rom_and_eeprom(s, r);
     if let Some(en) = &r.energy {
         render_energy(s, en);
+    }
+    for line in &r.unmodelled {
+        let _ = writeln!(s, "not modelled: {line}");
     }
     let _ = writeln!(s, "verdict: {}", r.verdict);
 }

@@ -75,6 +75,15 @@ struct EmuArgs {
     /// the program with an error (exit status 125), or `warn` at the end and let it run.
     #[arg(long, value_enum, value_name = "ACTION", default_value_t = GuardArg::Stop)]
     stack_guard: GuardArg,
+    /// Write a profile of where the states go by call stack to FILE, as folded stacks
+    /// (`caller;callee;… states`, one stack a line) for speedscope, inferno-flamegraph or
+    /// flamegraph.pl; the lines add up to the run's states.
+    #[arg(long, value_name = "FILE")]
+    profile: Option<std::path::PathBuf>,
+    /// Stop the program (exit status 125) at the first access to a register the chip does
+    /// not model or to a reserved address, instead of warning about each at the end.
+    #[arg(long)]
+    strict_io: bool,
 }
 
 /// What the stack guard does (`--stack-guard`).
@@ -193,6 +202,8 @@ fn main() -> ExitCode {
             gdb: args.gdb.as_deref(),
             symbols: args.symbols.as_deref(),
             stack_guard: args.stack_guard.into(),
+            profile: args.profile.as_deref(),
+            strict_io: args.strict_io,
         }),
         Some(Command::Fit(args)) => fit(&args),
         Some(Command::Run(args)) => run(&args),

@@ -111,6 +111,20 @@ pub struct RunArgs {
     /// top): `stop` the run with an error, or `warn` after the run and go on.
     #[arg(long, value_enum, value_name = "ACTION")]
     pub stack_guard: Option<StackGuardArg>,
+    /// Write a profile of where one firmware robot's states go by call stack (the learning
+    /// run, repeat 0) to FILE as folded stacks, for speedscope, inferno-flamegraph or
+    /// flamegraph.pl. The robot then runs instruction by instruction (the same results, more
+    /// slowly).
+    #[arg(long, value_name = "FILE")]
+    pub profile: Option<PathBuf>,
+    /// The robot --profile profiles (default 0).
+    #[arg(long, value_name = "K", requires = "profile")]
+    pub profile_robot: Option<usize>,
+    /// Stop a firmware robot (an error, or a dead robot with --keep-going) at its first access
+    /// to a register the emulated chip does not model or to a reserved address, instead of
+    /// warning about each after the run.
+    #[arg(long)]
+    pub strict_io: bool,
 }
 
 /// What the stack guard does (`--stack-guard`).
@@ -213,7 +227,25 @@ fn probed_robot(option: &str, k: usize, s: &Scenario) -> Result<usize> {
     Ok(k)
 }
 
-/// The probes `--vcd` and `--gdb` ask for, checked (a bad value fails before any run); the
+/// Whether two paths name one file (the same path, or the same file through links).
+fn same_file(a: &std::path::Path, b: &std::path::Path) -> bool {
+    if a == b {
+        return true;
+    }
+    let parent_and_name = |p: &std::path::Path| {
+        let parent = match p.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+            _ => std::path::PathBuf::from("."),
+        };
+        Some((
+            std::fs::canonicalize(parent).ok()?,
+            p.file_name()?.to_owned(),
+        ))
+    };
+    matches!((parent_and_name(a), parent_and_name(b)), (Some(x), Some(y)) if x == y)
+}
+
+/// The probes `--vcd`, `--profile` and `--gdb` ask for, checked (a bad value fails before any run); the
 /// GDB stub is listening when this returns.
 fn probes(a: &RunArgs, s: &Scenario, stage: &mut Stage) -> Result<swarm::experiment::RobotProbes> {
     let mut p = swarm::experiment::RobotProbes::default();
@@ -247,6 +279,31 @@ fn probes(a: &RunArgs, s: &Scenario, stage: &mut Stage) -> Result<swarm::experim
             robot,
             from,
             steps: steps.min(s.steps - from),
+            path: staged,
+            shown: path.clone(),
+        });
+    }
+    if let Some(path) = &a.profile {
+        let robot = probed_robot("--profile-robot", a.profile_robot.unwrap_or(0), s)?;
+        if a.vcd.as_deref().is_some_and(|v| same_file(v, path)) {
+            bail!(
+                "--profile `{}` is also the --vcd file: give each its own file",
+                path.display()
+            );
+        }
+        // Staged and committed with the run's files like the trace; fail now, not after the
+        // runs, if it cannot be written.
+        let staged = stage
+            .stage_outside("--profile", path)
+            .map_err(|e| anyhow::Error::new(OutputError(e.0)))?;
+        std::fs::write(&staged, b"")
+            .map_err(anyhow::Error::new)
+            .context(OutputError(format!(
+                "--profile: cannot create `{}`",
+                path.display()
+            )))?;
+        p.profile = Some(swarm::experiment::ProfileProbe {
+            robot,
             path: staged,
             shown: path.clone(),
         });
@@ -978,6 +1035,7 @@ fn run_all(
                         probes: probes.unwrap_or_default(),
                         replay,
                         stack_guard: a.stack_guard.unwrap_or_default().into(),
+                        strict_io: a.strict_io,
                     },
                 )
             })
@@ -1004,6 +1062,7 @@ fn measure_fit(s: &Scenario) -> Result<swarm::fit::FitReport> {
         kind: swarm::scenario::ControllerKind::Firmware,
         firmware: swarm::fit::FirmwareUnderTest::robot()?,
         compare: true,
+        strict_io: false,
     })?)
 }
 
@@ -1098,9 +1157,21 @@ fn factor_text(f: f64) -> String {
     }
 }
 
-/// One line per robot that died and per stack warning, run by run.
+/// One line per robot that died and per stack warning, run by run; one per robot and
+/// address its chip does not model, for the first run that touched it.
 fn render_failures(t: &mut String, runs: &[RunOutput]) {
+    let mut io_seen = std::collections::BTreeSet::new();
     for r in runs {
+        for (i, what) in &r.io_warnings {
+            if io_seen.insert((*i, what.clone())) {
+                let _ = writeln!(
+                    t,
+                    "IO    robot {i} in {} repeat {}: {what}",
+                    r.condition.name(),
+                    r.repeat
+                );
+            }
+        }
         for d in &r.dead {
             let _ = writeln!(
                 t,

@@ -269,6 +269,7 @@ fn s_records_never_panic_and_images_that_load_run_to_a_stop() {
                 &bytes,
                 &RunOptions {
                     max_states: Some(20_000),
+                    ..RunOptions::default()
                 },
                 &mut console,
                 None,
@@ -884,6 +885,7 @@ fn raw_gdb_sessions_get_protocol_answers_and_never_hang_the_stub() {
                     &mut mcu,
                     &RunOptions {
                         max_states: Some(1_000_000),
+                        ..RunOptions::default()
                     },
                     &mut std::io::sink(),
                     Probes {

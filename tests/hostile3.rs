@@ -140,6 +140,9 @@ fn a_trace_file_is_untouched_by_a_run_that_never_ran_or_failed() {
     let root = fresh("r3-vcd");
     let vcd = root.join("trace.vcd");
     std::fs::write(&vcd, b"an earlier trace").unwrap();
+    // The profile (issue 36) is an output outside the folder too, staged the same way.
+    let prof = root.join("robot.folded");
+    std::fs::write(&prof, b"an earlier profile").unwrap();
     // --out is a file: refused before anything runs.
     let file = root.join("x");
     std::fs::write(&file, b"a file").unwrap();
@@ -154,6 +157,8 @@ fn a_trace_file_is_untouched_by_a_run_that_never_ran_or_failed() {
             "1".into(),
             "--vcd".into(),
             s(&vcd).into(),
+            "--profile".into(),
+            s(&prof).into(),
             "--out".into(),
             s(out).into(),
         ]
@@ -162,6 +167,7 @@ fn a_trace_file_is_untouched_by_a_run_that_never_ran_or_failed() {
     let (code, _, err) = status(&a.iter().map(String::as_str).collect::<Vec<_>>());
     assert_eq!(code, 1, "{err}");
     assert_eq!(std::fs::read(&vcd).unwrap(), b"an earlier trace");
+    assert_eq!(std::fs::read(&prof).unwrap(), b"an earlier profile");
     // A run that fails after its trace began (the robots run an image that spins at boot, and
     // the step watchdog stops it): status 2, the trace untouched.
     let spin = root.join("spin.mot");
@@ -185,12 +191,15 @@ fn a_trace_file_is_untouched_by_a_run_that_never_ran_or_failed() {
         "1",
         "--vcd",
         s(&vcd),
+        "--profile",
+        s(&prof),
         "--out",
         s(&out),
     ]);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("nothing was written"), "{err}");
     assert_eq!(std::fs::read(&vcd).unwrap(), b"an earlier trace");
+    assert_eq!(std::fs::read(&prof).unwrap(), b"an earlier profile");
     assert!(!out.exists());
     // A run that succeeds replaces it, and leaves no staging file beside it.
     let out = root.join("good");
@@ -198,6 +207,29 @@ fn a_trace_file_is_untouched_by_a_run_that_never_ran_or_failed() {
     let o = ok(&a.iter().map(String::as_str).collect::<Vec<_>>());
     let trace = std::fs::read_to_string(&vcd).unwrap();
     assert!(trace.starts_with("$version"), "{o}");
+    let folded = std::fs::read_to_string(&prof).unwrap();
+    assert!(
+        folded.lines().count() > 1 && folded.contains(";main"),
+        "{folded}"
+    );
+    // One file cannot be both.
+    let (code, _, err) = status(&[
+        "run",
+        "--controller",
+        "firmware",
+        "--steps",
+        "5",
+        "--repeats",
+        "1",
+        "--vcd",
+        s(&vcd),
+        "--profile",
+        s(&vcd),
+        "--out",
+        s(&root.join("both")),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("also the --vcd file"), "{err}");
     let names: Vec<String> = std::fs::read_dir(&root)
         .unwrap()
         .flatten()

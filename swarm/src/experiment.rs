@@ -146,6 +146,8 @@ pub struct RunOutput {
     pub recorded: Option<(u32, Vec<u32>)>,
     /// Firmware robots whose stack left its room under a warning guard, with the first fault.
     pub stack_warnings: Vec<(usize, String)>,
+    /// The first access of each robot to each address its chip does not model, one line each.
+    pub io_warnings: Vec<(usize, String)>,
     /// The charge every robot drew from its pack over the run, summed, by part.
     pub energy: crate::energy::Charge,
     /// How often the drive voltage's bound cut a motor's current, summed over the robots.
@@ -568,6 +570,14 @@ impl Swarm {
         }
     }
 
+    /// Whether the firmware robots stop at their first access to what the chip does not
+    /// model (`--strict-io`) instead of reporting it ([`RunOutput::io_warnings`]).
+    pub fn set_strict_io(&mut self, on: bool) {
+        for r in &mut self.robots {
+            r.set_strict_io(on);
+        }
+    }
+
     /// Whether a robot whose controller fails is marked dead and the run goes on (default:
     /// the run stops with the error).
     pub fn set_keep_going(&mut self, keep_going: bool) {
@@ -983,12 +993,19 @@ impl Swarm {
             .enumerate()
             .filter_map(|(i, r)| r.stack_fault().map(|f| (i, f.to_string())))
             .collect();
+        let io_warnings = self
+            .robots
+            .iter()
+            .enumerate()
+            .flat_map(|(i, r)| r.io_reports().into_iter().map(move |w| (i, w)))
+            .collect();
         let mut motor_cap = crate::energy::CurrentCap::default();
         for d in &self.drives {
             motor_cap.add(d.cap());
         }
         Ok(RunOutput {
             stack_warnings,
+            io_warnings,
             energy: self.energy,
             motor_cap,
             condition: self.condition,
@@ -1029,6 +1046,21 @@ pub struct RobotProbes {
     /// A GDB stub for a robot, waiting for its client: (robot, listener). The run waits for
     /// the client before its first step and pauses while it has the robot stopped.
     pub gdb: Option<(usize, emu::chip::gdb::GdbListener)>,
+    /// A profile of where one firmware robot's states go by call stack, written as folded
+    /// stacks when the run ends.
+    pub profile: Option<ProfileProbe>,
+}
+
+/// A profile of one firmware robot's states by call stack ([`RobotProbes::profile`]).
+#[derive(Debug)]
+pub struct ProfileProbe {
+    /// The robot.
+    pub robot: usize,
+    /// The file the folded stacks are written to (a staging file, moved into place by the
+    /// caller).
+    pub path: std::path::PathBuf,
+    /// The file as the user named it, for messages.
+    pub shown: std::path::PathBuf,
 }
 
 /// How one run goes besides its scenario, condition and repeat: what it records and what looks
@@ -1048,6 +1080,9 @@ pub struct RunOptions {
     pub replay: Option<(crate::recording::Recorder, usize)>,
     /// What the firmware robots' stack guards do ([`Swarm::set_stack_guard_mode`]).
     pub stack_guard: emu::core::cpu::StackGuardMode,
+    /// Stop a firmware robot at its first access to what the chip does not model
+    /// ([`Swarm::set_strict_io`]).
+    pub strict_io: bool,
 }
 
 /// Runs one condition of one repeat. `progress` is called with the number of steps done since
@@ -1068,6 +1103,7 @@ pub fn run_one(
     let mut swarm = Swarm::new(s, condition, repeat, opts.record_track, images)?;
     swarm.set_keep_going(opts.keep_going);
     swarm.set_stack_guard_mode(opts.stack_guard);
+    swarm.set_strict_io(opts.strict_io);
     if let Some(path) = &opts.rows {
         swarm.set_rows(path)?;
     }
@@ -1086,6 +1122,13 @@ pub fn run_one(
         robot
             .attach_debugger(debugger)
             .with_context(|| format!("--gdb-robot {k}"))?;
+    }
+    if let Some(k) = probes.profile.as_ref().map(|pr| &pr.robot) {
+        swarm
+            .robot_mut(*k)
+            .with_context(|| format!("--profile-robot {k}: the run has {} robots", s.robots))?
+            .start_profile()
+            .with_context(|| format!("--profile-robot {k}"))?;
     }
     let mut tracing = false;
     for step in 0..s.steps {
@@ -1127,6 +1170,13 @@ pub fn run_one(
     }
     if let Some(robot) = debugged.and_then(|k| swarm.robot_mut(k)) {
         robot.detach_debugger();
+    }
+    if let Some(pr) = &probes.profile
+        && let Some((folded, _)) = swarm.robot_mut(pr.robot).and_then(Robot::take_profile)
+    {
+        std::fs::write(&pr.path, folded)
+            .map_err(anyhow::Error::new)
+            .context(crate::output_error::OutputError::cannot_write(&pr.shown))?;
     }
     swarm.finish()
 }

@@ -1055,6 +1055,7 @@ mod tests {
             robots,
             recorded: None,
             stack_warnings: Vec::new(),
+            io_warnings: Vec::new(),
             energy: crate::energy::Charge::default(),
             motor_cap: crate::energy::CurrentCap::default(),
         }

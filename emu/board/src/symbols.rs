@@ -185,6 +185,15 @@ impl SymbolTable {
         k.checked_sub(1).map(|k| &t.symbols[t.functions[k].1])
     }
 
+    /// The first addresses of the functions, ascending (for a profile's tail calls,
+    /// [`h8_3052f::profile::StackProfile::new`]).
+    #[must_use]
+    pub fn function_entries(&self) -> Vec<u32> {
+        let mut v: Vec<u32> = self.inner.functions.iter().map(|&(a, _)| a).collect();
+        v.dedup();
+        v
+    }
+
     /// Whether a function starts exactly at `addr`.
     #[must_use]
     pub fn is_function_start(&self, addr: u32) -> bool {
