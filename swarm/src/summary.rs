@@ -888,6 +888,24 @@ mod tests {
     }
 
     #[test]
+    fn the_bootstrap_order_statistic_is_far_from_a_rounding_edge_for_every_repeat_count() {
+        // The interval's ends are the resampled means at floor(tail · 10 000) from either end;
+        // the tail comes through statrs, which calls the host's exp and ln, so it may differ by
+        // a few ulps from one platform or C library to another. For every repeat count a
+        // scenario allows, tail · 10 000 lies at least 1e-6 from a whole number, far more than
+        // ulps can move it: the same order statistic everywhere.
+        // (Below 1 the floor is 0 whatever the ulps: a probability is never negative.)
+        let mut nearest = f64::INFINITY;
+        for n in 2..=1000 {
+            let x = expanded_tail(n) * BOOTSTRAP_RESAMPLES as f64;
+            if x >= 0.5 {
+                nearest = nearest.min((x - x.round()).abs());
+            }
+        }
+        assert!(nearest > 1e-6, "{nearest}");
+    }
+
+    #[test]
     fn the_expanded_tail_widens_small_samples_and_tends_to_2_5_percent() {
         // n = 5: sqrt(5/4) · 2.776 = 3.104, Φ(−3.104) = 0.000955.
         assert!(
