@@ -9,6 +9,10 @@
 //!
 //!     cargo run --release --example stuck_probe [arena|corridor|FILE.toml] [REPEATS] [SEED]
 
+// A test, example or bench may use the host's f64 functions (clippy.toml): it checks the
+// models within tolerances, and its own output is not a promised result.
+#![allow(clippy::disallowed_methods)]
+
 use nn_q15::DynLearner;
 use swarm::collisions::StuckDetector;
 use swarm::experiment::Swarm;

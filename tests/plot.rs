@@ -1,6 +1,10 @@
 //! Tests of the figures module (`src/plot.rs`) through its public API: files written and valid,
 //! output bytes deterministic, bad data and bad paths reported as errors.
 
+// A test, example or bench may use the host's f64 functions (clippy.toml): it checks the
+// models within tolerances, and its own output is not a promised result.
+#![allow(clippy::disallowed_methods)]
+
 use h8swarm::plot;
 use swarm::experiment::Outline;
 

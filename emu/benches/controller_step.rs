@@ -9,6 +9,10 @@
 //! register by register), the reference the shortcuts are measured against.
 //! The emulated states of each are printed once before timing.
 
+// A test, example or bench may use the host's f64 functions (clippy.toml): it checks the
+// models within tolerances, and its own output is not a promised result.
+#![allow(clippy::disallowed_methods)]
+
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};

@@ -1,6 +1,10 @@
 //! The controller on the emulated MCU: boot, the tick, steps within bounds derived here from
 //! docs/design.md §4.2, saves and their restore, a power cut in the middle of a save, determinism.
 
+// A test, example or bench may use the host's f64 functions (clippy.toml): it checks the
+// models within tolerances, and its own output is not a promised result.
+#![allow(clippy::disallowed_methods)]
+
 use emu::board::board::{CLOCK_HZ, RobotBoard, RobotConfig, robot_mcu};
 use emu::board::model::{Controller, ControllerConfig, ModelBus, StepReport};
 use emu::chip::mcu::Mcu;

@@ -492,7 +492,7 @@ mod tests {
     fn mean_sd(xs: &[f64]) -> (f64, f64) {
         let n = xs.len() as f64;
         let mean = xs.iter().sum::<f64>() / n;
-        let var = xs.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
+        let var = xs.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / (n - 1.0);
         (mean, var.sqrt())
     }
 
@@ -595,7 +595,7 @@ mod tests {
         let sd_tol = 4.0 * 0.015 / (2.0 * ng).sqrt(); // ≈ 0.14 mV
         let (s_mean, _) = mean_sd(&spikes);
         // A spike's residual is U[0.15, 0.2] + N(0, σ): sd = sqrt(0.05²/12 + σ²) = 20.8 mV.
-        let s_tol = 4.0 * ((0.05f64.powi(2) / 12.0) + 0.015f64.powi(2)).sqrt()
+        let s_tol = 4.0 * (((0.05f64 * 0.05) / 12.0) + (0.015f64 * 0.015)).sqrt()
             / (spikes.len() as f64).sqrt();
         eprintln!(
             "noise: {} reads, gaussian mean {:+.4} mV sd {:.4} mV (n {}), spike rate {:.5}, \

@@ -429,7 +429,7 @@ impl FreeWheels {
         let dt = seconds / n;
         let tau_s = self.params.motor_time_constant_s;
         let top = self.params.top_speed_m_per_s;
-        let decay = (-dt / tau_s).exp();
+        let decay = libm::exp(-dt / tau_s);
         let mean_factor = tau_s / dt * (1.0 - decay);
         let traction = self.params.wheel_traction_n();
         let inv_track = 1.0 / self.params.wheel_track_m;

@@ -378,7 +378,7 @@ pub fn world_params(s: &Scenario) -> WorldParams {
         )
         .into_iter()
         .map(|m| {
-            let (sin, cos) = m.angle_rad.sin_cos();
+            let (sin, cos) = libm::sincos(m.angle_rad);
             SensorMount {
                 x_m: m.x_m - cos * s.world.sensor_setback_m,
                 y_m: m.y_m - sin * s.world.sensor_setback_m,
@@ -956,7 +956,7 @@ impl Swarm {
             if first {
                 out.push((0.0, false));
             } else {
-                let d = (p.x_m - xy.0).hypot(p.y_m - xy.1);
+                let d = libm::hypot(p.x_m - xy.0, p.y_m - xy.1);
                 let stuck = self.stuck[i].record(d, self.drove[i] && self.dead[i].is_none());
                 out.push((d, stuck));
             }
@@ -1455,7 +1455,7 @@ fn record(
                 robot: i,
                 time_s,
                 corners: world.corners(i)?,
-                heading: (p.heading_rad.cos(), p.heading_rad.sin()),
+                heading: (libm::cos(p.heading_rad), libm::sin(p.heading_rad)),
             });
         }
     }
@@ -1671,15 +1671,15 @@ mod tests {
     fn metrics_of(k: u32, gap: bool) -> StepMetrics {
         let x = f64::from(k);
         StepMetrics {
-            mean_d: 700.0 + (x * 0.37).sin() * 50.0,
+            mean_d: 700.0 + libm::sin(x * 0.37) * 50.0,
             collisions_per_robot: f64::from(k % 7) / 3.0,
-            contact_percent: 100.0 * (x * 0.11).cos().abs(),
+            contact_percent: 100.0 * libm::cos(x * 0.11).abs(),
             stuck_percent: f64::from(k % 5) * 20.0,
             moving_percent: f64::from(k % 3) * 50.0,
             moved_mm: 70.0 / (1.0 + x),
             gap_cv: gap.then_some(0.1 + x * 1e-4),
             cpu_load_percent: 0.3 + x * 1e-6,
-            energy_per_robot_mj: 3500.0 + x.cos(),
+            energy_per_robot_mj: 3500.0 + libm::cos(x),
         }
     }
 

@@ -21,7 +21,6 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
 use statrs::distribution::{ContinuousCDF, Normal, StudentsT};
-use statrs::function::factorial::ln_binomial;
 
 use crate::experiment::{RunOutput, WindowSums};
 use crate::robot::Condition;
@@ -164,9 +163,16 @@ pub fn sign_test_p(k: u32, n: u32) -> f64 {
     if k > n {
         return 0.0;
     }
+    // ln C(n, j) − n ln 2 from libm's log-gamma and exponential (pure Rust: the same bits on
+    // every platform, docs/limits-and-failures.md).
+    let ln_gamma = |x: f64| libm::lgamma_r(x).0;
+    let ln_n_fact = ln_gamma(f64::from(n) + 1.0);
     let ln_half_n = f64::from(n) * std::f64::consts::LN_2;
     let p: f64 = (k..=n)
-        .map(|j| (ln_binomial(u64::from(n), u64::from(j)) - ln_half_n).exp())
+        .map(|j| {
+            let ln_c = ln_n_fact - ln_gamma(f64::from(j) + 1.0) - ln_gamma(f64::from(n - j) + 1.0);
+            libm::exp(ln_c - ln_half_n)
+        })
         .sum();
     p.min(1.0)
 }

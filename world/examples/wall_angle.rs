@@ -20,6 +20,10 @@
 //!
 //!     cargo run --release -p world --example wall_angle
 
+// A test, example or bench may use the host's f64 functions (clippy.toml): it checks the
+// models within tolerances, and its own output is not a promised result.
+#![allow(clippy::disallowed_methods)]
+
 #[path = "../tests/coulomb_reference/mod.rs"]
 mod coulomb_reference;
 mod rapier_scene;

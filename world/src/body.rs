@@ -91,7 +91,7 @@ impl BodyConst {
         BodyConst {
             hx,
             hy,
-            radius_m: hx.hypot(hy),
+            radius_m: libm::hypot(hx, hy),
             inv_m,
             inv_i,
             half_track,

@@ -113,7 +113,7 @@ pub(crate) fn box_box(a: &Obb, b: &Obb, max_sep_m: f64) -> Option<Manifold> {
     let (r1, r2) = face_ends(rf, face);
     // Side planes of the reference face: tangent t from r1 to r2.
     let (tx, ty) = (r2.0 - r1.0, r2.1 - r1.1);
-    let len = tx.hypot(ty);
+    let len = libm::hypot(tx, ty);
     let (tx, ty) = (tx / len, ty / len);
     let lo = r1.0 * tx + r1.1 * ty;
     let hi = r2.0 * tx + r2.1 * ty;
@@ -281,7 +281,13 @@ mod tests {
         for k in 0..200 {
             let t = f64::from(k) * 0.0314;
             let a = Obb::new(0.0, 0.0, t, 0.115, 0.09);
-            let b = Obb::new(0.2 * t.cos(), 0.15 * (1.3 * t).sin(), -t, 0.115, 0.09);
+            let b = Obb::new(
+                0.2 * libm::cos(t),
+                0.15 * libm::sin(1.3 * t),
+                -t,
+                0.115,
+                0.09,
+            );
             if let Some(o) = obb_overlap(&a, &b, 0.0) {
                 let m = box_box(&a, &b, 0.01).expect("overlapping boxes have a manifold");
                 let deepest = m.points[..m.count]

@@ -242,7 +242,8 @@ mod tests {
             m.full_duty_volts
         );
         assert!(
-            (GEARBOX_EFFICIENCY - GEAR_STAGE_EFFICIENCY.powi(GEAR_STAGES)).abs() < 1e-12,
+            (GEARBOX_EFFICIENCY - libm::pow(GEAR_STAGE_EFFICIENCY, f64::from(GEAR_STAGES))).abs()
+                < 1e-12,
             "0.9^4"
         );
         assert_eq!(m.gearbox_efficiency, GEARBOX_EFFICIENCY);

@@ -27,7 +27,7 @@ pub struct Obb {
 impl Obb {
     /// A box from centre, heading angle and half extents.
     pub fn new(x: f64, y: f64, heading_rad: f64, hx: f64, hy: f64) -> Obb {
-        let (s, c) = heading_rad.sin_cos();
+        let (s, c) = libm::sincos(heading_rad);
         Obb { x, y, c, s, hx, hy }
     }
 
@@ -165,7 +165,7 @@ fn point_segment_distance(p: (f64, f64), a: (f64, f64), b: (f64, f64)) -> f64 {
     } else {
         0.0
     };
-    (wx - t * ex).hypot(wy - t * ey)
+    libm::hypot(wx - t * ex, wy - t * ey)
 }
 
 /// Distance along a ray from `(ox, oy)` in unit direction `(dx, dy)` to the box, if it is hit
@@ -252,7 +252,7 @@ pub fn arc_factors(phi: f64) -> (f64, f64, f64, f64) {
         // 1 − cos φ = φ · cosc φ exactly, so cos needs no series of its own.
         (phi * sinc, 1.0 - phi * cosc, sinc, cosc)
     } else {
-        let (s, c) = phi.sin_cos();
+        let (s, c) = libm::sincos(phi);
         (s, c, s / phi, (1.0 - c) / phi)
     }
 }
@@ -325,7 +325,7 @@ mod tests {
             -SERIES_LIMIT_RAD * (1.0 - 1e-12),
         ] {
             let (s1, c1, sc1, cc1) = arc_factors(p);
-            let (s, c) = p.sin_cos();
+            let (s, c) = libm::sincos(p);
             assert!((s1 - s).abs() < 1e-16, "{s1} {s}");
             assert!((c1 - c).abs() < 1e-16);
             assert!((sc1 - s / p).abs() < 1e-15);
@@ -336,7 +336,7 @@ mod tests {
         for k in 1..=1000 {
             let p = SERIES_LIMIT_RAD * f64::from(k) / 1000.0 * if k % 2 == 0 { 1.0 } else { -1.0 };
             let (s1, c1, sc1, _) = arc_factors(p);
-            let (s, c) = p.sin_cos();
+            let (s, c) = libm::sincos(p);
             assert!(
                 (s1 - s).abs() < 2e-17 && (c1 - c).abs() < 2e-16 && (sc1 - s / p).abs() < 4e-16,
                 "{p}"
@@ -375,7 +375,7 @@ mod tests {
         assert!((obb_distance(&a, &b) - 0.27).abs() < 1e-15);
         // Corner to corner along the diagonal.
         let c = Obb::new(0.33, 0.28, 0.0, 0.115, 0.09);
-        assert!((obb_distance(&a, &c) - 0.1f64.hypot(0.1)).abs() < 1e-15);
+        assert!((obb_distance(&a, &c) - libm::hypot(0.1, 0.1)).abs() < 1e-15);
         let d = Obb::new(0.2, 0.0, 1.0, 0.115, 0.09);
         assert_eq!(obb_distance(&a, &d), 0.0);
     }
@@ -421,7 +421,10 @@ mod tests {
         use parry2d::shape::Cuboid;
 
         fn ppose(b: &Obb) -> PPose {
-            PPose::new(Vector::new(b.x as f32, b.y as f32), b.s.atan2(b.c) as f32)
+            PPose::new(
+                Vector::new(b.x as f32, b.y as f32),
+                libm::atan2(b.s, b.c) as f32,
+            )
         }
 
         proptest! {
@@ -496,9 +499,9 @@ mod tests {
             ) {
                 let b = Obb::new(0.0, 0.0, tb, HX, HY);
                 // Aim roughly at the box so that most rays hit.
-                let base = (-oy).atan2(-ox);
+                let base = libm::atan2(-oy, -ox);
                 let dir = if th.abs() < 1.0 { base + aim } else { th };
-                let (dy, dx) = dir.sin_cos();
+                let (dy, dx) = libm::sincos(dir);
                 let ours = ray_obb(ox, oy, dx, dy, &b, 10.0);
 
                 // f64 reference: the nearest crossing of the four edges (0 from inside).

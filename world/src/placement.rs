@@ -98,7 +98,7 @@ pub(crate) fn place_open(
             clearance_m: clr,
         });
     }
-    let reach = 2.0 * hx.hypot(hy) + clr;
+    let reach = 2.0 * libm::hypot(hx, hy) + clr;
     let mut grid_cells: Vec<Vec<u32>>;
     let cell_m = reach.max((w * h / (n.max(1) as f64)).sqrt());
     let nx = ((w / cell_m).ceil() as usize).max(1);
@@ -126,7 +126,7 @@ pub(crate) fn place_open(
         }
         attempts += 1;
         let theta = core::f64::consts::PI * (2.0 * unit(&mut rng) - 1.0);
-        let (s, c) = theta.sin_cos();
+        let (s, c) = libm::sincos(theta);
         let ex = hx * c.abs() + hy * s.abs() + clr;
         let ey = hx * s.abs() + hy * c.abs() + clr;
         let ux = unit(&mut rng);

@@ -356,7 +356,7 @@ impl World {
         Ok(Pose {
             x_m: b.x,
             y_m: b.y,
-            heading_rad: b.s.atan2(b.c),
+            heading_rad: libm::atan2(b.s, b.c),
         })
     }
 
@@ -931,7 +931,7 @@ fn check_robot_count(n: usize) -> Result<(), WorldError> {
 }
 
 fn body_pose(p: &Pose) -> BodyPose {
-    let (s, c) = p.heading_rad.sin_cos();
+    let (s, c) = libm::sincos(p.heading_rad);
     BodyPose {
         x: p.x_m,
         y: p.y_m,

@@ -6,6 +6,10 @@
 //! while θ < atan(half width / half length) + atan(μ_wall) (54.7° by default); past that the
 //! corner slides and the wall's force turns the robot parallel to the wall (docs/physics.md).
 
+// A test, example or bench may use the host's f64 functions (clippy.toml): it checks the
+// models within tolerances, and its own output is not a promised result.
+#![allow(clippy::disallowed_methods)]
+
 mod coulomb_reference;
 
 use coulomb_reference::{Sample, Scene};

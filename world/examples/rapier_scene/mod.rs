@@ -5,6 +5,10 @@
 //! towards the motor's mean speed over the step and resists its sideways slip, limited together
 //! to the patch's Coulomb friction (μ_floor · m · g / 2).
 
+// A test, example or bench may use the host's f64 functions (clippy.toml): it checks the
+// models within tolerances, and its own output is not a promised result.
+#![allow(clippy::disallowed_methods)]
+
 use rapier2d::prelude::*;
 
 /// A world without gravity (the floor is the plane of the scene), stepped by `dt` s, with four

@@ -205,7 +205,7 @@ pub(crate) mod tests {
         let pose: Vec<BodyPose> = xs
             .iter()
             .map(|&(fx, fy, th)| {
-                let (s, c) = th.sin_cos();
+                let (s, c) = libm::sincos(th);
                 BodyPose {
                     x: fx * w,
                     y: fy * h,

@@ -147,7 +147,7 @@ impl Corrections {
         b.y += py * s.body.inv_m;
         let dtheta = (r[0] * py - r[1] * px) * s.body.inv_i;
         if dtheta != 0.0 {
-            let (sn, cs) = dtheta.sin_cos();
+            let (sn, cs) = libm::sincos(dtheta);
             let (c, s) = (b.c * cs - b.s * sn, b.s * cs + b.c * sn);
             let k = 1.5 - 0.5 * (c * c + s * s);
             b.c = c * k;
@@ -302,8 +302,8 @@ impl Corrections {
 /// The pose a fraction `f` of the way from `a` to `b` (position linearly, heading by the
 /// shorter rotation).
 fn interpolate(a: BodyPose, b: BodyPose, f: f64) -> BodyPose {
-    let dtheta = (a.c * b.s - a.s * b.c).atan2(a.c * b.c + a.s * b.s);
-    let (sn, cs) = (f * dtheta).sin_cos();
+    let dtheta = libm::atan2(a.c * b.s - a.s * b.c, a.c * b.c + a.s * b.s);
+    let (sn, cs) = libm::sincos(f * dtheta);
     BodyPose {
         x: a.x + f * (b.x - a.x),
         y: a.y + f * (b.y - a.y),

@@ -129,7 +129,7 @@ impl MountRays {
                             params.cone_half_angle_rad
                                 * (2.0 * f64::from(r) / f64::from(k - 1) - 1.0)
                         };
-                        let (s, c) = (m.angle_rad + off).sin_cos();
+                        let (s, c) = libm::sincos(m.angle_rad + off);
                         (c, s)
                     })
                     .collect();

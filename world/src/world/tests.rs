@@ -3,6 +3,10 @@
 //! own tests stand in their files (the broad phase and the rays against brute force,
 //! placement; the geometry against `parry2d`).
 
+// A test, example or bench may use the host's f64 functions (clippy.toml): it checks the
+// models within tolerances, and its own output is not a promised result.
+#![allow(clippy::disallowed_methods)]
+
 use super::*;
 use crate::geometry::{ray_obb, ray_walls};
 use crate::motor::Behaviour;

@@ -9,6 +9,10 @@
 //! follow their targets with the motors' first-order lag. The body and wheel constants are the
 //! world's defaults.
 
+// A test, example or bench may use the host's f64 functions (clippy.toml): it checks the
+// models within tolerances, and its own output is not a promised result.
+#![allow(clippy::disallowed_methods)]
+
 use world::params::{
     BODY_LENGTH_M, BODY_WIDTH_M, GRAVITY_M_PER_S2, MASS_KG, MOTOR_TIME_CONSTANT_S, MU_FLOOR,
     TOP_SPEED_M_PER_S, WHEEL_TRACK_M,
