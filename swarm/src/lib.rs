@@ -16,6 +16,7 @@ pub mod collisions;
 pub mod energy;
 pub mod experiment;
 pub mod fit;
+pub mod motion;
 pub mod output_error;
 pub mod recording;
 pub mod robot;
