@@ -6,7 +6,7 @@
 //!   that is neither finished nor failed), one column per swept key, `seed`; then for every
 //!   condition and window of the points' summary.json the mean and 95 % interval of each
 //!   statistic (`learning.last.collisions_per_m.mean`, `….lo`, `….hi`) and of each condition's
-//!   robots (`learning.robots.ending_stuck_percent.mean`, `learning.robots.ending_stuck`, …);
+//!   robots (`learning.robots.ending_held_percent.mean`, `learning.robots.ending_held`, …);
 //!   then for every claim (column names from its text, `claim.<words>.…`): `outcome` (`holds`,
 //!   `unsure`, `fails`, `undecided`), `means_agree`, `apart` (intervals apart), `a` and `b`
 //!   (the two means compared: the claim is "a below b"), `effect` = b − a (positive when the
@@ -37,16 +37,21 @@ use super::points::{PointState, host_name, is_dead_leftover, point_state, read_s
 use swarm::text::printable;
 
 /// The statistics of a window in the order the table lists them (others follow, sorted).
-const STAT_ORDER: [&str; 9] = [
+const STAT_ORDER: [&str; 14] = [
     "mean_d",
     "collisions_per_robot",
+    "collisions_per_net_m",
     "collisions_per_m",
-    "collisions_per_moving_step",
     "contact_percent",
-    "stuck_percent",
-    "moving_percent",
+    "held_percent",
+    "shuttling_percent",
+    "circling_percent",
+    "exploring_percent",
+    "net_mm",
     "moved_mm",
+    "fresh_cells_per_100_steps",
     "gap_cv",
+    "touching_percent",
 ];
 
 /// A claim's words as a column name: lower case, runs of anything but letters and digits as

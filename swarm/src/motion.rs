@@ -295,6 +295,121 @@ impl MotionTracker {
     }
 }
 
+/// One robot's record over a whole run: how far it went (path and net metres), how often it
+/// collided, how its steps were classified, and its held spells. A **held spell** is a run of
+/// steps classified [`MotionClass::Held`]; its **onset** is its first held step. A spell is
+/// **lasting** when it holds for at least `lasting_steps` steps in a row, or until the run ends.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RobotTally {
+    /// Distance its centre moved, summed step to step (the path), metres.
+    pub distance_m: f64,
+    /// Net metres: its net displacement over the lag per step ([`MotionStep::net_m`]), summed
+    /// over the steps, metres.
+    pub net_m: f64,
+    /// Collisions counted for its behaviours.
+    pub collisions: u64,
+    /// Steps in which it moved at least [`crate::collisions::MOVING_MIN_MM`] (a reference).
+    pub moving_steps: u32,
+    /// Its steps by class, in the order of [`MotionClass::ALL`].
+    pub class_steps: [u32; 4],
+    /// Distance moved in the run's last window, metres.
+    pub last_window_distance_m: f64,
+    /// Net metres in the run's last window.
+    pub last_window_net_m: f64,
+    /// Collisions in the run's last window.
+    pub last_window_collisions: u64,
+    /// Distinct cells ([`CELL_M`]) it was in over the run's last window (set at the end).
+    pub last_window_cells: u32,
+    /// Distinct cells it was in over the run (set at the end).
+    pub cells_visited: u32,
+    /// Onset step of its first lasting held spell, if it had one.
+    pub first_lasting_held_step: Option<u32>,
+    /// Whether it was held at the run's last step.
+    pub ends_held: bool,
+    /// The class of its latest step.
+    pub last_class: Option<MotionClass>,
+    /// The current spell: its onset and how many steps it has lasted.
+    spell: Option<(u32, u32)>,
+    lasting_steps: u32,
+}
+
+impl RobotTally {
+    /// An empty record; spells of at least `lasting_steps` held steps are lasting.
+    #[must_use]
+    pub fn new(lasting_steps: u32) -> Self {
+        Self {
+            distance_m: 0.0,
+            net_m: 0.0,
+            collisions: 0,
+            moving_steps: 0,
+            class_steps: [0; 4],
+            last_window_distance_m: 0.0,
+            last_window_net_m: 0.0,
+            last_window_collisions: 0,
+            last_window_cells: 0,
+            cells_visited: 0,
+            first_lasting_held_step: None,
+            ends_held: false,
+            last_class: None,
+            spell: None,
+            lasting_steps: lasting_steps.max(1),
+        }
+    }
+
+    /// Steps it spent in class `c`.
+    #[must_use]
+    pub fn steps_in(&self, c: MotionClass) -> u32 {
+        self.class_steps[c.code() as usize]
+    }
+
+    /// Records step `k`: what the tracker said of it, the collisions counted for it, and
+    /// whether it is in the last window.
+    pub fn record(&mut self, k: u32, m: &MotionStep, collisions: u64, last: bool) {
+        self.distance_m += m.step_m;
+        self.net_m += m.net_m;
+        self.collisions += collisions;
+        if m.step_m * 1000.0 >= crate::collisions::MOVING_MIN_MM {
+            self.moving_steps += 1;
+        }
+        self.class_steps[m.class.code() as usize] += 1;
+        if last {
+            self.last_window_distance_m += m.step_m;
+            self.last_window_net_m += m.net_m;
+            self.last_window_collisions += collisions;
+        }
+        self.last_class = Some(m.class);
+        let held = m.class == MotionClass::Held;
+        self.ends_held = held;
+        if held {
+            let (onset, steps) = self.spell.map_or((k, 1), |(o, n)| (o, n + 1));
+            self.spell = Some((onset, steps));
+            if steps >= self.lasting_steps && self.first_lasting_held_step.is_none() {
+                self.first_lasting_held_step = Some(onset);
+            }
+        } else {
+            self.spell = None;
+        }
+    }
+
+    /// Whether it is held now (at the latest step recorded).
+    #[must_use]
+    pub fn held_now(&self) -> bool {
+        self.spell.is_some()
+    }
+
+    /// Closes the run: a spell still going at the end is lasting; the cells come from the
+    /// robot's tracker, the last window from step `last_from` on.
+    pub fn finish(&mut self, tracker: &MotionTracker, last_from: u32) {
+        if let Some((onset, _)) = self.spell
+            && self.first_lasting_held_step.is_none()
+        {
+            self.first_lasting_held_step = Some(onset);
+        }
+        self.cells_visited = tracker.cells_visited();
+        self.last_window_cells = tracker.cells_since(last_from);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -553,5 +668,56 @@ mod tests {
         }
         let m = t.record(0.3, 0.05);
         assert_eq!((m.fresh_cells, m.new_cells), (1, 0));
+    }
+
+    fn step(class: MotionClass, step_m: f64) -> MotionStep {
+        MotionStep {
+            class,
+            step_m,
+            net_m: if class == MotionClass::Exploring { step_m } else { 0.0 },
+            sq_disp_m2: [None; 3],
+            fresh_cells: 0,
+            new_cells: 0,
+        }
+    }
+
+    #[test]
+    fn a_tally_finds_the_first_lasting_spell_and_its_onset() {
+        let mut t = RobotTally::new(50);
+        // Steps 0..200 explore; held at 200..230 (too short); exploring again; held from 400
+        // on, lasting once held 50 times.
+        for k in 0..600u32 {
+            let held = (200..230).contains(&k) || k >= 400;
+            let m = if held {
+                step(MotionClass::Held, 0.0)
+            } else {
+                step(MotionClass::Exploring, 0.05)
+            };
+            t.record(k, &m, u64::from(k == 10), k >= 500);
+        }
+        assert_eq!(t.first_lasting_held_step, Some(400));
+        assert!(t.ends_held && t.held_now());
+        assert_eq!(t.steps_in(MotionClass::Held), 30 + 200);
+        assert_eq!(t.steps_in(MotionClass::Exploring), 370);
+        assert_eq!(t.collisions, 1);
+        assert_eq!(t.last_window_collisions, 0);
+        assert_eq!(t.moving_steps, 370);
+        assert!((t.distance_m - 0.05 * 370.0).abs() < 1e-9);
+        assert!((t.net_m - 0.05 * 370.0).abs() < 1e-9);
+        assert_eq!(t.last_window_distance_m, 0.0);
+        // A spell too short to be lasting still is, when the run ends in it.
+        let mut end = RobotTally::new(500);
+        for k in 0..300u32 {
+            let c = if k >= 250 {
+                MotionClass::Held
+            } else {
+                MotionClass::Shuttling
+            };
+            end.record(k, &step(c, 0.01), 0, false);
+        }
+        assert_eq!(end.first_lasting_held_step, None);
+        end.finish(&MotionTracker::new(), 250);
+        assert_eq!(end.first_lasting_held_step, Some(250));
+        assert_eq!(end.cells_visited, 0);
     }
 }
