@@ -10,7 +10,7 @@
 //!     cargo run --release --example stuck_probe [arena|corridor|FILE.toml] [REPEATS] [SEED]
 
 use nn_q15::DynLearner;
-use swarm::collisions::StuckDetector;
+use swarm::motion::{MotionClass, MotionTracker};
 use swarm::experiment::Swarm;
 use swarm::robot::{Brain, Condition};
 use swarm::scenario::Scenario;
@@ -128,14 +128,12 @@ fn run_repeat(
     let threshold = s.learner.threshold;
     let mut sw = Swarm::new(s, condition, repeat, false, None)?;
     let n = s.robots;
-    let mut det = vec![StuckDetector::default(); n];
+    let mut det = vec![MotionTracker::new(); n];
     let mut was_stuck = vec![false; n];
-    let mut xy: Vec<(f64, f64)> = (0..n)
-        .map(|i| {
-            let p = sw.world().pose(i).unwrap();
-            (p.x_m, p.y_m)
-        })
-        .collect();
+    for (i, d) in det.iter_mut().enumerate() {
+        let p = sw.world().pose(i)?;
+        d.start(p.x_m, p.y_m);
+    }
     let mut d_prev = vec![None::<i16>; n];
     let mut prev_win = vec![0usize; n];
     let mut since = vec![0u32; n];
@@ -143,10 +141,7 @@ fn run_repeat(
         sw.step()?;
         for i in 0..n {
             let pose = sw.world().pose(i)?;
-            let moved = (pose.x_m - xy[i].0).hypot(pose.y_m - xy[i].1);
-            xy[i] = (pose.x_m, pose.y_m);
-            let speeds = sw.world().wheel_speeds(i)?;
-            let is_stuck = det[i].record(moved, speeds.iter().any(|&v| v != 0.0));
+            let is_stuck = det[i].record(pose.x_m, pose.y_m).class == MotionClass::Held;
             let bumpers = sw.world().bumpers(i)?;
             let Some(robot) = sw.robot_mut(i) else {
                 continue;

@@ -1631,6 +1631,8 @@ mod tests {
             mean: vec![lo],
             lo: vec![lo],
             hi: vec![hi],
+            n: Vec::new(),
+            repeats: 0,
         };
         // Close to 0 (within 30 % of the span): the axis starts at 0.
         assert_eq!(value_range(&[s(0.2, 1.0)]).0, 0.0);
