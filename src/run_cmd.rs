@@ -1534,10 +1534,11 @@ fn claim_line(t: &mut String, c: &Claim) {
             c.unit
         )
     } else {
+        let r = &c.repeats;
         format!(
-            "{} of {} repeats meet all its parts",
-            c.repeats.for_,
-            c.repeats.for_ + c.repeats.against + c.repeats.tied + c.repeats.undefined
+            "{} of {} meet all its parts",
+            r.for_,
+            plural(r.for_ + r.against + r.tied + r.undefined, "repeat")
         )
     };
     let _ = writeln!(
