@@ -241,6 +241,24 @@ fn earlier_figures(out: &Path) -> Vec<String> {
         .collect()
 }
 
+/// Merges the sweep in `dir` into `out` (default `DIR/merged`) and, when `dir` holds a
+/// confirmation ([`super::confirm`]), it into `out/confirm` with the two side by side; returns
+/// what to print and whether every point of both finished.
+///
+/// # Errors
+/// Not a sweep folder (input); an output that cannot be written (tool).
+pub fn merge_all(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepError> {
+    let (mut t, complete) = merge(dir, out)?;
+    let out: PathBuf = out.map_or_else(|| dir.join("merged"), Path::to_path_buf);
+    if dir.join(super::confirm::CONFIRM_DIR).join("plan.json").is_file() {
+        let _ = writeln!(t);
+        let (ct, c_complete) = super::confirm::merge_confirmation(dir, &out)?;
+        t.push_str(&ct);
+        return Ok((t, complete && c_complete));
+    }
+    Ok((t, complete))
+}
+
 /// Merges the sweep in `dir` into `out` (default `DIR/merged`); returns what to print and
 /// whether every point finished.
 ///
@@ -379,7 +397,7 @@ fn write_csv(m: &Merged, out: &Path) -> Result<PathBuf, SweepError> {
 
 /// Each claim's result per point (its repeats for, against and tied, and its effect), for the
 /// figures.
-fn claim_series(m: &Merged) -> Vec<ClaimSeries> {
+pub(super) fn claim_series(m: &Merged) -> Vec<ClaimSeries> {
     m.claims
         .iter()
         .map(|(slug, text, paper)| ClaimSeries {

@@ -535,7 +535,7 @@ fn plan_of(sweep: &Sweep) -> Result<Plan, SweepError> {
 }
 
 /// The sweep folder `dir`, created if need be, as an absolute path.
-fn plan_folder(dir: &Path) -> Result<PathBuf, SweepError> {
+pub(super) fn plan_folder(dir: &Path) -> Result<PathBuf, SweepError> {
     std::fs::create_dir_all(dir).map_err(|e| {
         SweepError::tool(format!(
             "cannot create the sweep folder `{}`: {e}",
@@ -629,7 +629,7 @@ fn write_list(sweep: &Sweep, per_task: usize, path: &Path) -> Result<(), SweepEr
 }
 
 /// Whether two files hold the same bytes (read a block at a time).
-fn same_file_bytes(a: &Path, b: &Path) -> Result<bool, SweepError> {
+pub(super) fn same_file_bytes(a: &Path, b: &Path) -> Result<bool, SweepError> {
     let open = |p: &Path| {
         std::fs::File::open(p)
             .map(std::io::BufReader::new)
