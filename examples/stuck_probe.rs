@@ -10,8 +10,8 @@
 //!     cargo run --release --example stuck_probe [arena|corridor|FILE.toml] [REPEATS] [SEED]
 
 use nn_q15::DynLearner;
-use swarm::motion::{MotionClass, MotionTracker};
 use swarm::experiment::Swarm;
+use swarm::motion::{MotionClass, MotionTracker};
 use swarm::robot::{Brain, Condition};
 use swarm::scenario::Scenario;
 

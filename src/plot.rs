@@ -413,7 +413,12 @@ fn has_partial_points(fig: &LearningFigure) -> bool {
     fig.d
         .iter()
         .chain(&fig.collisions)
-        .chain(fig.more.iter().take(MAX_MORE_PANELS).flat_map(|p| &p.series))
+        .chain(
+            fig.more
+                .iter()
+                .take(MAX_MORE_PANELS)
+                .flat_map(|p| &p.series),
+        )
         .any(|s| (0..s.x.len()).any(|i| !s.full(i)))
 }
 
@@ -805,16 +810,8 @@ fn draw_panel<DB: DrawingBackend>(
                 .color(&colour)
                 .pos(Pos::new(HPos::Left, VPos::Bottom));
             for (i, &p) in points.iter().enumerate().filter(|&(i, _)| !s.full(i)) {
-                chart.draw_series(std::iter::once(Circle::new(
-                    p,
-                    7,
-                    WHITE.filled(),
-                )))?;
-                chart.draw_series(std::iter::once(Circle::new(
-                    p,
-                    7,
-                    colour.stroke_width(2),
-                )))?;
+                chart.draw_series(std::iter::once(Circle::new(p, 7, WHITE.filled())))?;
+                chart.draw_series(std::iter::once(Circle::new(p, 7, colour.stroke_width(2))))?;
                 chart.draw_series(std::iter::once(
                     EmptyElement::at(p)
                         + Text::new(format!("{}", s.n[i]), (8, -6), count_font.clone()),

@@ -1739,7 +1739,10 @@ fn write_robots(path: &Path, runs: &[RunOutput]) -> Result<()> {
                     format!("{}", t.last_window_net_m),
                     t.last_window_collisions.to_string(),
                     t.last_window_cells.to_string(),
-                    t.last_class.map(MotionClass::name).unwrap_or_default().to_string(),
+                    t.last_class
+                        .map(MotionClass::name)
+                        .unwrap_or_default()
+                        .to_string(),
                 ])?;
             }
         }

@@ -728,10 +728,7 @@ fn six_panels_with_the_held_overlay_and_side_by_side_arenas_are_drawn() {
     let (_, h3) = png_size(&std::fs::read(&png).unwrap());
     assert!(h3 > h2 + 400, "a third row: {h3} after {h2}");
     let svg_text = std::fs::read_to_string(&svg).unwrap();
-    assert!(
-        svg_text.contains("held robot-steps"),
-        "the right-hand axis"
-    );
+    assert!(svg_text.contains("held robot-steps"), "the right-hand axis");
     let panels = dir.join("arena.png");
     h8swarm::plot::arena_figure_panels(&[arena(3, 1.8, 200), arena(3, 1.8, 200)], &panels)
         .expect("draw panels");
@@ -918,7 +915,10 @@ fn a_right_axis_title_keeps_clear_of_the_next_panel_s() {
             }
         }
     }
-    assert_eq!(checked, 1, "the bottom-left panel has a neighbour: {checked}");
+    assert_eq!(
+        checked, 1,
+        "the bottom-left panel has a neighbour: {checked}"
+    );
 }
 
 /// A point that rests on fewer repeats than the condition ran is drawn as an open circle with
@@ -945,9 +945,16 @@ fn points_resting_on_fewer_repeats_are_marked_and_have_no_band() {
     let mut n = vec![5; fig.collisions[0].x.len()];
     n[k] = 3;
     fig.collisions[0].n = n;
-    assert_eq!(polygons(&fig), full + 1, "the band cut in two at the partial point");
+    assert_eq!(
+        polygons(&fig),
+        full + 1,
+        "the band cut in two at the partial point"
+    );
     let svg = std::fs::read_to_string(dir.join("fig.svg")).unwrap();
-    assert!(svg.contains("open circle: a window in which fewer repeats"), "the note");
+    assert!(
+        svg.contains("open circle: a window in which fewer repeats"),
+        "the note"
+    );
     assert!(svg.contains(">\n3\n</text>"), "its count beside it");
     // Every point partial: no band at all for that curve.
     fig.collisions[0].n = vec![3; fig.collisions[0].x.len()];

@@ -330,7 +330,10 @@ fn check_page(browser: &Browser, dir: &Path, s: &Scenario, k: u32, controller: &
     // The motion class the run gave robot 1's last step, and where it went.
     let want = classes[1].map_or("(from the first step on)", MotionClass::name);
     assert!(facts.contains(&format!("motion     {want}")), "{facts}");
-    assert!(facts.contains("net, path  ") && facts.contains("cells      "), "{facts}");
+    assert!(
+        facts.contains("net, path  ") && facts.contains("cells      "),
+        "{facts}"
+    );
     // A click on robot 1's drawn centre selects it too.
     tab.eval("h8.select(-1)");
     let picked = tab.eval(

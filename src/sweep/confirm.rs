@@ -84,7 +84,9 @@ fn coords_of(axes: &[Axis], mut index: usize) -> Vec<usize> {
 }
 
 /// The map's paper-claim series and its region (cells where they all hold, pooled).
-fn map_region(dir: &Path) -> Result<(Plan, Vec<PlanLine>, Vec<ClaimSeries>, Vec<usize>), SweepError> {
+fn map_region(
+    dir: &Path,
+) -> Result<(Plan, Vec<PlanLine>, Vec<ClaimSeries>, Vec<usize>), SweepError> {
     let (plan, lines, m) = super::merge::collect(dir)?;
     let not_ok = m.failed.len() + m.missing.len() + m.broken.len();
     if not_ok > 0 {
@@ -201,7 +203,10 @@ pub fn plan_confirmation(dir: &Path, bin: Option<&Path>) -> Result<String, Sweep
         "each task asks for {} CPUs, {} MB, {}",
         cplan.requests.cpus_per_task, cplan.requests.mem_mb, cplan.requests.time
     );
-    let _ = writeln!(t, "wrote {out_text} (plan.json, points.jsonl, sweep.sbatch, confirm.json)");
+    let _ = writeln!(
+        t,
+        "wrote {out_text} (plan.json, points.jsonl, sweep.sbatch, confirm.json)"
+    );
     let _ = writeln!(t, "on a cluster: sbatch {out_text}/sweep.sbatch");
     let _ = writeln!(t, "on this machine: h8swarm sweep run {out_text}");
     let _ = writeln!(
@@ -436,7 +441,9 @@ pub fn merge_confirmation(dir: &Path, out: &Path) -> Result<(String, bool), Swee
             let map: Vec<Cell> = map_cells.iter().map(|c| c[cell].clone()).collect();
             let confirmation: Vec<Cell> = conf_cells.iter().map(|c| c[cell].clone()).collect();
             let confirmed = !confirmation.is_empty()
-                && confirmation.iter().all(|c| c.outcome() == CellOutcome::Holds);
+                && confirmation
+                    .iter()
+                    .all(|c| c.outcome() == CellOutcome::Holds);
             let margin = confirmation
                 .iter()
                 .map(|c| {
@@ -506,7 +513,14 @@ fn write_table(
     }
     for s in series {
         for stage in ["map", "confirmation"] {
-            for part in ["outcome", "for", "against", "defined", "repeats_needed"] {
+            for part in [
+                "outcome",
+                "for",
+                "against",
+                "defined",
+                "towards",
+                "repeats_needed",
+            ] {
                 columns.push(format!("{stage}.{}.{part}", s.slug));
             }
         }
@@ -537,12 +551,14 @@ fn write_table(
                     CellOutcome::Opposite => "opposite",
                     CellOutcome::NoData => "no-data",
                 };
+                let power = Power::of(&paired(cell));
                 cells_text.extend([
                     o.to_string(),
                     cell.for_.to_string(),
                     cell.against.to_string(),
                     cell.defined.to_string(),
-                    Power::of(&paired(cell))
+                    power.towards.to_string(),
+                    power
                         .repeats_needed
                         .map(|n| n.to_string())
                         .unwrap_or_default(),
@@ -616,8 +632,13 @@ fn render(
             cell_words(axes, r.cell),
             r.neighbours_in_region,
             r.neighbours,
-            if r.in_region { "" } else { " (not itself in it)" },
-            r.margin.map_or_else(|| "none".into(), |m| format!("{m:+.2}"))
+            if r.in_region {
+                ""
+            } else {
+                " (not itself in it)"
+            },
+            r.margin
+                .map_or_else(|| "none".into(), |m| format!("{m:+.2}"))
         );
         for ((s, m), c) in series.iter().zip(&r.map).zip(&r.confirmation) {
             let words: String = s.text.split(':').next().unwrap_or(&s.text).to_string();
@@ -660,7 +681,9 @@ mod tests {
     fn axes() -> Vec<Axis> {
         let ax = |k: &str, n: usize| Axis {
             keys: vec![k.into()],
-            values: (0..n).map(|i| vec![toml::Value::Integer(i as i64)]).collect(),
+            values: (0..n)
+                .map(|i| vec![toml::Value::Integer(i as i64)])
+                .collect(),
         };
         vec![ax("a", 3), ax("b", 2)]
     }
@@ -685,7 +708,10 @@ mod tests {
             cells: CellChoice::RegionAndNeighbours,
             repeats: None,
         };
-        assert_eq!(choose_cells(&a, &c, &[cell_index(&a, &[0, 0])]), vec![0, 1, 2]);
+        assert_eq!(
+            choose_cells(&a, &c, &[cell_index(&a, &[0, 0])]),
+            vec![0, 1, 2]
+        );
         assert_eq!(seed_list(&[21, 22, 23]), "21-23");
         assert_eq!(seed_list(&[6, 9]), "6, 9");
     }

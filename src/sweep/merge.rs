@@ -250,7 +250,11 @@ fn earlier_figures(out: &Path) -> Vec<String> {
 pub fn merge_all(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepError> {
     let (mut t, complete) = merge(dir, out)?;
     let out: PathBuf = out.map_or_else(|| dir.join("merged"), Path::to_path_buf);
-    if dir.join(super::confirm::CONFIRM_DIR).join("plan.json").is_file() {
+    if dir
+        .join(super::confirm::CONFIRM_DIR)
+        .join("plan.json")
+        .is_file()
+    {
         let _ = writeln!(t);
         let (ct, c_complete) = super::confirm::merge_confirmation(dir, &out)?;
         t.push_str(&ct);
@@ -326,6 +330,7 @@ pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepErro
         m.broken.len()
     );
     render_points(&mut t, &m, dir);
+    render_repeat_warning(&mut t, &plan, &lines);
     for (slug, text, _) in &m.claims {
         let col = format!("claim.{slug}.outcome");
         let with: Vec<&str> = m
@@ -341,6 +346,7 @@ pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepErro
             printable(text)
         );
     }
+    render_power(&mut t, &plan, &coords, &paper);
     if !paper.is_empty() {
         let cells: usize = plan.axes.iter().map(|a| a.values.len()).product();
         let _ = writeln!(
@@ -447,6 +453,91 @@ fn remove_stale_figures(
         }
     }
     Ok(())
+}
+
+/// The warning `h8swarm run` gives when a point's repeats cannot reach p < 0.05, for the
+/// points of the plan, and whether a cell's pooled repeats can.
+fn render_repeat_warning(
+    t: &mut String,
+    plan: &super::plan::Plan,
+    lines: &[super::plan::PlanLine],
+) {
+    let repeats: Vec<i64> = lines
+        .iter()
+        .filter_map(|l| l.scenario.get("repeats").and_then(toml::Value::as_integer))
+        .collect();
+    let Some(&fewest) = repeats.iter().min() else {
+        return;
+    };
+    let min_needed = 5;
+    if fewest >= min_needed {
+        return;
+    }
+    let pooled = fewest * plan.seeds.len() as i64;
+    let _ = writeln!(
+        t,
+        "WARNING points of {fewest} repeats: a point's own one-sided sign test needs at least {min_needed} repeats all going one way to reach p < 0.05, so no claim can hold in a point{}",
+        if pooled >= min_needed {
+            format!(
+                "; the maps pool a cell's {} seeds ({pooled} repeats), which can",
+                plan.seeds.len()
+            )
+        } else {
+            format!(
+                "; nor in a cell of the maps ({} seeds x {fewest} = {pooled} repeats)",
+                plan.seeds.len()
+            )
+        }
+    );
+}
+
+/// Per claim of the paper's, its cells by pooled outcome, and the repeats a cell would need at
+/// the effect it shows where it is not yet decided (the median over those cells).
+fn render_power(
+    t: &mut String,
+    plan: &super::plan::Plan,
+    coords: &[Vec<usize>],
+    paper: &[&ClaimSeries],
+) {
+    use super::figures::{CellOutcome, cells};
+    for s in paper {
+        let cs = cells(&plan.axes, coords, s);
+        let count = |o: CellOutcome| cs.iter().filter(|c| c.outcome() == o).count();
+        let mut needed: Vec<u32> = cs
+            .iter()
+            .filter(|c| c.outcome() == CellOutcome::Unsure)
+            .filter_map(|c| {
+                let untied = c.for_ + c.against;
+                swarm::summary::Power::of(&swarm::summary::Paired {
+                    for_: c.for_,
+                    against: c.against,
+                    tied: c.defined - untied,
+                    undefined: 0,
+                    p: swarm::summary::sign_test_p(c.for_, untied),
+                    p_opposite: swarm::summary::sign_test_p(c.against, untied),
+                })
+                .repeats_needed
+            })
+            .collect();
+        needed.sort_unstable();
+        let unsure = count(CellOutcome::Unsure);
+        let need = match needed.get(needed.len() / 2) {
+            Some(n) if unsure > 0 => format!(
+                " (at the effect they show, a median of {n} repeats a cell would decide them)"
+            ),
+            _ => String::new(),
+        };
+        let words = s.text.split(':').next().unwrap_or(&s.text);
+        let _ = writeln!(
+            t,
+            "cells (pooled over seeds): {} holds in {}, unsure in {unsure}{need}, fails in {}, the opposite in {}, no data in {}",
+            printable(words),
+            count(CellOutcome::Holds),
+            count(CellOutcome::Fails),
+            count(CellOutcome::Opposite),
+            count(CellOutcome::NoData)
+        );
+    }
 }
 
 /// The report's lines on the points that did not finish: failed, missing, broken, and the
@@ -589,6 +680,8 @@ fn claim_cells(
             ("tied", r["tied"].clone()),
             ("undefined", r["undefined"].clone()),
             ("p", r["p"].clone()),
+            ("towards", c["power"]["towards"].clone()),
+            ("repeats_needed", c["power"]["repeats_needed"].clone()),
         ];
         for (part, v) in cells {
             let col = format!("claim.{slug}.{part}");

@@ -173,7 +173,8 @@ pub fn command(args: &SweepArgs) -> (String, Result<(), SweepError>) {
             ),
             Err(e) => (String::new(), Err(e)),
         },
-        SweepCommand::Confirm { dir, bin } => match confirm::plan_confirmation(dir, bin.as_deref()) {
+        SweepCommand::Confirm { dir, bin } => match confirm::plan_confirmation(dir, bin.as_deref())
+        {
             Ok(text) => (text, Ok(())),
             Err(e) => (String::new(), Err(e)),
         },

@@ -733,9 +733,12 @@ fn confirm_of(
         return Ok(None);
     };
     let at = format!("{where_}, [confirm]");
-    let f: ConfirmFile = toml::Value::Table(t.clone())
-        .try_into()
-        .map_err(|e: toml::de::Error| SweepError::input(format!("{at}: {}", one_line(e.message()))))?;
+    let f: ConfirmFile =
+        toml::Value::Table(t.clone())
+            .try_into()
+            .map_err(|e: toml::de::Error| {
+                SweepError::input(format!("{at}: {}", one_line(e.message())))
+            })?;
     let allow = f.allow_reserved_seeds.unwrap_or(false);
     let reserved = |s: u64| !allow && RESERVED_SEEDS.contains(&s);
     let seeds = match &f.seeds {
@@ -773,9 +776,7 @@ fn confirm_of(
     let cells = match &f.cells {
         None => CellChoice::Region,
         Some(toml::Value::String(s)) if s == "region" => CellChoice::Region,
-        Some(toml::Value::String(s)) if s == "region+neighbours" => {
-            CellChoice::RegionAndNeighbours
-        }
+        Some(toml::Value::String(s)) if s == "region+neighbours" => CellChoice::RegionAndNeighbours,
         Some(toml::Value::Array(list)) if !list.is_empty() => {
             let mut out = Vec::new();
             for (i, c) in list.iter().enumerate() {
@@ -828,7 +829,11 @@ fn listed_cell(c: &toml::Value, axes: &[Axis], at: &str) -> Result<Vec<usize>, S
     if let Some((k, _)) = given.iter().find(|(k, _)| !swept.contains(&k)) {
         return Err(SweepError::input(format!(
             "{at}: `{k}` is not a swept key: the cell's keys are {}",
-            swept.iter().map(|k| format!("`{k}`")).collect::<Vec<_>>().join(", ")
+            swept
+                .iter()
+                .map(|k| format!("`{k}`"))
+                .collect::<Vec<_>>()
+                .join(", ")
         )));
     }
     let mut coords = Vec::new();
@@ -837,9 +842,13 @@ fn listed_cell(c: &toml::Value, axes: &[Axis], at: &str) -> Result<Vec<usize>, S
             .keys
             .iter()
             .map(|k| {
-                given.iter().find(|(g, _)| g == k).map(|(_, v)| v).ok_or_else(|| {
-                    SweepError::input(format!("{at}: no value for the swept key `{k}`"))
-                })
+                given
+                    .iter()
+                    .find(|(g, _)| g == k)
+                    .map(|(_, v)| v)
+                    .ok_or_else(|| {
+                        SweepError::input(format!("{at}: no value for the swept key `{k}`"))
+                    })
             })
             .collect::<Result<_, _>>()?;
         let pos = a
@@ -850,7 +859,10 @@ fn listed_cell(c: &toml::Value, axes: &[Axis], at: &str) -> Result<Vec<usize>, S
                 SweepError::input(format!(
                     "{at}: {} = {} is not a value of the map's axis (valid: {})",
                     a.name(),
-                    vals.iter().map(|v| value_text(v)).collect::<Vec<_>>().join(", "),
+                    vals.iter()
+                        .map(|v| value_text(v))
+                        .collect::<Vec<_>>()
+                        .join(", "),
                     (0..a.values.len())
                         .map(|i| a.label(i))
                         .collect::<Vec<_>>()
@@ -1001,5 +1013,60 @@ mod tests {
         }
         assert_eq!(sanitize("eta0.001", 40), "eta0.001");
         assert_eq!(sanitize("a b//c", 40), "a_b_c");
+    }
+
+    #[test]
+    fn a_confirmation_runs_on_seeds_the_map_never_used_and_never_on_the_reserved_ones() {
+        let base = "seeds = [1, 2]\n[set]\nsteps = 50\n[grid]\n\"learner.eta\" = [0.01, 0.03]\n";
+        let with = |confirm: &str| sweep(&format!("{base}[confirm]\n{confirm}\n"));
+        let c = with("seeds = [21, 22]\ncells = \"region+neighbours\"")
+            .unwrap()
+            .confirm
+            .unwrap();
+        assert_eq!(c.seeds, vec![21, 22]);
+        assert_eq!(c.cells, CellChoice::RegionAndNeighbours);
+        // A count takes the first seeds the map did not use, skipping 11-20.
+        let c = with("seeds = 3").unwrap().confirm.unwrap();
+        assert_eq!(c.seeds, vec![3, 4, 5]);
+        assert_eq!(c.cells, CellChoice::Region);
+        let axes = vec![Axis {
+            keys: vec!["learner.eta".into()],
+            values: vec![vec![toml::Value::Float(0.01)]],
+        }];
+        let ten: Vec<u64> = (1..=10).collect();
+        let c = confirm_section("[confirm]\nseeds = 3\n", Path::new("t.toml"), &axes, &ten)
+            .unwrap()
+            .unwrap();
+        assert_eq!(c.seeds, vec![21, 22, 23]);
+        // The reserved seeds are refused, unless this is the check from outside.
+        let e = with("seeds = [21, 15]").unwrap_err();
+        assert!(
+            e.contains("seed 15") && e.contains("11-20") && e.contains("reserved"),
+            "{e}"
+        );
+        let c = with("seeds = [15]\nallow_reserved_seeds = true")
+            .unwrap()
+            .confirm
+            .unwrap();
+        assert_eq!(c.seeds, vec![15]);
+        // The map's own seeds are refused.
+        let e = with("seeds = [2, 21]").unwrap_err();
+        assert!(e.contains("seed 2") && e.contains("never used"), "{e}");
+        // Listed cells name a value of every axis.
+        let c = with("seeds = [21]\ncells = [{ \"learner.eta\" = 0.03 }]")
+            .unwrap()
+            .confirm
+            .unwrap();
+        assert_eq!(c.cells, CellChoice::Listed(vec![vec![1]]));
+        let e = with("seeds = [21]\ncells = [{ \"learner.eta\" = 0.5 }]").unwrap_err();
+        assert!(e.contains("not a value") && e.contains("0.01; 0.03"), "{e}");
+        let e = with("seeds = [21]\ncells = [{ \"learner.threshold\" = 10 }]").unwrap_err();
+        assert!(e.contains("not a swept key"), "{e}");
+        let e = with("seeds = [21]\ncells = \"everywhere\"").unwrap_err();
+        assert!(e.contains("region"), "{e}");
+        let e = with("cells = \"region\"").unwrap_err();
+        assert!(e.contains("no `seeds`"), "{e}");
+        let e = with("seeds = [21]\nrepeat = 3").unwrap_err();
+        assert!(e.contains("repeat"), "{e}");
     }
 }

@@ -401,7 +401,9 @@ pub fn metrics_row(condition: Condition, repeat: u32, k: u32, m: &StepMetrics) -
         format!("{}", m.fresh_cells),
         format!("{}", m.new_cells),
         opt(m.gap_cv),
-        m.touching.map(|t| u8::from(t).to_string()).unwrap_or_default(),
+        m.touching
+            .map(|t| u8::from(t).to_string())
+            .unwrap_or_default(),
         format!("{}", m.cpu_load_percent),
         format!("{}", m.energy_per_robot_mj),
     ]
@@ -1710,7 +1712,11 @@ mod tests {
             moving_percent: f64::from(k % 3) * 50.0,
             moved_mm: 70.0 / (1.0 + x),
             net_mm: 30.0 / (1.0 + x),
-            msd_cm2: [Some(x), (k >= 10).then_some(2.0 * x), (k >= 100).then_some(3.0 * x)],
+            msd_cm2: [
+                Some(x),
+                (k >= 10).then_some(2.0 * x),
+                (k >= 100).then_some(3.0 * x),
+            ],
             fresh_cells: f64::from(k % 11) / 3.0,
             new_cells: f64::from(k % 13) / 7.0,
             gap_cv: (gap && k % 9 != 0).then_some(0.1 + x * 1e-4),
@@ -1759,7 +1765,10 @@ mod tests {
                 assert_eq!(m.whole.touching_steps, steps.div_ceil(9));
                 assert_eq!(m.whole.gap_cv_steps + m.whole.touching_steps, steps);
             }
-            assert_eq!(m.whole.msd_steps, [steps, steps.saturating_sub(10), steps.saturating_sub(100)]);
+            assert_eq!(
+                m.whole.msd_steps,
+                [steps, steps.saturating_sub(10), steps.saturating_sub(100)]
+            );
         }
     }
 
@@ -1848,7 +1857,10 @@ mod tests {
                 },
             );
             let classes = f(6) + f(7) + f(8) + f(9);
-            assert!((classes - 100.0).abs() < 1e-9, "step {k}: classes sum to {classes}");
+            assert!(
+                (classes - 100.0).abs() < 1e-9,
+                "step {k}: classes sum to {classes}"
+            );
         }
         assert_eq!(out.metrics, again);
         assert_eq!(
@@ -1866,7 +1878,10 @@ mod tests {
             MSD_LAGS.map(|l| format!("msd_{l}_cm2"))[..],
             "the MSD columns name their lags"
         );
-        assert_eq!(out.metrics.whole.msd_steps, MSD_LAGS.map(|l| 451 - l as u32));
+        assert_eq!(
+            out.metrics.whole.msd_steps,
+            MSD_LAGS.map(|l| 451 - l as u32)
+        );
         // Every robot's tally adds up to its steps, and it was somewhere.
         for t in &out.robots {
             assert_eq!(t.class_steps.iter().sum::<u32>(), 450);

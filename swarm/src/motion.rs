@@ -674,7 +674,11 @@ mod tests {
         MotionStep {
             class,
             step_m,
-            net_m: if class == MotionClass::Exploring { step_m } else { 0.0 },
+            net_m: if class == MotionClass::Exploring {
+                step_m
+            } else {
+                0.0
+            },
             sq_disp_m2: [None; 3],
             fresh_cells: 0,
             new_cells: 0,

@@ -738,9 +738,8 @@ impl Quantity {
         }
         let steps = f64::from(w.steps);
         let robots = robots.max(1) as f64;
-        let per = |metres: f64| {
-            (metres >= MIN_MOVED_M).then(|| w.collisions_per_robot * robots / metres)
-        };
+        let per =
+            |metres: f64| (metres >= MIN_MOVED_M).then(|| w.collisions_per_robot * robots / metres);
         let msd = |l: usize| (w.msd_steps[l] > 0).then(|| w.msd_cm2[l] / f64::from(w.msd_steps[l]));
         match self {
             Quantity::MeanD => Some(w.mean_d / steps),
@@ -1571,7 +1570,10 @@ mod tests {
             }
         };
         let find = |cs: &[Claim], start: &str| -> Claim {
-            cs.iter().find(|c| c.claim.starts_with(start)).cloned().unwrap()
+            cs.iter()
+                .find(|c| c.claim.starts_with(start))
+                .cloned()
+                .unwrap()
         };
         for cheat in ["jitter", "shuttle"] {
             let paths = move |i: usize, k: u32| -> (f64, f64) {
@@ -1585,10 +1587,24 @@ mod tests {
             };
             let mut runs = Vec::new();
             for r in 0..5 {
-                runs.push(run_along(Condition::Learning, r, steps, win, &paths, &collided));
+                runs.push(run_along(
+                    Condition::Learning,
+                    r,
+                    steps,
+                    win,
+                    &paths,
+                    &collided,
+                ));
                 // The random walk's net progress: robots patrolling as robot 0 does.
                 let walk = |i: usize, k: u32| patrol(100 + 400 * i as u32, k);
-                runs.push(run_along(Condition::RandomWalk, r, steps, win, &walk, &|_, _| false));
+                runs.push(run_along(
+                    Condition::RandomWalk,
+                    r,
+                    steps,
+                    win,
+                    &walk,
+                    &|_, _| false,
+                ));
             }
             let a = analyse(&runs, 3, steps, win, 1);
             let last = &a.conditions[0].last;
@@ -1598,18 +1614,28 @@ mod tests {
                 // The old definitions: no robot-step stuck, so "keep moving" held.
                 let moved_per_step = last.moved_mm.mean;
                 assert!(moved_per_step > 0.0);
-                assert!((last.held_percent.mean - 200.0 / 3.0).abs() < 1.0, "{last:?}");
+                assert!(
+                    (last.held_percent.mean - 200.0 / 3.0).abs() < 1.0,
+                    "{last:?}"
+                );
                 let held = find(&a.claims, "part of keep exploring: held");
                 assert_eq!(held.outcome, Outcome::Fails, "{}", held.verdict);
             } else {
                 assert!(last.shuttling_percent.mean > 60.0, "{last:?}");
                 // The old measure: collisions per path metre fall.
-                let per_path = find(&a.claims, "for reference: collisions per path metre in the last window below the first");
+                let per_path = find(
+                    &a.claims,
+                    "for reference: collisions per path metre in the last window below the first",
+                );
                 assert_eq!(per_path.outcome, Outcome::Holds, "{}", per_path.verdict);
                 // Per net metre they rise.
                 let per_net = find(&a.claims, "collisions fall");
                 assert_eq!(per_net.outcome, Outcome::Fails, "{}", per_net.verdict);
-                assert!(per_net.values[0] > per_net.values[1], "{:?}", per_net.values);
+                assert!(
+                    per_net.values[0] > per_net.values[1],
+                    "{:?}",
+                    per_net.values
+                );
                 let explore = find(&a.claims, "part of keep exploring: net progress");
                 assert_eq!(explore.outcome, Outcome::Fails, "{}", explore.verdict);
             }
@@ -1621,15 +1647,32 @@ mod tests {
                 + l.circling_percent.mean
                 + l.exploring_percent.mean;
             assert!((sum - 100.0).abs() < 1e-9);
-            assert_eq!(a.conditions[0].robots.ending_held, if cheat == "jitter" { 10 } else { 0 });
+            assert_eq!(
+                a.conditions[0].robots.ending_held,
+                if cheat == "jitter" { 10 } else { 0 }
+            );
         }
         // Honest robots that keep patrolling hold both parts.
         let paths = |i: usize, k: u32| patrol(400 * i as u32, k);
         let mut runs = Vec::new();
         for r in 0..5 {
-            runs.push(run_along(Condition::Learning, r, steps, win, &paths, &|_, _| false));
+            runs.push(run_along(
+                Condition::Learning,
+                r,
+                steps,
+                win,
+                &paths,
+                &|_, _| false,
+            ));
             let walk = |i: usize, k: u32| patrol(100 + 400 * i as u32, k);
-            runs.push(run_along(Condition::RandomWalk, r, steps, win, &walk, &|_, _| false));
+            runs.push(run_along(
+                Condition::RandomWalk,
+                r,
+                steps,
+                win,
+                &walk,
+                &|_, _| false,
+            ));
         }
         let keep = find(&claims(&runs, 3, 1), "the robots keep exploring");
         assert_eq!(keep.outcome, Outcome::Holds, "{}", keep.verdict);
@@ -1653,8 +1696,22 @@ mod tests {
         let q = Quantity::MeanD;
         let some = |v: [f64; 5]| v.map(Some).to_vec();
         // Part a holds in repeats 0-3, part b in repeats 1-4: both in 1-3 only.
-        let a = Claim::paired("a", false, q, &some([1.0, 1.0, 1.0, 1.0, 9.0]), &some([5.0; 5]), 1);
-        let b = Claim::paired("b", false, q, &some([9.0, 1.0, 1.0, 1.0, 1.0]), &some([5.0; 5]), 1);
+        let a = Claim::paired(
+            "a",
+            false,
+            q,
+            &some([1.0, 1.0, 1.0, 1.0, 9.0]),
+            &some([5.0; 5]),
+            1,
+        );
+        let b = Claim::paired(
+            "b",
+            false,
+            q,
+            &some([9.0, 1.0, 1.0, 1.0, 1.0]),
+            &some([5.0; 5]),
+            1,
+        );
         let both = Claim::all_of("both", true, &[&a, &b]);
         assert_eq!((both.repeats.for_, both.repeats.against), (3, 2));
         assert_eq!(both.outcome, Outcome::Unsure);
@@ -1666,7 +1723,9 @@ mod tests {
     fn the_repeats_a_decision_needs_give_the_power_asked_for() {
         // Direct: P(X ≥ k | n, q) by the pmf's recursion, the critical k from sign_test_p.
         let power = |n: u32, q: f64| {
-            let k = (0..=n).find(|&k| sign_test_p(k, n) < SIGNIFICANCE).unwrap_or(n + 1);
+            let k = (0..=n)
+                .find(|&k| sign_test_p(k, n) < SIGNIFICANCE)
+                .unwrap_or(n + 1);
             let mut pmf = (1.0 - q).powi(n as i32);
             let mut tail = 0.0;
             for j in 0..=n {
@@ -1705,10 +1764,18 @@ mod tests {
         let n = p.repeats_needed.unwrap();
         assert!((60..130).contains(&n), "{n}");
         // Ties and missing values scale it up.
-        let p2 = Power::of(&Paired { tied: 25, undefined: 25, ..r });
+        let p2 = Power::of(&Paired {
+            tied: 25,
+            undefined: 25,
+            ..r
+        });
         assert_eq!(p2.repeats_needed, Some((f64::from(n) * 2.0).ceil() as u32));
         // More against: the opposite's.
-        let p3 = Power::of(&Paired { for_: 18, against: 32, ..r });
+        let p3 = Power::of(&Paired {
+            for_: 18,
+            against: 32,
+            ..r
+        });
         assert_eq!((p3.towards, p3.repeats_needed), ("opposite", Some(n)));
     }
 
