@@ -1,11 +1,12 @@
-//! What a stuck robot senses, evaluates and chooses: runs the learning and
-//! learning-off conditions of a scenario with model robots and, for every robot-step of the last
-//! window, records whether the robot is stuck (the metric's rule: its motors drove and it moved
-//! < 1 mm over the last 100 steps), its four proximities p (du), E = D(t) − D(t−1) (the
-//! evaluation the learner applies at this step), the winning behaviour, the winner's margin over
-//! the runner-up in the outputs O, and which bumper is pressed. Prints the means over stuck and
-//! over moving robot-steps, and how stuck spells end and how long they last over the whole run
-//! (a spell counted from the step the rule first flags it, i.e. 100 steps after it began).
+//! What a held robot senses, evaluates and chooses: runs the learning and learning-off
+//! conditions of a scenario with model robots and, for every robot-step of the last window,
+//! records whether the robot is held in place (`swarm::motion`'s class: its positions over 100
+//! steps within 5 cm of their mean, or under 2 cm of path over 20 steps), its four proximities p
+//! (du), E = D(t) − D(t−1) (the evaluation the learner applies at this step), the winning
+//! behaviour, the winner's margin over the runner-up in the outputs O, and which bumper is
+//! pressed. Prints the means over held and over free robot-steps, and how held spells end and
+//! how long they last over the whole run (a spell counted from the step the class first says
+//! held). (The file keeps its name from the earlier "stuck" detector it was written for.)
 //!
 //!     cargo run --release --example stuck_probe [arena|corridor|FILE.toml] [REPEATS] [SEED]
 
