@@ -377,42 +377,85 @@ pub const METRICS_HEADER: [&str; 22] = [
     "energy_per_robot_mj",
 ];
 
+/// Step `k`'s row of `metrics.csv` (see [`METRICS_HEADER`]) written into `buf` (cleared
+/// first), field after field; returns where each field ends. A run writes its rows this way,
+/// through one buffer, rather than a string per field.
+pub fn metrics_fields(
+    condition: Condition,
+    repeat: u32,
+    k: u32,
+    m: &StepMetrics,
+    buf: &mut String,
+) -> [usize; 22] {
+    use std::fmt::Write as _;
+    buf.clear();
+    let mut ends = [0usize; 22];
+    let mut field = 0;
+    let mut end = |buf: &String| {
+        ends[field] = buf.len();
+        field += 1;
+    };
+    buf.push_str(condition.name());
+    end(buf);
+    let _ = write!(buf, "{repeat}");
+    end(buf);
+    let _ = write!(buf, "{k}");
+    end(buf);
+    let opt = |buf: &mut String, v: Option<f64>| {
+        if let Some(v) = v {
+            let _ = write!(buf, "{v}");
+        }
+    };
+    for v in [
+        m.mean_d,
+        m.collisions_per_robot,
+        m.contact_percent,
+        m.held_percent,
+        m.shuttling_percent,
+        m.circling_percent,
+        m.exploring_percent,
+        m.moving_percent,
+        m.moved_mm,
+        m.net_mm,
+    ] {
+        let _ = write!(buf, "{v}");
+        end(buf);
+    }
+    for v in m.msd_cm2 {
+        opt(buf, v);
+        end(buf);
+    }
+    for v in [m.fresh_cells, m.new_cells] {
+        let _ = write!(buf, "{v}");
+        end(buf);
+    }
+    opt(buf, m.gap_cv);
+    end(buf);
+    if let Some(t) = m.touching {
+        buf.push(if t { '1' } else { '0' });
+    }
+    end(buf);
+    for v in [m.cpu_load_percent, m.energy_per_robot_mj] {
+        let _ = write!(buf, "{v}");
+        end(buf);
+    }
+    ends
+}
+
 /// Step `k`'s row of `metrics.csv` (see [`METRICS_HEADER`]).
 #[must_use]
 pub fn metrics_row(condition: Condition, repeat: u32, k: u32, m: &StepMetrics) -> [String; 22] {
-    let opt = |v: Option<f64>| v.map(|v| format!("{v}")).unwrap_or_default();
-    [
-        condition.name().to_string(),
-        repeat.to_string(),
-        k.to_string(),
-        format!("{}", m.mean_d),
-        format!("{}", m.collisions_per_robot),
-        format!("{}", m.contact_percent),
-        format!("{}", m.held_percent),
-        format!("{}", m.shuttling_percent),
-        format!("{}", m.circling_percent),
-        format!("{}", m.exploring_percent),
-        format!("{}", m.moving_percent),
-        format!("{}", m.moved_mm),
-        format!("{}", m.net_mm),
-        opt(m.msd_cm2[0]),
-        opt(m.msd_cm2[1]),
-        opt(m.msd_cm2[2]),
-        format!("{}", m.fresh_cells),
-        format!("{}", m.new_cells),
-        opt(m.gap_cv),
-        m.touching
-            .map(|t| u8::from(t).to_string())
-            .unwrap_or_default(),
-        format!("{}", m.cpu_load_percent),
-        format!("{}", m.energy_per_robot_mj),
-    ]
+    let mut buf = String::new();
+    let ends = metrics_fields(condition, repeat, k, m, &mut buf);
+    std::array::from_fn(|i| buf[if i == 0 { 0 } else { ends[i - 1] }..ends[i]].to_string())
 }
 
 /// A run's rows of `metrics.csv`, written as the steps complete.
 struct Rows {
     path: std::path::PathBuf,
     w: csv::Writer<std::io::BufWriter<std::fs::File>>,
+    /// The row being written, field after field.
+    buf: String,
 }
 
 /// The arena of a scenario (the square scaled to keep the paper's density for other than 3
@@ -618,6 +661,7 @@ impl Swarm {
                 path.display()
             )))?;
         self.rows = Some(Rows {
+            buf: String::with_capacity(256),
             path: path.to_path_buf(),
             w: csv::WriterBuilder::new()
                 .has_headers(false)
@@ -962,8 +1006,13 @@ impl Swarm {
             };
             self.metrics.add(k, &last);
             if let Some(rows) = self.rows.as_mut() {
+                let ends = metrics_fields(self.condition, self.repeat, k, &last, &mut rows.buf);
+                let buf = &rows.buf;
                 rows.w
-                    .write_record(metrics_row(self.condition, self.repeat, k, &last))
+                    .write_record(
+                        (0..ends.len())
+                            .map(|i| &buf[if i == 0 { 0 } else { ends[i - 1] }..ends[i]]),
+                    )
                     .map_err(anyhow::Error::new)
                     .with_context(|| {
                         crate::output_error::OutputError(format!(

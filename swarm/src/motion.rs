@@ -136,11 +136,20 @@ fn cell_of(x: f64, y: f64) -> u64 {
     (u64::from(ix as u32) << 32) | u64::from(iy as u32)
 }
 
+/// Distance between two points (their coordinates differ by at most a few hundred metres, so
+/// the plain formula cannot overflow; `hypot`'s care costs five times as much).
+fn dist(dx: f64, dy: f64) -> f64 {
+    (dx * dx + dy * dy).sqrt()
+}
+
 /// One robot's recent positions and the cells it has been in.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct MotionTracker {
     /// The last [`HISTORY`] positions, position `s` at `s % HISTORY`.
     ring: Vec<(f64, f64)>,
+    /// The last [`LAG_STEPS`] steps: the step ending at position `s` at `s % LAG_STEPS`, its
+    /// displacement and its length.
+    steps: Vec<(f64, f64, f64)>,
     /// Positions recorded: the start is position 0, the end of step k position k + 1.
     seen: u32,
     /// The cell of the latest position.
@@ -164,6 +173,7 @@ impl MotionTracker {
     /// Records where the robot starts (before its first step).
     pub fn start(&mut self, x: f64, y: f64) {
         self.ring = vec![(x, y); HISTORY];
+        self.steps = vec![(0.0, 0.0, 0.0); LAG_STEPS];
         self.seen = 1;
         self.cell = cell_of(x, y);
         self.left.clear();
@@ -182,28 +192,29 @@ impl MotionTracker {
             self.start(x, y);
         }
         let s = self.seen;
-        self.ring[s as usize % HISTORY] = (x, y);
-        self.seen += 1;
         let prev = self.at(s - 1);
-        let step_m = (x - prev.0).hypot(y - prev.1);
+        let (dx, dy) = (x - prev.0, y - prev.1);
+        let step_m = dist(dx, dy);
+        self.ring[s as usize % HISTORY] = (x, y);
+        self.steps[s as usize % LAG_STEPS] = (dx, dy, step_m);
+        self.seen += 1;
         let lag = (s as usize).min(LAG_STEPS) as u32;
         let back = self.at(s - lag);
-        let net = (x - back.0).hypot(y - back.1);
+        let net = dist(x - back.0, y - back.1);
+        // The lag's steps in order, from the oldest.
         let mut path = 0.0;
         let mut reversals = 0u32;
         let mut heading: Option<(f64, f64)> = None;
         for j in s - lag + 1..=s {
-            let (a, b) = (self.at(j - 1), self.at(j));
-            let d = (b.0 - a.0, b.1 - a.1);
-            let len = d.0.hypot(d.1);
+            let (ex, ey, len) = self.steps[j as usize % LAG_STEPS];
             path += len;
             if len >= REVERSAL_STEP_MIN_M {
                 if let Some(h) = heading
-                    && h.0 * d.0 + h.1 * d.1 < 0.0
+                    && h.0 * ex + h.1 * ey < 0.0
                 {
                     reversals += 1;
                 }
-                heading = Some(d);
+                heading = Some((ex, ey));
             }
         }
         let still = path < STILL_PATH_M * f64::from(lag) / LAG_STEPS as f64;
@@ -254,6 +265,15 @@ impl MotionTracker {
     /// Whether positions `s − HELD_STEPS ..= s` all lie within [`HELD_RADIUS_M`] of their mean.
     fn in_disc(&self, s: u32) -> bool {
         if (s as usize) < HELD_STEPS {
+            return false;
+        }
+        // Two points within the radius of one point are within twice it of each other: a robot
+        // whose first and last positions, or last two lag ends, are further apart is not held
+        // (most moving robots, decided without the mean).
+        let (a, b) = (self.at(s - HELD_STEPS as u32), self.at(s));
+        let c = self.at(s - LAG_STEPS as u32);
+        let far = |p: (f64, f64), q: (f64, f64)| dist(p.0 - q.0, p.1 - q.1) > 2.0 * HELD_RADIUS_M;
+        if far(a, b) || far(c, b) || far(a, c) {
             return false;
         }
         let n = HISTORY as f64;
