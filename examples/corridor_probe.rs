@@ -161,7 +161,7 @@ struct Gathered {
 fn run(s: &Scenario, c: Condition, repeat: u32, g: &mut Gathered) -> anyhow::Result<()> {
     let mut sw = Swarm::new(s, c, repeat, false, None)?;
     let n = s.robots;
-    let t = i32::from(s.learner.threshold);
+    let t = s.learner.threshold;
     let body = world::params::BODY_LENGTH_M;
     let length = swarm::experiment::arena_of(s)?.width_m();
     let last_from = s.steps.saturating_sub(s.window);

@@ -223,13 +223,16 @@ fn ready(tab: &mut Tab) {
 }
 
 /// The robots' poses at step `k` of the learning run's repeat 0, from the library.
+/// Each robot's pose (x, y, heading) at a step instant.
+type Poses = Vec<(f64, f64, f64)>;
+
 /// Where the robots are at step `k`'s instant, and the motion class of each one's step
 /// before it (none at step 0), as the run's own trackers classify them.
 fn truth(
     s: &Scenario,
     images: Option<&swarm::robot::Images>,
     k: u32,
-) -> (Vec<(f64, f64, f64)>, Vec<Option<MotionClass>>) {
+) -> (Poses, Vec<Option<MotionClass>>) {
     let mut swarm = Swarm::new(s, Condition::Learning, 0, false, images).unwrap();
     let mut trackers = vec![MotionTracker::new(); s.robots];
     let mut classes = vec![None; s.robots];

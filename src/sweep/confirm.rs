@@ -83,10 +83,11 @@ fn coords_of(axes: &[Axis], mut index: usize) -> Vec<usize> {
     out
 }
 
+/// A finished map: its plan, run list, the paper's claims over its points, and its region.
+type Map = (Plan, Vec<PlanLine>, Vec<ClaimSeries>, Vec<usize>);
+
 /// The map's paper-claim series and its region (cells where they all hold, pooled).
-fn map_region(
-    dir: &Path,
-) -> Result<(Plan, Vec<PlanLine>, Vec<ClaimSeries>, Vec<usize>), SweepError> {
+fn map_region(dir: &Path) -> Result<Map, SweepError> {
     let (plan, lines, m) = super::merge::collect(dir)?;
     let not_ok = m.failed.len() + m.missing.len() + m.broken.len();
     if not_ok > 0 {

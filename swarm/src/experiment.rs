@@ -1768,8 +1768,8 @@ mod tests {
             ],
             fresh_cells: f64::from(k % 11) / 3.0,
             new_cells: f64::from(k % 13) / 7.0,
-            gap_cv: (gap && k % 9 != 0).then_some(0.1 + x * 1e-4),
-            touching: gap.then_some(k % 9 == 0),
+            gap_cv: (gap && !k.is_multiple_of(9)).then_some(0.1 + x * 1e-4),
+            touching: gap.then_some(k.is_multiple_of(9)),
             cpu_load_percent: 0.3 + x * 1e-6,
             energy_per_robot_mj: 3500.0 + x.cos(),
         }

@@ -1550,7 +1550,7 @@ mod tests {
 
     /// Rocking 0.2–0.5 mm to either side of (x, y): steps of 0.4–1 mm, wedged in place.
     fn jitter(x: f64, y: f64, k: u32) -> (f64, f64) {
-        let side = if k % 2 == 0 { 1.0 } else { -1.0 };
+        let side = if k.is_multiple_of(2) { 1.0 } else { -1.0 };
         let off = side * (0.0002 + 0.0003 * f64::from((k * 7919) % 101) / 100.0);
         (x + off, y)
     }
@@ -1569,9 +1569,9 @@ mod tests {
         let (steps, win) = (1000u32, 300u32);
         let collided = |i: usize, k: u32| {
             if k < 500 {
-                k % 20 == 0
+                k.is_multiple_of(20)
             } else {
-                i == 0 && k % 15 == 0
+                i == 0 && k.is_multiple_of(15)
             }
         };
         let find = |cs: &[Claim], start: &str| -> Claim {
