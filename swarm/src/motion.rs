@@ -205,8 +205,10 @@ impl MotionTracker {
         let mut path = 0.0;
         let mut reversals = 0u32;
         let mut heading: Option<(f64, f64)> = None;
-        for j in s - lag + 1..=s {
-            let (ex, ey, len) = self.steps[j as usize % LAG_STEPS];
+        // The ring from the oldest of them on, wrapping round (no division per step).
+        let first = (s - lag + 1) as usize % LAG_STEPS;
+        let (tail, head) = self.steps.split_at(first);
+        for &(ex, ey, len) in head.iter().chain(tail).take(lag as usize) {
             path += len;
             if len >= REVERSAL_STEP_MIN_M {
                 if let Some(h) = heading
