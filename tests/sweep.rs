@@ -566,6 +566,31 @@ cells = [{ "learner.eta" = 0.03 }]
         table,
         std::fs::read_to_string(map.join("merged/confirmation.csv")).unwrap()
     );
+    // A tampered confirm.json or run list is one line and status 2, not a panic (a point's
+    // position outside the grid indexed past the map's cells).
+    let record = cdir.join("confirm.json");
+    let good = std::fs::read_to_string(&record).unwrap();
+    std::fs::write(
+        &record,
+        good.replace("\"cells\": [\n    1\n  ]", "\"cells\": [\n    9\n  ]"),
+    )
+    .unwrap();
+    let (code, err) = fails(&["sweep", "merge", s(&map)], &[]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("names cell 9"), "{err}");
+    std::fs::write(&record, good).unwrap();
+    let list_path = map.join("points.jsonl");
+    let list = std::fs::read_to_string(&list_path).unwrap();
+    std::fs::write(
+        &list_path,
+        list.replacen("\"coords\":[1]", "\"coords\":[7]", 1),
+    )
+    .unwrap();
+    let (code, err) = fails(&["sweep", "merge", s(&map)], &[]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("outside the plan's grid"), "{err}");
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    std::fs::write(&list_path, list).unwrap();
     // Seeds 11-20 are refused by plan; and a sweep without [confirm] has nothing to confirm.
     let bad = root.join("bad.toml");
     std::fs::write(&bad, sweep.replace("seeds = [21]", "seeds = [21, 13]")).unwrap();

@@ -409,7 +409,28 @@ pub fn merge_confirmation(dir: &Path, out: &Path) -> Result<(String, bool), Swee
             return Ok((t, false));
         }
     };
+    let grid: usize = plan.axes.iter().map(|a| a.values.len()).product();
+    if let Some(c) = record.cells.iter().find(|&&c| c >= grid.max(1)) {
+        return Err(SweepError::input(format!(
+            "`{}` names cell {c}, but the map has {grid} cells: plan the confirmation again with `h8swarm sweep confirm {}`",
+            cdir.join("confirm.json").display(),
+            dir.display()
+        )));
+    }
     let (cplan, clines, cm) = super::merge::collect(&cdir)?;
+    if clines.iter().any(|l| {
+        l.coords.len() != plan.axes.len()
+            || l.coords
+                .iter()
+                .zip(&plan.axes)
+                .any(|(&c, a)| c >= a.values.len())
+    }) {
+        return Err(SweepError::input(format!(
+            "`{}` holds a point outside the map's grid: plan the confirmation again with `h8swarm sweep confirm {}`",
+            cdir.join("points.jsonl").display(),
+            dir.display()
+        )));
+    }
     let cseries = super::merge::claim_series(&cm);
     let ccoords: Vec<Vec<usize>> = clines.iter().map(|l| l.coords.clone()).collect();
     let coords: Vec<Vec<usize>> = lines.iter().map(|l| l.coords.clone()).collect();

@@ -693,6 +693,18 @@ pub fn read_plan(dir: &Path) -> Result<(Plan, Vec<PlanLine>), SweepError> {
                 &"its index, id or task does not fit the plan",
             ));
         }
+        if line.coords.len() != plan.axes.len()
+            || line
+                .coords
+                .iter()
+                .zip(&plan.axes)
+                .any(|(&c, a)| c >= a.values.len())
+        {
+            return Err(not(
+                &format!("points.jsonl line {}", n + 1),
+                &"its position on the axes lies outside the plan's grid",
+            ));
+        }
         lines.push(line);
     }
     if lines.len() != plan.points {
