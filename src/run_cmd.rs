@@ -1584,6 +1584,33 @@ fn report_claims(t: &mut String, a: &Analysis) {
             " (see docs/claims.md for where they do)"
         }
     );
+    // The repeats that would decide every text claim at the effects seen here: what the
+    // default run's repeat count is chosen from (docs/claims.md).
+    let undecidable: Vec<&str> = paper
+        .iter()
+        .filter(|c| c.power.repeats_needed.is_none())
+        .map(|c| c.claim.split(':').next().unwrap_or(&c.claim))
+        .collect();
+    let most = paper.iter().filter_map(|c| c.power.repeats_needed).max();
+    match (most, undecidable.is_empty()) {
+        (Some(n), true) => {
+            let _ = writeln!(
+                t,
+                "at the effects seen here, about {n} repeats would decide every text claim (80 % power each)"
+            );
+        }
+        (_, false) => {
+            let _ = writeln!(
+                t,
+                "no number of repeats decides {} at the effect seen here{}",
+                undecidable.join(", "),
+                most.map_or_else(String::new, |n| format!(
+                    "; the others need about {n} repeats"
+                ))
+            );
+        }
+        (None, true) => {}
+    }
 }
 
 fn fmt_value(v: f64) -> String {
