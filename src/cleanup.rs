@@ -100,9 +100,13 @@ fn ignored_signals() -> Vec<i32> {
     (1..=64).filter(|s| mask & (1u64 << (s - 1)) != 0).collect()
 }
 
-/// Removes `dir` and everything in it; workers still writing into it may add a file while it
+/// Removes `dir` and everything in it (or the file `dir`); workers still writing into it may add a file while it
 /// goes, so it is tried a few times.
 fn remove_all(dir: &Path) {
+    if std::fs::symlink_metadata(dir).is_ok_and(|m| !m.is_dir()) {
+        let _ = std::fs::remove_file(dir);
+        return;
+    }
     for _ in 0..5 {
         match std::fs::remove_dir_all(dir) {
             Err(e) if e.kind() != std::io::ErrorKind::NotFound => {}

@@ -173,10 +173,11 @@ pub fn measure(cfg: &CostConfig) -> Result<CostReport> {
             cfg.steps
         );
     }
-    if !(cfg.step_period_s.is_finite() && cfg.step_period_s > 0.0) {
+    if !emu::board::model::step_period_ok(cfg.step_period_s) {
         bail!(
-            "--step-period-s must be a positive number of seconds, got {}",
-            cfg.step_period_s
+            "--step-period-s {}: valid is {}",
+            swarm::text::number(cfg.step_period_s),
+            emu::board::model::STEP_PERIOD_VALID
         );
     }
     let layout = InputLayout::new(cfg.history, cfg.bias).context("--history")?;
@@ -320,10 +321,15 @@ pub fn parse_eta(text: &str) -> Result<i32, String> {
         let v: f64 = t
             .parse()
             .map_err(|_| format!("`{t}` is not a learning rate: {valid}"))?;
-        if !(v.is_finite() && (0.0..=32767.0 / 32768.0).contains(&v)) {
-            return Err(format!("`{t}` is out of range: {valid}"));
+        // Taken when its Q15 value (rounded to nearest) is 0 to 32767: 0.99997 is 32767.
+        let q15 = (v * 32768.0).round();
+        if !(v.is_finite() && v >= 0.0 && q15 <= 32767.0) {
+            return Err(format!(
+                "`{}` is out of range: {valid}",
+                swarm::text::printable(t)
+            ));
         }
-        Ok((v * 32768.0).round() as i32)
+        Ok(q15 as i32)
     } else {
         match t.parse::<i64>() {
             Ok(v) if (0..=32767).contains(&v) => Ok(v as i32),
@@ -344,6 +350,10 @@ mod tests {
         assert_eq!(parse_eta("33"), Ok(33));
         assert_eq!(parse_eta("0.1"), Ok(3277));
         assert_eq!(parse_eta("0"), Ok(0));
+        // The largest the message offers is taken; one just above is not.
+        assert_eq!(parse_eta("0.99997"), Ok(32767));
+        assert!(parse_eta("0.99999").is_err());
+        assert!(parse_eta("-0.0001").is_err());
         assert_eq!(parse_eta("32767"), Ok(32767));
         for bad in ["1.0", "32768", "-1", "-0.5", "nan", "inf", "x", ""] {
             let e = parse_eta(bad).unwrap_err();

@@ -30,8 +30,9 @@ use std::sync::Arc;
 use emu::board::board::{RobotBoard, RobotConfig, robot_mcu};
 use emu::board::symbols::SymbolTable;
 use emu::chip::gdb::{Debugger, GdbError, GdbListener};
-use emu::chip::mcu::Mcu;
+use emu::chip::mcu::{IoReport, Mcu};
 use emu::chip::pins::NullBoard;
+use emu::chip::profile::StackProfile;
 use emu::chip::run::{Outcome, Probes, RunOptions, drain_into, run_mcu_probed};
 use emu::chip::trace::{CodeNames, PhaseRecorder};
 use emu::chip::vcd::{VcdInfo, VcdStream};
@@ -71,6 +72,10 @@ pub struct EmuOptions<'a> {
     pub symbols: Option<&'a Path>,
     /// What the stack guard does when a stack access leaves the stack's room.
     pub stack_guard: StackGuardMode,
+    /// Write a profile of where the states go by call stack here (folded stacks).
+    pub profile: Option<&'a Path>,
+    /// Stop at the first access to an address the chip does not model.
+    pub strict_io: bool,
 }
 
 fn input(msg: String) -> Failure {
@@ -116,6 +121,7 @@ pub fn run(o: &EmuOptions<'_>) -> Result<(), Failure> {
     let names = symbols(image, o.symbols)?.map(Arc::new);
     // Fail on a file that cannot be created before the program runs.
     let vcd_file = create_vcd(o.vcd)?;
+    let mut profile_file = create_profile(o.profile)?;
     let mut debugger = wait_for_debugger(o.gdb)?;
     let mut cpu = Cpu::new();
     let room = names
@@ -137,7 +143,14 @@ pub fn run(o: &EmuOptions<'_>) -> Result<(), Failure> {
     };
     let options = RunOptions {
         max_states: o.max_states,
+        strict_io: o.strict_io,
     };
+    let mut profile = profile_file.as_ref().map(|_| {
+        let entries = names.as_deref().map(SymbolTable::function_entries);
+        let code: Option<Arc<dyn CodeNames + Send + Sync>> =
+            names.clone().map(|n| n as Arc<dyn CodeNames + Send + Sync>);
+        StackProfile::new(code, entries, &cpu, mcu.now())
+    });
     let stdout = io::stdout();
     let mut console = stdout.lock();
     // Not locked for the whole run: the GDB stub's thread may have to say on stderr that
@@ -154,6 +167,7 @@ pub fn run(o: &EmuOptions<'_>) -> Result<(), Failure> {
             phases: phases.as_mut(),
             debugger: debugger.as_mut(),
             vcd: stream.as_mut(),
+            profile: profile.as_mut(),
         },
     );
     let _ = trace_out.flush();
@@ -170,13 +184,63 @@ pub fn run(o: &EmuOptions<'_>) -> Result<(), Failure> {
             ));
         }
     };
+    if let (Some(p), Some((file, path))) = (profile.as_mut(), profile_file.as_mut()) {
+        p.catch_up(mcu.now(), cpu.sleeping());
+        file.write_all(p.folded().as_bytes())
+            .and_then(|()| file.flush())
+            .map_err(|e| {
+                Failure::Tool(
+                    anyhow::Error::new(e)
+                        .context(format!("writing the profile `{}`", path.display())),
+                )
+            })?;
+    }
     if o.stats {
         eprintln!("{}", report.to_json());
     }
     if let Some(f) = &report.stack_fault {
         eprintln!("warning: image `{image}`: {f}");
     }
-    exit(&report.outcome, report.stats.states, image)
+    if !matches!(report.outcome, Outcome::Unmodelled(_)) {
+        for r in &report.io_reports {
+            eprintln!(
+                "warning: image `{image}`: {}",
+                describe(r, names.as_deref())
+            );
+        }
+    }
+    exit(
+        &report.outcome,
+        report.stats.states,
+        image,
+        names.as_deref(),
+    )
+}
+
+/// A report of the chip as one line, its function named when the image has symbols.
+fn describe(r: &IoReport, names: Option<&SymbolTable>) -> String {
+    match names {
+        Some(n) => emu::board::firmware::describe_io(n, r),
+        None => r.describe(None),
+    }
+}
+
+/// The `--profile` file, created (empty) when asked for, with its path.
+fn create_profile(
+    path: Option<&Path>,
+) -> Result<Option<(BufWriter<std::fs::File>, std::path::PathBuf)>, Failure> {
+    match path {
+        Some(p) => {
+            let f = std::fs::File::create(p).map_err(|e| {
+                input(format!(
+                    "--profile: cannot create `{}`: {e} (give a writable file path)",
+                    p.display()
+                ))
+            })?;
+            Ok(Some((BufWriter::new(f), p.to_path_buf())))
+        }
+        None => Ok(None),
+    }
 }
 
 /// The image loaded into a fresh MCU on the robot's board.
@@ -253,7 +317,9 @@ fn start_vcd(
         phase_at_start = p.drain_before(mcu.now() + 1).pop().map(|(_, name)| name);
         phases = Some(p);
     }
-    let (start, initial) = mcu.trace_beginning().unwrap_or_default();
+    let (start, initial) = mcu
+        .trace_beginning()
+        .unwrap_or((0, [false; emu::chip::trace::SIGNAL_COUNT]));
     let stream = VcdStream::start(
         Box::new(file),
         mcu.clock_hz(),
@@ -283,7 +349,12 @@ fn finish_vcd(
 }
 
 /// The exit the run's outcome calls for, with its line on standard error (module docs).
-fn exit(outcome: &Outcome, states: u64, image: &str) -> Result<(), Failure> {
+fn exit(
+    outcome: &Outcome,
+    states: u64,
+    image: &str,
+    names: Option<&SymbolTable>,
+) -> Result<(), Failure> {
     match *outcome {
         Outcome::Halted { exit_status: 0 } => Ok(()),
         Outcome::Halted { exit_status } => Err(Failure::Program(exit_status)),
@@ -304,6 +375,13 @@ fn exit(outcome: &Outcome, states: u64, image: &str) -> Result<(), Failure> {
         Outcome::Killed => {
             eprintln!("h8swarm emu: the GDB client killed the program");
             Err(Failure::Program(EXIT_KILLED))
+        }
+        Outcome::Unmodelled(ref r) => {
+            eprintln!(
+                "error: image `{image}`: {} (--strict-io)",
+                describe(r, names)
+            );
+            Err(Failure::Program(EXIT_CORE_ERROR))
         }
     }
 }

@@ -102,6 +102,10 @@ pub struct FitArgs {
     /// life (default: 2 000 mAh, a typical AA NiMH cell of 2008).
     #[arg(long, value_name = "MAH")]
     pub capacity_mah: Option<f64>,
+    /// Stop with an error at the image's first access to a register the emulated chip does
+    /// not model or to a reserved address, instead of naming them in the verdict.
+    #[arg(long)]
+    pub strict_io: bool,
 }
 
 impl FitArgs {
@@ -165,6 +169,13 @@ fn apply_what_ifs(mut cfg: ControllerConfig, a: &FitArgs) -> Result<ControllerCo
         cfg.save_every_steps = s;
     }
     if let Some(p) = a.step_period_s {
+        if !emu::board::model::step_period_ok(p) {
+            bail!(
+                "--step-period-s {}: valid is {}",
+                swarm::text::number(p),
+                emu::board::model::STEP_PERIOD_VALID
+            );
+        }
         cfg.step_period_s = p;
     }
     if let Some(hz) = a.clock_hz {
@@ -252,7 +263,8 @@ pub fn parse_capacity(given: Option<f64>) -> Result<f64> {
         None => Ok(swarm::energy::DEFAULT_CAPACITY_MAH),
         Some(c) if c.is_finite() && (1.0..=100_000.0).contains(&c) => Ok(c),
         Some(c) => bail!(
-            "--capacity-mah {c}: give a cell's capacity from 1 to 100000 mAh (AA NiMH cells hold 1 900-2 700 mAh)"
+            "--capacity-mah {}: give a cell's capacity from 1 to 100000 mAh (AA NiMH cells hold 1 900-2 700 mAh)",
+            swarm::text::number(c)
         ),
     }
 }
@@ -293,6 +305,7 @@ pub fn run(a: &FitArgs) -> Result<String> {
         kind,
         firmware: firmware.clone(),
         compare,
+        strict_io: a.strict_io,
     };
     let mut reports = Vec::new();
     for setting in &settings {
@@ -384,6 +397,9 @@ fn render(s: &mut String, name: &str, r: &FitReport) {
     render_rom_and_eeprom(s, r);
     if let Some(en) = &r.energy {
         render_energy(s, en);
+    }
+    for line in &r.unmodelled {
+        let _ = writeln!(s, "not modelled: {line}");
     }
     let _ = writeln!(s, "verdict: {}", r.verdict);
 }

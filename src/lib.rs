@@ -18,5 +18,6 @@ pub mod fit_cmd;
 pub mod plot;
 pub mod replay;
 pub mod run_cmd;
+pub mod stage;
 pub mod sweep;
 pub mod viewer;

@@ -75,6 +75,15 @@ struct EmuArgs {
     /// the program with an error (exit status 125), or `warn` at the end and let it run.
     #[arg(long, value_enum, value_name = "ACTION", default_value_t = GuardArg::Stop)]
     stack_guard: GuardArg,
+    /// Write a profile of where the states go by call stack to FILE, as folded stacks
+    /// (`caller;callee;… states`, one stack a line) for speedscope, inferno-flamegraph or
+    /// flamegraph.pl; the lines add up to the run's states.
+    #[arg(long, value_name = "FILE")]
+    profile: Option<std::path::PathBuf>,
+    /// Stop the program (exit status 125) at the first access to a register the chip does
+    /// not model or to a reserved address, instead of warning about each at the end.
+    #[arg(long)]
+    strict_io: bool,
 }
 
 /// What the stack guard does (`--stack-guard`).
@@ -172,7 +181,7 @@ enum Failure {
 fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
-        Err(e) => return usage(&e),
+        Err(e) => return usage(&with_escaped_values(e)),
     };
     // A run or a sweep's task removes its staging folders when a signal stops it.
     if matches!(
@@ -193,6 +202,8 @@ fn main() -> ExitCode {
             gdb: args.gdb.as_deref(),
             symbols: args.symbols.as_deref(),
             stack_guard: args.stack_guard.into(),
+            profile: args.profile.as_deref(),
+            strict_io: args.strict_io,
         }),
         Some(Command::Fit(args)) => fit(&args),
         Some(Command::Run(args)) => run(&args),
@@ -206,11 +217,17 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(Failure::Program(status)) => ExitCode::from(status),
         Err(Failure::Input(e)) => {
-            eprintln!("error: {}", printable(&format!("{e:#}")));
+            eprintln!(
+                "error: {}",
+                printable(&swarm::text::short_numbers(&format!("{e:#}")))
+            );
             ExitCode::from(2)
         }
         Err(Failure::Tool(e)) => {
-            eprintln!("error: {}", printable(&format!("{e:#}")));
+            eprintln!(
+                "error: {}",
+                printable(&swarm::text::short_numbers(&format!("{e:#}")))
+            );
             ExitCode::from(1)
         }
     }
@@ -224,8 +241,9 @@ fn usage(e: &clap::Error) -> ExitCode {
         eprintln!("error: a subcommand or argument is missing: see the usage below");
     }
     let printed = if e.use_stderr() {
-        // A usage error echoes what was typed: shown without its control characters (each
-        // of clap's lines made printable, so a value's ESC cannot reach the terminal).
+        // A usage error echoes what was typed: every value in it escaped first (so a value's
+        // newline cannot split the error line and its ESC is shown, not stripped), then each
+        // of clap's lines made printable.
         let text: String = e
             .render()
             .to_string()
@@ -249,6 +267,35 @@ fn usage(e: &clap::Error) -> ExitCode {
 
 /// Maps a write error to the right outcome: a closed pipe downstream (`h8swarm … | head`) is a
 /// normal end, anything else a tool failure.
+/// Writes a command's report to standard output, each line made [`printable`] (so no name
+/// from a file or an argument reaches the terminal as a control or format character), ending
+/// quietly when the reader has closed the pipe.
+fn write_text(text: &str) -> Result<(), Failure> {
+    let mut shown = String::with_capacity(text.len());
+    for line in text.lines() {
+        shown.push_str(&printable(line));
+        shown.push('\n');
+    }
+    let mut out = io::stdout().lock();
+    out.write_all(shown.as_bytes())
+        .and_then(|()| out.flush())
+        .or_else(write_failure)
+}
+
+/// The usage error to show for `e`: the same error found again with every argument made
+/// [`printable`], so that the values it quotes are escaped (a value's newline cannot split
+/// the error line, and its ESC is shown rather than stripped); `e` itself when the escaped
+/// arguments do not give an error of the same kind.
+fn with_escaped_values(e: clap::Error) -> clap::Error {
+    let escaped: Vec<String> = std::env::args_os()
+        .map(|a| printable(&a.to_string_lossy()))
+        .collect();
+    match Cli::try_parse_from(escaped) {
+        Err(again) if again.kind() == e.kind() => again,
+        _ => e,
+    }
+}
+
 fn write_failure(e: io::Error) -> Result<(), Failure> {
     if e.kind() == io::ErrorKind::BrokenPipe {
         Ok(())
@@ -316,18 +363,12 @@ fn cost(args: &CostArgs) -> Result<(), Failure> {
     } else {
         cost_report::render(&report)
     };
-    io::stdout()
-        .lock()
-        .write_all(text.as_bytes())
-        .or_else(write_failure)
+    write_text(&text)
 }
 
 fn fit(args: &fit_cmd::FitArgs) -> Result<(), Failure> {
     let text = fit_cmd::run(args).map_err(Failure::Input)?;
-    io::stdout()
-        .lock()
-        .write_all(text.as_bytes())
-        .or_else(write_failure)
+    write_text(&text)
 }
 
 fn sweep(args: &h8swarm::sweep::SweepArgs) -> Result<(), Failure> {
@@ -335,10 +376,7 @@ fn sweep(args: &h8swarm::sweep::SweepArgs) -> Result<(), Failure> {
     // What the command found is printed even when it ends in an error (the points a run
     // did, a merge's table of an incomplete sweep); the error line follows on stderr.
     let (text, result) = h8swarm::sweep::command(args);
-    io::stdout()
-        .lock()
-        .write_all(text.as_bytes())
-        .or_else(write_failure)?;
+    write_text(&text)?;
     result.map_err(|e| match e {
         SweepError::Input(m) => Failure::Input(anyhow::anyhow!(m)),
         SweepError::Tool(m) => Failure::Tool(anyhow::anyhow!(m)),
@@ -356,9 +394,15 @@ fn run_failure(e: anyhow::Error) -> Failure {
 }
 
 fn run(args: &run_cmd::RunArgs) -> Result<(), Failure> {
-    let text = run_cmd::run(args).map_err(run_failure)?;
-    io::stdout()
-        .lock()
-        .write_all(text.as_bytes())
-        .or_else(write_failure)
+    let text = match run_cmd::run(args) {
+        Ok(text) => text,
+        Err(e) => {
+            // A run that wrote its outputs but failed as a whole: its report first.
+            if let Some(f) = e.downcast_ref::<run_cmd::FailedRun>() {
+                write_text(&f.report)?;
+            }
+            return Err(run_failure(e));
+        }
+    };
+    write_text(&text)
 }

@@ -242,8 +242,7 @@ fn replay_step_on_core(
             update,
         }),
     };
-    serde_json::to_writer(&mut *out, &line).map_err(io::Error::other)?;
-    out.write_all(b"\n")?;
+    write_line(out, &line)?;
     Ok(())
 }
 
@@ -279,8 +278,16 @@ fn replay_step(
             update: meter.states(Phase::Update),
         }),
     };
-    serde_json::to_writer(&mut *out, &line).map_err(io::Error::other)?;
-    out.write_all(b"\n")
+    write_line(out, &line)
+}
+
+/// Writes `line` as one JSON line: rendered first, then written, so that a write error keeps
+/// its kind (a closed pipe stays BrokenPipe, which ends the command quietly), where
+/// serde_json's writer would wrap it.
+fn write_line(out: &mut dyn Write, line: &impl serde::Serialize) -> io::Result<()> {
+    let mut bytes = serde_json::to_vec(line).map_err(io::Error::other)?;
+    bytes.push(b'\n');
+    out.write_all(&bytes)
 }
 
 fn invalid_data(e: nn_q15::ShapeError) -> io::Error {
@@ -289,7 +296,20 @@ fn invalid_data(e: nn_q15::ShapeError) -> io::Error {
 
 fn parse_object(text: &str, line: usize) -> Result<Map<String, Value>, ReplayError> {
     match serde_json::from_str::<Value>(text) {
-        Ok(Value::Object(map)) => Ok(map),
+        Ok(Value::Object(map)) => match negative_zero_not_an_integer(text) {
+            // One rule for every number of the format: an integer, written without a fraction
+            // or an exponent. The fields refuse the others; the parsed value cannot tell
+            // `-0.0` or `-0e0` from the integer `-0`, so those are refused here, as written.
+            Some(token) => Err(ReplayError {
+                line,
+                field: None,
+                message: format!(
+                    "`{}` is not an integer: every number in a replay line is written without a fraction or an exponent",
+                    swarm::text::printable(token)
+                ),
+            }),
+            None => Ok(map),
+        },
         Ok(other) => Err(ReplayError {
             line,
             field: None,
@@ -301,6 +321,41 @@ fn parse_object(text: &str, line: usize) -> Result<Map<String, Value>, ReplayErr
             message: format!("bad JSON: {e}"),
         }),
     }
+}
+
+/// The first number in the JSON text `text` that is a negative zero written with a fraction or
+/// an exponent (`-0.0`, `-0e0`; strings skipped), if any.
+fn negative_zero_not_an_integer(text: &str) -> Option<&str> {
+    let b = text.as_bytes();
+    let mut i = 0;
+    while i < b.len() {
+        match b[i] {
+            b'"' => {
+                // Skip the string, escapes included.
+                i += 1;
+                while i < b.len() && b[i] != b'"' {
+                    i += if b[i] == b'\\' { 2 } else { 1 };
+                }
+                i += 1;
+            }
+            b'-' | b'0'..=b'9' => {
+                let start = i;
+                while i < b.len() && matches!(b[i], b'-' | b'+' | b'.' | b'e' | b'E' | b'0'..=b'9')
+                {
+                    i += 1;
+                }
+                let token = &text[start..i];
+                if token.starts_with('-')
+                    && token.contains(['.', 'e', 'E'])
+                    && token.parse::<f64>().is_ok_and(|v| v == 0.0)
+                {
+                    return Some(token);
+                }
+            }
+            _ => i += 1,
+        }
+    }
+    None
 }
 
 fn kind(v: &Value) -> &'static str {
@@ -624,9 +679,22 @@ mod tests {
         ra.unwrap();
         rb.unwrap();
         assert_eq!(a, b);
-        // Other floats stay refused.
-        let (_, r) = replay(&format!("{HEADER}\n{{\"x\": [1, 2], \"e\": -1.0}}\n"));
-        assert!(r.unwrap_err().contains("not an integer"));
+        // Numbers written with a fraction or an exponent are refused, whatever their value: one
+        // rule (`-0.0` and `-0e0` were once taken as 0 where `0.0` was refused).
+        for bad in ["-1.0", "0.0", "-0.0", "-0e0", "0E0", "1e1", "-0.0e-5"] {
+            let (_, r) = replay(&format!("{HEADER}\n{{\"x\": [1, 2], \"e\": {bad}}}\n"));
+            let e = r.unwrap_err();
+            assert!(e.contains("is not an integer"), "{bad}: {e}");
+        }
+        // A string may hold what looks like a number.
+        assert_eq!(
+            negative_zero_not_an_integer(r#"{"a": "-0.0", "b": [1, -0]}"#),
+            None
+        );
+        assert_eq!(
+            negative_zero_not_an_integer(r#"{"a": "x\"-0.0", "b": -0e3}"#),
+            Some("-0e3")
+        );
     }
 
     #[test]

@@ -20,6 +20,7 @@ use crate::plot::{
     ArenaFigure, LearningFigure, Panel, Series, SpaceTimeFigure, arena_figure_panels,
     learning_figure, spacetime_figure,
 };
+use crate::stage::Stage;
 use swarm::experiment::{RunOptions, RunOutput, build_world, run_one};
 use swarm::output_error::OutputError;
 use swarm::robot::{Condition, controller_config};
@@ -110,6 +111,20 @@ pub struct RunArgs {
     /// top): `stop` the run with an error, or `warn` after the run and go on.
     #[arg(long, value_enum, value_name = "ACTION")]
     pub stack_guard: Option<StackGuardArg>,
+    /// Write a profile of where one firmware robot's states go by call stack (the learning
+    /// run, repeat 0) to FILE as folded stacks, for speedscope, inferno-flamegraph or
+    /// flamegraph.pl. The robot then runs instruction by instruction (the same results, more
+    /// slowly).
+    #[arg(long, value_name = "FILE")]
+    pub profile: Option<PathBuf>,
+    /// The robot --profile profiles (default 0).
+    #[arg(long, value_name = "K", requires = "profile")]
+    pub profile_robot: Option<usize>,
+    /// Stop a firmware robot (an error, or a dead robot with --keep-going) at its first access
+    /// to a register the emulated chip does not model or to a reserved address, instead of
+    /// warning about each after the run.
+    #[arg(long)]
+    pub strict_io: bool,
 }
 
 /// What the stack guard does (`--stack-guard`).
@@ -212,9 +227,27 @@ fn probed_robot(option: &str, k: usize, s: &Scenario) -> Result<usize> {
     Ok(k)
 }
 
-/// The probes `--vcd` and `--gdb` ask for, checked (a bad value fails before any run); the
+/// Whether two paths name one file (the same path, or the same file through links).
+fn same_file(a: &std::path::Path, b: &std::path::Path) -> bool {
+    if a == b {
+        return true;
+    }
+    let parent_and_name = |p: &std::path::Path| {
+        let parent = match p.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+            _ => std::path::PathBuf::from("."),
+        };
+        Some((
+            std::fs::canonicalize(parent).ok()?,
+            p.file_name()?.to_owned(),
+        ))
+    };
+    matches!((parent_and_name(a), parent_and_name(b)), (Some(x), Some(y)) if x == y)
+}
+
+/// The probes `--vcd`, `--profile` and `--gdb` ask for, checked (a bad value fails before any run); the
 /// GDB stub is listening when this returns.
-fn probes(a: &RunArgs, s: &Scenario) -> Result<swarm::experiment::RobotProbes> {
+fn probes(a: &RunArgs, s: &Scenario, stage: &mut Stage) -> Result<swarm::experiment::RobotProbes> {
     let mut p = swarm::experiment::RobotProbes::default();
     if let Some(path) = &a.vcd {
         let robot = probed_robot("--vcd-robot", a.vcd_robot.unwrap_or(0), s)?;
@@ -230,8 +263,13 @@ fn probes(a: &RunArgs, s: &Scenario) -> Result<swarm::experiment::RobotProbes> {
         if steps == 0 {
             bail!("--vcd-steps 0: trace at least 1 step");
         }
-        // Fail now, not after the runs, if the file cannot be written.
-        std::fs::write(path, b"")
+        // The trace is an output like the others: written beside FILE and moved into place
+        // with the run's files, or not at all. Fail now, not after the runs, if it cannot be
+        // written.
+        let staged = stage
+            .stage_outside("--vcd", path)
+            .map_err(|e| anyhow::Error::new(OutputError(e.0)))?;
+        std::fs::write(&staged, b"")
             .map_err(anyhow::Error::new)
             .context(OutputError(format!(
                 "--vcd: cannot create `{}`",
@@ -241,7 +279,33 @@ fn probes(a: &RunArgs, s: &Scenario) -> Result<swarm::experiment::RobotProbes> {
             robot,
             from,
             steps: steps.min(s.steps - from),
-            path: path.clone(),
+            path: staged,
+            shown: path.clone(),
+        });
+    }
+    if let Some(path) = &a.profile {
+        let robot = probed_robot("--profile-robot", a.profile_robot.unwrap_or(0), s)?;
+        if a.vcd.as_deref().is_some_and(|v| same_file(v, path)) {
+            bail!(
+                "--profile `{}` is also the --vcd file: give each its own file",
+                path.display()
+            );
+        }
+        // Staged and committed with the run's files like the trace; fail now, not after the
+        // runs, if it cannot be written.
+        let staged = stage
+            .stage_outside("--profile", path)
+            .map_err(|e| anyhow::Error::new(OutputError(e.0)))?;
+        std::fs::write(&staged, b"")
+            .map_err(anyhow::Error::new)
+            .context(OutputError(format!(
+                "--profile: cannot create `{}`",
+                path.display()
+            )))?;
+        p.profile = Some(swarm::experiment::ProfileProbe {
+            robot,
+            path: staged,
+            shown: path.clone(),
         });
     }
     if let Some(addr) = &a.gdb {
@@ -267,11 +331,34 @@ struct Summary<'a> {
     conditions: &'a [ConditionStats],
     pairings: &'a [Pairing],
     claims: &'a [Claim],
+    /// The robots that died in each run (`--keep-going`); their repeats are left out of the
+    /// claims and the window statistics.
+    dead_robots: Vec<DeadEntry<'a>>,
     /// `false` when the user's image has no configuration block (it ran with its own
     /// settings, not the scenario's); absent otherwise.
     #[serde(skip_serializing_if = "Option::is_none")]
     image_configured: Option<bool>,
     battery: &'a swarm::battery::BatteryReport,
+}
+
+/// A run that ended and wrote its outputs but failed as a whole (every robot died): its report,
+/// to print before the error.
+#[derive(Debug, thiserror::Error)]
+#[error("{why}")]
+pub struct FailedRun {
+    /// The run's text, as a successful run prints it.
+    pub report: String,
+    /// Why the run failed.
+    pub why: String,
+}
+
+/// A dead robot as summary.json lists it.
+#[derive(Serialize)]
+struct DeadEntry<'a> {
+    condition: &'static str,
+    repeat: u32,
+    #[serde(flatten)]
+    robot: &'a swarm::experiment::DeadRobot,
 }
 
 /// Runs the experiment; returns the text to print.
@@ -331,10 +418,17 @@ pub fn run(a: &RunArgs) -> Result<String> {
     // Fail now if the robots do not fit the arena, or a probe's option is bad.
     build_world(&s, 0)?;
     let replay = replay_plan(a, &s)?;
-    let probes = std::sync::Mutex::new(Some(probes(a, &s)?));
-    // Every file is written into a staging folder beside `out` and moved into place only
-    // when the whole run succeeded; a failure before that leaves `out` as it was.
-    let stage = Stage::new(&out)?;
+    // Every file (the trace of --vcd too) is written into a staging folder beside `out` and
+    // moved into place only when the whole run succeeded; a failure before that leaves `out`
+    // (and the trace's file) as it was.
+    let mut stage = Stage::new("--out", &out).map_err(|e| anyhow::Error::new(OutputError(e.0)))?;
+    let probes = match probes(a, &s, &mut stage) {
+        Ok(p) => std::sync::Mutex::new(Some(p)),
+        Err(e) => {
+            let _ = stage.abandon();
+            return Err(e);
+        }
+    };
     let result = run_into(&RunContext {
         a,
         s: &s,
@@ -345,9 +439,14 @@ pub fn run(a: &RunArgs) -> Result<String> {
         threads: threads_or_all(a.threads),
     });
     match result {
-        Ok((mut text, names)) => {
-            stage.commit(&names).map_err(|e| {
-                e.context(format!(
+        Ok((mut text, names, dead)) => {
+            let commit = crate::stage::Commit {
+                files: names.clone(),
+                ours: OUTPUT_FILES.iter().map(|n| (*n).to_string()).collect(),
+                folders: Vec::new(),
+            };
+            stage.commit(&commit).map_err(|e| {
+                anyhow::Error::new(OutputError(e.0)).context(format!(
                     "the run into `{}` could not be moved into place",
                     out.display()
                 ))
@@ -367,7 +466,12 @@ pub fn run(a: &RunArgs) -> Result<String> {
                 list(&files),
                 plots.join(", ")
             );
-            Ok(text)
+            match dead {
+                // The record is written; the run itself is a failure of the image (bad
+                // input: exit status 2), reported after the run's own text.
+                Some(why) => Err(anyhow::Error::new(FailedRun { report: text, why })),
+                None => Ok(text),
+            }
         }
         Err(e) => {
             let kept = stage.abandon();
@@ -710,174 +814,6 @@ pub fn default_out_name(what: &str) -> String {
     }
 }
 
-/// A staging folder beside the output folder: `<parent>/.<name>.partial-<pid>`, registered
-/// for removal on SIGINT, SIGTERM and SIGHUP ([`crate::cleanup`]) while it exists.
-struct Stage {
-    out: PathBuf,
-    dir: PathBuf,
-    registered: Option<crate::cleanup::Staged>,
-}
-
-impl Stage {
-    fn new(out: &Path) -> Result<Stage> {
-        let name = out
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .filter(|n| n != "." && n != "..")
-            .ok_or_else(|| {
-                anyhow::Error::new(OutputError(format!(
-                    "--out `{}`: give a folder name (e.g. out/run1), not a root or `..`",
-                    out.display()
-                )))
-            })?;
-        if out.exists() && !out.is_dir() {
-            return Err(anyhow::Error::new(OutputError(format!(
-                "--out `{}` is a file: give a folder (new or holding earlier results)",
-                out.display()
-            ))));
-        }
-        let parent = match out.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-            _ => PathBuf::from("."),
-        };
-        let dir = parent.join(format!(".{name}.partial-{}", std::process::id()));
-        let registered = crate::cleanup::Staged::register(&dir);
-        std::fs::create_dir_all(&dir)
-            .map_err(anyhow::Error::new)
-            .context(OutputError(format!(
-                "cannot create the staging folder `{}` beside the output folder",
-                dir.display()
-            )))?;
-        Ok(Stage {
-            out: out.to_path_buf(),
-            dir,
-            registered: Some(registered),
-        })
-    }
-
-    fn path(&self, file: &str) -> PathBuf {
-        self.dir.join(file)
-    }
-
-    /// Moves the staged files into `out`, replacing earlier ones of the same names and
-    /// removing this tool's files the run did not write, all or nothing: every file in the
-    /// way is checked first, the earlier files are moved aside into the staging folder, the
-    /// new ones moved in, and on any failure everything is moved back (and `out` removed again
-    /// if this made it). A signal that arrives meanwhile waits for the move to end.
-    fn commit(mut self, names: &[String]) -> Result<()> {
-        let result = crate::cleanup::while_committing(|| self.move_into_place(names));
-        let kept = match &result {
-            Ok(()) => {
-                let _ = std::fs::remove_dir_all(&self.dir);
-                String::new()
-            }
-            Err(_) => self.remove_or_say(),
-        };
-        self.registered.take();
-        result.map_err(|e| if kept.is_empty() { e } else { e.context(kept) })
-    }
-
-    fn move_into_place(&self, names: &[String]) -> Result<()> {
-        let fail =
-            |what: String, e: std::io::Error| anyhow::Error::new(e).context(OutputError(what));
-        let replaced: Vec<&str> = OUTPUT_FILES
-            .iter()
-            .copied()
-            .chain(names.iter().map(String::as_str))
-            .collect::<std::collections::BTreeSet<&str>>()
-            .into_iter()
-            .collect();
-        // Checked before anything moves: what is in the way must be a file (ours, earlier).
-        for name in &replaced {
-            let to = self.out.join(name);
-            if let Ok(meta) = std::fs::symlink_metadata(&to)
-                && meta.is_dir()
-            {
-                return Err(anyhow::Error::new(OutputError(format!(
-                    "cannot replace `{}`: it is a folder, not a file h8swarm wrote; move it away and run again (the output folder is unchanged)",
-                    to.display()
-                ))));
-            }
-        }
-        let made_out = !self.out.exists();
-        std::fs::create_dir_all(&self.out).map_err(|e| {
-            fail(
-                format!("cannot create the output folder `{}`", self.out.display()),
-                e,
-            )
-        })?;
-        let aside = self.dir.join(".earlier");
-        let mut moved_aside: Vec<&str> = Vec::new();
-        let mut moved_in: Vec<&str> = Vec::new();
-        let moved = (|| -> Result<()> {
-            std::fs::create_dir_all(&aside)
-                .map_err(|e| fail(format!("cannot create `{}`", aside.display()), e))?;
-            for name in &replaced {
-                let from = self.out.join(name);
-                if std::fs::symlink_metadata(&from).is_ok() {
-                    std::fs::rename(&from, aside.join(name)).map_err(|e| {
-                        fail(
-                            format!("cannot move the earlier `{}` aside", from.display()),
-                            e,
-                        )
-                    })?;
-                    moved_aside.push(name);
-                }
-            }
-            for name in names {
-                std::fs::rename(self.dir.join(name), self.out.join(name)).map_err(|e| {
-                    fail(
-                        format!("cannot move `{name}` into `{}`", self.out.display()),
-                        e,
-                    )
-                })?;
-                moved_in.push(name);
-            }
-            Ok(())
-        })();
-        if moved.is_err() {
-            // Back as it was: the new files out, the earlier ones in.
-            for name in moved_in {
-                let _ = std::fs::rename(self.out.join(name), self.dir.join(name));
-            }
-            for name in moved_aside {
-                let _ = std::fs::rename(aside.join(name), self.out.join(name));
-            }
-            if made_out {
-                let _ = std::fs::remove_dir(&self.out);
-            }
-        }
-        moved
-    }
-
-    /// After a failed commit: removes the staging folder unless earlier files could not be
-    /// moved back out of it; says which.
-    fn remove_or_say(&self) -> String {
-        let aside = self.dir.join(".earlier");
-        let stranded = std::fs::read_dir(&aside).map(|d| d.count()).unwrap_or(0);
-        if stranded == 0 {
-            let _ = std::fs::remove_dir_all(&self.dir);
-            String::new()
-        } else {
-            format!(
-                "{stranded} earlier files could not be moved back: they are in `{}`",
-                aside.display()
-            )
-        }
-    }
-
-    /// Removes the staging folder after a failure; says what became of `out`.
-    fn abandon(mut self) -> String {
-        let _ = std::fs::remove_dir_all(&self.dir);
-        self.registered.take();
-        if self.out.is_dir() {
-            "the earlier results there are untouched".to_string()
-        } else {
-            "nothing was written".to_string()
-        }
-    }
-}
-
 /// Every file `h8swarm run` writes into its output folder (`arena.png` for the square arena,
 /// `spacetime.png` for the corridor; the others always).
 pub const OUTPUT_FILES: [&str; 9] = [
@@ -909,7 +845,7 @@ struct RunContext<'r> {
 
 /// Runs the experiment, writing its files into the staging folder; returns the text to print
 /// and the files written.
-fn run_into(cx: &RunContext) -> Result<(String, Vec<String>)> {
+fn run_into(cx: &RunContext) -> Result<(String, Vec<String>, Option<String>)> {
     let RunContext {
         a,
         s,
@@ -948,6 +884,16 @@ fn run_into(cx: &RunContext) -> Result<(String, Vec<String>)> {
         conditions: &analysis.conditions,
         pairings: &analysis.pairings,
         claims: &analysis.claims,
+        dead_robots: runs
+            .iter()
+            .flat_map(|r| {
+                r.dead.iter().map(|d| DeadEntry {
+                    condition: r.condition.name(),
+                    repeat: r.repeat,
+                    robot: d,
+                })
+            })
+            .collect(),
         image_configured: images
             .and_then(|i| i.user.as_ref())
             .map(|(fw, _)| fw.has_config_block())
@@ -970,7 +916,23 @@ fn run_into(cx: &RunContext) -> Result<(String, Vec<String>)> {
     render_failures(&mut t, &runs);
     let _ = writeln!(t);
     let _ = writeln!(t, "fit: {}", fit.verdict);
-    Ok((t, names))
+    Ok((t, names, all_dead(&runs, s.robots)))
+}
+
+/// When every robot of every run died (`--keep-going`): what to say, with the first
+/// robot's reason.
+fn all_dead(runs: &[RunOutput], robots: usize) -> Option<String> {
+    let every = !runs.is_empty() && runs.iter().all(|r| r.dead.len() >= robots);
+    every.then(|| {
+        let why = runs
+            .iter()
+            .flat_map(|r| &r.dead)
+            .next()
+            .map_or_else(String::new, |d| format!(" (the first: {})", d.why));
+        format!(
+            "every robot of every run died{why}: nothing could be judged (every claim is undecided); the outputs name the dead robots"
+        )
+    })
 }
 
 /// The conditions `s` runs (learning, then the controls it asks for) and its runs: every
@@ -1054,7 +1016,7 @@ fn run_all(
                         swarm::recording::Recorder::new(
                             p.opts.clone(),
                             (floor.width_m(), floor.height_m()),
-                            swarm::recording::part_paths(&stage.dir, c, r),
+                            swarm::recording::part_paths(stage.dir(), c, r),
                         )?,
                         p.robots,
                     )),
@@ -1073,6 +1035,7 @@ fn run_all(
                         probes: probes.unwrap_or_default(),
                         replay,
                         stack_guard: a.stack_guard.unwrap_or_default().into(),
+                        strict_io: a.strict_io,
                     },
                 )
             })
@@ -1099,6 +1062,7 @@ fn measure_fit(s: &Scenario) -> Result<swarm::fit::FitReport> {
         kind: swarm::scenario::ControllerKind::Firmware,
         firmware: swarm::fit::FirmwareUnderTest::robot()?,
         compare: true,
+        strict_io: false,
     })?)
 }
 
@@ -1128,7 +1092,14 @@ fn write_figures(
     .map(String::from)
     .to_vec();
     if let Some(plan) = replay {
-        write_replay(s, &stage.path("replay.html"), &stage.dir, plan, floor, runs)?;
+        write_replay(
+            s,
+            &stage.path("replay.html"),
+            stage.dir(),
+            plan,
+            floor,
+            runs,
+        )?;
         names.push("replay.html".into());
     }
     if let Some(track) = runs.iter().find_map(|r| r.track.as_ref()) {
@@ -1186,15 +1157,30 @@ fn factor_text(f: f64) -> String {
     }
 }
 
-/// One line per robot that died and per stack warning, run by run.
+/// One line per robot that died and per stack warning, run by run; one per robot and
+/// address its chip does not model, for the first run that touched it.
 fn render_failures(t: &mut String, runs: &[RunOutput]) {
+    let mut io_seen = std::collections::BTreeSet::new();
     for r in runs {
-        for (i, why) in &r.dead {
+        for (i, what) in &r.io_warnings {
+            if io_seen.insert((*i, what.clone())) {
+                let _ = writeln!(
+                    t,
+                    "IO    robot {i} in {} repeat {}: {what}",
+                    r.condition.name(),
+                    r.repeat
+                );
+            }
+        }
+        for d in &r.dead {
             let _ = writeln!(
                 t,
-                "DEAD  robot {i} in {} repeat {}: {why}",
+                "DEAD  robot {} in {} repeat {} (from step {}): {}",
+                d.robot,
                 r.condition.name(),
-                r.repeat
+                r.repeat,
+                d.step,
+                d.why
             );
         }
         for (i, fault) in &r.stack_warnings {
@@ -1286,6 +1272,7 @@ fn write_replay(
             .collect(),
         du_m: sensors::du::MM_PER_DU / 1000.0,
         robots: plan.robots,
+        run_robots: s.robots,
         steps: s.steps,
         stride: plan.opts.stride,
         step_period_s: s.timing.step_period_s,
@@ -1328,6 +1315,19 @@ fn warnings(s: &Scenario) -> Vec<String> {
         w.push(format!(
             "{} repeats: a one-sided sign test needs at least 5 repeats all going one way to reach p < 0.05, so no claim can hold",
             s.repeats
+        ));
+    }
+    if let Some(sym) = &s.controller.symbols
+        && s.controller.image.is_none()
+    {
+        w.push(format!(
+            "`controller.symbols` = {} is not used: it is the symbol table of `controller.image`, and {}",
+            swarm::text::printable(sym),
+            if s.controller.kind == swarm::scenario::ControllerKind::Model {
+                "the robots run the Rust model (controller.kind = \"model\")"
+            } else {
+                "the robots run the built-in firmware"
+            }
         ));
     }
     w
@@ -1715,7 +1715,7 @@ fn fmt_est(e: &Estimate) -> String {
 }
 
 /// The columns of `robots.csv`, one row per robot of every run.
-pub const ROBOTS_HEADER: [&str; 19] = [
+pub const ROBOTS_HEADER: [&str; 20] = [
     "condition",
     "repeat",
     "robot",
@@ -1735,6 +1735,7 @@ pub const ROBOTS_HEADER: [&str; 19] = [
     "last_window_collisions",
     "last_window_cells",
     "last_class",
+    "died_at_step",
 ];
 
 /// Writes every robot's record of every run (in run order, robots in index order).
@@ -1770,6 +1771,11 @@ fn write_robots(path: &Path, runs: &[RunOutput]) -> Result<()> {
                         .map(MotionClass::name)
                         .unwrap_or_default()
                         .to_string(),
+                    r.dead
+                        .iter()
+                        .find(|d| d.robot == i)
+                        .map(|d| d.step.to_string())
+                        .unwrap_or_default(),
                 ])?;
             }
         }

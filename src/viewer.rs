@@ -82,8 +82,10 @@ pub struct Header {
     pub sensors: Vec<MountHeader>,
     /// One du in metres (80/255 cm).
     pub du_m: f64,
-    /// Robots.
+    /// Robots recorded (the first of the run's).
     pub robots: usize,
+    /// Robots in the run.
+    pub run_robots: usize,
     /// Steps of a run.
     pub steps: u32,
     /// Steps between two frames.
@@ -92,7 +94,9 @@ pub struct Header {
     pub step_period_s: f64,
     /// `model` or `firmware`.
     pub controller: String,
-    /// The master seed.
+    /// The master seed, carried as text (a JavaScript number holds integers exactly only up
+    /// to 2^53).
+    #[serde(with = "u64_text")]
     pub seed: u64,
     /// Weights layout: inputs N and outputs M (0 when none are recorded).
     pub weights_shape: [usize; 2],
@@ -104,6 +108,20 @@ pub struct Header {
     pub runs: Vec<RunHeader>,
     /// The learning curves (all repeats).
     pub curves: Vec<CurveHeader>,
+}
+
+/// A `u64` as JSON text (`"18446744073709551615"`), so that no reader rounds it.
+mod u64_text {
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    pub fn serialize<S: Serializer>(v: &u64, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(&v.to_string())
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<u64, D::Error> {
+        let text = String::deserialize(d)?;
+        text.parse().map_err(serde::de::Error::custom)
+    }
 }
 
 /// Writes the viewer page `html` with `header` and the runs' part files (per run in the
@@ -360,6 +378,7 @@ mod tests {
                 sensors: vec![],
                 du_m: 0.8 / 255.0,
                 robots: 3,
+                run_robots: 3,
                 steps: 20,
                 stride,
                 step_period_s: 0.45,

@@ -139,6 +139,7 @@ fn the_fit_reports_the_robot_s_current_by_part_and_the_battery_life() {
         kind: ControllerKind::Firmware,
         firmware: FirmwareUnderTest::robot().unwrap(),
         compare: false,
+        strict_io: false,
     })
     .unwrap();
     let e = r.energy.clone().expect("the fit meters the energy");

@@ -26,6 +26,7 @@ fn config(behaviours: usize, layout: InputLayout, corridor: bool) -> FitConfig {
         kind: ControllerKind::Firmware,
         firmware: FirmwareUnderTest::robot().unwrap(),
         compare: true,
+        strict_io: false,
     }
 }
 

@@ -17,40 +17,9 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use proptest::prelude::*;
-use proptest::test_runner::{Config, TestRunner};
 
-fn cases() -> u32 {
-    cases_or(2_000)
-}
-
-/// `H8SWARM_FUZZ_CASES`, else `default`.
-fn cases_or(default: u32) -> u32 {
-    std::env::var("H8SWARM_FUZZ_CASES")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(default)
-}
-
-/// The same cases on every CI run (a fixed seed); a soak (`H8SWARM_FUZZ_CASES` set) draws new
-/// ones each time.
-fn runner() -> TestRunner {
-    runner_of(cases())
-}
-
-/// [`runner`] with `cases` cases.
-fn runner_of(cases: u32) -> TestRunner {
-    let config = Config {
-        cases,
-        failure_persistence: None,
-        ..Config::default()
-    };
-    if std::env::var_os("H8SWARM_FUZZ_CASES").is_some() {
-        TestRunner::new(config)
-    } else {
-        let rng = proptest::test_runner::TestRng::deterministic_rng(config.rng_algorithm);
-        TestRunner::new_with_rng(config, rng)
-    }
-}
+mod common;
+use common::fuzzing::*;
 
 /// Values that break things: wrong types, signs, sizes, special floats, long strings.
 fn hostile_value() -> impl Strategy<Value = String> {
@@ -151,13 +120,6 @@ fn apply(text: &str, edits: &[Edit]) -> String {
         }
     }
     lines.join("\n") + "\n"
-}
-
-/// An error's first line says what; it must exist and not be empty.
-fn one_line_first(message: &str) -> Result<(), TestCaseError> {
-    let first = message.lines().next().unwrap_or("");
-    prop_assert!(!first.trim().is_empty(), "an empty error: {message:?}");
-    Ok(())
 }
 
 #[test]
@@ -307,6 +269,7 @@ fn s_records_never_panic_and_images_that_load_run_to_a_stop() {
                 &bytes,
                 &RunOptions {
                     max_states: Some(20_000),
+                    ..RunOptions::default()
                 },
                 &mut console,
                 None,
@@ -505,34 +468,6 @@ fn argument_vectors_end_with_a_promised_status_and_write_only_where_they_ran() {
         statuses.contains_key(&0) && statuses.contains_key(&2),
         "{statuses:?} over {n}"
     );
-}
-
-/// A fresh, empty folder for a family's cases.
-fn family_dir(name: &str) -> std::path::PathBuf {
-    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("fuzz-{name}"));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-/// [`family_dir`] in memory where the system has it (/dev/shm): a family that makes and
-/// removes thousands of small files spends most of its time making inodes on a disk.
-fn family_dir_in_memory(name: &str) -> std::path::PathBuf {
-    let shm = Path::new("/dev/shm");
-    if !shm.is_dir() {
-        return family_dir(name);
-    }
-    let d = shm.join(format!("h8swarm-fuzz-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-/// No control character but line ends: what reaches a terminal.
-fn printable_text(text: &str) -> bool {
-    !text
-        .chars()
-        .any(|c| (c.is_control() && c != '\n') || ('\u{80}'..='\u{9f}').contains(&c))
 }
 
 /// A `[slurm]` value: numbers of every size and sign, Slurm's time formats and near misses,
@@ -950,6 +885,7 @@ fn raw_gdb_sessions_get_protocol_answers_and_never_hang_the_stub() {
                     &mut mcu,
                     &RunOptions {
                         max_states: Some(1_000_000),
+                        ..RunOptions::default()
                     },
                     &mut std::io::sink(),
                     Probes {
@@ -1056,20 +992,6 @@ fn raw_gdb_sessions_get_protocol_answers_and_never_hang_the_stub() {
 }
 
 /// Waits for `child` at most 120 s (a case may not hang); its exit status.
-fn wait_bounded(child: &mut std::process::Child, what: &str) -> std::process::ExitStatus {
-    let started = Instant::now();
-    loop {
-        if let Some(s) = child.try_wait().unwrap() {
-            return s;
-        }
-        if started.elapsed() > Duration::from_secs(120) {
-            let _ = child.kill();
-            panic!("{what} did not end within 120 s");
-        }
-        std::thread::sleep(Duration::from_millis(2));
-    }
-}
-
 /// Files of `dir` (names and bytes), sorted.
 fn files_of(dir: &Path) -> Vec<(std::ffi::OsString, Vec<u8>)> {
     let mut v: Vec<_> = std::fs::read_dir(dir)

@@ -175,7 +175,8 @@ fn a_users_image_on_chosen_robots_and_a_faulty_one_named() {
         "{err}"
     );
 
-    // An undefined opcode, named with its bytes; with --keep-going every robot dies.
+    // An undefined opcode, named with its bytes; with --keep-going every robot dies: the run
+    // writes its outputs, which name the dead robots, judges nothing, and says it failed.
     let bad = dir.join("bad.mot");
     std::fs::write(&bad, image(&[0x01, 0x50])).unwrap();
     let out = h8swarm(&[
@@ -184,22 +185,94 @@ fn a_users_image_on_chosen_robots_and_a_faulty_one_named() {
         "--steps",
         "5",
         "--repeats",
-        "1",
+        "2",
         "--keep-going",
         "--out",
         z.to_str().unwrap(),
     ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+        err.lines().filter(|l| l.starts_with("error:")).count() == 1
+            && err.contains("every robot of every run died"),
+        "{err}"
     );
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(
-        text.contains("DEAD  robot 2 in learning repeat 0")
-            && text.contains("undefined opcode at PC H'000100: 01 50"),
+        text.contains("DEAD  robot 2 in learning repeat 1 (from step 0)")
+            && text.contains("undefined opcode at PC H'000100: 01 50")
+            && !text.contains("HOLDS"),
         "{text}"
     );
+    assert_dead_everywhere(&z, 2, 3);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The outputs in `out` of a learning-only run of `repeats` repeats in which every one of
+/// `robots` robots died at step 0 name them, and judge no claim.
+fn assert_dead_everywhere(out: &Path, repeats: u32, robots: usize) {
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let dead = summary["dead_robots"].as_array().unwrap();
+    assert_eq!(dead.len(), repeats as usize * robots, "{dead:?}");
+    assert!(
+        dead.iter()
+            .all(|d| d["step"] == 0 && d["why"].as_str().unwrap().contains("undefined opcode")),
+        "{dead:?}"
+    );
+    for c in summary["claims"].as_array().unwrap() {
+        assert_eq!(c["outcome"], "undecided", "{c}");
+    }
+    let robots_csv = std::fs::read_to_string(out.join("robots.csv")).unwrap();
+    let mut lines = robots_csv.lines();
+    assert!(lines.next().unwrap().ends_with(",died_at_step"));
+    assert!(lines.all(|l| l.ends_with(",0")), "{robots_csv}");
+    let m = metrics(out);
+    let mut lines = m.lines();
+    assert!(lines.next().unwrap().ends_with(",dead_robots"));
+    let n = robots.to_string();
+    assert!(
+        lines.all(|l| l.rsplit(',').next() == Some(n.as_str())),
+        "{m}"
+    );
+}
+
+#[test]
+fn a_repeat_with_a_dead_robot_is_left_out_of_the_claims() {
+    // One robot of three runs an image that dies at boot: the run goes on (--keep-going),
+    // exits 0, and no claim is judged on the repeats that robot died in.
+    let dir = tmp("onedead");
+    let bad = dir.join("bad.mot");
+    std::fs::write(&bad, image(&[0x01, 0x50])).unwrap();
+    let scenario = dir.join("s.toml");
+    std::fs::write(
+        &scenario,
+        format!(
+            "base = \"arena\"\nsteps = 40\nrepeats = 2\nwindow = 10\n[controls]\nlearning_off = false\nrandom_walk = false\n[controller]\nkind = \"firmware\"\nimage = \"{}\"\nrobots = [1]\n",
+            bad.display()
+        ),
+    )
+    .unwrap();
+    let out_dir = dir.join("o");
+    let out = h8swarm(&[
+        "run",
+        scenario.to_str().unwrap(),
+        "--keep-going",
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("summary.json")).unwrap())
+            .unwrap();
+    let dead = summary["dead_robots"].as_array().unwrap();
+    assert_eq!(dead.len(), 2, "{dead:?}");
+    assert!(dead.iter().all(|d| d["robot"] == 1), "{dead:?}");
+    for c in summary["claims"].as_array().unwrap() {
+        assert_eq!(c["outcome"], "undecided", "{c}");
+        assert_eq!(c["repeats"]["undefined"], 2, "{c}");
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }
 

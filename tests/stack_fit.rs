@@ -20,6 +20,7 @@ fn the_robot_firmware_states_the_stack_room_it_leaves() {
         kind: ControllerKind::Firmware,
         firmware: FirmwareUnderTest::robot().unwrap(),
         compare: false,
+        strict_io: false,
     })
     .unwrap();
     let st = r.stack.clone().expect("measured on the core");
@@ -60,6 +61,7 @@ fn an_image_whose_frame_does_not_fit_does_not_fit_and_says_where() {
             phases: vec![PhaseDef::new("fill", &["fill"])],
         },
         compare: false,
+        strict_io: false,
     })
     .unwrap();
     let st = r.stack.clone().unwrap();

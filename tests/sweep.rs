@@ -578,6 +578,21 @@ cells = [{ "learner.eta" = 0.03 }]
     let (code, err) = fails(&["sweep", "merge", s(&map)], &[]);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("names cell 9"), "{err}");
+    // Map and confirmation are one commit: the map's half is not written either.
+    let elsewhere = root.join("elsewhere");
+    let (code, err) = fails(&["sweep", "merge", s(&map), "--out", s(&elsewhere)], &[]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        !elsewhere.join("sweep.csv").exists(),
+        "the map's merge was committed without its confirmation"
+    );
+    let left: Vec<_> = std::fs::read_dir(&root)
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.contains("partial"))
+        .collect();
+    assert!(left.is_empty(), "staging left behind: {left:?}");
     std::fs::write(&record, good).unwrap();
     let list_path = map.join("points.jsonl");
     let list = std::fs::read_to_string(&list_path).unwrap();
@@ -588,7 +603,7 @@ cells = [{ "learner.eta" = 0.03 }]
     .unwrap();
     let (code, err) = fails(&["sweep", "merge", s(&map)], &[]);
     assert_eq!(code, 2, "{err}");
-    assert!(err.contains("outside the plan's grid"), "{err}");
+    assert!(err.contains("lie outside the plan's axes"), "{err}");
     assert_eq!(err.trim().lines().count(), 1, "{err}");
     std::fs::write(&list_path, list).unwrap();
     // Seeds 11-20 are refused by plan; and a sweep without [confirm] has nothing to confirm.

@@ -427,6 +427,34 @@ fn the_viewer_shows_the_run_as_recorded() {
         .unwrap();
     s.controller.kind = swarm::scenario::ControllerKind::Firmware;
     check_page(&browser, &fw, &s, 41, "firmware");
+    // The largest seed, and one robot of three recorded: the title says both as they are (the
+    // seed once came out as 18446744073709552000, through a JavaScript number).
+    let big = root.join("big-seed");
+    run(
+        &[
+            "run",
+            "arena",
+            "--steps",
+            "20",
+            "--repeats",
+            "1",
+            "--seed",
+            "18446744073709551615",
+            "--replay-robots",
+            "1",
+        ],
+        &big,
+    );
+    let url = format!("file://{}", big.join("replay.html").display());
+    let mut tab = browser.open(&url);
+    ready(&mut tab);
+    let title = tab.eval("document.getElementById('title').textContent");
+    let title = title.as_str().unwrap();
+    assert!(
+        title.contains("seed 18446744073709551615") && title.contains("1 of 3 robots recorded"),
+        "{title}"
+    );
+    assert!(tab.complaints().is_empty(), "{:?}", tab.complaints());
 }
 
 /// 1 000 robots: the page loads and draws; its drawing rate is measured and printed.

@@ -8,8 +8,8 @@
 //!    through), [`core::cpu`] (decode, execute, timing by the manual's I·S_I + … + N·S_N rule,
 //!    an objdump-form disassembler; generic over the bus) and [`core::srec`] (the Motorola
 //!    S-record loader for `.mot` images). It knows no chip.
-//! 2. [`chip`] — the H8/3052F: [`chip::periph`] (A/D, ITU, ports, interrupt controller, SCI1,
-//!    each synchronised lazily to the clock), [`chip::mcu`] (the chip as one bus: memories,
+//! 2. [`chip`] — the H8/3052F: [`chip::periph`] (A/D, ITU, ports, interrupt controller with
+//!    the IRQ inputs, SCI1, watchdog timer, each synchronised lazily to the clock), [`chip::mcu`] (the chip as one bus: memories,
 //!    peripherals, the [`chip::pins::Board`] outside its pins),
 //!    [`chip::machine`] (the MCU with nothing connected), [`chip::run`]
 //!    (running an image to its halt, with console, trace and statistics) and [`chip::power`]
@@ -51,7 +51,11 @@
 //! - SCI1 transmits as on the chip: a byte is sent when TDRE is cleared with SCR.TE = 1, and
 //!   TDRE/TEND return after the frame time the BRR formula gives ([`chip::periph::sci`]).
 //! - The [`chip::machine::Machine`] loads S-record data into flash only; data for other
-//!   addresses is an error. Registers of modules that are not modelled read 0 and ignore writes.
+//!   addresses is an error. Registers of modules that are not modelled read 0 and ignore writes,
+//!   and the first access to each is reported with its register's name ([`chip::iomap`],
+//!   [`chip::mcu::IoReport`]).
+//! - The watchdog timer resets the chip at its overflow in watchdog timer mode: 518 states,
+//!   every module reset but RSTCSR (WRST set), then the reset vector ([`chip::periph::wdt`]).
 //! - Memory is allocated on first use: the flash when an image is loaded (an empty flash
 //!   reads H'FF), the RAM on its first write (untouched RAM reads 0) ([`chip::mcu`]).
 //! - A/D: the input is sampled at the end of the sampling window, t_D (maximum, 17/9 states)

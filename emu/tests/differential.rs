@@ -63,6 +63,7 @@ fn every_program_image_prints_its_host_output_and_exits_0() {
         let mut console = Vec::new();
         let options = RunOptions {
             max_states: Some(MAX_STATES_PER_PROGRAM),
+            ..RunOptions::default()
         };
         let report = match run_image(&image, &options, &mut console, None) {
             Ok(r) => r,

@@ -191,7 +191,7 @@ fn lockstep<B: Board>(
         }
         match ea {
             Ok(Event::Interrupt(_)) => tally.interrupts += 1,
-            Ok(Event::Executed) => {}
+            Ok(Event::Executed | Event::Reset | Event::Break) => {}
             Ok(Event::Halted) | Err(_) => {
                 tally.end = Some(ea);
                 break;
@@ -865,7 +865,9 @@ fn run_vs_steps<B: Board>(
         match ea {
             Ok(Event::Halted) | Err(_) => break,
             // An interrupt or a wait: go on to the same deadline.
-            Ok(Event::Interrupt(_)) | Ok(Event::Asleep) => deadline = ma.now().min(deadline),
+            Ok(Event::Interrupt(_) | Event::Asleep | Event::Reset | Event::Break) => {
+                deadline = ma.now().min(deadline);
+            }
             Ok(Event::Executed) => {}
         }
     }

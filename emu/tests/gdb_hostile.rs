@@ -31,6 +31,7 @@ fn session() -> (TcpStream, JoinHandle<RunReport>) {
             &mut mcu,
             &RunOptions {
                 max_states: Some(2_000_000),
+                ..RunOptions::default()
             },
             &mut std::io::sink(),
             Probes {

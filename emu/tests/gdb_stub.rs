@@ -44,6 +44,7 @@ fn debugged(fw: &Firmware) -> (Client, JoinHandle<RunReport>) {
             &mut mcu,
             &RunOptions {
                 max_states: Some(BUDGET_STATES),
+                ..RunOptions::default()
             },
             &mut std::io::sink(),
             Probes {
@@ -206,6 +207,7 @@ fn a_client_that_detaches_lets_the_firmware_run_on_to_the_same_end() {
         &mut mcu,
         &RunOptions {
             max_states: Some(BUDGET_STATES),
+            ..RunOptions::default()
         },
         &mut std::io::sink(),
         Probes::default(),

@@ -272,7 +272,12 @@ fn the_vcd_file_reads_back_with_the_states_as_timestamps() {
     assert_eq!(header.timescale, Some((10, vcd::TimescaleUnit::NS)));
     let mut ids = std::collections::HashMap::new();
     for s in Signal::ALL {
-        let var = header.find_var(&["h8_3052f", s.name()]).unwrap();
+        let var = match s {
+            Signal::PortOut(p, b) => header
+                .find_var(&["ports", &format!("{}_{b}", p.name())])
+                .unwrap(),
+            _ => header.find_var(&["h8_3052f", s.name()]).unwrap(),
+        };
         assert_eq!(var.size, 1);
         ids.insert(var.code, s);
     }
@@ -326,6 +331,7 @@ fn the_instruction_trace_and_the_phase_signal_name_the_same_code() {
         &mut mcu,
         &RunOptions {
             max_states: Some(3 * TICK_STATES),
+            ..RunOptions::default()
         },
         &mut std::io::sink(),
         Probes {
@@ -334,6 +340,7 @@ fn the_instruction_trace_and_the_phase_signal_name_the_same_code() {
             phases: Some(&mut phases),
             debugger: None,
             vcd: None,
+            profile: None,
         },
     )
     .unwrap();

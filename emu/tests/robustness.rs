@@ -116,7 +116,7 @@ proptest! {
         let img = SrecImage { header: None, chunks: vec![Chunk { address: 0, data }], start: None };
         let text = srec::write_s3(&img, 32);
         let mut out = Vec::new();
-        let opts = RunOptions { max_states: Some(20_000) };
+        let opts = RunOptions { max_states: Some(20_000), ..RunOptions::default() };
         let r = run_image(text.as_bytes(), &opts, &mut out, None);
         prop_assert!(r.is_ok());
     }

@@ -101,6 +101,7 @@ fn the_state_budget_stops_a_run() {
     let mut console = Vec::new();
     let opts = RunOptions {
         max_states: Some(100),
+        ..RunOptions::default()
     };
     let r = run_image(HI_MOT.as_bytes(), &opts, &mut console, None).unwrap();
     assert_eq!(r.outcome, Outcome::MaxStates);
@@ -149,6 +150,7 @@ fn sleeping_with_nothing_to_wake_is_reported() {
     // With a budget the sleep fast-forwards to it.
     let opts = RunOptions {
         max_states: Some(1_000_000),
+        ..RunOptions::default()
     };
     let r = run_image(img.as_bytes(), &opts, &mut console, None).unwrap();
     assert_eq!(r.outcome, Outcome::MaxStates);

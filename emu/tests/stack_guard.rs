@@ -465,6 +465,7 @@ fn run_image_guards_the_whole_ram_and_emu_names_the_function() {
         m.mcu_mut(),
         &RunOptions {
             max_states: Some(20_000_000),
+            ..RunOptions::default()
         },
         &mut console,
         Probes {

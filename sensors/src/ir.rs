@@ -4,7 +4,6 @@
 //! sensor ([`IrSensor`]).
 
 use rand_core::Rng;
-use rand_distr::{Distribution, StandardNormal};
 use seeding::Purpose;
 
 use crate::curve::{
@@ -417,7 +416,7 @@ impl IrSensor {
 
     /// Draw one read's noise: σ·N(0,1), plus a uniform spike with `spike_probability`.
     fn read_noise_volts(&mut self) -> f64 {
-        let gauss: f64 = StandardNormal.sample(&mut self.noise_rng);
+        let gauss = crate::rng::standard_normal(&mut self.noise_rng);
         let mut noise = self.params.noise_sigma_volts * gauss;
         if unit_f64(&mut self.noise_rng) < self.params.spike_probability {
             noise += uniform_f64(

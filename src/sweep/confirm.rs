@@ -304,6 +304,7 @@ fn confirmation_plan(
         axes: plan.axes.clone(),
         seeds: confirm.seeds.clone(),
         points: count,
+        cells: Some(chosen.to_vec()),
         points_per_task: per_task,
         tasks,
         max_parallel: plan.max_parallel,
@@ -383,15 +384,19 @@ fn outcome_words(c: &Cell) -> String {
     format!("{word} {}/{}", c.for_, c.defined)
 }
 
-/// Merges the confirmation of the map in `dir` (its folder exists) into `out/confirm` and
-/// writes the side-by-side table into `out`; returns what to print and whether every
-/// confirmation point finished.
+/// Merges the confirmation of the map in `dir` (its folder exists) into the merge's staging
+/// folder: the confirmation's own merge under `confirm/`, the side-by-side table beside the
+/// map's. Returns what it staged; the caller commits it with the map's merge.
 ///
 /// # Errors
 /// A damaged folder (input); an output that cannot be written (tool).
-pub fn merge_confirmation(dir: &Path, out: &Path) -> Result<(String, bool), SweepError> {
+pub(super) fn merge_confirmation(
+    dir: &Path,
+    stage: &crate::stage::Stage,
+) -> Result<super::merge::Staged, SweepError> {
     let cdir = dir.join(CONFIRM_DIR);
-    let (mut t, complete) = super::merge::merge(&cdir, Some(&out.join(CONFIRM_DIR)))?;
+    let mut staged = super::merge::merge_into(&cdir, stage, &format!("{CONFIRM_DIR}/"))?;
+    let t = &mut staged.text;
     let record: ConfirmRecord = std::fs::read_to_string(cdir.join("confirm.json"))
         .ok()
         .and_then(|s| serde_json::from_str(&s).ok())
@@ -406,7 +411,8 @@ pub fn merge_confirmation(dir: &Path, out: &Path) -> Result<(String, bool), Swee
         Ok(v) => v,
         Err(e) => {
             let _ = writeln!(t, "the confirmation cannot be judged: {e}");
-            return Ok((t, false));
+            staged.complete = false;
+            return Ok(staged);
         }
     };
     let grid: usize = plan.axes.iter().map(|a| a.values.len()).product();
@@ -508,12 +514,17 @@ pub fn merge_confirmation(dir: &Path, out: &Path) -> Result<(String, bool), Swee
             .then(a.cell.cmp(&b.cell))
     });
     let default = rows.first().filter(|r| r.confirmed).map(|r| r.cell);
-    write_table(out, axes, &series, &rows, default, &record)?;
-    render(&mut t, axes, &series, &rows, default, &record, &cplan);
-    Ok((t, complete))
+    write_table(stage.dir(), axes, &series, &rows, default, &record)?;
+    staged.files.extend(
+        ["confirmation.csv", "confirmation.json"]
+            .into_iter()
+            .map(str::to_string),
+    );
+    render(t, axes, &series, &rows, default, &record, &cplan);
+    Ok(staged)
 }
 
-/// Writes `confirmation.csv` and `confirmation.json` into `out`.
+/// Writes `confirmation.csv` and `confirmation.json` into `out` (the merge's staging folder).
 fn write_table(
     out: &Path,
     axes: &[Axis],
@@ -603,7 +614,7 @@ fn write_table(
     let bytes = w
         .into_inner()
         .map_err(|e| SweepError::tool(format!("writing confirmation.csv: {e}")))?;
-    write_atomic(&out.join("confirmation.csv"), &bytes)?;
+    write_staged(&out.join("confirmation.csv"), &bytes)?;
     let doc = json!({
         "map": record.map,
         "choice": record.choice,
@@ -618,7 +629,13 @@ fn write_table(
     let text = serde_json::to_string_pretty(&doc)
         .map_err(|e| SweepError::tool(format!("writing confirmation.json: {e}")))?
         + "\n";
-    write_atomic(&out.join("confirmation.json"), text.as_bytes())
+    write_staged(&out.join("confirmation.json"), text.as_bytes())
+}
+
+/// Writes a file into the merge's staging folder (moved into place by its commit).
+fn write_staged(path: &Path, bytes: &[u8]) -> Result<(), SweepError> {
+    std::fs::write(path, bytes)
+        .map_err(|e| SweepError::tool(format!("cannot write `{}`: {e}", path.display())))
 }
 
 /// The printed side-by-side table and the default.

@@ -6,7 +6,9 @@
 //! not exist or is complete. A point whose folder holds `status.json` with `"status": "ok"`
 //! and the planned `scenario.toml` is finished and skipped; anything else (no folder, a failed
 //! point, a folder of another scenario, a temporary folder left by a task that was killed) is
-//! removed and run again. A point depends only on its scenario, so its files are the same byte
+//! removed and run again. A task claims a point before it touches anything of it (an exclusive
+//! lock on `points/.lock-ID`, which the kernel frees when its holder ends), so two tasks on one
+//! plan never work on one point, and a killed task's points are taken over. A point depends only on its scenario, so its files are the same byte
 //! for byte whichever task runs it and with how many threads (`run.txt`, the console text with
 //! its wall time, is the exception).
 
@@ -27,6 +29,8 @@ pub enum Outcome {
     Done,
     /// Run now, and it failed (the reason is in its `status.json`).
     Failed(String),
+    /// Another task that is alive holds it (two sweeps on one plan): left to that task.
+    Held,
 }
 
 fn io_err(what: &str, p: &Path, e: &std::io::Error) -> SweepError {
@@ -46,6 +50,87 @@ pub fn run_point(
     if point_state(points, line) == PointState::Ok {
         return Ok(Outcome::Skipped);
     }
+    // The point is claimed before anything of it is touched: an exclusive lock on
+    // `points/.lock-ID`, which the kernel releases when the holder ends however it ends (so
+    // a killed task's points are taken over by the next). A point another live task holds is
+    // left to it.
+    let Some(claim) = Claim::take(points, &line.id)? else {
+        return Ok(Outcome::Held);
+    };
+    // Checked again under the claim: the holder before may have finished it.
+    let outcome = if point_state(points, line) == PointState::Ok {
+        Ok(Outcome::Skipped)
+    } else {
+        run_claimed(points, line, threads)
+    };
+    claim.release();
+    outcome
+}
+
+/// An exclusive claim on a point (see [`run_point`]): a lock on `points/.lock-ID`.
+struct Claim {
+    path: PathBuf,
+    file: std::fs::File,
+    _registered: crate::cleanup::Staged,
+}
+
+/// The prefix of a claim's file under `points/`.
+pub const CLAIM_PREFIX: &str = ".lock-";
+
+/// Locks the file at `path` if no one holds it: `Ok(None)` when another process holds its
+/// lock. The lock holds only if the file locked is still the one at `path` (a holder may have
+/// removed it between the open and the lock): otherwise it is tried again.
+fn lock_file(path: &Path) -> Result<Option<std::fs::File>, SweepError> {
+    use std::os::unix::fs::MetadataExt;
+    loop {
+        let file = std::fs::OpenOptions::new()
+            .create(true)
+            .truncate(false)
+            .write(true)
+            .open(path)
+            .map_err(|e| io_err("open the claim", path, &e))?;
+        match file.try_lock() {
+            Ok(()) => {}
+            Err(std::fs::TryLockError::WouldBlock) => return Ok(None),
+            Err(std::fs::TryLockError::Error(e)) => {
+                return Err(io_err("lock the claim", path, &e));
+            }
+        }
+        let held = file.metadata().map(|m| (m.dev(), m.ino())).ok();
+        let there = std::fs::metadata(path).map(|m| (m.dev(), m.ino())).ok();
+        if held.is_some() && held == there {
+            return Ok(Some(file));
+        }
+    }
+}
+
+impl Claim {
+    /// Takes the claim on point `id`, or `None` when another live task holds it.
+    fn take(points: &Path, id: &str) -> Result<Option<Claim>, SweepError> {
+        let path = points.join(format!("{CLAIM_PREFIX}{id}"));
+        // Removed if a signal stops the task (the lock itself goes with the process).
+        let registered = crate::cleanup::Staged::register(&path);
+        Ok(lock_file(&path)?.map(|file| Claim {
+            path,
+            file,
+            _registered: registered,
+        }))
+    }
+
+    /// Gives the claim up, removing its file (a task that opened it meanwhile finds it gone
+    /// once it holds the lock, and tries again).
+    fn release(self) {
+        let _ = std::fs::remove_file(&self.path);
+        let _ = self.file.unlock();
+    }
+}
+
+/// Runs a point this task has claimed.
+fn run_claimed(
+    points: &Path,
+    line: &PlanLine,
+    threads: Option<usize>,
+) -> Result<Outcome, SweepError> {
     let final_dir = points.join(&line.id);
     // Leftovers of this point: a broken or failed folder, temporary folders of killed tasks
     // (`.tmp-ID-…`) and the staging folders of their runs (`..tmp-ID-….partial-PID`).
@@ -130,6 +215,15 @@ pub fn remove_dead_leftovers(points: &Path) -> Result<Vec<String>, SweepError> {
     let mut removed = Vec::new();
     for e in std::fs::read_dir(points).into_iter().flatten().flatten() {
         let name = e.file_name().to_string_lossy().into_owned();
+        // A claim no one holds (its task was killed): removed under its lock.
+        if name.starts_with(CLAIM_PREFIX) {
+            let p = e.path();
+            if let Some(file) = lock_file(&p)? {
+                let _ = std::fs::remove_file(&p);
+                drop(file);
+            }
+            continue;
+        }
         if is_dead_leftover(&name, &host) {
             let p = e.path();
             std::fs::remove_dir_all(&p).map_err(|e| io_err("remove", &p, &e))?;
@@ -221,7 +315,7 @@ pub fn run_task(
         ),
         share.len()
     );
-    let (mut done, mut skipped, mut failed) = (0, 0, 0);
+    let (mut done, mut skipped, mut failed, mut held) = (0, 0, 0, 0);
     for line in share {
         let started = Instant::now();
         let outcome = run_point(&points, line, threads)?;
@@ -242,13 +336,22 @@ pub fn run_task(
                 failed += 1;
                 format!("{} FAILED: {why}", line.id)
             }
+            Outcome::Held => {
+                held += 1;
+                format!("{} is being run by another task: left to it", line.id)
+            }
         };
         // One line per point as it ends, for Slurm's log (standard output holds the totals).
         eprintln!("{}", swarm::text::printable(&line_text));
     }
     let _ = writeln!(
         t,
-        "{done} run, {skipped} skipped (finished before), {failed} failed"
+        "{done} run, {skipped} skipped (finished before), {failed} failed{}",
+        if held > 0 {
+            format!(", {held} left to another task running them now")
+        } else {
+            String::new()
+        }
     );
     Ok((t, failed == 0))
 }

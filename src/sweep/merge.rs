@@ -243,43 +243,107 @@ fn earlier_figures(out: &Path) -> Vec<String> {
 
 /// Merges the sweep in `dir` into `out` (default `DIR/merged`) and, when `dir` holds a
 /// confirmation ([`super::confirm`]), it into `out/confirm` with the two side by side; returns
-/// what to print and whether every point of both finished.
+/// what to print and whether every point of both finished. Every file of both is written into
+/// one staging folder and moved into place in one commit ([`crate::stage`]): a failure leaves
+/// `out` as it was, map and confirmation alike.
 ///
 /// # Errors
 /// Not a sweep folder (input); an output that cannot be written (tool).
-pub fn merge_all(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepError> {
-    let (mut t, complete) = merge(dir, out)?;
+pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepError> {
     let out: PathBuf = out.map_or_else(|| dir.join("merged"), Path::to_path_buf);
+    let stage = crate::stage::Stage::new("--out", &out).map_err(|e| SweepError::tool(e.0))?;
+    let mut done = merge_into(dir, &stage, "")?;
+    // Merge's own files of an earlier merge into `out` that this one may not write again: the
+    // confirmation's (a map merged without one leaves no stale confirmation beside it).
+    let confirm_prefix = format!("{}/", super::confirm::CONFIRM_DIR);
+    done.ours.extend(
+        ["confirmation.csv", "confirmation.json"]
+            .into_iter()
+            .map(str::to_string),
+    );
+    done.ours.extend(
+        ["sweep.csv", "sweep.json"]
+            .into_iter()
+            .map(|f| format!("{confirm_prefix}{f}")),
+    );
+    done.ours.extend(
+        earlier_figures(&out.join(super::confirm::CONFIRM_DIR))
+            .into_iter()
+            .map(|f| format!("{confirm_prefix}{f}")),
+    );
     if dir
         .join(super::confirm::CONFIRM_DIR)
         .join("plan.json")
         .is_file()
     {
-        let _ = writeln!(t);
-        let (ct, c_complete) = super::confirm::merge_confirmation(dir, &out)?;
-        t.push_str(&ct);
-        return Ok((t, complete && c_complete));
+        let _ = writeln!(done.text);
+        let c = super::confirm::merge_confirmation(dir, &stage)?;
+        done.text.push_str(&c.text);
+        done.complete &= c.complete;
+        done.files.extend(c.files);
+        done.folders.extend(c.folders);
     }
-    Ok((t, complete))
+    stage
+        .commit(&crate::stage::Commit {
+            files: done.files,
+            ours: done.ours,
+            folders: done.folders,
+        })
+        .map_err(|e| {
+            SweepError::tool(format!(
+                "the merge into `{}` could not be moved into place: {e}",
+                out.display()
+            ))
+        })?;
+    Ok((done.text, done.complete))
 }
 
-/// Merges the sweep in `dir` into `out` (default `DIR/merged`); returns what to print and
-/// whether every point finished.
+/// What one merge staged ([`merge_into`]): the text to print, whether every point finished,
+/// and the staged files, merge's earlier files to remove and the folders, as the stage's
+/// commit takes them.
+pub(super) struct Staged {
+    /// What to print.
+    pub text: String,
+    /// Whether every point finished.
+    pub complete: bool,
+    /// Staged files, relative to the output folder.
+    pub files: Vec<String>,
+    /// Merge's files of an earlier merge that go when not written again.
+    pub ours: Vec<String>,
+    /// Folders that exist after the commit.
+    pub folders: Vec<String>,
+}
+
+/// Merges the sweep in `dir` into the staging folder `stage` under `prefix` (`""` for the
+/// output folder itself, `"confirm/"` for the confirmation's sub-folder): `sweep.csv`,
+/// `sweep.json` and the figures in `plots/`. Nothing is committed.
 ///
 /// # Errors
-/// Not a sweep folder (input); an output that cannot be written (tool).
-pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepError> {
+/// Not a sweep folder (input); a file that cannot be written (tool).
+pub(super) fn merge_into(
+    dir: &Path,
+    stage: &crate::stage::Stage,
+    prefix: &str,
+) -> Result<Staged, SweepError> {
     let (plan, lines, m) = collect(dir)?;
-    let out: PathBuf = out.map_or_else(|| dir.join("merged"), Path::to_path_buf);
+    let out = stage.out().join(prefix);
     let plots = out.join("plots");
-    // Only merge's own files are replaced: the figures of an earlier merge into `out` (its
-    // sweep.json lists them) that this one does not draw again are removed; anything else in
-    // `out` or `out/plots` is the user's and stays.
-    let earlier = earlier_figures(&out);
-    std::fs::create_dir_all(&plots)
-        .map_err(|e| SweepError::tool(format!("cannot create `{}`: {e}", plots.display())))?;
+    // Every file is written into the staging folder and moved into place in one commit
+    // (crate::stage): a failure (a full disk) leaves `out` as it was. Only merge's own files
+    // are replaced: the figures of an earlier merge into `out` (its sweep.json lists them) that
+    // this one does not draw again are removed; anything else in `out` or `out/plots` is the
+    // user's and stays.
+    let earlier: Vec<String> = earlier_figures(&out)
+        .into_iter()
+        .map(|f| format!("{prefix}{f}"))
+        .collect();
+    let staged_plots = stage.path(&format!("{prefix}plots"));
+    std::fs::create_dir_all(&staged_plots).map_err(|e| {
+        SweepError::tool(format!("cannot create `{}`: {e}", staged_plots.display()))
+    })?;
 
-    let csv_path = write_csv(&m, &out)?;
+    write_csv(&m, &stage.path(&format!("{prefix}sweep.csv")))?;
+    let csv_path = out.join("sweep.csv");
 
     let series = claim_series(&m);
     let coords: Vec<Vec<usize>> = lines.iter().map(|l| l.coords.clone()).collect();
@@ -303,20 +367,22 @@ pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepErro
         "columns": m.columns,
         "rows": m.rows,
     });
-    let figures = claim_figures(&plan.axes, &coords, &series, &plots)?;
+    let figures = claim_figures(&plan.axes, &coords, &series, &staged_plots)?;
     let figure_names: Vec<String> = figures
         .iter()
         .filter_map(|p| p.file_name())
         .map(|n| format!("plots/{}", n.to_string_lossy()))
         .collect();
-    remove_stale_figures(&out, &earlier, &figure_names)?;
     let mut doc = doc;
     doc["figures"] = json!(figure_names);
     let json_path = out.join("sweep.json");
     let text = serde_json::to_string_pretty(&doc)
         .map_err(|e| SweepError::tool(format!("writing sweep.json: {e}")))?
         + "\n";
-    super::write_atomic(&json_path, text.as_bytes())?;
+    std::fs::write(stage.path(&format!("{prefix}sweep.json")), text.as_bytes())
+        .map_err(|e| SweepError::tool(format!("cannot write `{}`: {e}", json_path.display())))?;
+    let mut files = vec![format!("{prefix}sweep.csv"), format!("{prefix}sweep.json")];
+    files.extend(figure_names.iter().map(|f| format!("{prefix}{f}")));
 
     let mut t = String::new();
     let _ = writeln!(
@@ -379,12 +445,25 @@ pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepErro
         let _ = writeln!(t, "(no claim had values to draw)");
     }
     let complete = m.failed.is_empty() && m.missing.is_empty() && m.broken.is_empty();
-    Ok((t, complete))
+    let folders = if prefix.is_empty() {
+        vec!["plots".to_string()]
+    } else {
+        vec![
+            prefix.trim_end_matches('/').to_string(),
+            format!("{prefix}plots"),
+        ]
+    };
+    Ok(Staged {
+        text: t,
+        complete,
+        files,
+        ours: earlier,
+        folders,
+    })
 }
 
-/// Writes the merged table as `out/sweep.csv` (rendered in memory, then written in one step);
-/// returns its path.
-fn write_csv(m: &Merged, out: &Path) -> Result<PathBuf, SweepError> {
+/// Writes the merged table to `path` (rendered in memory, then written in one step).
+fn write_csv(m: &Merged, path: &Path) -> Result<(), SweepError> {
     let mut w = csv::Writer::from_writer(Vec::new());
     let csv_err = |e: csv::Error| SweepError::tool(format!("writing sweep.csv: {e}"));
     w.write_record(&m.columns).map_err(csv_err)?;
@@ -395,10 +474,8 @@ fn write_csv(m: &Merged, out: &Path) -> Result<PathBuf, SweepError> {
     let bytes = w
         .into_inner()
         .map_err(|e| SweepError::tool(format!("writing sweep.csv: {e}")))?;
-    let csv_path = out.join("sweep.csv");
-    super::write_atomic(&csv_path, &bytes)?;
-
-    Ok(csv_path)
+    std::fs::write(path, &bytes)
+        .map_err(|e| SweepError::tool(format!("cannot write `sweep.csv`: {e}")))
 }
 
 /// Each claim's result per point (its repeats for, against and tied, and its effect), for the
@@ -432,27 +509,6 @@ pub(super) fn claim_series(m: &Merged) -> Vec<ClaimSeries> {
                 .collect(),
         })
         .collect()
-}
-
-/// Removes the figures an earlier merge into `out` drew (`earlier`, as its sweep.json lists
-/// them) that this one did not draw again (`drawn`).
-fn remove_stale_figures(
-    out: &Path,
-    earlier: &[String],
-    drawn: &[String],
-) -> Result<(), SweepError> {
-    for old in earlier.iter().filter(|n| !drawn.contains(n)) {
-        let p = out.join(old);
-        if p.is_file() {
-            std::fs::remove_file(&p).map_err(|e| {
-                SweepError::tool(format!(
-                    "cannot remove the earlier figure `{}`: {e}",
-                    p.display()
-                ))
-            })?;
-        }
-    }
-    Ok(())
 }
 
 /// The warning `h8swarm run` gives when a point's repeats cannot reach p < 0.05, for the

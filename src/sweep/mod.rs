@@ -77,6 +77,14 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), SweepError> {
         })
 }
 
+/// A name read from a file, as an error message shows it (control and format characters
+/// escaped, at most 80 characters).
+#[must_use]
+pub fn text_of(name: &str) -> String {
+    let shown: String = name.chars().take(80).collect();
+    swarm::text::printable(&shown)
+}
+
 /// Options of `h8swarm sweep`.
 #[derive(Args, Debug, Clone)]
 pub struct SweepArgs {
@@ -182,7 +190,7 @@ pub fn command(args: &SweepArgs) -> (String, Result<(), SweepError>) {
             dir,
             out,
             require_complete,
-        } => match merge::merge_all(dir, out.as_deref()) {
+        } => match merge::merge(dir, out.as_deref()) {
             Ok((text, complete)) if *require_complete && !complete => (
                 text,
                 Err(SweepError::input(

@@ -104,6 +104,11 @@ pub struct Plan {
     pub seeds: Vec<u64>,
     /// Number of points.
     pub points: usize,
+    /// The cells of the axes' grid (index, the first axis slowest) the plan runs, in
+    /// increasing order, when not all of them: a confirmation ([`super::confirm`]) runs the
+    /// map's grid in chosen cells only.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cells: Option<Vec<usize>>,
     /// Points per array task.
     pub points_per_task: usize,
     /// Number of array tasks (0 to `tasks` − 1).
@@ -527,6 +532,7 @@ fn plan_of(sweep: &Sweep) -> Result<Plan, SweepError> {
         axes: sweep.axes.clone(),
         seeds: sweep.seeds.clone(),
         points: sweep.count,
+        cells: None,
         points_per_task: per_task,
         tasks,
         max_parallel,
@@ -536,6 +542,8 @@ fn plan_of(sweep: &Sweep) -> Result<Plan, SweepError> {
 
 /// The sweep folder `dir`, created if need be, as an absolute path.
 pub(super) fn plan_folder(dir: &Path) -> Result<PathBuf, SweepError> {
+    // One rule for output folders (as `run`'s and `merge`'s): a folder with a name of its own.
+    crate::stage::check_out_folder("--out", dir).map_err(|e| SweepError::tool(e.0))?;
     std::fs::create_dir_all(dir).map_err(|e| {
         SweepError::tool(format!(
             "cannot create the sweep folder `{}`: {e}",
@@ -678,31 +686,57 @@ pub fn read_plan(dir: &Path) -> Result<(Plan, Vec<PlanLine>), SweepError> {
     let plan_text =
         std::fs::read_to_string(dir.join("plan.json")).map_err(|e| not("plan.json", &e))?;
     let plan: Plan = serde_json::from_str(&plan_text).map_err(|e| not("plan.json", &e))?;
+    // A plan edited by hand: its sizes are checked before anything is sized by them.
+    check_plan_sizes(&plan).map_err(|e| not("plan.json", &e))?;
     let list =
         std::fs::read_to_string(dir.join("points.jsonl")).map_err(|e| not("points.jsonl", &e))?;
     let mut lines = Vec::new();
+    let mut ids = std::collections::BTreeSet::new();
     for (n, l) in list.lines().enumerate() {
-        let line: PlanLine = serde_json::from_str(l)
-            .map_err(|e| not(&format!("points.jsonl line {}", n + 1), &e))?;
+        let at = format!("points.jsonl line {}", n + 1);
+        if n >= plan.points {
+            return Err(not(
+                "points.jsonl",
+                &format!("more lines than the plan's {} points", plan.points),
+            ));
+        }
+        let line: PlanLine = serde_json::from_str(l).map_err(|e| not(&at, &e))?;
         if line.index != n
             || line.id != super::spec::sanitize(&line.id, super::spec::MAX_ID_CHARS)
             || line.task >= plan.tasks.max(1)
         {
-            return Err(not(
-                &format!("points.jsonl line {}", n + 1),
-                &"its index, id or task does not fit the plan",
-            ));
+            return Err(not(&at, &"its index, id or task does not fit the plan"));
         }
-        if line.coords.len() != plan.axes.len()
-            || line
+        let fits = line.coords.len() == plan.axes.len()
+            && line
                 .coords
                 .iter()
                 .zip(&plan.axes)
-                .any(|(&c, a)| c >= a.values.len())
+                .all(|(&c, a)| c < a.values.len());
+        if !fits {
+            return Err(not(
+                &at,
+                &format!(
+                    "its coords {:?} lie outside the plan's axes (sizes {:?})",
+                    line.coords,
+                    plan.axes.iter().map(|a| a.values.len()).collect::<Vec<_>>()
+                ),
+            ));
+        }
+        if let Some(list) = &plan.cells
+            && list
+                .binary_search(&super::figures::cell_index(&plan.axes, &line.coords))
+                .is_err()
         {
             return Err(not(
-                &format!("points.jsonl line {}", n + 1),
-                &"its position on the axes lies outside the plan's grid",
+                &at,
+                &format!("its coords {:?} lie outside the plan's cells", line.coords),
+            ));
+        }
+        if !ids.insert(line.id.clone()) {
+            return Err(not(
+                &at,
+                &format!("its id `{}` is another point's too", line.id),
             ));
         }
         lines.push(line);
@@ -718,6 +752,56 @@ pub fn read_plan(dir: &Path) -> Result<(Plan, Vec<PlanLine>), SweepError> {
         ));
     }
     Ok((plan, lines))
+}
+
+/// Checks the sizes a plan.json gives before anything is allocated by them: every axis has
+/// values, one per key; the grid's cells times the seeds is the plan's number of points,
+/// computed without overflow, and at most [`super::spec::MAX_POINTS`]; the tasks fit the
+/// points.
+fn check_plan_sizes(plan: &Plan) -> Result<(), String> {
+    if plan.points > super::spec::MAX_POINTS {
+        return Err(format!(
+            "{} points: at most {} are allowed",
+            plan.points,
+            super::spec::MAX_POINTS
+        ));
+    }
+    let mut cells: usize = 1;
+    for a in &plan.axes {
+        if a.keys.is_empty()
+            || a.values.is_empty()
+            || a.values.iter().any(|v| v.len() != a.keys.len())
+        {
+            return Err(format!(
+                "the axis `{}` needs values, one per key",
+                super::text_of(&a.name())
+            ));
+        }
+        cells = cells
+            .checked_mul(a.values.len())
+            .filter(|&c| c <= super::spec::MAX_POINTS)
+            .ok_or_else(|| format!("its axes make more than {} cells", super::spec::MAX_POINTS))?;
+    }
+    if let Some(list) = &plan.cells {
+        if list.windows(2).any(|w| w[0] >= w[1]) || list.last().is_some_and(|&c| c >= cells) {
+            return Err(format!(
+                "its cells must be distinct, in increasing order and below the grid's {cells}"
+            ));
+        }
+        cells = list.len();
+    }
+    let want = cells.checked_mul(plan.seeds.len());
+    if want != Some(plan.points) {
+        return Err(format!(
+            "{} points, but its axes and seeds make {}",
+            plan.points,
+            want.map_or_else(|| "too many".to_string(), |w| w.to_string())
+        ));
+    }
+    if plan.tasks > plan.points.max(1) {
+        return Err(format!("{} tasks for {} points", plan.tasks, plan.points));
+    }
+    Ok(())
 }
 
 #[cfg(test)]

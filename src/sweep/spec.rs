@@ -462,9 +462,10 @@ impl Keys {
                 "{where_}: `seed` is the sweep's own axis: give the master seeds as `seeds = [..]` at the top of the sweep file"
             )));
         }
-        if key == "name" || key == "base" {
+        let head = key.split('.').next().unwrap_or(key);
+        if ["name", "base", "seeds", "slurm", "set", "grid", "zip"].contains(&head) {
             return Err(SweepError::input(format!(
-                "{where_}: `{key}` belongs at the top of the sweep file, not in a grid or set"
+                "{where_}: `{key}` is a key of the sweep file itself: give it before the first [table] (TOML puts every key after a [table] header into that table), not in a grid or set"
             )));
         }
         if key.is_empty() || key.split('.').any(str::is_empty) {

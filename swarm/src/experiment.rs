@@ -162,18 +162,32 @@ pub struct RunOutput {
     pub track: Option<Track>,
     /// EEPROM records written over the run (all robots).
     pub saves: u64,
-    /// Robots that died (with `--keep-going`), with why.
-    pub dead: Vec<(usize, String)>,
+    /// Robots that died (with `--keep-going`): which, in which step, why.
+    pub dead: Vec<DeadRobot>,
     /// Each robot's record over the run (distance, collisions, stuck spells), by index.
     pub robots: Vec<RobotTally>,
     /// With a recorder: the frames recorded and the frames with weights.
     pub recorded: Option<(u32, Vec<u32>)>,
     /// Firmware robots whose stack left its room under a warning guard, with the first fault.
     pub stack_warnings: Vec<(usize, String)>,
+    /// The first access of each robot to each address its chip does not model, one line each.
+    pub io_warnings: Vec<(usize, String)>,
     /// The charge every robot drew from its pack over the run, summed, by part.
     pub energy: crate::energy::Charge,
     /// How often the drive voltage's bound cut a motor's current, summed over the robots.
     pub motor_cap: crate::energy::CurrentCap,
+}
+
+/// A robot whose controller failed in a run with `--keep-going`: it is dead from then on (its
+/// motors coast), and the run's claims leave its repeat out.
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize)]
+pub struct DeadRobot {
+    /// Its index.
+    pub robot: usize,
+    /// The step in which it died.
+    pub step: u32,
+    /// Why.
+    pub why: String,
 }
 
 /// Sums of a run's per-step metrics over a span of steps: the summary's and the figure's
@@ -352,7 +366,7 @@ impl RunMetrics {
 
 /// The columns of `metrics.csv`, one row per step of every run (the MSD columns' lags are
 /// [`crate::motion::MSD_LAGS`]).
-pub const METRICS_HEADER: [&str; 22] = [
+pub const METRICS_HEADER: [&str; 23] = [
     "condition",
     "repeat",
     "step",
@@ -375,21 +389,24 @@ pub const METRICS_HEADER: [&str; 22] = [
     "robots_touching",
     "cpu_load_percent",
     "energy_per_robot_mj",
+    "dead_robots",
 ];
 
 /// Step `k`'s row of `metrics.csv` (see [`METRICS_HEADER`]) written into `buf` (cleared
-/// first), field after field; returns where each field ends. A run writes its rows this way,
+/// first), field after field; `dead` robots had died by its end (`--keep-going`). Returns where
+/// each field ends. A run writes its rows this way,
 /// through one buffer, rather than a string per field.
 pub fn metrics_fields(
     condition: Condition,
     repeat: u32,
     k: u32,
     m: &StepMetrics,
+    dead: usize,
     buf: &mut String,
-) -> [usize; 22] {
+) -> [usize; 23] {
     use std::fmt::Write as _;
     buf.clear();
-    let mut ends = [0usize; 22];
+    let mut ends = [0usize; 23];
     let mut field = 0;
     let mut end = |buf: &String| {
         ends[field] = buf.len();
@@ -439,14 +456,23 @@ pub fn metrics_fields(
         let _ = write!(buf, "{v}");
         end(buf);
     }
+    let _ = write!(buf, "{dead}");
+    end(buf);
     ends
 }
 
-/// Step `k`'s row of `metrics.csv` (see [`METRICS_HEADER`]).
+/// Step `k`'s row of `metrics.csv` (see [`METRICS_HEADER`]); `dead` robots had died by its
+/// end (`--keep-going`).
 #[must_use]
-pub fn metrics_row(condition: Condition, repeat: u32, k: u32, m: &StepMetrics) -> [String; 22] {
+pub fn metrics_row(
+    condition: Condition,
+    repeat: u32,
+    k: u32,
+    m: &StepMetrics,
+    dead: usize,
+) -> [String; 23] {
     let mut buf = String::new();
-    let ends = metrics_fields(condition, repeat, k, m, &mut buf);
+    let ends = metrics_fields(condition, repeat, k, m, dead, &mut buf);
     std::array::from_fn(|i| buf[if i == 0 { 0 } else { ends[i - 1] }..ends[i]].to_string())
 }
 
@@ -548,8 +574,8 @@ pub struct Swarm {
     /// Go on when a robot's controller fails: the robot is dead from then on (its motors
     /// coast; it is left out of the means).
     keep_going: bool,
-    /// Why each dead robot died.
-    dead: Vec<Option<String>>,
+    /// The step in which each dead robot died, and why.
+    dead: Vec<Option<(u32, String)>>,
     /// The replay recorder and how many robots it records, when the run is recorded.
     recorder: Option<(crate::recording::Recorder, usize)>,
     /// Each robot's motors and bridges, metered over the world's sub-steps.
@@ -683,19 +709,33 @@ impl Swarm {
         }
     }
 
+    /// Whether the firmware robots stop at their first access to what the chip does not
+    /// model (`--strict-io`) instead of reporting it ([`RunOutput::io_warnings`]).
+    pub fn set_strict_io(&mut self, on: bool) {
+        for r in &mut self.robots {
+            r.set_strict_io(on);
+        }
+    }
+
     /// Whether a robot whose controller fails is marked dead and the run goes on (default:
     /// the run stops with the error).
     pub fn set_keep_going(&mut self, keep_going: bool) {
         self.keep_going = keep_going;
     }
 
-    /// The robots that died, with why.
+    /// The robots that died, with the step and why.
     #[must_use]
-    pub fn dead(&self) -> Vec<(usize, String)> {
+    pub fn dead(&self) -> Vec<DeadRobot> {
         self.dead
             .iter()
             .enumerate()
-            .filter_map(|(i, d)| d.clone().map(|d| (i, d)))
+            .filter_map(|(i, d)| {
+                d.clone().map(|(step, why)| DeadRobot {
+                    robot: i,
+                    step,
+                    why,
+                })
+            })
             .collect()
     }
 
@@ -703,7 +743,7 @@ impl Swarm {
     fn fail(&mut self, i: usize, e: anyhow::Error) -> Result<()> {
         let e = e.context(format!("robot {i}"));
         if self.keep_going {
-            self.dead[i] = Some(format!("{e:#}"));
+            self.dead[i] = Some((self.started, format!("{e:#}")));
             Ok(())
         } else {
             Err(e)
@@ -1006,7 +1046,9 @@ impl Swarm {
             };
             self.metrics.add(k, &last);
             if let Some(rows) = self.rows.as_mut() {
-                let ends = metrics_fields(self.condition, self.repeat, k, &last, &mut rows.buf);
+                let dead = self.dead.iter().flatten().filter(|d| d.0 <= k).count();
+                let ends =
+                    metrics_fields(self.condition, self.repeat, k, &last, dead, &mut rows.buf);
                 let buf = &rows.buf;
                 rows.w
                     .write_record(
@@ -1076,12 +1118,19 @@ impl Swarm {
             .enumerate()
             .filter_map(|(i, r)| r.stack_fault().map(|f| (i, f.to_string())))
             .collect();
+        let io_warnings = self
+            .robots
+            .iter()
+            .enumerate()
+            .flat_map(|(i, r)| r.io_reports().into_iter().map(move |w| (i, w)))
+            .collect();
         let mut motor_cap = crate::energy::CurrentCap::default();
         for d in &self.drives {
             motor_cap.add(d.cap());
         }
         Ok(RunOutput {
             stack_warnings,
+            io_warnings,
             energy: self.energy,
             motor_cap,
             condition: self.condition,
@@ -1108,8 +1157,10 @@ pub struct VcdProbe {
     /// Traced steps: the trace ends when the step after the last one begins sensing (so the
     /// last step's behaviour shows to its end), or with the run.
     pub steps: u32,
-    /// The VCD file.
+    /// The file the trace is written to (a staging file, moved into place by the caller).
     pub path: std::path::PathBuf,
+    /// The file as the user named it, for messages.
+    pub shown: std::path::PathBuf,
 }
 
 /// What to look at inside one robot of a run: its pins, its firmware under GDB.
@@ -1120,6 +1171,21 @@ pub struct RobotProbes {
     /// A GDB stub for a robot, waiting for its client: (robot, listener). The run waits for
     /// the client before its first step and pauses while it has the robot stopped.
     pub gdb: Option<(usize, emu::chip::gdb::GdbListener)>,
+    /// A profile of where one firmware robot's states go by call stack, written as folded
+    /// stacks when the run ends.
+    pub profile: Option<ProfileProbe>,
+}
+
+/// A profile of one firmware robot's states by call stack ([`RobotProbes::profile`]).
+#[derive(Debug)]
+pub struct ProfileProbe {
+    /// The robot.
+    pub robot: usize,
+    /// The file the folded stacks are written to (a staging file, moved into place by the
+    /// caller).
+    pub path: std::path::PathBuf,
+    /// The file as the user named it, for messages.
+    pub shown: std::path::PathBuf,
 }
 
 /// How one run goes besides its scenario, condition and repeat: what it records and what looks
@@ -1139,6 +1205,9 @@ pub struct RunOptions {
     pub replay: Option<(crate::recording::Recorder, usize)>,
     /// What the firmware robots' stack guards do ([`Swarm::set_stack_guard_mode`]).
     pub stack_guard: emu::core::cpu::StackGuardMode,
+    /// Stop a firmware robot at its first access to what the chip does not model
+    /// ([`Swarm::set_strict_io`]).
+    pub strict_io: bool,
 }
 
 /// Runs one condition of one repeat. `progress` is called with the number of steps done since
@@ -1159,6 +1228,7 @@ pub fn run_one(
     let mut swarm = Swarm::new(s, condition, repeat, opts.record_track, images)?;
     swarm.set_keep_going(opts.keep_going);
     swarm.set_stack_guard_mode(opts.stack_guard);
+    swarm.set_strict_io(opts.strict_io);
     if let Some(path) = &opts.rows {
         swarm.set_rows(path)?;
     }
@@ -1178,6 +1248,13 @@ pub fn run_one(
             .attach_debugger(debugger)
             .with_context(|| format!("--gdb-robot {k}"))?;
     }
+    if let Some(k) = probes.profile.as_ref().map(|pr| &pr.robot) {
+        swarm
+            .robot_mut(*k)
+            .with_context(|| format!("--profile-robot {k}: the run has {} robots", s.robots))?
+            .start_profile()
+            .with_context(|| format!("--profile-robot {k}"))?;
+    }
     let mut tracing = false;
     for step in 0..s.steps {
         if let Some(v) = &probes.vcd {
@@ -1191,7 +1268,7 @@ pub fn run_one(
                         format!("--vcd-robot {}: the robots run no firmware", v.robot)
                     })?;
                 let file = std::fs::File::create(&v.path)
-                    .with_context(|| format!("--vcd: cannot create `{}`", v.path.display()))?;
+                    .with_context(|| format!("--vcd: cannot create `{}`", v.shown.display()))?;
                 robot
                     .start_pin_trace(names, Box::new(file), &vcd_info(v, s, condition, repeat))
                     .with_context(|| format!("--vcd-robot {}", v.robot))?;
@@ -1205,7 +1282,7 @@ pub fn run_one(
         if let Some(v) = &probes.vcd
             && let Some(written) = swarm.robot_mut(v.robot).and_then(Robot::take_pin_trace)
         {
-            written.with_context(|| format!("--vcd: cannot write `{}`", v.path.display()))?;
+            written.with_context(|| format!("--vcd: cannot write `{}`", v.shown.display()))?;
             tracing = false;
         }
         progress(1);
@@ -1214,10 +1291,17 @@ pub fn run_one(
         && tracing
         && let Some(written) = swarm.robot_mut(v.robot).and_then(Robot::finish_pin_trace)
     {
-        written.with_context(|| format!("--vcd: cannot write `{}`", v.path.display()))?;
+        written.with_context(|| format!("--vcd: cannot write `{}`", v.shown.display()))?;
     }
     if let Some(robot) = debugged.and_then(|k| swarm.robot_mut(k)) {
         robot.detach_debugger();
+    }
+    if let Some(pr) = &probes.profile
+        && let Some((folded, _)) = swarm.robot_mut(pr.robot).and_then(Robot::take_profile)
+    {
+        std::fs::write(&pr.path, folded)
+            .map_err(anyhow::Error::new)
+            .context(crate::output_error::OutputError::cannot_write(&pr.shown))?;
     }
     swarm.finish()
 }

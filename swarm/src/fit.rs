@@ -120,6 +120,9 @@ pub struct FitConfig {
     pub firmware: FirmwareUnderTest,
     /// Also run the other controller and put its figures beside each phase.
     pub compare: bool,
+    /// Stop the measurement at the image's first access to a register the emulated chip does
+    /// not model (or a reserved address) instead of noting it in the verdict.
+    pub strict_io: bool,
 }
 
 /// Why the fit could not be measured.
@@ -446,6 +449,11 @@ pub struct FitReport {
     pub tightest_margin_percent: f64,
     /// The one-line verdict.
     pub verdict: String,
+    /// The image's first access to each address the emulated chip does not model (a register
+    /// of a module it does not model, a reserved address), one line each; empty for the robot
+    /// firmware. Their effect on the chip is not in the figures.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub unmodelled: Vec<String>,
 }
 
 /// What the fit's world drives on the robot's board: four IR sensors whose distances the driver
@@ -538,6 +546,9 @@ struct Measured {
     stack: Option<StackLine>,
     /// The charge over the measured step periods.
     energy: Option<Metered>,
+    /// The first access to each address the chip does not model: (what, in a few words; the
+    /// whole line).
+    unmodelled: Vec<(String, String)>,
 }
 
 /// What the charge meter saw over the measured step periods.
@@ -659,6 +670,13 @@ fn measure_firmware(cfg: &FitConfig) -> Result<Measured, FitError> {
         .unwrap_or(emu::core::memmap::RAM_END + 1);
     let stack_high_water = stack_top.saturating_sub(run.profiler.min_sp());
     let stack = run.stack_line(fw, fault.as_ref());
+    let unmodelled = run
+        .rig
+        .mcu
+        .io_reports()
+        .iter()
+        .map(|r| (r.short(), fw.describe_io(r)))
+        .collect();
     Ok(Measured {
         source: fw.name.clone(),
         boot_states,
@@ -668,6 +686,7 @@ fn measure_firmware(cfg: &FitConfig) -> Result<Measured, FitError> {
         stack_high_water: Some(stack_high_water),
         stack: Some(stack),
         energy,
+        unmodelled,
     })
 }
 
@@ -726,6 +745,10 @@ struct FirmwareRun {
     period: u64,
     /// The MCU's clock, Hz.
     clock: f64,
+    /// Stop at the first access to what the chip does not model ([`FitConfig::strict_io`]).
+    strict_io: bool,
+    /// The image's symbols, to name that access's function.
+    symbols: emu::board::symbols::SymbolTable,
 }
 
 impl FirmwareRun {
@@ -757,6 +780,8 @@ impl FirmwareRun {
             boot_limit: (BOOT_LIMIT_S * clock) as u64,
             period,
             clock,
+            strict_io: cfg.strict_io,
+            symbols: fw.symbols.clone(),
         })
     }
 
@@ -771,6 +796,20 @@ impl FirmwareRun {
                 at,
                 source: halted(&self.cpu),
             }),
+            Ok(Event::Break) if self.strict_io => {
+                let what = self
+                    .rig
+                    .mcu
+                    .io_reports()
+                    .last()
+                    .map_or_else(String::new, |r| {
+                        emu::board::firmware::describe_io(&self.symbols, r)
+                    });
+                Err(FitError::Run {
+                    at,
+                    source: RunError::Unmodelled(what),
+                })
+            }
             Ok(e) => Ok(e),
             Err(e) => Err(FitError::Run {
                 at,
@@ -1037,6 +1076,7 @@ fn measure_model(cfg: &FitConfig) -> Result<Measured, FitError> {
         stack_high_water: None,
         stack: None,
         energy,
+        unmodelled: Vec::new(),
     })
 }
 
@@ -1090,9 +1130,10 @@ fn report(cfg: &FitConfig, m: &Measured, other: Option<&Measured>) -> FitReport 
     let eeprom = eeprom_line(c, save_max);
     let margins = Margins::new(ram_used, rom_used, cpu_worst_percent, m.stack.as_ref());
     let verdict = format!(
-        "{}: {}{} x {} network, RAM {} of {} B, ROM {} B of {} KB, worst step {:.2} % of the {} s period (mean {:.3} %); tightest margin: {} with {:.1} % left",
+        "{}: {}{}{} x {} network, RAM {} of {} B, ROM {} B of {} KB, worst step {:.2} % of the {} s period (mean {:.3} %); tightest margin: {} with {:.1} % left",
         if margins.fits { "FITS" } else { "DOES NOT FIT" },
         margins.stack_note,
+        unmodelled_note(&m.unmodelled),
         n_in,
         c.behaviours,
         ram_used,
@@ -1141,6 +1182,18 @@ fn report(cfg: &FitConfig, m: &Measured, other: Option<&Measured>) -> FitReport 
         tightest: margins.tightest,
         tightest_margin_percent: margins.tightest_percent,
         verdict,
+        unmodelled: m.unmodelled.iter().map(|(_, line)| line.clone()).collect(),
+    }
+}
+
+/// The verdict's note on what the image uses that the chip does not model (empty when
+/// nothing): `uses MAR0AR of the DMAC and FLMCR1 of the flash, not modelled; `.
+fn unmodelled_note(unmodelled: &[(String, String)]) -> String {
+    let what: Vec<&str> = unmodelled.iter().map(|(w, _)| w.as_str()).collect();
+    match what.as_slice() {
+        [] => String::new(),
+        [one] => format!("uses {one}, not modelled; "),
+        [first @ .., last] => format!("uses {} and {last}, not modelled; ", first.join(", ")),
     }
 }
 

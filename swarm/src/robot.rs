@@ -411,7 +411,10 @@ impl Robot {
             .phases_mut()
             .and_then(|p| p.drain_before(now + 1).pop())
             .map_or_else(|| emu::chip::trace::UNNAMED_PHASE.to_string(), |(_, n)| n);
-        let (start, initial) = self.mcu.trace_beginning().unwrap_or_default();
+        let (start, initial) = self
+            .mcu
+            .trace_beginning()
+            .unwrap_or((0, [false; emu::chip::trace::SIGNAL_COUNT]));
         self.vcd = Some(VcdStream::start(
             out,
             self.mcu.clock_hz(),
@@ -583,6 +586,51 @@ impl Robot {
             Brain::Firmware(c) => c.stack_fault(),
             Brain::Model(_) => None,
         }
+    }
+
+    /// Whether a firmware robot stops at the first access to what its chip does not model
+    /// (see [`FirmwareController::set_strict_io`]).
+    pub fn set_strict_io(&mut self, on: bool) {
+        if let Brain::Firmware(c) = &mut self.brain {
+            c.set_strict_io(on);
+        }
+    }
+
+    /// The first access to each address the chip does not model, one line each, named from
+    /// the firmware's symbols ([`emu::chip::mcu::IoReport`]).
+    #[must_use]
+    pub fn io_reports(&self) -> Vec<String> {
+        self.mcu
+            .io_reports()
+            .iter()
+            .map(|r| match &self.brain {
+                Brain::Firmware(c) => c.describe_io(r),
+                Brain::Model(_) => r.describe(None),
+            })
+            .collect()
+    }
+
+    /// Starts a profile of where a firmware robot's states go by call stack
+    /// ([`FirmwareController::start_profile`]).
+    ///
+    /// # Errors
+    /// A robot whose controller is the model.
+    pub fn start_profile(&mut self) -> Result<()> {
+        let Brain::Firmware(c) = &mut self.brain else {
+            anyhow::bail!("its controller is the Rust model: only firmware robots can be profiled");
+        };
+        c.start_profile(self.mcu.now());
+        Ok(())
+    }
+
+    /// Ends the profile under way and returns it as folded stacks, with the robot's states
+    /// (its MCU's clock) they add up to (`None` when none is under way).
+    pub fn take_profile(&mut self) -> Option<(String, u64)> {
+        let Brain::Firmware(c) = &mut self.brain else {
+            return None;
+        };
+        let now = self.mcu.now();
+        c.take_profile(now).map(|p| (p.folded(), now))
     }
 
     /// The wheel commands the motor pins give now.

@@ -360,7 +360,10 @@ fn finite(key: &str, v: f64, lo: f64, hi: f64) -> Result<()> {
     if v.is_finite() && v >= lo && v <= hi {
         Ok(())
     } else {
-        bail!("`{key}` = {v} is out of range: valid is {lo} to {hi}")
+        bail!(
+            "`{key}` = {} is out of range: valid is {lo} to {hi}",
+            crate::text::number(v)
+        )
     }
 }
 
@@ -549,9 +552,13 @@ impl Scenario {
                 "`name` is {name_chars} characters long: give at most {MAX_NAME_CHARS} (it titles the figures and the summary)"
             );
         }
-        if let Some(c) = self.name.chars().find(|c| c.is_control()) {
+        if let Some(c) = self
+            .name
+            .chars()
+            .find(|&c| c.is_control() || crate::text::is_format_char(c))
+        {
             bail!(
-                "`name` holds the control character U+{:04X}: give printable text (it is shown on the terminal and in the figures)",
+                "`name` holds the control or format character U+{:04X}: give printable text (it is shown on the terminal and in the figures)",
                 u32::from(c)
             );
         }
@@ -579,17 +586,11 @@ impl Scenario {
 
     /// The step period (a whole number of ticks) and the clock.
     fn check_timing(&self) -> Result<()> {
-        finite(
-            "timing.step_period_s",
-            self.timing.step_period_s,
-            0.01,
-            600.0,
-        )?;
-        let ticks = self.timing.step_period_s / emu::board::model::TICK_S;
-        if (ticks - ticks.round()).abs() > 1e-9 {
+        if !emu::board::model::step_period_ok(self.timing.step_period_s) {
             bail!(
-                "`timing.step_period_s` = {} is not a whole number of 10 ms ticks (0.45 and 0.60 are the paper's)",
-                self.timing.step_period_s
+                "`timing.step_period_s` = {}: valid is {}",
+                crate::text::number(self.timing.step_period_s),
+                emu::board::model::STEP_PERIOD_VALID
             );
         }
         range(

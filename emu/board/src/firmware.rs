@@ -8,8 +8,9 @@ use std::sync::{Arc, OnceLock};
 use crate::symbols::{SymbolError, SymbolTable};
 use h8_3052f::flash::Flash;
 use h8_3052f::gdb::{DebugAction, Debugger};
-use h8_3052f::mcu::{LoadError, Mcu, check_image};
+use h8_3052f::mcu::{IoReport, LoadError, Mcu, check_image};
 use h8_3052f::pins::Board;
+use h8_3052f::profile::StackProfile;
 use h8_3052f::trace::{CodeNames, PhaseRecorder};
 use h8300h::bus::FastPathHints;
 use h8300h::cpu::{
@@ -505,8 +506,28 @@ impl Firmware {
             _ => cpu.flush_decode_cache(),
         }
         cpu.reset(mcu);
+        // The first access to what the chip does not model stops the CPU, so that its report
+        // names the instruction ([`Firmware::describe_io`]).
+        mcu.set_io_break(true);
         Ok(())
     }
+
+    /// A report of the chip ([`IoReport`]) as one line, its instruction's function named from
+    /// the image's symbols.
+    #[must_use]
+    pub fn describe_io(&self, r: &IoReport) -> String {
+        describe_io(&self.symbols, r)
+    }
+}
+
+/// A report of the chip ([`IoReport`]) as one line, its instruction's function named from
+/// `symbols`.
+#[must_use]
+pub fn describe_io(symbols: &SymbolTable, r: &IoReport) -> String {
+    let function =
+        r.pc.and_then(|pc| symbols.function_at(pc))
+            .map(|s| s.c_name());
+    r.describe(function)
 }
 
 /// Reads a big-endian value of `N` bytes at `addr` (no bus cycle).
@@ -538,6 +559,10 @@ pub enum RunError {
         /// What the status means for the robot firmware.
         why: String,
     },
+    /// The firmware touched an address the chip does not model, with the chip told to stop
+    /// it there ([`FirmwareController::set_strict_io`]).
+    #[error("{0} (stopped by --strict-io)")]
+    Unmodelled(String),
 }
 
 /// Runs `cpu` until the clock reaches `deadline` (sleeping through idle time).
@@ -623,6 +648,13 @@ pub struct FirmwareController {
     symbols: SymbolTable,
     /// Whether the stack guard's room still has to take in what the firmware carves at boot.
     booting: bool,
+    /// Whether the first access to what the chip does not model stops the firmware.
+    strict_io: bool,
+    /// The reports of such accesses already looked at under `strict_io`.
+    io_seen: usize,
+    /// A profile of where the states go by call stack, while one is recorded
+    /// ([`Self::start_profile`]): the firmware then runs instruction by instruction.
+    profile: Option<Box<StackProfile>>,
 }
 
 impl Clone for FirmwareController {
@@ -638,6 +670,9 @@ impl Clone for FirmwareController {
             debugger: None,
             symbols: self.symbols.clone(),
             booting: self.booting,
+            strict_io: self.strict_io,
+            io_seen: self.io_seen,
+            profile: None,
         }
     }
 }
@@ -667,7 +702,45 @@ impl FirmwareController {
             debugger: None,
             symbols: fw.symbols.clone(),
             booting: true,
+            strict_io: false,
+            io_seen: 0,
+            profile: None,
         })
+    }
+
+    /// Whether the first access to an address the chip does not model stops the firmware
+    /// with [`RunError::Unmodelled`] (`true`) or is only reported (`false`, the default;
+    /// [`Mcu::io_reports`], [`Self::describe_io`]).
+    pub fn set_strict_io(&mut self, on: bool) {
+        self.strict_io = on;
+    }
+
+    /// A report of the chip as one line, named from the image's symbols.
+    #[must_use]
+    pub fn describe_io(&self, r: &IoReport) -> String {
+        describe_io(&self.symbols, r)
+    }
+
+    /// Starts a profile of where the states go by call stack ([`StackProfile`]) from the
+    /// clock `now` (the states before it go to `[reset]`): from here on the firmware runs
+    /// instruction by instruction (the same states at the same instants, more slowly).
+    pub fn start_profile(&mut self, now: u64) {
+        let names: std::sync::Arc<dyn CodeNames + Send + Sync> =
+            std::sync::Arc::new(self.symbols.clone());
+        let entries = self.symbols.function_entries();
+        self.profile = Some(Box::new(StackProfile::new(
+            Some(names),
+            Some(entries),
+            &self.cpu,
+            now,
+        )));
+    }
+
+    /// Ends the profile, with the states up to `now` attributed, and returns it.
+    pub fn take_profile(&mut self, now: u64) -> Option<StackProfile> {
+        let mut p = self.profile.take()?;
+        p.catch_up(now, self.cpu.sleeping());
+        Some(*p)
     }
 
     /// What the stack guard does when a stack access leaves the room: stop the firmware with
@@ -772,18 +845,30 @@ impl FirmwareController {
         mut stop: impl FnMut(&Mcu<B>) -> bool,
     ) -> Result<Event, RunError> {
         use h8300h::bus::Bus;
-        if self.cpu.sleeping() && self.debugger.is_none() && self.phases.is_none() {
+        if self.cpu.sleeping()
+            && self.debugger.is_none()
+            && self.phases.is_none()
+            && self.profile.is_none()
+        {
             // Idle cycles (tick, handler, back to sleep) proven to repeat are advanced at once.
             let idle = self.cpu.run_idle(mcu, deadline, &mut |_, m| stop(m))?;
             self.busy += idle.busy;
             match idle.end {
                 Some(Event::Halted) => return Err(halted(&self.cpu)),
-                Some(event) => return Ok(event),
+                Some(event) => {
+                    self.check_io(mcu, event)?;
+                    return Ok(event);
+                }
                 None => {}
             }
         }
         if self.cpu.sleeping() {
+            let t = mcu.now();
             mcu.sleep_until_irq(deadline);
+            if let Some(p) = self.profile.as_mut() {
+                p.catch_up(t, false);
+                p.catch_up(mcu.now(), true);
+            }
             if mcu.now() >= deadline {
                 return Ok(Event::Asleep);
             }
@@ -791,6 +876,8 @@ impl FirmwareController {
         let t0 = mcu.now();
         let event = if self.debugger.is_some() {
             self.run_debugged(mcu, deadline, &mut stop)?
+        } else if self.profile.is_some() {
+            self.run_profiled(mcu, deadline, &mut stop)?
         } else if let Some(p) = self.phases.as_mut() {
             // Which function runs, observed after every instruction (a stretch that loop
             // fast-forwarding skips stays in one loop, so in one function).
@@ -812,9 +899,58 @@ impl FirmwareController {
         match event {
             Event::Halted => return Err(halted(&self.cpu)),
             Event::Asleep => {}
-            Event::Executed | Event::Interrupt(_) => self.busy += mcu.now() - t0,
+            Event::Executed | Event::Interrupt(_) | Event::Reset | Event::Break => {
+                self.busy += mcu.now() - t0;
+            }
         }
+        self.check_io(mcu, event)?;
         Ok(event)
+    }
+
+    /// After a break (the first access to an address the chip does not model): under
+    /// [`Self::set_strict_io`], the firmware stops with the report.
+    fn check_io<B: Board>(&mut self, mcu: &Mcu<B>, event: Event) -> Result<(), RunError> {
+        if event == Event::Break && self.strict_io {
+            let reports = mcu.io_reports();
+            if let Some(r) = reports.get(self.io_seen) {
+                self.io_seen = reports.len();
+                return Err(RunError::Unmodelled(self.describe_io(r)));
+            }
+        }
+        Ok(())
+    }
+
+    /// [`Self::run`]'s loop while a profile is recorded: step by step, each step attributed.
+    fn run_profiled<B: Board>(
+        &mut self,
+        mcu: &mut Mcu<B>,
+        deadline: u64,
+        stop: &mut impl FnMut(&Mcu<B>) -> bool,
+    ) -> Result<Event, RunError> {
+        use h8300h::bus::Bus;
+        while mcu.now() < deadline {
+            let Some(p) = self.profile.as_deref_mut() else {
+                break;
+            };
+            let t0 = mcu.now();
+            let event = p.step(&mut self.cpu, mcu, deadline)?;
+            if let Some(ph) = self.phases.as_mut() {
+                match event {
+                    Event::Executed | Event::Reset => ph.observe(mcu.now(), self.cpu.pc()),
+                    Event::Interrupt(_) => {
+                        let at = mcu
+                            .trace_last_interrupt()
+                            .map_or(t0, |a| a.t.clamp(t0, mcu.now()));
+                        ph.observe(at, self.cpu.pc());
+                    }
+                    _ => {}
+                }
+            }
+            if event != Event::Executed || self.cpu.sleeping() || stop(mcu) {
+                return Ok(event);
+            }
+        }
+        Ok(Event::Executed)
     }
 
     /// [`Self::run`]'s loop under a debugger: step by step, asking it before each step.

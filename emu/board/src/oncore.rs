@@ -212,13 +212,14 @@ impl LearnerOnCore {
                 .run_one(&mut self.cpu, &mut self.mcu, deadline)
                 .map_err(|source| OnCoreError::Cpu { routine, source })?
             {
-                Event::Halted | Event::Asleep => {
+                // A routine that sleeps, halts or resets the chip does not return.
+                Event::Halted | Event::Asleep | Event::Reset => {
                     return Err(OnCoreError::Halted {
                         routine,
                         pc: self.cpu.pc(),
                     });
                 }
-                Event::Executed | Event::Interrupt(_) => {}
+                Event::Executed | Event::Interrupt(_) | Event::Break => {}
             }
             if self.mcu.now() - t0 > CALL_LIMIT_STATES {
                 return Err(OnCoreError::Runaway {

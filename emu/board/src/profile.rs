@@ -7,7 +7,9 @@
 //! state goes to the phase of the frame that spends it, so a phase includes its callees — except
 //! callees that are phases of their own — and an interrupt's entry (priority decision, stacking,
 //! vector) belongs to its handler. States spent in SLEEP waiting for an interrupt are idle; all
-//! others are busy. The lowest stack pointer seen is the stack's high-water mark.
+//! others are busy. The lowest stack pointer seen is the stack's high-water mark. A watchdog
+//! reset empties the call stack (its states, and what runs until the next call, are outside
+//! every phase's functions unless the reset vector's code is one).
 
 use std::collections::HashMap;
 
@@ -212,7 +214,7 @@ impl Profiler {
             match self.run_one(cpu, bus, deadline)? {
                 Event::Halted => return Ok(Event::Halted),
                 Event::Asleep => return Ok(Event::Asleep),
-                Event::Executed | Event::Interrupt(_) => {}
+                Event::Executed | Event::Interrupt(_) | Event::Reset | Event::Break => {}
             }
         }
     }
@@ -271,7 +273,13 @@ impl Profiler {
                     self.states[cur] += dt;
                 }
                 Event::Asleep => self.idle += dt,
-                Event::Halted => {
+                Event::Halted | Event::Break => {
+                    let cur = self.current();
+                    self.states[cur] += dt;
+                }
+                // A watchdog reset: the program starts over, outside every function.
+                Event::Reset => {
+                    self.stack.clear();
                     let cur = self.current();
                     self.states[cur] += dt;
                 }

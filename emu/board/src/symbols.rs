@@ -94,8 +94,9 @@ impl SymbolTable {
             let (Some(kind), None) = (kind.next(), kind.next()) else {
                 return Err(bad());
             };
-            // A name is shown in traces and on the terminal: no control characters.
-            if name.chars().any(char::is_control) || kind.is_control() {
+            // A name is shown in traces and on the terminal: no control or format characters
+            // (a right-to-left override would reorder what follows it).
+            if name.chars().any(|c| c.is_control() || is_format_char(c)) || kind.is_control() {
                 return Err(bad());
             }
             symbols.push(Symbol {
@@ -184,6 +185,15 @@ impl SymbolTable {
         k.checked_sub(1).map(|k| &t.symbols[t.functions[k].1])
     }
 
+    /// The first addresses of the functions, ascending (for a profile's tail calls,
+    /// [`h8_3052f::profile::StackProfile::new`]).
+    #[must_use]
+    pub fn function_entries(&self) -> Vec<u32> {
+        let mut v: Vec<u32> = self.inner.functions.iter().map(|&(a, _)| a).collect();
+        v.dedup();
+        v
+    }
+
     /// Whether a function starts exactly at `addr`.
     #[must_use]
     pub fn is_function_start(&self, addr: u32) -> bool {
@@ -203,4 +213,38 @@ impl h8_3052f::trace::CodeNames for SymbolTable {
         }
         self.function_at(pc).map(Symbol::c_name)
     }
+}
+
+/// Whether `c` is a Unicode format character (general category Cf, Unicode 15.1's
+/// UnicodeData.txt: among them the bidirectional controls U+061C, U+200E, U+200F, U+202A to
+/// U+202E and U+2066 to U+2069, the zero-width U+200B to U+200D and U+2060, the byte-order
+/// mark U+FEFF, the interlinear annotations U+FFF9 to U+FFFB and the tags U+E0001 and U+E0020
+/// to U+E007F) or the line or paragraph separator (U+2028, U+2029: they end a line on some
+/// terminals).
+#[must_use]
+pub fn is_format_char(c: char) -> bool {
+    matches!(
+        c,
+        '\u{ad}'
+            | '\u{600}'..='\u{605}'
+            | '\u{61c}'
+            | '\u{6dd}'
+            | '\u{70f}'
+            | '\u{890}'..='\u{891}'
+            | '\u{8e2}'
+            | '\u{180e}'
+            | '\u{200b}'..='\u{200f}'
+            | '\u{2028}'..='\u{202e}'
+            | '\u{2060}'..='\u{2064}'
+            | '\u{2066}'..='\u{206f}'
+            | '\u{feff}'
+            | '\u{fff9}'..='\u{fffb}'
+            | '\u{110bd}'
+            | '\u{110cd}'
+            | '\u{13430}'..='\u{1343f}'
+            | '\u{1bca0}'..='\u{1bca3}'
+            | '\u{1d173}'..='\u{1d17a}'
+            | '\u{e0001}'
+            | '\u{e0020}'..='\u{e007f}'
+    )
 }

@@ -45,22 +45,40 @@
 //! events, so that they are synchronised with the chip's clock, and the board is brought up to
 //! the clock whenever the chip is ([`Mcu::sync`]); the board applies them lazily.
 //!
-//! # Other registers
-//! Registers of modules not modelled (DMAC, watchdog, SCI0, TPC, ports 1, 3, 5, 6, 7, 8, 9,
-//! the bus controller, the IRQ registers) read 0 and ignore writes.
+//! # The watchdog's reset
+//! The watchdog timer ([`crate::periph::wdt`]) in watchdog timer mode resets the chip when its
+//! counter overflows: the chip offers the CPU a reset request
+//! ([`RESET_REQUEST`](h8300h::bus::RESET_REQUEST)), and when the
+//! CPU takes it ([`CpuSignal::Reset`]) every module returns to its reset state (the WDT keeps
+//! RSTCSR, with WRST set), port 4's lines are released, and the clock moves to the end of the
+//! internal reset (518 states after the overflow). The RAM keeps its contents, the board its
+//! parts' state.
+//!
+//! # Registers the chip does not model
+//! Registers of modules not modelled (the DMA controller, the flash memory's control, SCI0,
+//! the TPC, the refresh controller, the D/A converter, the bus controller, MDCR, DIVCR,
+//! MSTCR, SCMR1), reserved I/O addresses and addresses outside the memory map read 0 (H'FF
+//! outside the map) and ignore writes, as on a chip where nothing answers; the first access to
+//! each is *reported* ([`IoReport`], named from [`crate::iomap`]). With
+//! [`Mcu::set_io_break`] on, the chip also asks the CPU to stop right after the access
+//! ([`BREAK_REQUEST`]), and the report gets the instruction's address when the CPU stops
+//! ([`CpuSignal::Break`]).
 
 use std::cell::Cell;
 
 use crate::flash::Flash;
+use crate::iomap::{Register, register_at};
 use crate::periph::Peripheral;
 use crate::periph::adc::{ADCR, ADDRA, Adc};
 use crate::periph::intc::Intc;
+use crate::periph::irq::{self, Irq};
 use crate::periph::itu::{self, Itu, PwmWave};
-use crate::periph::ports::{PortPins, Ports};
+use crate::periph::ports::{PortId, PortPins, Ports};
 use crate::periph::sci::Sci;
+use crate::periph::wdt::{self, Wdt};
 use crate::pins::Board;
 use crate::trace::{Accepted, ChipView, PinTrace, Tracer};
-use h8300h::bus::{Bus, CpuSignal, FastPathHints, fresh_code_generation};
+use h8300h::bus::{BREAK_REQUEST, Bus, CpuSignal, FastPathHints, fresh_code_generation};
 use h8300h::memmap::{
     ADDRESS_MASK, Area, IO_ACCESS_STATES, RAM_BYTES, RAM_START, ROM_BYTES, ROM_END,
 };
@@ -157,6 +175,79 @@ pub struct TiocaOutput {
     pub wave: Option<PwmWave>,
 }
 
+/// The first access to an address the chip does not model: a register of a module (or a
+/// register of a module) it does not model, a reserved I/O address, or an address outside the
+/// memory map ([`crate::iomap`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct IoReport {
+    /// The address (24 bits).
+    pub addr: u32,
+    /// The register there, or `None` for a reserved address or one outside the memory map.
+    pub register: Option<&'static Register>,
+    /// A write (else a read).
+    pub write: bool,
+    /// The instant of the access (states).
+    pub at: u64,
+    /// The address of the instruction that made it, when the CPU told the chip
+    /// ([`Mcu::set_io_break`]).
+    pub pc: Option<u32>,
+}
+
+impl IoReport {
+    /// What lies at the address, in words: `MAR0AR (H'FFFF20) of the DMA controller (DMAC)`,
+    /// `H'FFFF1C, a reserved I/O address`, `H'100000, outside the memory map`.
+    #[must_use]
+    pub fn what(&self) -> String {
+        match self.register {
+            Some(r) => format!(
+                "{} (H'{:06X}) of {} ({})",
+                r.name,
+                self.addr,
+                r.unit.title(),
+                r.unit.short()
+            ),
+            None if Area::of(self.addr) == Area::Io => {
+                format!("H'{:06X}, a reserved I/O address", self.addr)
+            }
+            None => format!("H'{:06X}, outside the memory map of mode 7", self.addr),
+        }
+    }
+
+    /// The report as one line: the instruction (with its function's name when `function`
+    /// gives it), the access, what lies there and that the chip does not model it.
+    #[must_use]
+    pub fn describe(&self, function: Option<&str>) -> String {
+        let at = match (self.pc, function) {
+            (Some(pc), Some(f)) => format!("PC H'{pc:06X} in {f}"),
+            (Some(pc), None) => format!("PC H'{pc:06X}"),
+            (None, _) => format!("state {}", self.at),
+        };
+        let access = if self.write { "writes" } else { "reads" };
+        let effect = if self.write {
+            "the write is ignored"
+        } else if Area::of(self.addr) == Area::Io {
+            "it reads 0"
+        } else {
+            "it reads H'FF"
+        };
+        format!("{at}: {access} {}, not modelled ({effect})", self.what())
+    }
+
+    /// What the program uses that the chip does not model, in a few words: the register and
+    /// its module (`MAR0AR of the DMAC`), or the reserved address.
+    #[must_use]
+    pub fn short(&self) -> String {
+        match self.register {
+            Some(r) => format!("{} of the {}", r.name, r.unit.short()),
+            None => format!("H'{:06X} (reserved)", self.addr),
+        }
+    }
+}
+
+/// Most reports of addresses outside the I/O area kept (the first access to each): a program
+/// that sweeps memory gets a bounded list.
+pub const MAX_UNMAPPED_REPORTS: usize = 64;
+
 /// The H8/3052F with its board.
 #[derive(Clone, Debug)]
 pub struct Mcu<B: Board> {
@@ -171,7 +262,19 @@ pub struct Mcu<B: Board> {
     adc: Adc,
     intc: Intc,
     ports: Ports,
+    wdt: Wdt,
+    irq: Irq,
     board: B,
+    /// Reports of first accesses to addresses the chip does not model, in order.
+    io_reports: Vec<IoReport>,
+    /// The I/O addresses (low byte) reported so far.
+    io_seen: [u64; 4],
+    /// Whether a first access raises a break request ([`Mcu::set_io_break`]).
+    io_break: bool,
+    /// A break request stands (until the CPU takes it).
+    break_pending: bool,
+    /// Internal resets so far (the watchdog's).
+    resets: u64,
     /// The winning interrupt request as of the last computation.
     irq_cached: Cell<Option<u8>>,
     /// The cached request is valid while `now` is below this.
@@ -181,7 +284,8 @@ pub struct Mcu<B: Board> {
 }
 
 /// The on-chip module that owns an I/O address: the chip's map of its register blocks, each
-/// block as its module declares it ([`Peripheral::FIRST`]..=[`Peripheral::LAST`]).
+/// block as its module declares it ([`Peripheral::FIRST`]..=[`Peripheral::LAST`]), less the
+/// addresses in it the module does not model.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Module {
     Itu,
@@ -189,31 +293,63 @@ enum Module {
     Ports,
     Adc,
     Intc,
-    /// No module: reads 0, writes are ignored.
+    Wdt,
+    Irq,
+    /// No module: reads 0, writes are ignored, the first access is reported.
     Unmodelled,
 }
 
+/// The module of each I/O address, by its low byte (the I/O area is H'FFFF1C–H'FFFFFF).
+const ROUTES: [Module; 256] = {
+    let mut t = [Module::Unmodelled; 256];
+    let mut i = 0;
+    while i < 256 {
+        t[i] = Module::route(0xFF_FF00 | i as u32);
+        i += 1;
+    }
+    t
+};
+
 impl Module {
     /// Every module, in the order the chip synchronises and resets them.
-    const ALL: [Module; 5] = [
+    const ALL: [Module; 7] = [
         Module::Itu,
         Module::Adc,
         Module::Sci,
         Module::Ports,
         Module::Intc,
+        Module::Wdt,
+        Module::Irq,
     ];
+
+    /// The module that models the register at `a` (an I/O address), if any: the blocks the
+    /// modules own, less the addresses inside them they do not model (the port block's
+    /// reserved addresses; BRCR and H'FFFFF7 in the interrupt controller's).
+    const fn route(a: u32) -> Module {
+        match a {
+            <Itu as Peripheral>::FIRST..=<Itu as Peripheral>::LAST => Module::Itu,
+            <Sci as Peripheral>::FIRST..=<Sci as Peripheral>::LAST => Module::Sci,
+            <Ports as Peripheral>::FIRST..=<Ports as Peripheral>::LAST => {
+                if crate::periph::ports::PortId::of_register(a).is_some() {
+                    Module::Ports
+                } else {
+                    Module::Unmodelled
+                }
+            }
+            <Adc as Peripheral>::FIRST..=<Adc as Peripheral>::LAST => Module::Adc,
+            <Wdt as Peripheral>::FIRST..=<Wdt as Peripheral>::LAST => Module::Wdt,
+            irq::ISCR..=irq::ISR => Module::Irq,
+            crate::periph::intc::SYSCR | crate::periph::intc::IPRA | crate::periph::intc::IPRB => {
+                Module::Intc
+            }
+            _ => Module::Unmodelled,
+        }
+    }
 
     /// The module whose block holds `a` (an I/O address).
     #[inline]
     fn of(a: u32) -> Module {
-        match a {
-            <Itu as Peripheral>::FIRST..=<Itu as Peripheral>::LAST => Module::Itu,
-            <Sci as Peripheral>::FIRST..=<Sci as Peripheral>::LAST => Module::Sci,
-            <Ports as Peripheral>::FIRST..=<Ports as Peripheral>::LAST => Module::Ports,
-            <Adc as Peripheral>::FIRST..=<Adc as Peripheral>::LAST => Module::Adc,
-            <Intc as Peripheral>::FIRST..=<Intc as Peripheral>::LAST => Module::Intc,
-            _ => Module::Unmodelled,
-        }
+        ROUTES[(a & 0xFF) as usize]
     }
 
     /// Whether a write to the module can change the interrupt decision.
@@ -225,6 +361,8 @@ impl Module {
             Module::Ports => <Ports as Peripheral>::AFFECTS_IRQ,
             Module::Adc => <Adc as Peripheral>::AFFECTS_IRQ,
             Module::Intc => <Intc as Peripheral>::AFFECTS_IRQ,
+            Module::Wdt => <Wdt as Peripheral>::AFFECTS_IRQ,
+            Module::Irq => true,
             Module::Unmodelled => false,
         }
     }
@@ -261,6 +399,18 @@ macro_rules! on_module {
                 let ($p, $outside) = (&mut $mcu.intc, ());
                 $body
             }
+            Module::Wdt => {
+                let ($p, $outside) = (&mut $mcu.wdt, ());
+                $body
+            }
+            Module::Irq => {
+                let $p = &mut $mcu.irq;
+                let $outside = irq::IrqView {
+                    ports: &$mcu.ports,
+                    board: &$mcu.board,
+                };
+                $body
+            }
             Module::Unmodelled => $none,
         }
     };
@@ -288,8 +438,16 @@ macro_rules! fold_modules {
             let $p = &$mcu.ports;
             $body
         });
-        combine(all, {
+        let all = combine(all, {
             let $p = &$mcu.intc;
+            $body
+        });
+        let all = combine(all, {
+            let $p = &$mcu.wdt;
+            $body
+        });
+        combine(all, {
+            let $p = &$mcu.irq;
             $body
         })
     }};
@@ -324,10 +482,21 @@ impl<B: Board> Mcu<B> {
             adc: Adc::new(),
             intc: Intc::new(),
             ports: Ports::new(),
+            wdt: Wdt::new(),
+            irq: Irq::new(),
             board,
+            io_reports: Vec::new(),
+            io_seen: [0; 4],
+            io_break: false,
+            break_pending: false,
+            resets: 0,
             irq_cached: Cell::new(None),
             irq_valid_until: Cell::new(0),
             tracer: None,
+        })
+        .map(|mut m: Mcu<B>| {
+            m.irq.reset(0, &m.ports, &m.board);
+            m
         })
     }
 
@@ -496,10 +665,17 @@ impl<B: Board> Mcu<B> {
         )
     }
 
-    /// The earliest state after now at which an enabled interrupt request appears.
+    /// The earliest state after now at which an enabled interrupt request (or the watchdog's
+    /// reset request) appears: a module's, or a change of the pins the board drives while an
+    /// IRQ is enabled.
     fn next_irq_time(&self) -> Option<u64> {
         let now = self.now;
-        fold_modules!(self, |p| Peripheral::next_request(p, now), earliest)
+        let modules = fold_modules!(self, |p| Peripheral::next_request(p, now), earliest);
+        if self.irq.enabled() {
+            earliest(modules, self.board.next_pin_change(now))
+        } else {
+            modules
+        }
     }
 
     /// What ITU channel `n`'s TIOCA output does now (channels out of range: neither driving nor
@@ -563,7 +739,7 @@ impl<B: Board> Mcu<B> {
 
     /// The pin trace under way: its first instant and every signal's level then.
     #[must_use]
-    pub fn trace_beginning(&self) -> Option<(u64, [bool; 12])> {
+    pub fn trace_beginning(&self) -> Option<(u64, [bool; crate::trace::SIGNAL_COUNT])> {
         self.tracer.as_ref().map(|t| t.beginning())
     }
 
@@ -626,6 +802,20 @@ impl<B: Board> Mcu<B> {
         Some(tracer.finish(now, self.clock_hz, &mut self.board))
     }
 
+    /// The CPU stopped for the break request after the instruction at `pc`: the reports
+    /// made since get its address.
+    #[cold]
+    fn break_taken(&mut self, pc: u32) {
+        for r in self.io_reports.iter_mut().rev() {
+            if r.pc.is_some() {
+                break;
+            }
+            r.pc = Some(pc);
+        }
+        self.break_pending = false;
+        self.invalidate_irq();
+    }
+
     /// A CPU signal for the trace under way.
     #[cold]
     fn trace_cpu_signal(&mut self, signal: CpuSignal) {
@@ -636,6 +826,7 @@ impl<B: Board> Mcu<B> {
                 CpuSignal::Sleep => t.set_sleeping(now, true, &self.ports),
                 CpuSignal::Wake => t.set_sleeping(now, false, &self.ports),
                 CpuSignal::Interrupt(v) => t.accepted(now, v),
+                CpuSignal::Reset | CpuSignal::Break { .. } => {}
             }
         }
     }
@@ -698,10 +889,135 @@ impl<B: Board> Mcu<B> {
         for m in Module::ALL {
             on_module!(self, m, |p, _outside| Peripheral::reset(p), ());
         }
+        self.irq.reset(self.now, &self.ports, &self.board);
         self.invalidate_irq();
         if self.tracer.is_some() {
             self.trace_after_write(Module::Itu);
             self.trace_after_write(Module::Adc);
+        }
+    }
+
+    /// The watchdog's internal reset, taken by the CPU now (module docs): every module to its
+    /// reset state but the WDT's RSTCSR, port 4's lines released, the clock to the reset's end.
+    #[cold]
+    fn internal_reset(&mut self) {
+        // Everything up to the reset happens first (a byte SCI1 has finished sending is out;
+        // the WDT has set WRST).
+        self.sync();
+        let now = self.now;
+        let end = self.wdt.reset_end().unwrap_or(now).max(now);
+        let wdt = self.wdt.clone();
+        self.reset_peripherals();
+        self.wdt = wdt;
+        self.wdt.internal_reset(now);
+        self.board.port4_drive(self.ports.port4().driven_low(), now);
+        self.now = end;
+        self.resets += 1;
+        self.invalidate_irq();
+    }
+
+    /// Internal resets so far (the watchdog's, [`crate::periph::wdt`]).
+    #[must_use]
+    pub const fn resets(&self) -> u64 {
+        self.resets
+    }
+
+    /// The watchdog timer (read-only view; use the bus to program it).
+    #[must_use]
+    pub fn wdt(&self) -> &Wdt {
+        &self.wdt
+    }
+
+    /// The IRQ inputs (read-only view).
+    #[must_use]
+    pub fn irq(&self) -> &Irq {
+        &self.irq
+    }
+
+    /// The ports' registers (read-only view).
+    #[must_use]
+    pub fn ports(&self) -> &Ports {
+        &self.ports
+    }
+
+    /// Levels of port `id`'s pins now: output pins at their latch (or at the ITU's output on
+    /// ports A and B), input pins as the board leaves them (a pull-up, else 0); for a board
+    /// that watches the chip's outputs ([`crate::pins::Board::port_pins`] is the other way).
+    /// Port 2 and 4 give their latch and pull-ups only.
+    pub fn port_pins(&mut self, id: PortId) -> u8 {
+        let now = self.now;
+        match id {
+            PortId::PA => self.ports.pa_pins(&mut self.itu, now),
+            PortId::PB => self.ports.pb_pins(&mut self.itu, now),
+            _ => {
+                let outside = self.board.port_pins(id, now);
+                self.ports.levels(id, outside)
+            }
+        }
+    }
+
+    /// The reports of first accesses to addresses the chip does not model, in order
+    /// ([`IoReport`]).
+    #[must_use]
+    pub fn io_reports(&self) -> &[IoReport] {
+        &self.io_reports
+    }
+
+    /// Turns break requests on (or off, the default): with them on, the first access to an
+    /// address the chip does not model asks the CPU to stop before its next instruction
+    /// ([`BREAK_REQUEST`]; the CPU returns [`h8300h::cpu::Event::Break`]), and the report gets
+    /// the instruction's address when it does.
+    pub fn set_io_break(&mut self, on: bool) {
+        self.io_break = on;
+        if !on {
+            self.break_pending = false;
+        }
+        self.invalidate_irq();
+    }
+
+    /// An access to I/O address `a` that no module models: the first one is reported.
+    #[cold]
+    #[inline(never)]
+    fn unmodelled_io(&mut self, a: u32, write: bool) {
+        let low = (a & 0xFF) as usize;
+        let bit = 1u64 << (low & 63);
+        if self.io_seen[low >> 6] & bit != 0 {
+            return;
+        }
+        self.io_seen[low >> 6] |= bit;
+        self.report_io(a, write);
+    }
+
+    /// An access to an address outside the memory map: the first one to each is reported (at
+    /// most [`MAX_UNMAPPED_REPORTS`] such).
+    #[cold]
+    #[inline(never)]
+    fn unmapped_access(&mut self, a: u32, write: bool) {
+        let mut n = 0;
+        for r in &self.io_reports {
+            if r.register.is_none() && Area::of(r.addr) == Area::Unmapped {
+                if r.addr == a {
+                    return;
+                }
+                n += 1;
+            }
+        }
+        if n < MAX_UNMAPPED_REPORTS {
+            self.report_io(a, write);
+        }
+    }
+
+    fn report_io(&mut self, a: u32, write: bool) {
+        self.io_reports.push(IoReport {
+            addr: a,
+            register: register_at(a),
+            write,
+            at: self.now,
+            pc: None,
+        });
+        if self.io_break {
+            self.break_pending = true;
+            self.invalidate_irq();
         }
     }
 
@@ -722,6 +1038,15 @@ impl<B: Board> Mcu<B> {
     #[cold]
     fn refresh_irq(&self) -> Option<u8> {
         let now = self.now;
+        if self.break_pending {
+            // Asked at every boundary until the CPU takes it.
+            self.irq_cached.set(Some(BREAK_REQUEST));
+            self.irq_valid_until.set(now);
+            return Some(BREAK_REQUEST);
+        }
+        if self.irq.enabled() {
+            self.irq.catch_up(now, &self.ports, &self.board);
+        }
         let requests = fold_modules!(self, |p| Peripheral::requests(p, now), |a, b| a | b);
         let winner = self.intc.choose(requests);
         let valid_until = match self.next_irq_time() {
@@ -743,7 +1068,10 @@ impl<B: Board> Mcu<B> {
             self,
             Module::of(a),
             |p, outside| Peripheral::read::<B>(p, a, now, outside),
-            0
+            {
+                self.unmodelled_io(a, false);
+                0
+            }
         )
     }
 
@@ -757,15 +1085,39 @@ impl<B: Board> Mcu<B> {
         if self.tracer.is_some() {
             self.trace_before_write();
         }
-        on_module!(
-            self,
-            module,
-            |p, outside| Peripheral::write::<B>(p, a, v, now, outside),
-            ()
-        );
+        if module == Module::Ports && irq::is_irq_port_register(a) {
+            self.port_write_irq(a, v);
+        } else {
+            on_module!(
+                self,
+                module,
+                |p, outside| Peripheral::write::<B>(p, a, v, now, outside),
+                self.unmodelled_io(a, true)
+            );
+        }
         if self.tracer.is_some() {
             self.trace_after_write(module);
         }
+    }
+
+    /// A write to port 8's or 9's DDR or DR, whose pins are IRQ inputs: the IRQ flags are
+    /// caught up to the write and see the pins' new levels at its instant.
+    #[cold]
+    fn port_write_irq(&mut self, a: u32, v: u8) {
+        let now = self.now;
+        self.irq.catch_up(now, &self.ports, &self.board);
+        Peripheral::write::<B>(
+            &mut self.ports,
+            a,
+            v,
+            now,
+            PortPins {
+                board: &mut self.board,
+                itu: &mut self.itu,
+            },
+        );
+        self.irq.after_port_write(now, &self.ports, &self.board);
+        self.invalidate_irq();
     }
 }
 
@@ -809,7 +1161,10 @@ impl<B: Board> Bus for Mcu<B> {
             Area::Rom => self.rom_byte(a),
             Area::Ram => self.ram_byte(a),
             Area::Io => self.io_read8(a),
-            Area::Unmapped => 0xff,
+            Area::Unmapped => {
+                self.unmapped_access(a, false);
+                0xff
+            }
         }
     }
 
@@ -835,8 +1190,8 @@ impl<B: Board> Bus for Mcu<B> {
                 }
             }
             Area::Io => {
-                if itu::is_word_register(a) {
-                    // One cycle on the ITU's 16-bit internal bus.
+                if itu::is_word_register(a) || wdt::is_word_register(a) {
+                    // One cycle on the ITU's (the WDT's) 16-bit internal bus.
                     self.now += u64::from(itu::ITU_WORD_ACCESS_STATES);
                     let hi = self.io_read8(a);
                     let lo = self.io_read8(a + 1);
@@ -852,6 +1207,7 @@ impl<B: Board> Bus for Mcu<B> {
             }
             Area::Unmapped => {
                 self.now += u64::from(Area::Unmapped.word_states());
+                self.unmapped_access(a, false);
                 0xffff
             }
         }
@@ -865,8 +1221,10 @@ impl<B: Board> Bus for Mcu<B> {
         match area {
             Area::Ram => self.ram_mut()[(a - RAM_START) as usize & RAM_INDEX_MASK] = value,
             Area::Io => self.io_write8(a, value),
-            // Flash is not writable through the bus; nothing answers unmapped addresses.
-            Area::Rom | Area::Unmapped => {}
+            // Flash is not writable through the bus.
+            Area::Rom => {}
+            // Nothing answers unmapped addresses.
+            Area::Unmapped => self.unmapped_access(a, true),
         }
     }
 
@@ -893,6 +1251,11 @@ impl<B: Board> Bus for Mcu<B> {
                     if self.tracer.is_some() {
                         self.trace_after_write(Module::Itu);
                     }
+                } else if wdt::is_word_register(a) {
+                    // The WDT's password words: one cycle, the word as a whole.
+                    self.now += u64::from(wdt::WDT_WORD_ACCESS_STATES);
+                    self.before_irq_write();
+                    self.wdt.write16(a, value, self.now);
                 } else {
                     self.now += u64::from(IO_ACCESS_STATES);
                     self.io_write8(a, hi);
@@ -900,7 +1263,11 @@ impl<B: Board> Bus for Mcu<B> {
                     self.io_write8(a + 1, lo);
                 }
             }
-            area @ (Area::Rom | Area::Unmapped) => self.now += u64::from(area.word_states()),
+            Area::Rom => self.now += u64::from(Area::Rom.word_states()),
+            Area::Unmapped => {
+                self.now += u64::from(Area::Unmapped.word_states());
+                self.unmapped_access(a, true);
+            }
         }
     }
 
@@ -918,30 +1285,46 @@ impl<B: Board> Bus for Mcu<B> {
         }
     }
 
-    /// Tells a pin trace under way (SLEEP, and the accepted interrupts); otherwise nothing.
+    /// Tells a pin trace under way (SLEEP, and the accepted interrupts); takes the reset
+    /// (module docs), withdraws a break request (the reports get the instruction's address),
+    /// and clears an IRQ flag whose exception handling begins.
     #[inline]
     fn cpu_signal(&mut self, signal: CpuSignal) {
+        match signal {
+            CpuSignal::Reset => self.internal_reset(),
+            CpuSignal::Break { pc } => self.break_taken(pc),
+            CpuSignal::Interrupt(v) if (irq::VECTOR_IRQ0..irq::VECTOR_IRQ0 + 6).contains(&v) => {
+                self.irq.accepted(v);
+                self.invalidate_irq();
+            }
+            _ => {}
+        }
         if self.tracer.is_some() {
             self.trace_cpu_signal(signal);
         }
     }
 
+    /// Moves the clock to the next instant a request can appear, again while none does (a pin
+    /// the board drives may change without requesting: a rising edge, a disabled IRQ), up to
+    /// `deadline`.
     fn sleep_until_irq(&mut self, deadline: u64) -> bool {
-        if self.pending_irq().is_some() {
-            return true;
-        }
-        match self.next_irq_time() {
-            Some(t) if t <= deadline => {
-                self.now = self.now.max(t);
-                self.sync();
-                self.pending_irq().is_some()
+        loop {
+            if self.pending_irq().is_some() {
+                return true;
             }
-            _ => {
-                if deadline != u64::MAX {
-                    self.now = self.now.max(deadline);
+            match self.next_irq_time() {
+                Some(t) if t <= deadline && t > self.now => {
+                    self.now = t;
                     self.sync();
                 }
-                false
+                Some(t) if t <= self.now => return false,
+                _ => {
+                    if deadline != u64::MAX {
+                        self.now = self.now.max(deadline);
+                        self.sync();
+                    }
+                    return false;
+                }
             }
         }
     }
@@ -994,12 +1377,20 @@ impl<B: Board> FastPathHints for Mcu<B> {
             || Peripheral::next_event(&self.ports, now).is_some()
             || Peripheral::next_event(&self.intc, now).is_some()
             || self.board.next_event_states(now).is_some()
+            || (self.irq.enabled() && self.board.next_pin_change(now).is_some())
         {
             return None;
         }
         let mut out = Vec::with_capacity(80);
         self.itu.idle_signature(now, &mut out);
         Some(out)
+    }
+
+    /// The watchdog's next request (an overflow of a running counter): the signature leaves
+    /// the WDT out — it counts on in absolute time whatever the cycles do, and the program may
+    /// not touch it in a cycle ([`FastPathHints::idle_io`]) — so no cycle is advanced past it.
+    fn idle_horizon(&self) -> u64 {
+        Peripheral::next_request(&self.wdt, self.now).unwrap_or(u64::MAX)
     }
 
     /// The ITU's registers: the only ones [`FastPathHints::idle_signature`] covers.
@@ -1099,6 +1490,77 @@ mod tests {
         assert_eq!(m.read8(SYSCR), SYSCR_RESET);
         m.write8(SYSCR, 0x09);
         assert_eq!(m.read8(SYSCR), 0x09);
-        assert_eq!(m.read8(0xFF_FFC0), 0); // P1DDR: not modelled
+        // P1DDR: modelled now (write-only, reads H'FF); nothing reported.
+        assert_eq!(m.read8(0xFF_FFC0), 0xFF);
+        assert!(m.io_reports().is_empty());
+        // MAR0AR (the DMAC's): reads 0, ignores writes, reported once per address.
+        assert_eq!(m.read8(0xFF_FF20), 0);
+        m.write8(0xFF_FF20, 0x12);
+        assert_eq!(m.read8(0xFF_FF20), 0);
+        // BRCR (bus controller) inside the interrupt controller's block; a reserved address;
+        // outside the memory map (a word: one report of its address).
+        m.write8(0xFF_FFF3, 1);
+        assert_eq!(m.read8(0xFF_FF1C), 0);
+        assert_eq!(m.read16(0x10_0000), 0xFFFF);
+        m.write16(0x10_0000, 1);
+        let r = m.io_reports();
+        assert_eq!(r.len(), 4, "{r:?}");
+        assert_eq!(r[0].register.map(|x| x.name), Some("MAR0AR"));
+        assert!(!r[0].write);
+        assert_eq!(r[1].register.map(|x| x.name), Some("BRCR"));
+        assert!(r[1].write);
+        assert_eq!(r[2].register, None);
+        assert_eq!(r[2].addr, 0xFF_FF1C);
+        assert_eq!(r[3].addr, 0x10_0000);
+        assert!(r.iter().all(|x| x.pc.is_none()));
+        assert_eq!(
+            r[0].describe(Some("main")),
+            "state 15: reads MAR0AR (H'FFFF20) of the DMA controller (DMAC), not modelled (it reads 0)"
+        );
+        assert!(
+            r[2].describe(None).contains("a reserved I/O address"),
+            "{}",
+            r[2].describe(None)
+        );
+        assert!(r[3].describe(None).contains("outside the memory map"));
+        // Breaks: a first access raises a break request until the CPU takes it.
+        assert_eq!(m.pending_irq(), None);
+        m.set_io_break(true);
+        m.write8(0xFF_FFB0, 0); // SMR0 (SCI0)
+        assert_eq!(m.pending_irq(), Some(BREAK_REQUEST));
+        m.cpu_signal(CpuSignal::Break { pc: 0x1234 });
+        assert_eq!(m.pending_irq(), None);
+        assert_eq!(m.io_reports()[4].pc, Some(0x1234));
+        assert_eq!(m.io_reports()[4].register.map(|x| x.name), Some("SMR0"));
+        // Already reported: no new break.
+        m.write8(0xFF_FFB0, 0);
+        assert_eq!(m.pending_irq(), None);
+    }
+
+    #[test]
+    fn every_io_address_is_modelled_or_reported() {
+        // The chip's routes agree with the register table: an address a module models is a
+        // register of that module's unit; every other one is reported.
+        use crate::iomap::Unit;
+        for a in h8300h::memmap::IO_START..=h8300h::memmap::IO_END {
+            let reg = register_at(a);
+            let module = Module::of(a);
+            let unit = reg.map(|r| r.unit);
+            let expected = match module {
+                Module::Itu => Some(Unit::Itu),
+                Module::Sci => Some(Unit::Sci1),
+                Module::Ports => Some(Unit::Ports),
+                Module::Adc => Some(Unit::Ad),
+                Module::Wdt => Some(Unit::Wdt),
+                Module::Intc | Module::Irq => Some(Unit::Intc),
+                Module::Unmodelled => {
+                    let mut m = mcu();
+                    m.read8(a);
+                    assert_eq!(m.io_reports().len(), 1, "H'{a:06X}");
+                    continue;
+                }
+            };
+            assert_eq!(unit, expected, "H'{a:06X} routed to {module:?}");
+        }
     }
 }

@@ -5,6 +5,8 @@
 //! The chip knows its pins, not the parts on them: what sits on a pin (a sensor, a bumper, an
 //! EEPROM) is the board layer's business (`robot_board::wiring`, `robot_board::board`).
 
+use crate::periph::ports::{ExternalPins, PortId};
+
 /// The robot outside the chip, as the MCU's pins see it.
 ///
 /// Every instant a board is given is not earlier than one it was given before and not later
@@ -31,6 +33,24 @@ pub trait Board {
     /// the chip reads back its own levels.
     fn port4_pins(&mut self, _now_states: u64) -> u8 {
         0xFF
+    }
+
+    /// What the outside drives on the pins of port `port` at `now_states`: the board's side of
+    /// ports 1, 3, 5–9, A and B (ports 2 and 4 have their own methods above). The pins it does
+    /// not drive read high through a pull-up, else float (read 0); an output pin of the chip
+    /// reads its latch whatever the board says. What a board drives is a function of time the
+    /// chip may ask about for any instant since the board was last synchronised
+    /// ([`Board::sync`]), in order; it changes only at the instants
+    /// [`Board::next_pin_change`] gives. Default: nothing connected ([`ExternalPins::NONE`]).
+    fn port_pins(&self, _port: PortId, _now_states: u64) -> ExternalPins {
+        ExternalPins::NONE
+    }
+
+    /// The first instant after `now_states` at which [`Board::port_pins`] changes for any
+    /// port, if it will: the chip catches its IRQ inputs up to each such instant (an edge is
+    /// never missed) and wakes a sleeping CPU for an enabled IRQ. Default: never.
+    fn next_pin_change(&self, _now_states: u64) -> Option<u64> {
+        None
     }
 
     /// The first instant after `now_states` at which the board's own parts change something

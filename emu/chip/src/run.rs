@@ -23,8 +23,9 @@ use std::io::Write;
 
 use crate::gdb::DebugAction;
 use crate::machine::{LoadError, Machine};
-use crate::mcu::Mcu;
+use crate::mcu::{IoReport, Mcu};
 use crate::pins::Board;
+use crate::profile::StackProfile;
 use crate::trace::{CodeNames, PhaseRecorder, phase_name};
 use h8300h::bus::Bus;
 use h8300h::cpu::disasm::format_instr;
@@ -37,6 +38,9 @@ pub struct RunOptions {
     /// Stop once the clock reaches this many states (checked between instructions, so the
     /// last instruction may end a few states past it). `None`: no limit.
     pub max_states: Option<u64>,
+    /// Stop at the first access to an address the chip does not model
+    /// ([`Outcome::Unmodelled`]) instead of reporting it and going on.
+    pub strict_io: bool,
 }
 
 /// How a run ended.
@@ -60,6 +64,9 @@ pub enum Outcome {
     },
     /// A GDB client killed the program.
     Killed,
+    /// The program touched an address the chip does not model, under
+    /// [`RunOptions::strict_io`].
+    Unmodelled(IoReport),
 }
 
 /// Counters of a run.
@@ -77,6 +84,8 @@ pub struct RunStats {
     pub interrupts: u64,
     /// Bytes transmitted on SCI1.
     pub console_bytes: u64,
+    /// Watchdog resets (internal resets of the chip).
+    pub resets: u64,
 }
 
 /// The result of a run: how it ended and what it cost.
@@ -89,6 +98,9 @@ pub struct RunReport {
     /// The first stack access that left the stack's room, under a guard that only warns
     /// (a stopping guard's fault is the [`Outcome::Error`]).
     pub stack_fault: Option<StackFault>,
+    /// The first access to each address the chip does not model, with the instruction that
+    /// made it ([`crate::mcu::IoReport`]).
+    pub io_reports: Vec<IoReport>,
 }
 
 impl RunReport {
@@ -103,6 +115,7 @@ impl RunReport {
             Outcome::Error(e) => ("error", None, Some(e.to_string())),
             Outcome::SleptForever { .. } => ("slept_forever", None, None),
             Outcome::Killed => ("killed", None, None),
+            Outcome::Unmodelled(r) => ("unmodelled", None, Some(r.describe(None))),
         };
         let json = StatsJson {
             outcome,
@@ -115,6 +128,8 @@ impl RunReport {
             phi_hz: u64::from(self.stats.clock_hz),
             interrupts: self.stats.interrupts,
             console_bytes: self.stats.console_bytes,
+            resets: self.stats.resets,
+            unmodelled_accesses: self.io_reports.len(),
         };
         // A struct of numbers, strings and options always serialises.
         serde_json::to_string(&json).unwrap_or_default()
@@ -134,6 +149,24 @@ struct StatsJson {
     phi_hz: u64,
     interrupts: u64,
     console_bytes: u64,
+    /// Left out when 0 (the output of a program without is as it always was).
+    #[serde(skip_serializing_if = "is_zero")]
+    resets: u64,
+    /// Left out when 0.
+    #[serde(skip_serializing_if = "is_zero_usize")]
+    unmodelled_accesses: usize,
+}
+
+/// For `skip_serializing_if`.
+#[allow(clippy::trivially_copy_pass_by_ref)]
+fn is_zero(v: &u64) -> bool {
+    *v == 0
+}
+
+/// For `skip_serializing_if`.
+#[allow(clippy::trivially_copy_pass_by_ref)]
+fn is_zero_usize(v: &usize) -> bool {
+    *v == 0
 }
 
 /// Why a run could not start or could not write its output. The message names the stage; the
@@ -238,6 +271,9 @@ pub struct Probes<'a> {
     /// changes wait or [`crate::vcd::DRAIN_SLICE_STATES`] states passed, so the trace is
     /// never held whole. What is left at the end is the caller's to finish.
     pub vcd: Option<&'a mut crate::vcd::VcdStream<'static>>,
+    /// A profile of where the states go by call stack ([`StackProfile`]), started before the
+    /// run: every step is attributed (the waits in sleep mode to `[sleep]`).
+    pub profile: Option<&'a mut StackProfile>,
 }
 
 /// Writes the pin trace's and the phases' changes up to now into `vcd` (see [`Probes::vcd`]).
@@ -285,6 +321,14 @@ fn trace_line(
         Ok(Event::Asleep) => {
             let _ = write!(line, "{pc:06x}: <asleep> {states:>4} states");
         }
+        Ok(Event::Reset) => {
+            let _ = write!(
+                line,
+                "{pc:06x}: <watchdog reset -> {:06x}> {states:>4} states",
+                cpu.pc()
+            );
+        }
+        Ok(Event::Break) => {}
         Err(e) => {
             let _ = write!(line, "{pc:06x}: <error: {e}>");
         }
@@ -293,7 +337,7 @@ fn trace_line(
         // The code the step ran in: the instruction's, or the handler's for an
         // interrupt's entry (as the phase signal of a pin trace names it).
         let at = match event {
-            Ok(Event::Interrupt(_)) => cpu.pc(),
+            Ok(Event::Interrupt(_) | Event::Reset) => cpu.pc(),
             _ => pc,
         };
         let _ = write!(line, "  {}", phase_name(n, at));
@@ -312,7 +356,7 @@ fn observe_step<B: Board>(
     event: &Result<Event, CpuError>,
 ) {
     match event {
-        Ok(Event::Executed) => p.observe(machine.now(), cpu.pc()),
+        Ok(Event::Executed | Event::Reset) => p.observe(machine.now(), cpu.pc()),
         Ok(Event::Interrupt(_)) => {
             let at = machine
                 .trace_last_interrupt()
@@ -341,7 +385,11 @@ pub fn run_mcu_probed<B: Board>(
         mut phases,
         mut debugger,
         mut vcd,
+        mut profile,
     } = probes;
+    // The first access to an address the chip does not model stops the CPU, so that the
+    // report names its instruction.
+    machine.set_io_break(true);
     let mut drained_at = machine.now();
     let deadline = options.max_states.unwrap_or(u64::MAX);
     if let Some(p) = phases.as_deref_mut() {
@@ -361,12 +409,33 @@ pub fn run_mcu_probed<B: Board>(
                 DebugAction::Kill => break Outcome::Killed,
             }
         }
+        if let Some(p) = profile.as_deref_mut()
+            && debugger.is_none()
+            && cpu.sleeping()
+        {
+            // The wait in sleep mode is the profile's `[sleep]`, not the interrupt's entry.
+            p.catch_up(machine.now(), false);
+            machine.sleep_until_irq(deadline);
+            p.catch_up(machine.now(), true);
+        }
         let pc = cpu.pc();
         let t0 = machine.now();
+        let was_sleeping = cpu.sleeping();
         let event = match debugger.as_deref_mut() {
             Some(d) => d.step(cpu, machine, deadline),
             None => cpu.step(machine, deadline),
         };
+        if let Some(p) = profile.as_deref_mut() {
+            p.after_step(cpu, t0, machine.now(), was_sleeping, &event);
+        }
+        if event == Ok(Event::Break) {
+            if options.strict_io
+                && let Some(r) = machine.io_reports().last()
+            {
+                break Outcome::Unmodelled(*r);
+            }
+            continue;
+        }
         if let Some(w) = trace.as_deref_mut() {
             trace_line(&mut line, cpu, pc, machine.now() - t0, &event, names);
             w.write_all(line.as_bytes())?;
@@ -381,7 +450,7 @@ pub fn run_mcu_probed<B: Board>(
             drained_at = machine.now();
         }
         match event {
-            Ok(Event::Executed) => {}
+            Ok(Event::Executed | Event::Reset | Event::Break) => {}
             Ok(Event::Interrupt(_)) => interrupts += 1,
             Ok(Event::Halted) => {
                 break Outcome::Halted {
@@ -481,6 +550,8 @@ fn report<B: Board>(
             clock_hz: machine.clock_hz(),
             interrupts,
             console_bytes: machine.sci().bytes_sent(),
+            resets: machine.resets(),
         },
+        io_reports: machine.io_reports().to_vec(),
     }
 }

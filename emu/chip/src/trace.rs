@@ -7,7 +7,9 @@
 //! drive them), PB0–PB3, the EEPROM bus's SDA (P4.7) and SCL (P4.6) as *line levels*, ADST
 //! and ADF of ADCSR, the ITU0 compare-match A interrupt request IMIA0 (flag and enable: the
 //! robot's tick, from the compare match until the handler clears the flag) and SLEEP (the
-//! CPU in sleep mode).
+//! CPU in sleep mode); and for each of the eleven ports (P1–P9, PA, PB) what the port itself
+//! drives, one signal a pin ([`Signal::PortOut`]: the DR latch on an output pin, DDR = 1; 0 on
+//! an input pin), so every port write a program makes shows at its instant.
 //!
 //! A line of the EEPROM bus is the wired AND of everything on it: low while the master (port
 //! 4) or a part on the board pulls it low ([`Board::port4_pins`]); otherwise high only through
@@ -39,7 +41,7 @@
 use crate::periph::adc::Adc;
 use crate::periph::itu::{IMFA, Itu};
 use crate::periph::ports::{
-    P4_SCL, P4_SDA, PA_TIOCA1, PA_TIOCA2, PB_TIOCA3, PB_TIOCA4, Port, Ports,
+    P4_SCL, P4_SDA, PA_TIOCA1, PA_TIOCA2, PB_TIOCA3, PB_TIOCA4, Port, PortId, Ports,
 };
 use crate::pins::Board;
 
@@ -70,24 +72,54 @@ pub enum Signal {
     Imia0,
     /// The CPU in sleep mode.
     Sleep,
+    /// Pin `bit` (0–7) of a port as the port drives it: its DR bit while the pin is an output
+    /// (DDR = 1), else 0 (named `P1_0`…`PB_7` in a VCD file).
+    PortOut(PortId, u8),
 }
 
+/// How many signals a trace has: the twelve named ones and eight per port.
+pub const SIGNAL_COUNT: usize = 12 + 8 * 11;
+
+/// The named signals, in the order traces list them (then the ports' pins).
+const NAMED: [Signal; 12] = [
+    Signal::Tioca1,
+    Signal::Tioca2,
+    Signal::Pb0,
+    Signal::Pb1,
+    Signal::Pb2,
+    Signal::Pb3,
+    Signal::Sda,
+    Signal::Scl,
+    Signal::Adst,
+    Signal::Adf,
+    Signal::Imia0,
+    Signal::Sleep,
+];
+
 impl Signal {
-    /// Every signal, in the order traces list them.
-    pub const ALL: [Signal; 12] = [
-        Signal::Tioca1,
-        Signal::Tioca2,
-        Signal::Pb0,
-        Signal::Pb1,
-        Signal::Pb2,
-        Signal::Pb3,
-        Signal::Sda,
-        Signal::Scl,
-        Signal::Adst,
-        Signal::Adf,
-        Signal::Imia0,
-        Signal::Sleep,
-    ];
+    /// Every signal, in the order traces list them: the twelve named ones, then the ports'
+    /// pins, P1.0–P1.7 to PB.0–PB.7.
+    pub const ALL: [Signal; SIGNAL_COUNT] = {
+        let mut all = [Signal::Sleep; SIGNAL_COUNT];
+        let mut i = 0;
+        while i < 12 {
+            all[i] = NAMED[i];
+            i += 1;
+        }
+        let mut p = 0;
+        while p < 11 {
+            let mut b = 0;
+            while b < 8 {
+                all[12 + 8 * p + b] = Signal::PortOut(PortId::ALL[p], b as u8);
+                b += 1;
+            }
+            p += 1;
+        }
+        all
+    };
+
+    /// The twelve named signals (the ports' pins are not among them).
+    pub const NAMED: [Signal; 12] = NAMED;
 
     /// The signal's name in traces (a VCD variable name: no spaces).
     #[must_use]
@@ -105,6 +137,7 @@ impl Signal {
             Signal::Adf => "ADF",
             Signal::Imia0 => "IMIA0",
             Signal::Sleep => "SLEEP",
+            Signal::PortOut(p, _) => p.name(),
         }
     }
 
@@ -124,12 +157,29 @@ impl Signal {
             Signal::Adf => "ADCSR.ADF (A/D end flag)",
             Signal::Imia0 => "ITU0 IMIA request (IMFA0 and IMIEA0: the 10 ms tick)",
             Signal::Sleep => "CPU in sleep mode",
+            Signal::PortOut(..) => "the port's output: DR on output pins (DDR = 1), 0 on inputs",
         }
     }
 
+    /// The signal's place in [`Signal::ALL`] (and in a trace's level arrays).
     #[inline]
-    const fn index(self) -> usize {
-        self as usize
+    #[must_use]
+    pub const fn index(self) -> usize {
+        match self {
+            Signal::Tioca1 => 0,
+            Signal::Tioca2 => 1,
+            Signal::Pb0 => 2,
+            Signal::Pb1 => 3,
+            Signal::Pb2 => 4,
+            Signal::Pb3 => 5,
+            Signal::Sda => 6,
+            Signal::Scl => 7,
+            Signal::Adst => 8,
+            Signal::Adf => 9,
+            Signal::Imia0 => 10,
+            Signal::Sleep => 11,
+            Signal::PortOut(p, b) => 12 + 8 * p.index() + (b & 7) as usize,
+        }
     }
 }
 
@@ -165,7 +215,7 @@ pub struct PinTrace {
     /// The last instant of the trace (states).
     pub end: u64,
     /// Each signal's level at `start`, in [`Signal::ALL`] order.
-    pub initial: [bool; 12],
+    pub initial: [bool; SIGNAL_COUNT],
     /// The changes after `start`.
     pub changes: Vec<PinChange>,
     /// The interrupts accepted during the trace.
@@ -194,8 +244,8 @@ impl PinTrace {
 #[derive(Clone, Debug)]
 pub(crate) struct Tracer {
     start: u64,
-    initial: [bool; 12],
-    levels: [bool; 12],
+    initial: [bool; SIGNAL_COUNT],
+    levels: [bool; SIGNAL_COUNT],
     changes: Vec<PinChange>,
     interrupts: Vec<Accepted>,
     /// The ITU as of its last write (it evolves from there as the real one does).
@@ -230,8 +280,8 @@ impl Tracer {
         let lines = chip.board.port4_pins(now);
         let mut t = Tracer {
             start: now,
-            initial: [false; 12],
-            levels: [false; 12],
+            initial: [false; SIGNAL_COUNT],
+            levels: [false; SIGNAL_COUNT],
             changes: Vec::new(),
             interrupts: Vec::new(),
             itu: itu.clone(),
@@ -246,8 +296,8 @@ impl Tracer {
     }
 
     /// Every signal's level at `t` from the copies, the port-4 line levels taken so far and the ports.
-    fn compute(&self, t: u64, ports: &Ports) -> [bool; 12] {
-        let mut v = [false; 12];
+    fn compute(&self, t: u64, ports: &Ports) -> [bool; SIGNAL_COUNT] {
+        let mut v = [false; SIGNAL_COUNT];
         let pa = ports.port_a();
         let pin_a = |ch: usize, bit: u8| {
             let (level, drives) = self.itu.output_at(ch, t);
@@ -280,6 +330,12 @@ impl Tracer {
         v[Signal::Adf.index()] = adf;
         v[Signal::Imia0.index()] = self.itu.requests_of(0, t) & IMFA != 0;
         v[Signal::Sleep.index()] = self.sleeping;
+        for p in PortId::ALL {
+            let out = ports.port(p).output_levels();
+            for b in 0..8u8 {
+                v[Signal::PortOut(p, b).index()] = out & (1 << b) != 0;
+            }
+        }
         v
     }
 
@@ -372,7 +428,7 @@ impl Tracer {
     }
 
     /// The trace's first instant and the levels then.
-    pub(crate) fn beginning(&self) -> (u64, [bool; 12]) {
+    pub(crate) fn beginning(&self) -> (u64, [bool; SIGNAL_COUNT]) {
         (self.start, self.initial)
     }
 

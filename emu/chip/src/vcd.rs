@@ -13,9 +13,12 @@
 //! stub's clock.
 //!
 //! # Contents
-//! Scope `h8_3052f` holds one 1-bit wire per [`Signal`] (named by [`Signal::name`]);
+//! Scope `h8_3052f` holds one 1-bit wire per named [`Signal`] (named by [`Signal::name`]);
 //! scope `firmware` holds `phase`, a string variable naming the code that runs
-//! ([`crate::trace::PhaseRecorder`]). The values at the trace's start are given in a
+//! ([`crate::trace::PhaseRecorder`]); scope `ports` holds one 1-bit wire per pin of each port,
+//! `P1_0`–`P1_7` to `PB_0`–`PB_7`, what the port drives ([`Signal::PortOut`]: DR on its output
+//! pins, 0 on its inputs), so a program's port writes show (1-bit wires, not 8-bit vectors:
+//! sigrok's VCD input reads only 1-bit wires). The values at the trace's start are given in a
 //! `$dumpvars` block; a last timestamp marks its end. At one instant only a signal's final
 //! level is written, and only if it changed.
 
@@ -23,7 +26,8 @@ use std::io::{self, Write};
 
 use vcd::{IdCode, SimulationCommand, TimescaleUnit, Value, VarType, Writer};
 
-use crate::trace::{PinChange, PinTrace, Signal};
+use crate::periph::ports::PortId;
+use crate::trace::{PinChange, PinTrace, SIGNAL_COUNT, Signal};
 
 /// The VCD time unit for a clock: (count, unit) for `$timescale`, and how many such units one
 /// state lasts, or `None` when a state is no whole number of femtoseconds.
@@ -102,9 +106,10 @@ pub const DRAIN_SLICE_STATES: u64 = 1 << 20;
 pub struct VcdStream<'w> {
     w: Writer<io::BufWriter<Box<dyn Write + Send + 'w>>>,
     clock: Clock,
+    /// Every signal's wire, in [`Signal::ALL`] order.
     ids: Vec<IdCode>,
     phase_id: Option<IdCode>,
-    levels: [bool; 12],
+    levels: [bool; SIGNAL_COUNT],
     phase_now: Option<String>,
     start: u64,
 }
@@ -128,7 +133,7 @@ impl<'w> VcdStream<'w> {
         out: Box<dyn Write + Send + 'w>,
         clock_hz: u32,
         start: u64,
-        initial: [bool; 12],
+        initial: [bool; SIGNAL_COUNT],
         phase: Option<&str>,
         info: &VcdInfo,
     ) -> io::Result<VcdStream<'w>> {
@@ -154,17 +159,20 @@ impl<'w> VcdStream<'w> {
                 &info.source
             },
         );
-        for s in Signal::ALL {
+        for s in Signal::NAMED {
             comment.push_str(&format!(" {}: {}.", s.name(), s.description()));
         }
         if phase.is_some() {
             comment.push_str(" phase: the function that runs (symbol table).");
         }
+        comment.push_str(
+            " P1_0-PB_7: what each port drives on each pin (DR on its output pins, 0 on its inputs).",
+        );
         w.comment(&comment)?;
         w.timescale(count, unit)?;
         w.add_module("h8_3052f")?;
-        let mut ids: Vec<IdCode> = Vec::with_capacity(Signal::ALL.len());
-        for s in Signal::ALL {
+        let mut ids: Vec<IdCode> = Vec::with_capacity(SIGNAL_COUNT);
+        for s in Signal::NAMED {
             ids.push(w.add_wire(1, s.name())?);
         }
         w.upscope()?;
@@ -177,14 +185,24 @@ impl<'w> VcdStream<'w> {
             }
             None => None,
         };
+        w.add_module("ports")?;
+        for p in PortId::ALL {
+            for b in 0..8 {
+                ids.push(w.add_wire(1, &format!("{}_{b}", p.name()))?);
+            }
+        }
+        w.upscope()?;
         w.enddefinitions()?;
         w.timestamp(clock.stamp(start))?;
         w.begin(SimulationCommand::Dumpvars)?;
-        for (i, id) in ids.iter().enumerate() {
+        for (i, id) in ids.iter().enumerate().take(Signal::NAMED.len()) {
             w.change_scalar(*id, bit(initial[i]))?;
         }
         if let (Some(id), Some(name)) = (phase_id, phase) {
             w.change_string(id, name)?;
+        }
+        for (i, id) in ids.iter().enumerate().skip(Signal::NAMED.len()) {
+            w.change_scalar(*id, bit(initial[i]))?;
         }
         w.end()?;
         Ok(VcdStream {
@@ -228,7 +246,7 @@ impl<'w> VcdStream<'w> {
             }
             let mut now = self.levels;
             while let Some(c) = pins.get(i).filter(|c| c.t == t) {
-                now[c.signal as usize] = c.level;
+                now[c.signal.index()] = c.level;
                 i += 1;
             }
             let mut phase_at: Option<&str> = self.phase_now.as_deref();
@@ -239,13 +257,18 @@ impl<'w> VcdStream<'w> {
             let phase_changed = phase_at != self.phase_now.as_deref();
             if now != self.levels || phase_changed {
                 self.w.timestamp(self.clock.stamp(t))?;
-                for (n, id) in self.ids.iter().enumerate() {
+                for (n, id) in self.ids.iter().enumerate().take(Signal::NAMED.len()) {
                     if now[n] != self.levels[n] {
                         self.w.change_scalar(*id, bit(now[n]))?;
                     }
                 }
                 if let (true, Some(id), Some(name)) = (phase_changed, self.phase_id, phase_at) {
                     self.w.change_string(id, name)?;
+                }
+                for (n, id) in self.ids.iter().enumerate().skip(Signal::NAMED.len()) {
+                    if now[n] != self.levels[n] {
+                        self.w.change_scalar(*id, bit(now[n]))?;
+                    }
                 }
             }
             self.levels = now;

@@ -19,7 +19,34 @@ pub enum CpuSignal {
     Wake,
     /// The interrupt with this vector was accepted: its exception handling begins now.
     Interrupt(u8),
+    /// The CPU takes the bus's reset request ([`RESET_REQUEST`]) now: the chip resets itself
+    /// (its modules to their reset state) and holds the CPU in reset for as long as the reset
+    /// lasts (the bus advances the clock to its end); then the CPU reads the reset vector.
+    Reset,
+    /// The CPU stopped before the next instruction for the bus's break request
+    /// ([`BREAK_REQUEST`]): the bus withdraws the request. `pc` is the address of the
+    /// instruction executed last ([`crate::cpu::Cpu::last_pc`]), the one whose access the bus
+    /// wanted seen.
+    Break {
+        /// The instruction executed last.
+        pc: u32,
+    },
 }
+
+/// What [`Bus::pending_irq`] returns for a **reset request**: vector 0, the reset exception.
+/// The chip's own reset (the watchdog's internal reset, H8/3052F hardware manual section 12)
+/// is taken at the next instruction boundary whatever CCR says, wakes a sleeping CPU, and
+/// beats every interrupt; the CPU then signals [`CpuSignal::Reset`] and starts over from the
+/// reset vector ([`crate::cpu::Event::Reset`]).
+pub const RESET_REQUEST: u8 = 0;
+
+/// What [`Bus::pending_irq`] returns for a **break request**: no vector (the H8/300H has 61)
+/// but the bus's request that the CPU stop before the next instruction and return to its
+/// caller ([`crate::cpu::Event::Break`]), for instance so that the caller can name the
+/// instruction that just touched a register the chip does not model. Taken whatever CCR says,
+/// before any interrupt, without waking a sleeping CPU; the CPU signals
+/// [`CpuSignal::Break`] and the bus withdraws the request.
+pub const BREAK_REQUEST: u8 = 0xFF;
 
 /// A bus on the H8/3052F's 24-bit address space with a clock in states.
 ///
@@ -44,7 +71,9 @@ pub trait Bus {
     /// Charges `states` internal operation states (no bus access).
     fn internal(&mut self, states: u32);
     /// The vector number of the highest-priority interrupt that is requested and enabled at its
-    /// source, if any. Masking by CCR.I is the CPU's business, not the bus's.
+    /// source, if any. Masking by CCR.I is the CPU's business, not the bus's. Besides the
+    /// vectors, a bus may return [`RESET_REQUEST`] (the chip resets itself) or
+    /// [`BREAK_REQUEST`] (stop before the next instruction); both beat every interrupt.
     fn pending_irq(&self) -> Option<u8>;
     /// SLEEP: advances the clock until an interrupt request is pending or the clock reaches
     /// `deadline`, whichever is first. Returns whether an interrupt is pending.
@@ -110,6 +139,15 @@ pub trait FastPathHints: Bus {
     /// same interrupt requests at the same instants). `None` (the default): no promise.
     fn idle_signature(&mut self) -> Option<Vec<u64>> {
         None
+    }
+
+    /// For the core's idle-cycle fast-forwarding: the instant up to which the devices outside
+    /// [`FastPathHints::idle_signature`] leave the program alone — no interrupt or reset
+    /// request of theirs appears before it (a free-running watchdog's next overflow). Idle
+    /// cycles are advanced only as far as they end by it; the cycle in which it falls is run.
+    /// The default, `u64::MAX`: nothing outside the signature ever requests.
+    fn idle_horizon(&self) -> u64 {
+        u64::MAX
     }
 
     /// Whether accesses to the device register at `addr` are covered by

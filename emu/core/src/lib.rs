@@ -12,3 +12,8 @@ pub mod bus;
 pub mod cpu;
 pub mod memmap;
 pub mod srec;
+
+/// The crate's README, whose example runs as a doc test.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;

@@ -55,6 +55,16 @@ pub enum Area {
 
 impl Area {
     /// The area that holds `addr` (only the low 24 bits count).
+    ///
+    /// ```
+    /// use h8300h::memmap::Area;
+    /// assert_eq!(Area::of(0x00_0100), Area::Rom);
+    /// assert_eq!(Area::of(0xFF_E000), Area::Ram);
+    /// assert_eq!(Area::of(0xFF_FFB8), Area::Io);
+    /// assert_eq!(Area::of(0x10_0000), Area::Unmapped);
+    /// // An access's states: a word from RAM one 2-state cycle, from I/O two 3-state ones.
+    /// assert_eq!((Area::Ram.word_states(), Area::Io.word_states()), (2, 6));
+    /// ```
     #[must_use]
     pub const fn of(addr: u32) -> Area {
         let a = addr & ADDRESS_MASK;

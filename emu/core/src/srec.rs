@@ -122,6 +122,14 @@ fn hex_val(c: u8) -> Option<u8> {
 
 /// Parses an S-record file.
 ///
+/// ```
+/// // Two bytes at H'000100 (an S1 record) and the end record (S9).
+/// let image = h8300h::srec::parse(b"S1050100F82AD7\nS9030000FC\n").unwrap();
+/// assert_eq!(image.chunks[0].address, 0x100);
+/// assert_eq!(image.chunks[0].data, [0xF8, 0x2A]);
+/// assert!(h8300h::srec::parse(b"S1050100F82AD6\n").is_err()); // bad checksum
+/// ```
+///
 /// # Errors
 /// [`SrecError`] naming the first bad line and what is wrong with it.
 pub fn parse(text: &[u8]) -> Result<SrecImage, SrecError> {

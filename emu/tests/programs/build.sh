@@ -12,6 +12,12 @@
 # programs, which overflow their stack on purpose and have no host run):
 #   target: as above  ->  stack/<name>.mot, and h8300-hms-nm -n  ->  stack/<name>.sym
 #
+# and for every program chip/<name>.c listed in CHIP_PROGRAMS (the chip's test programs: the
+# watchdog, the IRQ inputs, registers the emulator does not model, a call structure for the
+# profile; they use the hardware and have no host run), with chip/crt0.S, whose vector table
+# points vectors 12, 20 and 24 at the program's handlers:
+#   target: as above  ->  chip/<name>.mot, and h8300-hms-nm -n  ->  chip/<name>.sym
+#
 # Usage:
 #   ./build.sh            build into this folder (commit the .mot and .expected files)
 #   ./build.sh --check    rebuild into a temporary folder and fail, listing the
@@ -35,6 +41,7 @@ cd "$here"
 
 PROGRAMS=(arith shifts muldiv bitops structs recursion funcptr switch q15learn crcmacdiv)
 STACK_PROGRAMS=(stack_deep stack_after stack_close)
+CHIP_PROGRAMS=(wdt idle_wdt unmodelled callstack irq irq_board minibot)
 SUPPORT_C=(console.c)
 
 H8_PREFIX="${H8_PREFIX:-h8300-hms-}"
@@ -137,6 +144,24 @@ build_all() {
       cp "$obj/$name.map" "$obj/$name.coff" "$listing_dir/"
     fi
   done
+  # The chip's programs: their own crt0, target only, with their symbol tables.
+  "${H8_PREFIX}gcc" "${TARGET_CFLAGS[@]}" -x assembler -c chip/crt0.S -o "$obj/chip_crt0.o"
+  mkdir -p "$out/chip" "$obj/chip"
+  for name in "${CHIP_PROGRAMS[@]}"; do
+    "${H8_PREFIX}gcc" "${TARGET_CFLAGS[@]}" -Ichip -c "chip/$name.c" -o "$obj/chip/$name.o"
+    # The linker script puts *crt0.o(.text) first: the chip crt0 is linked as chip/crt0.o.
+    cp "$obj/chip_crt0.o" "$obj/chip/crt0.o"
+    "${H8_PREFIX}gcc" "${TARGET_CFLAGS[@]}" -T h8-3052f.ld -Wl,-Map,"$obj/chip/$name.map" \
+      "$obj/chip/crt0.o" "$obj/chip/$name.o" "${support_objs[@]}" "$obj/runtime.o" \
+      -o "$obj/chip/$name.coff"
+    (cd "$obj/chip" && "${H8_PREFIX}objcopy" -O srec "$name.coff" "$name.mot")
+    "${H8_PREFIX}nm" -n "$obj/chip/$name.coff" > "$obj/chip/$name.sym"
+    cp "$obj/chip/$name.mot" "$obj/chip/$name.sym" "$out/chip/"
+    chmod 644 "$out/chip/$name.mot" "$out/chip/$name.sym"
+    if [[ -n "$listing_dir" ]]; then
+      "${H8_PREFIX}objdump" -d -j .text "$obj/chip/$name.coff" > "$listing_dir/chip_$name.lst"
+    fi
+  done
 }
 
 case "$mode" in
@@ -149,6 +174,10 @@ case "$mode" in
     for name in "${STACK_PROGRAMS[@]}"; do
       printf 'stack/%-12s %6d bytes .mot  %5d lines .sym\n' "$name" \
         "$(wc -c < "stack/$name.mot")" "$(wc -l < "stack/$name.sym")"
+    done
+    for name in "${CHIP_PROGRAMS[@]}"; do
+      printf 'chip/%-13s %6d bytes .mot  %5d lines .sym\n' "$name" \
+        "$(wc -c < "chip/$name.mot")" "$(wc -l < "chip/$name.sym")"
     done
     ;;
   ubsan)
@@ -178,6 +207,20 @@ case "$mode" in
         fi
       done
     done
+    for name in "${CHIP_PROGRAMS[@]}"; do
+      for ext in mot sym; do
+        if [[ ! -f "chip/$name.$ext" ]] || ! cmp -s "$work/fresh/chip/$name.$ext" "chip/$name.$ext"; then
+          differ+=("chip/$name.$ext")
+        fi
+      done
+    done
+    for f in chip/*.mot; do
+      [[ -e "$f" ]] || continue
+      name="$(basename "${f%.mot}")"
+      if [[ ! " ${CHIP_PROGRAMS[*]} " == *" $name "* ]]; then
+        differ+=("$f (not built by build.sh)")
+      fi
+    done
     for f in stack/*.mot; do
       [[ -e "$f" ]] || continue
       name="$(basename "${f%.mot}")"
@@ -199,6 +242,6 @@ case "$mode" in
       printf '  %s\n' "${differ[@]}" >&2
       exit 1
     fi
-    echo "build.sh --check: all ${#PROGRAMS[@]} programs' .mot and .expected files and the ${#STACK_PROGRAMS[@]} stack programs' .mot and .sym files match a fresh build"
+    echo "build.sh --check: all ${#PROGRAMS[@]} programs' .mot and .expected files, the ${#STACK_PROGRAMS[@]} stack programs' and the ${#CHIP_PROGRAMS[@]} chip programs' .mot and .sym files match a fresh build"
     ;;
 esac

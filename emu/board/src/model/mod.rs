@@ -94,6 +94,20 @@ pub const CLOCK_MIN_HZ: u32 = h8_3052f::mcu::MIN_CLOCK_HZ;
 pub const CLOCK_MAX_HZ: u32 = h8_3052f::mcu::MAX_CLOCK_HZ;
 /// Longest step period accepted (10 minutes).
 pub const MAX_STEP_PERIOD_S: f64 = 600.0;
+
+/// What a step period may be, as messages say it ([`step_period_ok`]).
+pub const STEP_PERIOD_VALID: &str =
+    "a whole number of 10 ms ticks from 0.01 to 600 s (0.45 and 0.60 are the paper's)";
+
+/// The one rule for a step period, wherever it is given (a scenario's
+/// `timing.step_period_s`, `fit --step-period-s`, `cost --step-period-s`, the controller's
+/// configuration): finite, a whole number of [`TICK_S`] ticks, from one tick to
+/// [`MAX_STEP_PERIOD_S`].
+#[must_use]
+pub fn step_period_ok(step_period_s: f64) -> bool {
+    let ticks = step_period_s / TICK_S;
+    (TICK_S..=MAX_STEP_PERIOD_S).contains(&step_period_s) && (ticks - ticks.round()).abs() < 1e-9
+}
 /// Amplitude of the fresh random weights: uniform in ±0.5 (±16384 in Q15).
 pub const INITIAL_WEIGHT_AMPLITUDE: i16 = 16384;
 /// Most ACK polls per page write before the save gives up (well past a 5 ms write cycle).
@@ -449,18 +463,11 @@ impl Controller {
                 "at least 1 (one record every S steps)",
             ));
         }
-        let ticks = cfg.step_period_s / TICK_S;
-        if !(cfg.step_period_s.is_finite()
-            && cfg.step_period_s >= TICK_S
-            && cfg.step_period_s <= MAX_STEP_PERIOD_S
-            && (ticks - ticks.round()).abs() < 1e-9)
-        {
+        if !step_period_ok(cfg.step_period_s) {
             return Err(config_error(
                 "step_period_s",
                 cfg.step_period_s,
-                format!(
-                    "a whole number of 10 ms ticks from {TICK_S} to {MAX_STEP_PERIOD_S} s (0.45 and 0.60 are the paper's)"
-                ),
+                STEP_PERIOD_VALID,
             ));
         }
         let tick_counts = (TICK_S * f64::from(cfg.clock_hz) / PRESCALE as f64).round();
@@ -481,7 +488,7 @@ impl Controller {
         let timing = firmware_i2c_timing(cfg.clock_hz)?;
         let cfg_fast = cfg.fast_forward;
         Ok(Self {
-            ticks_per_step: ticks.round() as u64,
+            ticks_per_step: (cfg.step_period_s / TICK_S).round() as u64,
             tick_counts,
             cfg,
             learner,

@@ -10,15 +10,17 @@
 //!    in their default priority order, which is the vector order).
 //!
 //! Requests are passed as a bit mask indexed by vector number (bit `v` = vector `v`
-//! requested), so choosing is two mask operations and a trailing-zero count. NMI (vector 7,
-//! never masked) and the IRQ pins are not wired on the robot; the CPU core handles masking by
+//! requested), so choosing is two mask operations and a trailing-zero count. A reset request
+//! (bit 0, the watchdog's, [`h8300h::bus::RESET_REQUEST`]) and NMI (vector 7; no NMI pin is
+//! wired here) beat every interrupt whatever the IPRs say; the CPU core handles masking by
 //! CCR.I. The UI bit as a second mask (SYSCR.UE = 0) is not modelled (the core treats UI as a
 //! user bit, SYSCR.UE = 1 after reset).
 //!
-//! The module owns the interrupt controller's register block H'FFFFF2–H'FFFFF9 (the manual's
-//! Table 5-2: SYSCR, ISCR, IER, ISR, IPRA, IPRB). SYSCR reads back what was written (reset
-//! H'0B); IPRA/IPRB act as above; the IRQ registers (ISCR, IER, ISR: no IRQ pin is wired) and
-//! the bus controller's BRCR at H'FFFFF3 read 0 and ignore writes.
+//! Of the interrupt controller's registers (the manual's Table 5-2: SYSCR, ISCR, IER, ISR,
+//! IPRA, IPRB at H'FFFFF2–H'FFFFF9) this module holds SYSCR, which reads back what was written
+//! (reset H'0B), and IPRA/IPRB, which act as above; the IRQ registers ISCR, IER and ISR are
+//! [`crate::periph::irq`]'s. The chip routes H'FFFFF2, F8 and F9 here; BRCR at H'FFFFF3 is the
+//! bus controller's (not modelled) and H'FFFFF7 is reserved.
 
 use super::Peripheral;
 use crate::pins::Board;
@@ -65,6 +67,9 @@ pub const IPRB_SCI0: u8 = 0x08;
 pub const IPRB_SCI1: u8 = 0x04;
 /// IPRB bit 1: A/D converter (vector 60).
 pub const IPRB_AD: u8 = 0x02;
+
+/// The requests that beat every interrupt: the reset request (bit 0) and NMI (vector 7).
+const NON_MASKABLE: u64 = 1 | (1 << 7);
 
 /// A mask with bits `first..=last` set (vectors as bit numbers).
 const fn vectors(first: u32, last: u32) -> u64 {
@@ -165,13 +170,21 @@ impl Intc {
         u8::from(vector < 64 && self.level1 & (1u64 << vector) != 0)
     }
 
-    /// The winning vector among `requests` (bit `v` = vector `v` requested): the lowest
-    /// vector at level 1 if any, else the lowest vector at level 0.
+    /// The winning vector among `requests` (bit `v` = vector `v` requested): a reset request
+    /// (0) or NMI (7) if any, else the lowest vector at level 1 if any, else the lowest vector
+    /// at level 0.
     #[inline]
     #[must_use]
     pub fn choose(&self, requests: u64) -> Option<u8> {
+        let top = requests & NON_MASKABLE;
         let high = requests & self.level1;
-        let pick = if high != 0 { high } else { requests };
+        let pick = if top != 0 {
+            top
+        } else if high != 0 {
+            high
+        } else {
+            requests
+        };
         if pick == 0 {
             None
         } else {

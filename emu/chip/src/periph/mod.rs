@@ -5,10 +5,12 @@
 //!
 //! - [`adc`]: the 10-bit A/D converter (ADDRA–D, ADCSR, ADCR; single and scan mode);
 //! - [`itu`]: the 16-bit integrated timer unit, channels 0–4 (compare match, PWM mode);
-//! - [`ports`]: ports 2, 4, A and B (write-only DDRs, pull-ups, the pins they share with the
-//!   ITU, the EEPROM bus on port 4);
+//! - [`ports`]: ports 1–9, A and B (write-only DDRs, pull-ups, the pins they share with the
+//!   ITU, the EEPROM bus on port 4, what the board drives on the others);
 //! - [`intc`]: the interrupt controller (SYSCR, IPRA/IPRB and the priority decision);
-//! - [`sci`]: SCI1, the console.
+//! - [`irq`]: the IRQ0–IRQ5 inputs (ISCR, IER, ISR) on ports 8 and 9;
+//! - [`sci`]: SCI1, the console;
+//! - [`wdt`]: the watchdog timer (interval interrupt, internal reset).
 //!
 //! Every module implements [`Peripheral`]: it owns one block of I/O addresses, answers reads
 //! and writes in it, catches up with the clock, says when it next needs attention and which
@@ -17,9 +19,11 @@
 
 pub mod adc;
 pub mod intc;
+pub mod irq;
 pub mod itu;
 pub mod ports;
 pub mod sci;
+pub mod wdt;
 
 use crate::pins::Board;
 

@@ -1,22 +1,31 @@
-//! The I/O ports the robot uses: port 2 (bumpers), port 4 (the bit-banged I²C bus), port A
-//! (ITU outputs TIOCA1/TIOCA2 to the motor drivers) and port B (H-bridge direction inputs)
-//! (H8/3052F hardware manual, section 9 "I/O Ports"; addresses from appendix B).
+//! The I/O ports of the H8/3052F: ports 1–9, A and B (H8/3052F hardware manual, section 9
+//! "I/O Ports"; addresses from appendix B.1). On the robot, port 2 carries the bumpers, port 4
+//! the bit-banged I²C bus, port A the ITU outputs TIOCA1/TIOCA2 to the motor drivers and port
+//! B the H-bridge direction inputs; a user's image may use any of them.
 //!
-//! Each port has a data direction register (DDR: 1 = output), a data register (DR, the output
-//! latch) and, for ports 2 and 4, an input pull-up control register (PCR). Behaviour modelled:
+//! Each port has a data direction register (DDR: 1 = output; port 7, input only, has none), a
+//! data register (DR, the output latch) and, for ports 2, 4 and 5, an input pull-up control
+//! register (PCR). Ports 5, 6, 8 and 9 have fewer than eight pins ([`PortId::pins`]: P5.0–3,
+//! P6.0–6, P8.0–4, P9.0–5); the bits of the pins they lack are reserved and read 1. Behaviour
+//! modelled:
 //!
 //! - **DDRs are write-only.** The manual: a DDR cannot be read; a read returns 1 in every bit.
 //!   So reading PnDDR returns [`DDR_READ_VALUE`] (H'FF) whatever was written — firmware keeps a
 //!   shadow copy (docs/design.md §3.6).
 //! - **DR reads** return the DR latch for output bits (DDR = 1) and the pin level for input
 //!   bits (DDR = 0).
-//! - **Pull-ups** (P2PCR, P4PCR): an input pin with its PCR bit set is pulled high by the
-//!   on-chip MOS pull-up; a pin that nothing drives and nothing pulls up *floats*. A floating
-//!   input is undefined on the chip; here it reads 0 (a deterministic stand-in), so firmware
-//!   that forgets to enable the pull-ups it needs (bumpers, I²C) misreads as it would on the
-//!   robot. The pull-up is off for output bits, as on the chip. Ports A and B have no
+//! - **Pull-ups** (P2PCR, P4PCR, P5PCR): an input pin with its PCR bit set is pulled high by
+//!   the on-chip MOS pull-up; a pin that nothing drives and nothing pulls up *floats*. A
+//!   floating input is undefined on the chip; here it reads 0 (a deterministic stand-in), so
+//!   firmware that forgets to enable the pull-ups it needs (bumpers, I²C) misreads as it would
+//!   on the robot. The pull-up is off for output bits, as on the chip. The other ports have no
 //!   pull-ups.
-//! - Pins driven by a peripheral (TIOCA outputs of the ITU) read their peripheral level.
+//! - **What drives an input pin** is the board's: port 2's pins are pulled low or released
+//!   ([`Board::port2_pins`]: the bumpers), port 4's lines are the EEPROM bus (below), and every
+//!   other port's input pins are driven high or low, or left alone, by
+//!   [`Board::port_pins`] ([`ExternalPins`]).
+//! - Pins driven by a peripheral (TIOCA outputs of the ITU on ports A and B) read their
+//!   peripheral level.
 //! - Port 4 is used open-drain (on the robot, P4.7/P4.6 carry its bit-banged I²C bus,
 //!   [`P4_SDA`], [`P4_SCL`]): a pin is pulled low while its DDR bit is 1 with DR = 0 and
 //!   released otherwise (a 1 in DR with DDR = 1 would drive the line high; it is treated as a
@@ -24,9 +33,12 @@
 //!   board the new pulls at the instant of the write ([`Board::port4_drive`]); P4DR reads
 //!   return the lines as the board leaves them at the instant of the read
 //!   ([`Board::port4_pins`]).
+//! - P8.0–P8.3 are also the IRQ0–IRQ3 inputs and P9.4–P9.5 IRQ4–IRQ5 ([`IRQ_PINS`]): the
+//!   interrupt controller's IRQ logic ([`crate::periph::irq`]) watches their levels.
 //!
-//! [`Ports`] is the four ports as one [`Peripheral`] owning the port block H'FFFFC0–H'FFFFDB;
-//! the registers of the ports not modelled (1, 3, 5, 6, 7, 8, 9) read 0 and ignore writes.
+//! [`Ports`] is the eleven ports as one [`Peripheral`] owning the port block
+//! H'FFFFC0–H'FFFFDB; its reserved addresses (H'FFFFCC, D5, D7, D9) read 0 and ignore writes
+//! (the chip reports accesses to them, [`crate::iomap`]).
 
 use super::Peripheral;
 use super::itu::Itu;
@@ -53,6 +65,35 @@ pub const PADR: u32 = 0xFF_FFD3;
 pub const PBDDR: u32 = 0xFF_FFD4;
 /// Address of PBDR, port B data register (H'FFFFD6).
 pub const PBDR: u32 = 0xFF_FFD6;
+
+/// Address of P1DDR (H8/3052F manual, appendix B.1: H'FFFFC0).
+pub const P1DDR: u32 = 0xFF_FFC0;
+/// Address of P1DR (H'FFFFC2).
+pub const P1DR: u32 = 0xFF_FFC2;
+/// Address of P3DDR (H'FFFFC4).
+pub const P3DDR: u32 = 0xFF_FFC4;
+/// Address of P3DR (H'FFFFC6).
+pub const P3DR: u32 = 0xFF_FFC6;
+/// Address of P5DDR (H'FFFFC8).
+pub const P5DDR: u32 = 0xFF_FFC8;
+/// Address of P6DDR (H'FFFFC9).
+pub const P6DDR: u32 = 0xFF_FFC9;
+/// Address of P5DR (H'FFFFCA).
+pub const P5DR: u32 = 0xFF_FFCA;
+/// Address of P6DR (H'FFFFCB).
+pub const P6DR: u32 = 0xFF_FFCB;
+/// Address of P8DDR (H'FFFFCD).
+pub const P8DDR: u32 = 0xFF_FFCD;
+/// Address of P7DR, port 7's data register (input only: it reads the pins; H'FFFFCE).
+pub const P7DR: u32 = 0xFF_FFCE;
+/// Address of P8DR (H'FFFFCF).
+pub const P8DR: u32 = 0xFF_FFCF;
+/// Address of P9DDR (H'FFFFD0).
+pub const P9DDR: u32 = 0xFF_FFD0;
+/// Address of P9DR (H'FFFFD2).
+pub const P9DR: u32 = 0xFF_FFD2;
+/// Address of P5PCR, port 5 input pull-up control register (H'FFFFDB).
+pub const P5PCR: u32 = 0xFF_FFDB;
 
 /// Port-A bit of TIOCA0 (PA2; H8/3052F manual, port A pin functions).
 pub const PA_TIOCA0: u8 = 0x04;
@@ -147,22 +188,176 @@ pub const PORTS_FIRST: u32 = 0xFF_FFC0;
 /// Last address of the port block: P5PCR (H'FFFFDB).
 pub const PORTS_LAST: u32 = 0xFF_FFDB;
 
+/// One of the chip's eleven I/O ports.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum PortId {
+    /// Port 1 (address bus A7–A0 in the expanded modes).
+    P1,
+    /// Port 2 (the robot's bumpers).
+    P2,
+    /// Port 3.
+    P3,
+    /// Port 4 (the robot's EEPROM bus).
+    P4,
+    /// Port 5 (P5.0–3).
+    P5,
+    /// Port 6 (P6.0–6).
+    P6,
+    /// Port 7 (input only; the analog inputs AN0–AN7).
+    P7,
+    /// Port 8 (P8.0–4; IRQ0–IRQ3 on P8.0–3).
+    P8,
+    /// Port 9 (P9.0–5; the SCIs' pins, IRQ4/IRQ5 on P9.4–5).
+    P9,
+    /// Port A (the ITU's TIOCA0–2, the robot's motor PWM).
+    PA,
+    /// Port B (TIOCA3/TIOCA4, the robot's H-bridge inputs).
+    PB,
+}
+
+impl PortId {
+    /// Every port, in the order of [`PortId::index`].
+    pub const ALL: [PortId; 11] = [
+        PortId::P1,
+        PortId::P2,
+        PortId::P3,
+        PortId::P4,
+        PortId::P5,
+        PortId::P6,
+        PortId::P7,
+        PortId::P8,
+        PortId::P9,
+        PortId::PA,
+        PortId::PB,
+    ];
+
+    /// 0–10, in the order of [`PortId::ALL`].
+    #[inline]
+    #[must_use]
+    pub const fn index(self) -> usize {
+        self as usize
+    }
+
+    /// The port's name: `P1`–`P9`, `PA`, `PB`.
+    #[must_use]
+    pub const fn name(self) -> &'static str {
+        match self {
+            PortId::P1 => "P1",
+            PortId::P2 => "P2",
+            PortId::P3 => "P3",
+            PortId::P4 => "P4",
+            PortId::P5 => "P5",
+            PortId::P6 => "P6",
+            PortId::P7 => "P7",
+            PortId::P8 => "P8",
+            PortId::P9 => "P9",
+            PortId::PA => "PA",
+            PortId::PB => "PB",
+        }
+    }
+
+    /// The bits of the pins the port has (section 9: port 5 has four pins, port 6 seven,
+    /// port 8 five, port 9 six); the other bits are reserved and read 1.
+    #[must_use]
+    pub const fn pins(self) -> u8 {
+        match self {
+            PortId::P5 => 0x0F,
+            PortId::P6 => 0x7F,
+            PortId::P8 => 0x1F,
+            PortId::P9 => 0x3F,
+            _ => 0xFF,
+        }
+    }
+
+    /// The port whose DDR, DR or PCR is at `addr`, and which of the three it is.
+    #[must_use]
+    pub const fn of_register(addr: u32) -> Option<(PortId, PortReg)> {
+        use PortReg::{Ddr, Dr, Pcr};
+        Some(match addr {
+            P1DDR => (PortId::P1, Ddr),
+            P2DDR => (PortId::P2, Ddr),
+            P1DR => (PortId::P1, Dr),
+            P2DR => (PortId::P2, Dr),
+            P3DDR => (PortId::P3, Ddr),
+            P4DDR => (PortId::P4, Ddr),
+            P3DR => (PortId::P3, Dr),
+            P4DR => (PortId::P4, Dr),
+            P5DDR => (PortId::P5, Ddr),
+            P6DDR => (PortId::P6, Ddr),
+            P5DR => (PortId::P5, Dr),
+            P6DR => (PortId::P6, Dr),
+            P8DDR => (PortId::P8, Ddr),
+            P7DR => (PortId::P7, Dr),
+            P8DR => (PortId::P8, Dr),
+            P9DDR => (PortId::P9, Ddr),
+            PADDR => (PortId::PA, Ddr),
+            P9DR => (PortId::P9, Dr),
+            PADR => (PortId::PA, Dr),
+            PBDDR => (PortId::PB, Ddr),
+            PBDR => (PortId::PB, Dr),
+            P2PCR => (PortId::P2, Pcr),
+            P4PCR => (PortId::P4, Pcr),
+            P5PCR => (PortId::P5, Pcr),
+            _ => return None,
+        })
+    }
+}
+
+/// Which register of a port.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PortReg {
+    /// The data direction register.
+    Ddr,
+    /// The data register.
+    Dr,
+    /// The input pull-up control register.
+    Pcr,
+}
+
+/// What the outside drives on a port's pins ([`Board::port_pins`]): where `driven` has a 1,
+/// the pin is held at the level of the same bit of `levels`; the other pins are left alone (an
+/// input pin then reads high only through its pull-up, else floats and reads 0).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ExternalPins {
+    /// The pins something outside drives.
+    pub driven: u8,
+    /// Their levels.
+    pub levels: u8,
+}
+
+impl ExternalPins {
+    /// Nothing connected.
+    pub const NONE: ExternalPins = ExternalPins {
+        driven: 0,
+        levels: 0,
+    };
+}
+
+/// The IRQ inputs' pins: (port, bit) of IRQ0–IRQ5 (section 5, IRQ pins; section 9: P8.0–P8.3
+/// are IRQ0–IRQ3, P9.4 and P9.5 IRQ4 and IRQ5).
+pub const IRQ_PINS: [(PortId, u8); 6] = [
+    (PortId::P8, 0x01),
+    (PortId::P8, 0x02),
+    (PortId::P8, 0x04),
+    (PortId::P8, 0x08),
+    (PortId::P9, 0x10),
+    (PortId::P9, 0x20),
+];
+
 /// What the ports see around them during an access.
 pub struct PortPins<'a, B: Board> {
-    /// The board, for the levels of the port-2 pins ([`Board::port2_pins`]: the bumpers) and
-    /// the port-4 lines ([`Board::port4_pins`], [`Board::port4_drive`]: the EEPROM bus).
+    /// The board, for the levels of the port-2 pins ([`Board::port2_pins`]: the bumpers), the
+    /// port-4 lines ([`Board::port4_pins`], [`Board::port4_drive`]: the EEPROM bus) and the
+    /// other ports' input pins ([`Board::port_pins`]).
     pub board: &'a mut B,
     /// The ITU, whose TIOCA outputs share pins with ports A and B.
     pub itu: &'a mut Itu,
 }
 
-/// Ports 2, 4, A and B.
+/// The eleven ports.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Ports {
-    p2: Port,
-    p4: Port,
-    pa: Port,
-    pb: Port,
+    ports: [Port; 11],
 }
 
 impl Ports {
@@ -170,35 +365,39 @@ impl Ports {
     #[must_use]
     pub const fn new() -> Self {
         Ports {
-            p2: Port::new(),
-            p4: Port::new(),
-            pa: Port::new(),
-            pb: Port::new(),
+            ports: [Port::new(); 11],
         }
+    }
+
+    /// Port `id`'s registers (DDR as written, DR, PCR).
+    #[inline]
+    #[must_use]
+    pub const fn port(&self, id: PortId) -> Port {
+        self.ports[id.index()]
     }
 
     /// Port 4's registers (DDR as written, DR, PCR).
     #[must_use]
     pub const fn port4(&self) -> Port {
-        self.p4
+        self.port(PortId::P4)
     }
 
     /// Port A's registers (DDR as written, DR).
     #[must_use]
     pub const fn port_a(&self) -> Port {
-        self.pa
+        self.port(PortId::PA)
     }
 
     /// Port B's registers (DDR as written, DR).
     #[must_use]
     pub const fn port_b(&self) -> Port {
-        self.pb
+        self.port(PortId::PB)
     }
 
     /// Pin levels of port A at `now`: ITU-driven TIOCA0–2 (PA2, PA4, PA6), else the output
     /// latch; input pins with nothing connected float and read 0 (port A has no pull-ups).
     pub fn pa_pins(&self, itu: &mut Itu, now: u64) -> u8 {
-        let mut pins = self.pa.output_levels();
+        let mut pins = self.port_a().output_levels();
         for (ch, bit) in [(0, PA_TIOCA0), (1, PA_TIOCA1), (2, PA_TIOCA2)] {
             let (level, drives) = itu.tioca(ch, now);
             if drives {
@@ -211,7 +410,7 @@ impl Ports {
     /// Pin levels of port B at `now`: ITU-driven TIOCA3/TIOCA4 (PB0, PB2), else the output
     /// latch.
     pub fn pb_pins(&self, itu: &mut Itu, now: u64) -> u8 {
-        let mut pins = self.pb.output_levels();
+        let mut pins = self.port_b().output_levels();
         for (ch, bit) in [(3, PB_TIOCA3), (4, PB_TIOCA4)] {
             let (level, drives) = itu.tioca(ch, now);
             if drives {
@@ -221,10 +420,55 @@ impl Ports {
         pins
     }
 
+    /// The levels of a port's pins given what the outside drives: output pins at their latch,
+    /// input pins at the outside's level, else high through a pull-up, else 0 (floating); the
+    /// pins the port lacks read 1. Not for port 2 and 4, whose pins the board reports apart,
+    /// nor for the ITU's pins on ports A and B ([`Ports::pa_pins`], [`Ports::pb_pins`]).
+    #[must_use]
+    pub fn levels(&self, id: PortId, outside: ExternalPins) -> u8 {
+        let p = self.port(id);
+        let input = !p.ddr;
+        let external = (outside.levels & outside.driven) | (p.pulled_up() & !outside.driven);
+        (p.output_levels() | (external & input)) | !id.pins()
+    }
+
     /// Levels of port 4's input pins as the board leaves the lines; a released pin reads high
     /// only through its pull-up.
     fn p4_inputs<B: Board>(&self, board: &mut B, now: u64) -> u8 {
-        self.p4.open_drain_levels(board.port4_pins(now))
+        self.port4().open_drain_levels(board.port4_pins(now))
+    }
+
+    /// What a read of port `id`'s DR returns at `now`.
+    fn read_dr<B: Board>(&self, id: PortId, now: u64, pins: PortPins<'_, B>) -> u8 {
+        let p = self.port(id);
+        match id {
+            PortId::P2 => {
+                let released = pins.board.port2_pins(now);
+                p.read_dr(p.open_drain_levels(released))
+            }
+            PortId::P4 => {
+                let inputs = self.p4_inputs(pins.board, now);
+                p.read_dr(inputs)
+            }
+            PortId::PA | PortId::PB => {
+                let own = if id == PortId::PA {
+                    self.pa_pins(pins.itu, now)
+                } else {
+                    self.pb_pins(pins.itu, now)
+                };
+                let outside = pins.board.port_pins(id, now);
+                p.read_dr(own | (outside.levels & outside.driven))
+            }
+            // Input only: the pins as the outside leaves them.
+            PortId::P7 => {
+                let outside = pins.board.port_pins(id, now);
+                outside.levels & outside.driven
+            }
+            _ => {
+                let outside = pins.board.port_pins(id, now);
+                p.read_dr(self.levels(id, outside)) | !id.pins()
+            }
+        }
     }
 }
 
@@ -237,50 +481,27 @@ impl Peripheral for Ports {
 
     #[inline]
     fn read<B: Board>(&mut self, addr: u32, now: u64, pins: PortPins<'_, B>) -> u8 {
-        match addr {
-            P2DDR | P4DDR | PADDR | PBDDR => DDR_READ_VALUE,
-            P2DR => {
-                let released = pins.board.port2_pins(now);
-                self.p2.read_dr(self.p2.open_drain_levels(released))
-            }
-            P4DR => {
-                let inputs = self.p4_inputs(pins.board, now);
-                self.p4.read_dr(inputs)
-            }
-            PADR => {
-                let levels = self.pa_pins(pins.itu, now);
-                self.pa.read_dr(levels)
-            }
-            PBDR => {
-                let levels = self.pb_pins(pins.itu, now);
-                self.pb.read_dr(levels)
-            }
-            P2PCR => self.p2.pcr,
-            P4PCR => self.p4.pcr,
-            _ => 0,
+        match PortId::of_register(addr) {
+            Some((_, PortReg::Ddr)) => DDR_READ_VALUE,
+            Some((id, PortReg::Dr)) => self.read_dr(id, now, pins),
+            Some((id, PortReg::Pcr)) => self.port(id).pcr | !id.pins(),
+            None => 0,
         }
     }
 
     #[inline]
     fn write<B: Board>(&mut self, addr: u32, value: u8, now: u64, pins: PortPins<'_, B>) {
-        match addr {
-            P2DDR => self.p2.ddr = value,
-            P2DR => self.p2.dr = value,
-            P2PCR => self.p2.pcr = value,
-            P4DDR => {
-                self.p4.ddr = value;
-                pins.board.port4_drive(self.p4.driven_low(), now);
-            }
-            P4DR => {
-                self.p4.dr = value;
-                pins.board.port4_drive(self.p4.driven_low(), now);
-            }
-            P4PCR => self.p4.pcr = value,
-            PADDR => self.pa.ddr = value,
-            PADR => self.pa.dr = value,
-            PBDDR => self.pb.ddr = value,
-            PBDR => self.pb.dr = value,
-            _ => {}
+        let Some((id, reg)) = PortId::of_register(addr) else {
+            return;
+        };
+        let p = &mut self.ports[id.index()];
+        match reg {
+            PortReg::Ddr => p.ddr = value,
+            PortReg::Dr => p.dr = value,
+            PortReg::Pcr => p.pcr = value,
+        }
+        if id == PortId::P4 && reg != PortReg::Pcr {
+            pins.board.port4_drive(p.driven_low(), now);
         }
     }
 

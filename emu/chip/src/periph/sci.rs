@@ -108,7 +108,7 @@ pub struct Sci {
     tdre_seen: bool,
     /// Transmitted bytes not yet collected.
     out: Vec<u8>,
-    /// Bytes transmitted since reset.
+    /// Bytes transmitted since power-on.
     sent: u64,
 }
 
@@ -309,7 +309,7 @@ impl Sci {
         }
     }
 
-    /// Bytes transmitted since reset.
+    /// Bytes transmitted since the MCU was built (resets do not clear the count).
     #[must_use]
     pub const fn bytes_sent(&self) -> u64 {
         self.sent
@@ -360,8 +360,14 @@ impl Peripheral for Sci {
     }
 
     #[inline]
+    /// The registers to their reset values and a frame under way dropped; the bytes already
+    /// sent stay the console's (they are on the wire), and so does their count.
     fn reset(&mut self) {
+        let out = std::mem::take(&mut self.out);
+        let sent = self.sent;
         *self = Sci::new();
+        self.out = out;
+        self.sent = sent;
     }
 }
 

@@ -515,6 +515,13 @@ impl WordSource for SliceSource<'_> {
 
 /// Decodes one instruction from a byte slice.
 ///
+/// ```
+/// use h8300h::cpu::decode::{decode_bytes, DecodeError};
+/// let d = decode_bytes(&[0x6A, 0x28, 0x00, 0xFF, 0xFF, 0x20]).unwrap(); // mov.b r0l,@0xffff20:24
+/// assert_eq!(d.len_bytes(), 6);
+/// assert!(matches!(decode_bytes(&[0x6A]), Err(DecodeError::Truncated { .. })));
+/// ```
+///
 /// # Errors
 /// [`DecodeError::Undefined`] if the bytes are no instruction, [`DecodeError::Truncated`] if the
 /// slice ends inside one.

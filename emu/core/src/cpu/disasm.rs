@@ -152,6 +152,14 @@ fn bit_instr(s: &mut String, op: BitOp, num: BitNum, target: BitTarget) {
 }
 
 /// The objdump text of `d`, an instruction at address `addr` (used for branch targets).
+///
+/// ```
+/// use h8300h::cpu::decode::decode_bytes;
+/// use h8300h::cpu::disasm::format_instr;
+/// assert_eq!(format_instr(decode_bytes(&[0xF8, 0x2A]).unwrap(), 0x100), "mov.b\t#0x2a,r0l");
+/// // A branch shows its target.
+/// assert_eq!(format_instr(decode_bytes(&[0x40, 0x10]).unwrap(), 0x100), "bra\t.+16 (0x112)");
+/// ```
 #[must_use]
 pub fn format_instr(d: Decoded, addr: u32) -> String {
     let mut out = String::with_capacity(32);
@@ -244,6 +252,13 @@ pub struct Line {
 /// Disassembles a byte slice loaded at `base`, one [`Line`] per instruction. Bytes that decode
 /// to no instruction become one line per word with `text: None` (and a trailing odd byte one
 /// line of its own), as objdump steps over them.
+///
+/// ```
+/// let lines = h8300h::cpu::disasm::disassemble(&[0xF8, 0x2A, 0x01, 0x80], 0x100);
+/// let text: Vec<_> = lines.iter().map(|l| (l.addr, l.text.clone().unwrap())).collect();
+/// // objdump writes a tab after every mnemonic, with operands or without.
+/// assert_eq!(text, [(0x100, "mov.b\t#0x2a,r0l".to_string()), (0x102, "sleep\t".to_string())]);
+/// ```
 #[must_use]
 pub fn disassemble(bytes: &[u8], base: u32) -> Vec<Line> {
     let mut lines = Vec::new();

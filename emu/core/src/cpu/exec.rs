@@ -383,6 +383,7 @@ impl Cpu {
         self.pc = next;
         self.instructions += 1;
         self.last_copy = d;
+        self.last_copy_pc = pc;
         self.last_index = LAST_IN_COPY;
         self.exec_instr(bus, d, pc, next)
     }
@@ -642,8 +643,12 @@ impl Cpu {
     /// masked and no NMI is pending (nothing could wake it).
     #[inline(always)]
     fn sleep<B: Bus>(&mut self, bus: &mut B) -> Event {
-        let nmi = bus.pending_irq() == Some(super::VECTOR_NMI);
-        if self.ccr & CCR_I != 0 && !nmi {
+        // NMI and a reset request would wake it even so.
+        let wakes = matches!(
+            bus.pending_irq(),
+            Some(super::VECTOR_NMI | crate::bus::RESET_REQUEST)
+        );
+        if self.ccr & CCR_I != 0 && !wakes {
             self.state = RunState::Halted;
             return Event::Halted;
         }

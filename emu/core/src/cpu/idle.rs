@@ -30,7 +30,9 @@
 //!   likewise: s_C − s_B = s_B − s_A for each.
 //!
 //! Then cycles 2..=J repeat A and B with the same branches, interrupts, device accesses and
-//! timing, and `n` of them are advanced at once: registers and the changing longwords to their
+//! timing, and `n` of them are advanced at once (those that end by the deadline and by
+//! [`FastPathHints::idle_horizon`], the next request of a device the signature leaves out, such
+//! as a free-running watchdog): registers and the changing longwords to their
 //! values after cycle 1 + n, the devices and the clock by [`FastPathHints::idle_shift`] (n·P states),
 //! the instruction count by n times the cycle's. The cycle after them runs as usual (the one
 //! where the counter reaches its threshold and the loop ends is never skipped). A cycle that
@@ -350,9 +352,10 @@ impl Cpu {
                 }
             }
         };
-        // Cycles 2..=last are proven; advance those that end by the deadline.
+        // Cycles 2..=last are proven; advance those that end by the deadline and by the
+        // instant a device outside the signature next requests.
         let now = bus.now();
-        let room = deadline.saturating_sub(now) / plan.period;
+        let room = deadline.min(bus.idle_horizon()).saturating_sub(now) / plan.period;
         let n = (plan.last - 1).min(room).min(u64::from(u32::MAX));
         if n == 0 {
             return Ok(run);

@@ -99,7 +99,7 @@ pub use stack::{StackAccess, StackFault, StackGuard, StackGuardMode, StackRoom};
 
 use std::sync::Arc;
 
-use crate::bus::{Bus, CpuSignal, FastPathHints};
+use crate::bus::{BREAK_REQUEST, Bus, CpuSignal, FastPathHints, RESET_REQUEST};
 use crate::memmap::Area;
 use decode::{DecodeError, Decoded, Instr, WordSource, decode};
 
@@ -183,6 +183,15 @@ pub enum Event {
     Halted,
     /// The CPU is in sleep mode and the deadline passed with no interrupt to wake it.
     Asleep,
+    /// The bus's reset request ([`RESET_REQUEST`]: the chip's internal reset, the watchdog's)
+    /// was taken: the chip reset itself, and the CPU starts over from the reset vector
+    /// (registers cleared, CCR.I = 1). No instruction ran.
+    Reset,
+    /// The bus asked the CPU to stop before the next instruction ([`BREAK_REQUEST`]: the chip
+    /// saw something its owner wants to look at with the CPU in hand, such as the first access
+    /// to a register it does not model). Nothing ran and nothing changed; the next step goes on
+    /// where this one stopped ([`Cpu::last_pc`] is the instruction that was executed last).
+    Break,
 }
 
 /// Run state of the CPU.
@@ -243,6 +252,8 @@ pub struct Cpu {
     last_index: u32,
     /// The instruction executed last on the reference path.
     last_copy: Decoded,
+    /// Its address.
+    last_copy_pc: u32,
     /// The stack guard's bounds ([`stack::Bounds::OFF`] without a guard).
     stack_bounds: stack::Bounds,
     /// The stack guard, if one is set.
@@ -300,6 +311,7 @@ impl Cpu {
             instructions: 0,
             last_index: LAST_IN_COPY,
             last_copy: EMPTY_SLOT,
+            last_copy_pc: 0,
             stack_bounds: stack::Bounds::OFF,
             stack_guard: None,
             stack_fault: None,
@@ -375,6 +387,18 @@ impl Cpu {
                 .get(self.last_index as usize)
                 .copied()
                 .unwrap_or(EMPTY_SLOT)
+        }
+    }
+
+    /// The address of the instruction executed last (0 before the first): the instruction a
+    /// bus access just seen belongs to, after a step or an [`Event::Break`]. After a loop was
+    /// fast-forwarded, its back edge.
+    #[must_use]
+    pub fn last_pc(&self) -> u32 {
+        if self.last_index == LAST_IN_COPY {
+            self.last_copy_pc
+        } else {
+            self.last_index << 1
         }
     }
 
@@ -502,6 +526,7 @@ impl Cpu {
     /// after replacing the ROM image.
     pub fn flush_decode_cache(&mut self) {
         self.last_copy = self.last_executed();
+        self.last_copy_pc = self.last_pc();
         self.last_index = LAST_IN_COPY;
         self.cache = Arc::new([]);
         self.fast = Arc::new([]);
@@ -578,26 +603,78 @@ impl Cpu {
         }
     }
 
-    /// Whether an interrupt with vector `v` gets through the CCR mask.
+    /// Whether a request `v` of [`Bus::pending_irq`] gets through the CCR mask: an interrupt
+    /// while CCR.I = 0; NMI, a reset request and a break request always.
     #[inline]
     fn accepts(&self, v: u8) -> bool {
-        v == VECTOR_NMI || self.ccr & CCR_I == 0
+        self.ccr & CCR_I == 0 || matches!(v, VECTOR_NMI | RESET_REQUEST | BREAK_REQUEST)
     }
 
     /// Before an instruction: ends the one-instruction delay after LDC/ANDC/ORC/XORC, or
-    /// accepts a pending interrupt the mask lets through (its exception handling runs) and
-    /// returns its vector.
+    /// takes a pending request the mask lets through (an interrupt's exception handling, a
+    /// reset, a break) and returns the step's event.
     #[inline(always)]
-    fn take_interrupt<B: Bus>(&mut self, bus: &mut B) -> Result<Option<u8>, CpuError> {
+    fn take_interrupt<B: Bus>(&mut self, bus: &mut B) -> Result<Option<Event>, CpuError> {
         if self.irq_inhibit {
-            self.irq_inhibit = false;
-        } else if let Some(v) = bus.pending_irq()
+            return Ok(self.after_inhibit(bus));
+        }
+        if let Some(v) = bus.pending_irq()
             && self.accepts(v)
         {
-            self.interrupt(bus, v)?;
-            return Ok(Some(v));
+            return self.take_request(bus, v).map(Some);
         }
         Ok(None)
+    }
+
+    /// The boundary right after LDC/ANDC/ORC/XORC: no interrupt is accepted, but a reset or a
+    /// break request is taken (a break keeps the delay for the instruction that follows).
+    #[cold]
+    #[inline(never)]
+    fn after_inhibit<B: Bus>(&mut self, bus: &mut B) -> Option<Event> {
+        match bus.pending_irq() {
+            Some(BREAK_REQUEST) => {
+                bus.cpu_signal(CpuSignal::Break { pc: self.last_pc() });
+                Some(Event::Break)
+            }
+            Some(RESET_REQUEST) => {
+                self.reset_exception(bus);
+                Some(Event::Reset)
+            }
+            _ => {
+                self.irq_inhibit = false;
+                None
+            }
+        }
+    }
+
+    /// Takes request `v` (accepted): an interrupt's exception handling, the reset exception,
+    /// or a break.
+    #[inline(never)]
+    fn take_request<B: Bus>(&mut self, bus: &mut B, v: u8) -> Result<Event, CpuError> {
+        match v {
+            BREAK_REQUEST => {
+                bus.cpu_signal(CpuSignal::Break { pc: self.last_pc() });
+                Ok(Event::Break)
+            }
+            RESET_REQUEST => {
+                self.reset_exception(bus);
+                Ok(Event::Reset)
+            }
+            _ => {
+                self.interrupt(bus, v)?;
+                Ok(Event::Interrupt(v))
+            }
+        }
+    }
+
+    /// The reset exception for the bus's reset request ([`RESET_REQUEST`]): the chip resets
+    /// itself and holds the CPU for the reset's duration ([`CpuSignal::Reset`]), then the CPU
+    /// starts as after power-on ([`Cpu::reset`]: registers cleared, CCR.I = 1, PC from vector
+    /// 0). The instruction count, the decode caches and the stack guard carry on.
+    #[cold]
+    fn reset_exception<B: Bus>(&mut self, bus: &mut B) {
+        bus.cpu_signal(CpuSignal::Reset);
+        self.reset(bus);
     }
 
     /// Runs one step: accepts a pending interrupt, or executes one instruction, or (in sleep
@@ -699,8 +776,8 @@ impl Cpu {
             // not a reload of the one just stored.
             let mut pc = self.pc;
             loop {
-                if let Some(v) = self.take_interrupt(bus)? {
-                    return Ok(Event::Interrupt(v));
+                if let Some(event) = self.take_interrupt(bus)? {
+                    return Ok(event);
                 }
                 let idx = (pc >> 1) as usize;
                 if let Some(slot) = self.fast.get(idx)
@@ -758,8 +835,8 @@ impl Cpu {
     /// bus's token.
     #[inline(always)]
     fn step_fast<B: Bus>(&mut self, bus: &mut B) -> Result<Event, CpuError> {
-        if let Some(v) = self.take_interrupt(bus)? {
-            return Ok(Event::Interrupt(v));
+        if let Some(event) = self.take_interrupt(bus)? {
+            return Ok(event);
         }
         let pc = self.pc;
         let idx = (pc >> 1) as usize;
@@ -807,10 +884,14 @@ impl Cpu {
             RunState::Halted => return Ok(Event::Halted),
             RunState::Sleeping => {
                 loop {
-                    if let Some(v) = bus.pending_irq()
-                        && self.accepts(v)
-                    {
-                        break;
+                    match bus.pending_irq() {
+                        // A break does not wake the CPU: it stops here, still asleep.
+                        Some(BREAK_REQUEST) => {
+                            bus.cpu_signal(CpuSignal::Break { pc: self.last_pc() });
+                            return Ok(Event::Break);
+                        }
+                        Some(v) if self.accepts(v) => break,
+                        _ => {}
                     }
                     if bus.now() >= deadline || !bus.sleep_until_irq(deadline) {
                         return Ok(Event::Asleep);
@@ -820,8 +901,8 @@ impl Cpu {
                 bus.cpu_signal(CpuSignal::Wake);
             }
         }
-        if let Some(v) = self.take_interrupt(bus)? {
-            return Ok(Event::Interrupt(v));
+        if let Some(event) = self.take_interrupt(bus)? {
+            return Ok(event);
         }
         let d = self.fetch_decode(bus)?;
         self.execute(bus, d)
