@@ -402,7 +402,7 @@ impl Power {
                 format!("the opposite would need about {n} repeats at this effect")
             }
             ("none", _) if self.observed_share.is_some() => {
-                "as many repeats go each way: no number of repeats decides it".into()
+                "at an even split no number of repeats decides it".into()
             }
             ("none", _) => "no repeat decides it".into(),
             _ => format!("more than {MAX_REPEATS_NEEDED} repeats would be needed at this effect"),

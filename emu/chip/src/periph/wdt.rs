@@ -241,16 +241,10 @@ impl Wdt {
         self.sync(now);
         let [password, data] = value.to_be_bytes();
         match (addr, password) {
-            (TCSR, PASSWORD_TCNT) => {
-                if self.running() {
-                    self.tcnt = data;
-                }
-            }
+            (TCSR, PASSWORD_TCNT) if self.running() => self.tcnt = data,
             (TCSR, PASSWORD_TCSR) => self.write_tcsr(data),
-            (RSTCSR_WRITE, PASSWORD_TCSR) => {
-                if data & RSTCSR_WRST == 0 {
-                    self.rstcsr &= !RSTCSR_WRST;
-                }
+            (RSTCSR_WRITE, PASSWORD_TCSR) if data & RSTCSR_WRST == 0 => {
+                self.rstcsr &= !RSTCSR_WRST;
             }
             (RSTCSR_WRITE, PASSWORD_RSTOE) => {
                 self.rstcsr = (self.rstcsr & !RSTCSR_RSTOE) | (data & RSTCSR_RSTOE);
