@@ -689,7 +689,7 @@ fn render(
             };
             let _ = writeln!(
                 t,
-                "     {:<28} map {:<16} confirmation {}{need}",
+                "     {:<28} map {:<18} confirmation {}{need}",
                 printable(&words),
                 outcome_words(m),
                 outcome_words(c)
