@@ -194,10 +194,10 @@ fn run_repeat(
 
 /// Prints what `condition`'s runs gathered, `runs` the robot-runs (repeats × robots).
 fn print_gathered(condition: Condition, runs: usize, g: &Gathered) {
-    g.stuck.print(&format!("{}, stuck", condition.name()));
-    g.moving.print(&format!("{}, moving", condition.name()));
+    g.stuck.print(&format!("{}, held", condition.name()));
+    g.moving.print(&format!("{}, not held", condition.name()));
     println!(
-        "|  {}: stuck spells ended in the last window {} (the behaviour then: fwd {}, back {}, left {}, right {}); robots stuck at the end {} of {} |",
+        "|  {}: held spells ended in the last window {} (the behaviour then: fwd {}, back {}, left {}, right {}); robots held at the end {} of {} |",
         condition.name(),
         g.spells_ended,
         g.ended_by[0],
@@ -217,7 +217,7 @@ fn print_gathered(condition: Condition, runs: usize, g: &Gathered) {
         .map(|x| u64::from(x.0))
         .sum();
     println!(
-        "|  {}: whole run: {} stuck spells, {} ended (median length {} steps, 90th percentile {}), {} lasted to the end; spells of 1 000 steps or more hold {:.0} % of the stuck robot-steps |",
+        "|  {}: whole run: {} held spells, {} ended (median length {} steps, 90th percentile {}), {} lasted to the end; spells of 1 000 steps or more hold {:.0} % of the held robot-steps |",
         condition.name(),
         spells.len(),
         ended.len(),
