@@ -1,11 +1,12 @@
-//! What a stuck robot senses, evaluates and chooses: runs the learning and
-//! learning-off conditions of a scenario with model robots and, for every robot-step of the last
-//! window, records whether the robot is stuck (the metric's rule: its motors drove and it moved
-//! < 1 mm over the last 100 steps), its four proximities p (du), E = D(t) − D(t−1) (the
-//! evaluation the learner applies at this step), the winning behaviour, the winner's margin over
-//! the runner-up in the outputs O, and which bumper is pressed. Prints the means over stuck and
-//! over moving robot-steps, and how stuck spells end and how long they last over the whole run
-//! (a spell counted from the step the rule first flags it, i.e. 100 steps after it began).
+//! What a held robot senses, evaluates and chooses: runs the learning and learning-off
+//! conditions of a scenario with model robots and, for every robot-step of the last window,
+//! records whether the robot is held in place (`swarm::motion`'s class: its positions over 100
+//! steps within 5 cm of their mean, or under 2 cm of path over 20 steps), its four proximities p
+//! (du), E = D(t) − D(t−1) (the evaluation the learner applies at this step), the winning
+//! behaviour, the winner's margin over the runner-up in the outputs O, and which bumper is
+//! pressed. Prints the means over held and over free robot-steps, and how held spells end and
+//! how long they last over the whole run (a spell counted from the step the class first says
+//! held). (The file keeps its name from the earlier "stuck" detector it was written for.)
 //!
 //!     cargo run --release --example stuck_probe [arena|corridor|FILE.toml] [REPEATS] [SEED]
 
@@ -14,8 +15,8 @@
 #![allow(clippy::disallowed_methods)]
 
 use nn_q15::DynLearner;
-use swarm::collisions::StuckDetector;
 use swarm::experiment::Swarm;
+use swarm::motion::{MotionClass, MotionTracker};
 use swarm::robot::{Brain, Condition};
 use swarm::scenario::Scenario;
 
@@ -132,14 +133,12 @@ fn run_repeat(
     let threshold = s.learner.threshold;
     let mut sw = Swarm::new(s, condition, repeat, false, None)?;
     let n = s.robots;
-    let mut det = vec![StuckDetector::default(); n];
+    let mut det = vec![MotionTracker::new(); n];
     let mut was_stuck = vec![false; n];
-    let mut xy: Vec<(f64, f64)> = (0..n)
-        .map(|i| {
-            let p = sw.world().pose(i).unwrap();
-            (p.x_m, p.y_m)
-        })
-        .collect();
+    for (i, d) in det.iter_mut().enumerate() {
+        let p = sw.world().pose(i)?;
+        d.start(p.x_m, p.y_m);
+    }
     let mut d_prev = vec![None::<i16>; n];
     let mut prev_win = vec![0usize; n];
     let mut since = vec![0u32; n];
@@ -147,10 +146,7 @@ fn run_repeat(
         sw.step()?;
         for i in 0..n {
             let pose = sw.world().pose(i)?;
-            let moved = (pose.x_m - xy[i].0).hypot(pose.y_m - xy[i].1);
-            xy[i] = (pose.x_m, pose.y_m);
-            let speeds = sw.world().wheel_speeds(i)?;
-            let is_stuck = det[i].record(moved, speeds.iter().any(|&v| v != 0.0));
+            let is_stuck = det[i].record(pose.x_m, pose.y_m).class == MotionClass::Held;
             let bumpers = sw.world().bumpers(i)?;
             let Some(robot) = sw.robot_mut(i) else {
                 continue;
@@ -202,10 +198,10 @@ fn run_repeat(
 
 /// Prints what `condition`'s runs gathered, `runs` the robot-runs (repeats × robots).
 fn print_gathered(condition: Condition, runs: usize, g: &Gathered) {
-    g.stuck.print(&format!("{}, stuck", condition.name()));
-    g.moving.print(&format!("{}, moving", condition.name()));
+    g.stuck.print(&format!("{}, held", condition.name()));
+    g.moving.print(&format!("{}, not held", condition.name()));
     println!(
-        "|  {}: stuck spells ended in the last window {} (the behaviour then: fwd {}, back {}, left {}, right {}); robots stuck at the end {} of {} |",
+        "|  {}: held spells ended in the last window {} (the behaviour then: fwd {}, back {}, left {}, right {}); robots held at the end {} of {} |",
         condition.name(),
         g.spells_ended,
         g.ended_by[0],
@@ -225,7 +221,7 @@ fn print_gathered(condition: Condition, runs: usize, g: &Gathered) {
         .map(|x| u64::from(x.0))
         .sum();
     println!(
-        "|  {}: whole run: {} stuck spells, {} ended (median length {} steps, 90th percentile {}), {} lasted to the end; spells of 1 000 steps or more hold {:.0} % of the stuck robot-steps |",
+        "|  {}: whole run: {} held spells, {} ended (median length {} steps, 90th percentile {}), {} lasted to the end; spells of 1 000 steps or more hold {:.0} % of the held robot-steps |",
         condition.name(),
         spells.len(),
         ended.len(),

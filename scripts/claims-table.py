@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The claims of the paper over seeds: reads OUT/<name>-seed<k>/summary.json (as written by
 scripts/paper-runs.sh) and prints, per setting, the window means of every condition (mean over
-seeds of each seed's mean over its repeats), the robots ending stuck, and per claim each seed's
+seeds of each seed's mean over its repeats), the robots ending held, and per claim each seed's
 outcome (repeats for the claim of those with a value) with the outcome pooled over the seeds
 (the repeats' counts added, the same one-sided sign test at p < 0.05).
 
@@ -53,8 +53,8 @@ for name, seeds in runs.items():
     print(f"### {name} (seeds {', '.join(map(str, ks))}, "
           f"{first['conditions'][0]['first']['mean_d']['n']} repeats each)")
     print()
-    print("| condition | window | D (du) | coll./robot | coll./m | contact % | stuck % | moving % | moved mm/step | gap CV |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
+    print("| condition | window | D (du) | coll./robot | coll./net m | coll./path m | contact % | held % | shuttling % | exploring % | net mm/step | path mm/step | gap CV |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     conds = [c["condition"] for c in first["conditions"]]
     for ci, cname in enumerate(conds):
         for w in ("first", "last"):
@@ -63,16 +63,17 @@ for name, seeds in runs.items():
                 vals = [v["mean"] for v in vals if v is not None and v["mean"] is not None]
                 return fmt(sum(vals) / len(vals)) if vals else "–"
             print(f"| {cname} | {w} | {avg('mean_d')} | {avg('collisions_per_robot')} | "
-                  f"{avg('collisions_per_m')} | {avg('contact_percent')} | {avg('stuck_percent')} | "
-                  f"{avg('moving_percent')} | {avg('moved_mm')} | {avg('gap_cv')} |")
+                  f"{avg('collisions_per_net_m')} | {avg('collisions_per_m')} | "
+                  f"{avg('contact_percent')} | {avg('held_percent')} | {avg('shuttling_percent')} | "
+                  f"{avg('exploring_percent')} | {avg('net_mm')} | {avg('moved_mm')} | {avg('gap_cv')} |")
     print()
-    print("| condition | robots ending the run stuck | with a lasting stuck spell |")
+    print("| condition | robots ending the run held | with a lasting held spell |")
     print("|---|---|---|")
     for ci, cname in enumerate(conds):
         r = [seeds[k]["conditions"][ci]["robots"] for k in ks]
         n = sum(x["robots"] for x in r)
-        print(f"| {cname} | {sum(x['ending_stuck'] for x in r)} of {n} | "
-              f"{sum(x['with_lasting_spell'] for x in r)} of {n} |")
+        print(f"| {cname} | {sum(x['ending_held'] for x in r)} of {n} | "
+              f"{sum(x['with_lasting_held_spell'] for x in r)} of {n} |")
     print()
     print("| claim | " + " | ".join(f"seed {k}" for k in ks) + " | pooled over the seeds |")
     print("|---|" + "---|" * len(ks) + "---|")

@@ -115,6 +115,20 @@ pub struct Series {
     pub lo: Vec<f64>,
     /// Upper edge of the band at each x (e.g. the maximum over repeats).
     pub hi: Vec<f64>,
+    /// How many repeats each point rests on (empty: all of them, [`Series::repeats`]). A point
+    /// resting on fewer is drawn as an open circle with its count beside it, and no band is
+    /// drawn through it.
+    pub n: Vec<usize>,
+    /// The repeats the series' condition ran (0: not said).
+    pub repeats: usize,
+}
+
+impl Series {
+    /// Whether point `i` rests on every repeat.
+    #[must_use]
+    pub fn full(&self, i: usize) -> bool {
+        self.n.get(i).is_none_or(|&n| n >= self.repeats)
+    }
 }
 
 /// The paper's Fig. 6/7: left panel mean D per window (du), right panel collisions per robot per
@@ -129,15 +143,15 @@ pub struct LearningFigure {
     pub d: Vec<Series>,
     /// Series of the right panel: collisions per robot per window.
     pub collisions: Vec<Series>,
-    /// Further panels (at most four, e.g. collisions per metre, contact time and the
-    /// corridor's gap CV), drawn two to a row under the first two; none keeps the paper's
-    /// two-panel figure.
+    /// Further panels (at most eight, e.g. collisions per net metre, net progress, contact
+    /// time and the corridor's gap CV), drawn two to a row under the first two; none keeps the
+    /// paper's two-panel figure.
     pub more: Vec<Panel>,
-    /// The share of stuck robot-steps per condition (percent, labels as in the panels), drawn
+    /// The share of held robot-steps per condition (percent, labels as in the panels), drawn
     /// dotted on a right-hand axis of 0–100 % in the collisions panel and in every further
-    /// panel that asks for it, so a falling collision curve is read beside the robots that
-    /// stopped; none draws no overlay.
-    pub stuck: Vec<Series>,
+    /// panel that asks for it, so a falling collision curve is read beside the robots held in
+    /// place; none draws no overlay.
+    pub held: Vec<Series>,
     /// Mark every point (a run with few windows, whose lines are no trend).
     pub markers: bool,
 }
@@ -151,8 +165,8 @@ pub struct Panel {
     pub y_label: String,
     /// Its series (checked like the first two panels').
     pub series: Vec<Series>,
-    /// Draw [`LearningFigure::stuck`] on a right-hand axis.
-    pub stuck_overlay: bool,
+    /// Draw [`LearningFigure::held`] on a right-hand axis.
+    pub held_overlay: bool,
 }
 
 /// The paper's Fig. 8: the arena from above with every robot's trajectory and its outline at a
@@ -225,6 +239,23 @@ pub enum PlotError {
         lo: usize,
         /// Length of `hi`.
         hi: usize,
+    },
+    /// A series' repeat counts do not match its points.
+    #[error(
+        "{panel} series {index} ({label:?}): x has {x} points but n has {n} counts; give one \
+         per point or none"
+    )]
+    CountMismatch {
+        /// The panel.
+        panel: &'static str,
+        /// Position of the series in its panel's list.
+        index: usize,
+        /// The series' label.
+        label: String,
+        /// Length of `x`.
+        x: usize,
+        /// Length of `n`.
+        n: usize,
     },
     /// A value of a series is NaN, infinite or beyond ±[`MAX_ABS_VALUE`].
     #[error(
@@ -348,8 +379,8 @@ pub fn learning_figure(fig: &LearningFigure, png: &Path, svg: &Path) -> Result<(
     for p in fig.more.iter().take(MAX_MORE_PANELS) {
         validate_panel("further", &p.series)?;
     }
-    if !fig.stuck.is_empty() {
-        validate_panel("stuck", &fig.stuck)?;
+    if !fig.held.is_empty() {
+        validate_panel("held", &fig.held)?;
     }
     check_png_name(png)?;
     register_font()?;
@@ -357,7 +388,7 @@ pub fn learning_figure(fig: &LearningFigure, png: &Path, svg: &Path) -> Result<(
     let (w, mut h) = LEARNING_SIZE_PX;
     h += more_rows(fig) * (LEARNING_SIZE_PX.1 - LEARNING_TITLE_PX - 60);
     let rows = legend_rows(&styles, w as i32 - 60).map_err(|e| draw_error(png, e))?;
-    let extra_rows = rows.len().saturating_sub(1) as u32;
+    let extra_rows = rows.len().saturating_sub(1) as u32 + u32::from(has_partial_points(fig));
     let size = (w, h + extra_rows * LEGEND_ROW_PX);
 
     let mut rgb = vec![0u8; (size.0 as usize) * (size.1 as usize) * 3];
@@ -377,8 +408,23 @@ pub fn learning_figure(fig: &LearningFigure, png: &Path, svg: &Path) -> Result<(
     std::fs::write(svg, text.as_bytes()).map_err(|e| write_error(svg, e))
 }
 
-/// Most further panels of the learning figure (two rows of two).
-const MAX_MORE_PANELS: usize = 4;
+/// Most further panels of the learning figure (four rows of two).
+const MAX_MORE_PANELS: usize = 8;
+
+/// Whether a panel's point rests on fewer than all repeats (the legend then says what its
+/// open circle means).
+fn has_partial_points(fig: &LearningFigure) -> bool {
+    fig.d
+        .iter()
+        .chain(&fig.collisions)
+        .chain(
+            fig.more
+                .iter()
+                .take(MAX_MORE_PANELS)
+                .flat_map(|p| &p.series),
+        )
+        .any(|s| (0..s.x.len()).any(|i| !s.full(i)))
+}
 
 /// Rows of further panels under the first two.
 fn more_rows(fig: &LearningFigure) -> u32 {
@@ -423,6 +469,15 @@ fn validate_panel(panel: &'static str, series: &[Series]) -> Result<(), PlotErro
                     value,
                 });
             }
+        }
+        if !s.n.is_empty() && s.n.len() != n {
+            return Err(PlotError::CountMismatch {
+                panel,
+                index,
+                label: label(),
+                x: n,
+                n: s.n.len(),
+            });
         }
         if let Some(at) = (1..n).find(|&i| s.x[i] <= s.x[i - 1]) {
             return Err(PlotError::NotIncreasing {
@@ -508,7 +563,8 @@ fn draw_learning<DB: DrawingBackend>(
     root.fill(&WHITE)?;
     let (w, h) = root.dim_in_pixel();
     let legend_font = (FONT_FAMILY, LEGEND_FONT_PX).into_font().color(&INK);
-    let legend_px = rows.len() as u32 * LEGEND_ROW_PX + 14;
+    let partial = has_partial_points(fig);
+    let legend_px = (rows.len() as u32 + u32::from(partial)) * LEGEND_ROW_PX + 14;
 
     let (title_area, rest) = root.split_vertically(LEARNING_TITLE_PX);
     let (panels, legend_area) =
@@ -525,19 +581,19 @@ fn draw_learning<DB: DrawingBackend>(
 
     let rows_of_panels = 1 + more_rows(fig);
     let areas = panels.split_evenly((rows_of_panels as usize, 2));
-    let stuck = (!fig.stuck.is_empty()).then_some(fig.stuck.as_slice());
+    let held = (!fig.held.is_empty()).then_some(fig.held.as_slice());
     let first = [
         Panel {
             caption: "Mean summed sensor distance D".into(),
             y_label: "mean summed distance D (du)".into(),
             series: fig.d.clone(),
-            stuck_overlay: false,
+            held_overlay: false,
         },
         Panel {
             caption: "Collisions".into(),
             y_label: "collisions per robot per window".into(),
             series: fig.collisions.clone(),
-            stuck_overlay: true,
+            held_overlay: true,
         },
     ];
     let all = first.iter().chain(fig.more.iter().take(MAX_MORE_PANELS));
@@ -546,12 +602,12 @@ fn draw_learning<DB: DrawingBackend>(
             area,
             p,
             &fig.x_label,
-            stuck.filter(|_| p.stuck_overlay),
+            held.filter(|_| p.held_overlay),
             fig.markers,
             styles,
         )?;
     }
-    draw_curve_legend(&legend_area, styles, rows, &legend_font)
+    draw_curve_legend(&legend_area, styles, rows, &legend_font, partial)
 }
 
 /// Axis range of one panel: every mean and band value, padded; starts at 0 when the values are
@@ -633,12 +689,12 @@ fn draw_panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     panel: &Panel,
     x_label: &str,
-    stuck: Option<&[Series]>,
+    held: Option<&[Series]>,
     markers: bool,
     styles: &CurveStyles,
 ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
     let series = &panel.series;
-    let (x0, x1) = match stuck {
+    let (x0, x1) = match held {
         Some(st) => {
             let (a, b) = x_range(series);
             let (c, d) = x_range(st);
@@ -647,15 +703,17 @@ fn draw_panel<DB: DrawingBackend>(
         None => x_range(series),
     };
     let (y0, y1) = value_range(series);
+    // The right-hand axis' title is drawn inside its label area, which ends a margin short of
+    // the panel's edge, so it never reaches into the next panel's y-axis title.
     let mut chart = ChartBuilder::on(area)
         .margin_left(14)
-        .margin_right(if stuck.is_some() { 8 } else { 34 })
+        .margin_right(if held.is_some() { 26 } else { 34 })
         .margin_top(6)
         .margin_bottom(4)
         .caption(&panel.caption, (FONT_FAMILY, 22).into_font().color(&INK))
         .x_label_area_size(62)
         .y_label_area_size(92)
-        .right_y_label_area_size(if stuck.is_some() { 80 } else { 0 })
+        .right_y_label_area_size(if held.is_some() { 84 } else { 0 })
         .build_cartesian_2d(x0..x1, y0..y1)?
         .set_secondary_coord(x0..x1, 0.0..100.0);
     let y_label = panel.y_label.as_str();
@@ -675,10 +733,10 @@ fn draw_panel<DB: DrawingBackend>(
         .x_label_formatter(&x_fmt)
         .y_label_formatter(&y_fmt)
         .draw()?;
-    if let Some(st) = stuck {
+    if let Some(st) = held {
         chart
             .configure_secondary_axes()
-            .y_desc("stuck robot-steps (%), dotted")
+            .y_desc("held robot-steps (%), dotted")
             .label_style((FONT_FAMILY, 16).into_font().color(&INK))
             .axis_desc_style((FONT_FAMILY, 19).into_font().color(&INK))
             .axis_style(INK.mix(0.7))
@@ -703,29 +761,65 @@ fn draw_panel<DB: DrawingBackend>(
         }
     }
 
-    // Bands first, then dashed lines, then solid lines, so the learning runs lie on top.
+    // Bands first, then dashed lines, then solid lines, so the learning runs lie on top. A
+    // band is drawn over each run of points that rest on every repeat (a point that rests on
+    // fewer has no band: its interval would be of a part of the repeats only).
     for s in series {
-        if s.lo.iter().zip(&s.hi).all(|(l, h)| l == h) {
-            continue;
-        }
         let alpha = if s.dashed { 0.11 } else { 0.22 };
-        let outline: Vec<(f64, f64)> =
-            s.x.iter()
-                .zip(&s.hi)
-                .map(|(&x, &y)| (x, y))
-                .chain(s.x.iter().zip(&s.lo).rev().map(|(&x, &y)| (x, y)))
+        let mut i = 0;
+        while i < s.x.len() {
+            if !s.full(i) {
+                i += 1;
+                continue;
+            }
+            let start = i;
+            while i < s.x.len() && s.full(i) {
+                i += 1;
+            }
+            let run = start..i;
+            if s.lo[run.clone()]
+                .iter()
+                .zip(&s.hi[run.clone()])
+                .all(|(l, h)| l == h)
+            {
+                continue;
+            }
+            let outline: Vec<(f64, f64)> = run
+                .clone()
+                .map(|k| (s.x[k], s.hi[k]))
+                .chain(run.rev().map(|k| (s.x[k], s.lo[k])))
                 .collect();
-        chart.draw_series(std::iter::once(Polygon::new(
-            outline,
-            styles.colour(&s.label).mix(alpha).filled(),
-        )))?;
+            chart.draw_series(std::iter::once(Polygon::new(
+                outline,
+                styles.colour(&s.label).mix(alpha).filled(),
+            )))?;
+        }
     }
     for dashed in [true, false] {
         for s in series.iter().filter(|s| s.dashed == dashed) {
             let colour = styles.colour(&s.label);
             let points: Vec<(f64, f64)> = s.x.iter().copied().zip(s.mean.iter().copied()).collect();
             if markers || points.len() == 1 {
-                chart.draw_series(points.iter().map(|&p| Circle::new(p, 6, colour.filled())))?;
+                chart.draw_series(
+                    points
+                        .iter()
+                        .enumerate()
+                        .filter(|&(i, _)| s.full(i))
+                        .map(|(_, &p)| Circle::new(p, 6, colour.filled())),
+                )?;
+            }
+            // Points resting on fewer than all repeats: an open circle, the count beside it.
+            let count_font = (FONT_FAMILY, 15)
+                .into_font()
+                .color(&colour)
+                .pos(Pos::new(HPos::Left, VPos::Bottom));
+            for (i, &p) in points.iter().enumerate().filter(|&(i, _)| !s.full(i)) {
+                chart.draw_series(std::iter::once(Circle::new(p, 7, WHITE.filled())))?;
+                chart.draw_series(std::iter::once(Circle::new(p, 7, colour.stroke_width(2))))?;
+                chart.draw_series(std::iter::once(
+                    EmptyElement::at(p)
+                        + Text::new(format!("{}", s.n[i]), (8, -6), count_font.clone()),
+                ))?;
             }
             if points.len() > 1 && dashed {
                 chart.draw_series(DashedLineSeries::new(
@@ -742,12 +836,14 @@ fn draw_panel<DB: DrawingBackend>(
     Ok(())
 }
 
-/// The shared legend under both panels: a line sample over a band swatch, then the label.
+/// The shared legend under the panels: a line sample over a band swatch, then the label; with
+/// `partial`, a note on the points that rest on fewer repeats.
 fn draw_curve_legend<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     styles: &CurveStyles,
     rows: &[LegendRow],
     font: &TextStyle,
+    partial: bool,
 ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
     let (w, _) = area.dim_in_pixel();
     let text = font.pos(Pos::new(HPos::Left, VPos::Center));
@@ -772,6 +868,15 @@ fn draw_curve_legend<DB: DrawingBackend>(
             area.draw_text(label, &text, (x + LEGEND_SAMPLE_PX + 10, y))?;
             x += width;
         }
+    }
+    if partial {
+        let y = rows.len() as i32 * LEGEND_ROW_PX as i32 + 6;
+        let note = font.pos(Pos::new(HPos::Center, VPos::Center));
+        area.draw_text(
+            "open circle: a window in which fewer repeats have a value (their number beside it); no band there",
+            &note,
+            (w as i32 / 2, y),
+        )?;
     }
     Ok(())
 }
@@ -1527,6 +1632,8 @@ mod tests {
             mean: vec![lo],
             lo: vec![lo],
             hi: vec![hi],
+            n: Vec::new(),
+            repeats: 0,
         };
         // Close to 0 (within 30 % of the span): the axis starts at 0.
         assert_eq!(value_range(&[s(0.2, 1.0)]).0, 0.0);

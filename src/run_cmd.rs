@@ -1234,7 +1234,13 @@ fn write_replay(
             x: d.x.clone(),
             mean_d: d.mean.clone(),
             collisions_per_robot: find(&fig.collisions, &d.label),
-            stuck_percent: find(&fig.stuck, &d.label),
+            held_percent: find(&fig.held, &d.label),
+            net_mm: fig
+                .more
+                .iter()
+                .find(|p| p.caption.starts_with("Net progress"))
+                .map(|p| find(&p.series, &d.label))
+                .unwrap_or_default(),
         })
         .collect();
     let params = swarm::experiment::world_params(s);
@@ -1333,27 +1339,53 @@ fn warnings(s: &Scenario) -> Vec<String> {
 struct Units {
     mean_d: &'static str,
     collisions_per_robot: &'static str,
+    collisions_per_net_m: &'static str,
     collisions_per_m: &'static str,
     collisions_per_moving_step: &'static str,
     contact_percent: &'static str,
-    stuck_percent: &'static str,
+    held_percent: &'static str,
+    shuttling_percent: &'static str,
+    circling_percent: &'static str,
+    exploring_percent: &'static str,
     moving_percent: &'static str,
     moved_mm: &'static str,
+    net_mm: &'static str,
+    straightness: &'static str,
+    msd_cm2: &'static str,
+    msd_exponent: &'static str,
+    fresh_cells_per_100_steps: &'static str,
+    new_cells: &'static str,
     gap_cv: &'static str,
+    touching_percent: &'static str,
     distance_m: &'static str,
+    net_m: &'static str,
+    cells_visited: &'static str,
 }
 
 const UNITS: Units = Units {
     mean_d: "du (1 du = 80/255 cm), mean over robots and steps",
     collisions_per_robot: "collisions per robot over the window",
-    collisions_per_m: "collisions per metre the robots' centres moved (none below 1 m moved)",
-    collisions_per_moving_step: "collisions per robot-step in which the robot moved at least 5 mm",
+    collisions_per_net_m: "collisions per net metre: the robots' net displacement over 20 steps, per step, summed (none below 1 m)",
+    collisions_per_m: "collisions per metre of path the robots' centres moved (none below 1 m); a reference: shuttling adds path",
+    collisions_per_moving_step: "collisions per robot-step in which the robot moved at least 5 mm; a reference",
     contact_percent: "% of robot time with a bumper pressed",
-    stuck_percent: "% of robot-steps stuck (moved < 1 mm over the last 100 steps while driving)",
-    moving_percent: "% of robot-steps in which the robot moved at least 5 mm",
-    moved_mm: "mm a robot's centre moved per step",
-    gap_cv: "coefficient of variation of the gaps between neighbours",
-    distance_m: "metres a robot's centre moved over the run",
+    held_percent: "% of robot-steps held in place (positions over 100 steps within 5 cm of their mean, or under 2 cm of path over 20 steps)",
+    shuttling_percent: "% of robot-steps shuttling (net displacement over 20 steps under 0.2 of the path, with a reversal)",
+    circling_percent: "% of robot-steps circling (net displacement over 20 steps under 0.2 of the path, no reversal)",
+    exploring_percent: "% of robot-steps exploring (net displacement over 20 steps at least 0.2 of the path)",
+    moving_percent: "% of robot-steps in which the robot moved at least 5 mm; a reference",
+    moved_mm: "mm a robot's centre moved per step (path)",
+    net_mm: "mm per step of net progress: a robot's net displacement over the last 20 steps over 20",
+    straightness: "net progress over path",
+    msd_cm2: "cm², mean squared displacement over 1, 10 and 100 steps",
+    msd_exponent: "log10(MSD over 100 steps / MSD over 10): 2 straight driving, 1 diffusion, 0 confinement",
+    fresh_cells_per_100_steps: "cells (0.2 m) a robot enters per 100 steps that it had not been in for 100 steps",
+    new_cells: "cells (0.2 m) per robot entered for the first time in the run, over the window",
+    gap_cv: "coefficient of variation of the gaps between neighbours, over the steps in which no two touch (none when they touch in half the window)",
+    touching_percent: "% of corridor steps in which two neighbours are closer than 1 cm",
+    distance_m: "metres a robot's centre moved over the run (path)",
+    net_m: "net metres a robot made over the run",
+    cells_visited: "distinct cells (0.2 m) a robot was in over the run",
 };
 
 /// The printed tables: per condition the first and last window, the robots, the pairings and
@@ -1377,13 +1409,13 @@ fn report(t: &mut String, s: &Scenario, a: &Analysis) {
     report_claims(t, a);
 }
 
-/// Per condition: the first and last window's measures, and the robots that ended stuck or
-/// had a lasting stuck spell.
+/// Per condition: the first and last window's measures, and the robots that ended held or
+/// had a lasting held spell.
 fn report_conditions(t: &mut String, a: &Analysis) {
     let _ = writeln!(
         t,
         "{:<14} {:>26} {:>26} {:>26}",
-        "condition", "D (du)", "collisions per robot", "collisions per metre"
+        "condition", "D (du)", "collisions per robot", "collisions per net metre"
     );
     let arrow = |f: &Estimate, l: &Estimate| format!("{} -> {}", fmt_mean(f), fmt_mean(l));
     for c in &a.conditions {
@@ -1394,43 +1426,80 @@ fn report_conditions(t: &mut String, a: &Analysis) {
             c.condition.name(),
             arrow(&f.mean_d, &l.mean_d),
             arrow(&f.collisions_per_robot, &l.collisions_per_robot),
-            arrow(&f.collisions_per_m, &l.collisions_per_m),
+            arrow(&f.collisions_per_net_m, &l.collisions_per_net_m),
         );
         let _ = writeln!(
             t,
-            "{:<14} last window: D {}, collisions per metre {}",
+            "{:<14} last window: D {}, collisions per net metre {} (per path metre {})",
             "",
             fmt_est(&l.mean_d),
+            fmt_est(&l.collisions_per_net_m),
             fmt_est(&l.collisions_per_m)
         );
         let _ = writeln!(
             t,
-            "{:<14} stuck {} -> {} %; moving {} -> {} %; contact {} -> {} %; moved {} -> {} mm per step",
+            "{:<14} held {} -> {} %; shuttling {} -> {} %; circling {} -> {} %; exploring {} -> {} %",
             "",
-            fmt_mean(&f.stuck_percent),
-            fmt_est(&l.stuck_percent),
-            fmt_mean(&f.moving_percent),
-            fmt_mean(&l.moving_percent),
-            fmt_mean(&f.contact_percent),
-            fmt_est(&l.contact_percent),
+            fmt_mean(&f.held_percent),
+            fmt_est(&l.held_percent),
+            fmt_mean(&f.shuttling_percent),
+            fmt_mean(&l.shuttling_percent),
+            fmt_mean(&f.circling_percent),
+            fmt_mean(&l.circling_percent),
+            fmt_mean(&f.exploring_percent),
+            fmt_mean(&l.exploring_percent),
+        );
+        let _ = writeln!(
+            t,
+            "{:<14} net progress {} -> {} mm per step of {} -> {} mm path; MSD exponent {} -> {}; fresh cells per 100 steps {} -> {}",
+            "",
+            fmt_mean(&f.net_mm),
+            fmt_est(&l.net_mm),
             fmt_mean(&f.moved_mm),
             fmt_mean(&l.moved_mm),
+            fmt_mean(&f.msd_exponent),
+            fmt_mean(&l.msd_exponent),
+            fmt_mean(&f.fresh_cells_per_100_steps),
+            fmt_mean(&l.fresh_cells_per_100_steps),
+        );
+        let _ = writeln!(
+            t,
+            "{:<14} contact {} -> {} %; moving (5 mm a step, a reference) {} -> {} %",
+            "",
+            fmt_mean(&f.contact_percent),
+            fmt_est(&l.contact_percent),
+            fmt_mean(&f.moving_percent),
+            fmt_mean(&l.moving_percent),
         );
         if let (Some(fg), Some(lg)) = (&f.gap_cv, &l.gap_cv) {
-            let _ = writeln!(t, "{:<14} gap CV {} -> {}", "", fmt_mean(fg), fmt_est(lg));
+            let touching = match (&f.touching_percent, &l.touching_percent) {
+                (Some(ft), Some(lt)) => format!(
+                    "; neighbours touching {} -> {} % of steps",
+                    fmt_mean(ft),
+                    fmt_mean(lt)
+                ),
+                _ => String::new(),
+            };
+            let _ = writeln!(
+                t,
+                "{:<14} gap CV {} -> {} (over the steps no neighbours touch){touching}",
+                "",
+                fmt_mean(fg),
+                fmt_est(lg)
+            );
         }
         let r = &c.robots;
         let onset = r
-            .first_lasting_stuck_step_median
+            .first_lasting_held_step_median
             .map_or_else(String::new, |m| format!(", median onset step {m:.0}"));
         let _ = writeln!(
             t,
-            "{:<14} robots ending the run stuck {} of {} ({} %); a lasting stuck spell: {} of {}{onset}",
+            "{:<14} robots ending the run held {} of {} ({} %); a lasting held spell: {} of {}{onset}",
             "",
-            r.ending_stuck,
+            r.ending_held,
             r.robots,
-            fmt_est(&r.ending_stuck_percent),
-            r.with_lasting_spell,
+            fmt_est(&r.ending_held_percent),
+            r.with_lasting_held_spell,
             r.robots,
         );
     }
@@ -1441,17 +1510,45 @@ fn report_pairings(t: &mut String, a: &Analysis) {
     for p in &a.pairings {
         let _ = writeln!(
             t,
-            "robot by robot against {}: learning frees {} and traps {} of {} robots, leaves {} alone ({} stuck under both, {} under neither); McNemar exact p = {}",
+            "robot by robot against {}: learning frees {} and traps {} of {} robots held at the end, leaves {} alone ({} held under both, {} under neither); McNemar exact p = {}",
             p.other.name(),
             p.frees,
             p.traps,
             p.robots,
-            p.both_stuck + p.neither,
-            p.both_stuck,
+            p.both_held + p.neither,
+            p.both_held,
             p.neither,
             swarm::summary::fmt_p(p.p)
         );
     }
+}
+
+/// One claim's line: its outcome, its words, the values compared (or, for a claim of parts,
+/// the repeats that meet all of them), the verdict and what a decision would take.
+fn claim_line(t: &mut String, c: &Claim) {
+    let values = if c.parts.is_empty() {
+        format!(
+            "{} vs {} {}",
+            fmt_value(c.values[0]),
+            fmt_value(c.values[1]),
+            c.unit
+        )
+    } else {
+        let r = &c.repeats;
+        format!(
+            "{} of {} meet all its parts",
+            r.for_,
+            plural(r.for_ + r.against + r.tied + r.undefined, "repeat")
+        )
+    };
+    let _ = writeln!(
+        t,
+        "{:<9} {} ({values}: {}; {})",
+        c.outcome.word(),
+        c.claim,
+        c.verdict,
+        c.power.words()
+    );
 }
 
 /// The paper's claims, then those against the controls it lacks, and how many of its text
@@ -1462,27 +1559,15 @@ fn report_claims(t: &mut String, a: &Analysis) {
         t,
         "The paper's claims (learning, paired by repeat, one-sided sign test at p < 0.05):"
     );
-    let line = |t: &mut String, c: &Claim| {
-        let _ = writeln!(
-            t,
-            "{:<9} {} ({} vs {} {}: {})",
-            c.outcome.word(),
-            c.claim,
-            fmt_value(c.values[0]),
-            fmt_value(c.values[1]),
-            c.unit,
-            c.verdict
-        );
-    };
     for c in a.claims.iter().filter(|c| c.paper) {
-        line(t, c);
+        claim_line(t, c);
     }
     let _ = writeln!(
         t,
-        "Against the controls the paper lacks, and for reference:"
+        "Their parts, against the controls the paper lacks, and for reference:"
     );
     for c in a.claims.iter().filter(|c| !c.paper) {
-        line(t, c);
+        claim_line(t, c);
     }
     let paper: Vec<&Claim> = a.claims.iter().filter(|c| c.paper).collect();
     let held = paper
@@ -1499,6 +1584,33 @@ fn report_claims(t: &mut String, a: &Analysis) {
             " (see docs/claims.md for where they do)"
         }
     );
+    // The repeats that would decide every text claim at the effects seen here: what the
+    // default run's repeat count is chosen from (docs/claims.md).
+    let undecidable: Vec<&str> = paper
+        .iter()
+        .filter(|c| c.power.repeats_needed.is_none())
+        .map(|c| c.claim.split(':').next().unwrap_or(&c.claim))
+        .collect();
+    let most = paper.iter().filter_map(|c| c.power.repeats_needed).max();
+    match (most, undecidable.is_empty()) {
+        (Some(n), true) => {
+            let _ = writeln!(
+                t,
+                "at the effects seen here, about {n} repeats would decide every text claim (80 % power each)"
+            );
+        }
+        (_, false) => {
+            let _ = writeln!(
+                t,
+                "no number of repeats decides {} at the effect seen here{}",
+                undecidable.join(", "),
+                most.map_or_else(String::new, |n| format!(
+                    "; the others need about {n} repeats"
+                ))
+            );
+        }
+        (None, true) => {}
+    }
 }
 
 fn fmt_value(v: f64) -> String {
@@ -1603,18 +1715,26 @@ fn fmt_est(e: &Estimate) -> String {
 }
 
 /// The columns of `robots.csv`, one row per robot of every run.
-pub const ROBOTS_HEADER: [&str; 12] = [
+pub const ROBOTS_HEADER: [&str; 20] = [
     "condition",
     "repeat",
     "robot",
     "distance_m",
+    "net_m",
     "collisions",
     "moving_steps",
-    "stuck_steps",
-    "ends_stuck",
-    "first_lasting_stuck_step",
+    "held_steps",
+    "shuttling_steps",
+    "circling_steps",
+    "exploring_steps",
+    "cells_visited",
+    "ends_held",
+    "first_lasting_held_step",
     "last_window_distance_m",
+    "last_window_net_m",
     "last_window_collisions",
+    "last_window_cells",
+    "last_class",
     "died_at_step",
 ];
 
@@ -1625,20 +1745,32 @@ fn write_robots(path: &Path, runs: &[RunOutput]) -> Result<()> {
         w.write_record(ROBOTS_HEADER)?;
         for r in runs {
             for (i, t) in r.robots.iter().enumerate() {
+                use swarm::motion::MotionClass;
                 w.write_record([
                     r.condition.name().to_string(),
                     r.repeat.to_string(),
                     i.to_string(),
                     format!("{}", t.distance_m),
+                    format!("{}", t.net_m),
                     t.collisions.to_string(),
                     t.moving_steps.to_string(),
-                    t.stuck_steps.to_string(),
-                    u8::from(t.ends_stuck).to_string(),
-                    t.first_lasting_stuck_step
+                    t.steps_in(MotionClass::Held).to_string(),
+                    t.steps_in(MotionClass::Shuttling).to_string(),
+                    t.steps_in(MotionClass::Circling).to_string(),
+                    t.steps_in(MotionClass::Exploring).to_string(),
+                    t.cells_visited.to_string(),
+                    u8::from(t.ends_held).to_string(),
+                    t.first_lasting_held_step
                         .map(|k| k.to_string())
                         .unwrap_or_default(),
                     format!("{}", t.last_window_distance_m),
+                    format!("{}", t.last_window_net_m),
                     t.last_window_collisions.to_string(),
+                    t.last_window_cells.to_string(),
+                    t.last_class
+                        .map(MotionClass::name)
+                        .unwrap_or_default()
+                        .to_string(),
                     r.dead
                         .iter()
                         .find(|d| d.robot == i)
@@ -1675,11 +1807,13 @@ fn write_metrics_csv(path: &Path, parts: &[PathBuf]) -> Result<()> {
 }
 
 /// The learning figure: per condition, mean D and collisions per robot per window (the
-/// paper's two panels), then collisions per metre moved, contact time and, in the corridor,
-/// the gap CV and the robots moving; the stuck robot-steps drawn dotted beside every
-/// collision curve. Each curve is the mean over repeats with its 95 % band (the mean alone
-/// with one repeat); a window in which no repeat has a value (collisions per metre of robots
-/// that did not move) has no point.
+/// paper's two panels), then collisions per net metre, net progress, collisions per path metre
+/// (a reference), the area covered, contact time, exploring robot-steps and, in the corridor,
+/// the gap CV and the steps with neighbours touching; the held robot-steps drawn dotted beside
+/// every collision curve. Each curve is the mean over repeats with its 95 % band (the mean
+/// alone with one repeat); a window in which no repeat has a value (collisions per net metre of
+/// robots that went nowhere) has no point, and one in which only some have a value is drawn
+/// as an open circle with their number beside it, without a band.
 fn learning(s: &Scenario, runs: &[RunOutput]) -> LearningFigure {
     let win = s.window.max(1);
     let windows = runs
@@ -1696,7 +1830,7 @@ fn learning(s: &Scenario, runs: &[RunOutput]) -> LearningFigure {
                 continue;
             }
             of_c.sort_by_key(|r| r.repeat);
-            let (mut xs, mut m, mut lo, mut hi) = (vec![], vec![], vec![], vec![]);
+            let (mut xs, mut m, mut lo, mut hi, mut n) = (vec![], vec![], vec![], vec![], vec![]);
             for w in 0..windows {
                 let vals: Vec<Option<f64>> = of_c
                     .iter()
@@ -1710,6 +1844,7 @@ fn learning(s: &Scenario, runs: &[RunOutput]) -> LearningFigure {
                 m.push(e.mean);
                 lo.push(e.lo.unwrap_or(e.mean));
                 hi.push(e.hi.unwrap_or(e.mean));
+                n.push(e.n);
             }
             if xs.is_empty() {
                 continue;
@@ -1725,39 +1860,73 @@ fn learning(s: &Scenario, runs: &[RunOutput]) -> LearningFigure {
                 mean: m,
                 lo,
                 hi,
+                n,
+                repeats: of_c.len(),
             });
         }
         out
     };
     let mut more = Vec::new();
-    let per_m = panel(Quantity::CollisionsPerM);
-    if !per_m.is_empty() {
-        more.push(Panel {
-            caption: "Collisions per metre moved (robots that stop add nothing)".to_string(),
-            y_label: "collisions per metre".to_string(),
-            series: per_m,
-            stuck_overlay: true,
-        });
-    }
-    more.push(Panel {
-        caption: "Contact time (a bumper pressed)".to_string(),
-        y_label: "% of robot time".to_string(),
-        series: panel(Quantity::ContactPercent),
-        stuck_overlay: false,
-    });
-    if runs.iter().all(|r| r.metrics.whole.all_have_gap_cv()) {
-        more.push(Panel {
-            caption: "Gap CV between neighbours (evenly spaced: low)".to_string(),
-            y_label: "coefficient of variation".to_string(),
-            series: panel(Quantity::GapCv),
-            stuck_overlay: false,
-        });
-        more.push(Panel {
-            caption: "Robots moving (at least 5 mm in a step)".to_string(),
-            y_label: "% of robot-steps".to_string(),
-            series: panel(Quantity::MovingPercent),
-            stuck_overlay: false,
-        });
+    let mut add = |caption: &str, y_label: &str, q: Quantity, held_overlay: bool| {
+        let series = panel(q);
+        if !series.is_empty() {
+            more.push(Panel {
+                caption: caption.to_string(),
+                y_label: y_label.to_string(),
+                series,
+                held_overlay,
+            });
+        }
+    };
+    add(
+        "Collisions per net metre (shuttling and standing earn nothing)",
+        "collisions per net metre",
+        Quantity::CollisionsPerNetM,
+        true,
+    );
+    add(
+        "Net progress (net displacement over 20 steps, per step)",
+        "mm per step",
+        Quantity::NetMm,
+        false,
+    );
+    add(
+        "Collisions per path metre (a reference: shuttling adds path)",
+        "collisions per metre of path",
+        Quantity::CollisionsPerM,
+        true,
+    );
+    add(
+        "Area covered (cells of 0.2 m not visited for 100 steps)",
+        "fresh cells per 100 steps",
+        Quantity::FreshCells,
+        false,
+    );
+    add(
+        "Contact time (a bumper pressed)",
+        "% of robot time",
+        Quantity::ContactPercent,
+        false,
+    );
+    add(
+        "Robot-steps exploring (net at least 0.2 of the path)",
+        "% of robot-steps",
+        Quantity::ExploringPercent,
+        false,
+    );
+    if runs.iter().all(|r| r.metrics.whole.is_corridor()) {
+        add(
+            "Gap CV between neighbours (steps none touch; even: low)",
+            "coefficient of variation",
+            Quantity::GapCv,
+            false,
+        );
+        add(
+            "Steps with neighbours touching (closer than 1 cm)",
+            "% of steps",
+            Quantity::TouchingPercent,
+            false,
+        );
     }
     LearningFigure {
         title: format!(
@@ -1777,7 +1946,7 @@ fn learning(s: &Scenario, runs: &[RunOutput]) -> LearningFigure {
         d: panel(Quantity::MeanD),
         collisions: panel(Quantity::CollisionsPerRobot),
         more,
-        stuck: panel(Quantity::StuckPercent),
+        held: panel(Quantity::HeldPercent),
         markers: windows < 3,
     }
 }
@@ -1819,7 +1988,8 @@ fn arena(s: &Scenario, t: &swarm::experiment::Track) -> Vec<ArenaFigure> {
             .collect();
         ArenaFigure {
             title: format!(
-                "{} {} steps ({:.0}-{:.0} s), {} robots{}",
+                "learning, repeat 0, seed {}: {} {} steps ({:.0}-{:.0} s), {} robots{}",
+                s.seed,
                 if from == 0 { "first" } else { "last" },
                 to - from,
                 t0,

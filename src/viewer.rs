@@ -53,8 +53,10 @@ pub struct CurveHeader {
     pub mean_d: Vec<f64>,
     /// Collisions per robot per window.
     pub collisions_per_robot: Vec<f64>,
-    /// Stuck robot-steps, percent.
-    pub stuck_percent: Vec<f64>,
+    /// Held robot-steps, percent.
+    pub held_percent: Vec<f64>,
+    /// Net progress, mm per step (empty when no window has a value).
+    pub net_mm: Vec<f64>,
 }
 
 /// The header of a replay: everything the page needs besides the frames.
@@ -328,7 +330,8 @@ mod tests {
             bumpers: [k.is_multiple_of(2), false, i == 1, k.is_multiple_of(3)],
             p: [k as u8, 255, 7, (i * 40) as u8],
             d: k as i16 + 262 + 40 * i as i16,
-            stuck: i == 0 && k > 4,
+            held: i == 0 && k > 4,
+            motion: (k > 0).then(|| swarm::motion::MotionClass::ALL[(k as usize + i) % 4]),
             saved: k == 6,
             dead: false,
             load_percent: 0.37 * t,
@@ -409,7 +412,11 @@ mod tests {
                     let dh = (got.heading_rad - want.heading_rad.rem_euclid(tau)).rem_euclid(tau);
                     assert!(dh.min(tau - dh) <= std::f64::consts::PI / 256.0 + 1e-12);
                     assert_eq!(got.flags & 7, want.behaviour);
-                    assert_eq!(got.flags & flag::STUCK != 0, want.stuck);
+                    assert_eq!(got.flags & flag::HELD != 0, want.held);
+                    assert_eq!(
+                        (got.flags & flag::MOTION) >> flag::MOTION_SHIFT,
+                        want.motion.map_or(0, swarm::motion::MotionClass::code)
+                    );
                     assert_eq!(got.flags & flag::SAVED != 0, want.saved);
                     assert_eq!(got.p, want.p);
                     let bits = want

@@ -35,6 +35,8 @@ fn series(label: &str, dashed: bool, n: usize, band: f64, f: impl Fn(f64) -> f64
         hi: mean.iter().map(|m| m + band).collect(),
         x,
         mean,
+        n: Vec::new(),
+        repeats: 5,
     }
 }
 
@@ -58,7 +60,7 @@ fn learning() -> LearningFigure {
             series("random walk", true, 100, 0.08, |x| 0.95 - 0.03 * wiggle(x)),
         ],
         more: Vec::new(),
-        stuck: Vec::new(),
+        held: Vec::new(),
         markers: false,
     }
 }
@@ -606,6 +608,12 @@ mod sweeps {
             mean: (0..n).map(|_| value(rng)).collect(),
             lo: (0..n).map(|_| value(rng)).collect(),
             hi: (0..n).map(|_| value(rng)).collect(),
+            n: if rng.random() {
+                Vec::new()
+            } else {
+                (0..n).map(|_| rng.random_range(1..6)).collect()
+            },
+            repeats: 5,
             x,
         }
     }
@@ -658,7 +666,7 @@ mod sweeps {
                     .map(|_| random_series(&mut rng))
                     .collect(),
                 more: Vec::new(),
-                stuck: Vec::new(),
+                held: Vec::new(),
                 markers: rng.random(),
             };
             let result = learning_figure(&fig, &dir.join("fig.png"), &dir.join("fig.svg"));
@@ -689,20 +697,20 @@ mod sweeps {
 }
 
 #[test]
-fn six_panels_with_the_stuck_overlay_and_side_by_side_arenas_are_drawn() {
+fn six_panels_with_the_held_overlay_and_side_by_side_arenas_are_drawn() {
     let dir = out_dir("four_panels");
     let mut fig = learning();
-    let panel = |caption: &str, series: &[Series], stuck_overlay| h8swarm::plot::Panel {
+    let panel = |caption: &str, series: &[Series], held_overlay| h8swarm::plot::Panel {
         caption: caption.into(),
         y_label: "y".into(),
         series: series.to_vec(),
-        stuck_overlay,
+        held_overlay,
     };
     fig.more = vec![
         panel("Collisions per metre", &fig.collisions, true),
         panel("Contact time", &fig.d, false),
     ];
-    fig.stuck = fig
+    fig.held = fig
         .collisions
         .iter()
         .map(|s| Series {
@@ -724,10 +732,7 @@ fn six_panels_with_the_stuck_overlay_and_side_by_side_arenas_are_drawn() {
     let (_, h3) = png_size(&std::fs::read(&png).unwrap());
     assert!(h3 > h2 + 400, "a third row: {h3} after {h2}");
     let svg_text = std::fs::read_to_string(&svg).unwrap();
-    assert!(
-        svg_text.contains("stuck robot-steps"),
-        "the right-hand axis"
-    );
+    assert!(svg_text.contains("held robot-steps"), "the right-hand axis");
     let panels = dir.join("arena.png");
     h8swarm::plot::arena_figure_panels(&[arena(3, 1.8, 200), arena(3, 1.8, 200)], &panels)
         .expect("draw panels");
@@ -839,4 +844,127 @@ fn the_space_time_figure_is_drawn() {
         plot::spacetime_figure(&empty, &png),
         Err(PlotError::NothingToDraw)
     ));
+}
+
+/// The SVG's rotated axis titles: (x, y, font size, angle, text).
+fn axis_titles(svg: &str) -> Vec<(f64, f64, f64, u32, String)> {
+    let mut out = Vec::new();
+    let mut rest = svg;
+    while let Some(at) = rest.find("<text ") {
+        rest = &rest[at..];
+        let end = rest.find("</text>").unwrap();
+        let element = &rest[..end];
+        rest = &rest[end..];
+        let attr = |name: &str| -> Option<&str> {
+            let k = element.find(&format!(" {name}=\""))? + name.len() + 3;
+            Some(&element[k..k + element[k..].find('"')?])
+        };
+        let Some(transform) = attr("transform") else {
+            continue;
+        };
+        let angle: u32 = transform
+            .trim_start_matches("rotate(")
+            .split(',')
+            .next()
+            .unwrap()
+            .trim()
+            .parse()
+            .unwrap();
+        let num = |name| attr(name).unwrap().parse::<f64>().unwrap();
+        let text = element[element.find('>').unwrap() + 1..].trim().to_string();
+        out.push((num("x"), num("y"), num("font-size"), angle, text));
+    }
+    out
+}
+
+/// The right-hand axis title of a panel with the held overlay keeps clear of the y-axis title
+/// of the panel beside it: at least one and a half letters' height between the two (they were
+/// 22 px apart at a 15 px font, reading as one label running into the next panel).
+#[test]
+fn a_right_axis_title_keeps_clear_of_the_next_panel_s() {
+    let dir = out_dir("axis_titles");
+    let mut fig = learning();
+    let panel = |caption: &str, series: &[Series], held_overlay| h8swarm::plot::Panel {
+        caption: caption.into(),
+        y_label: "% of robot time".into(),
+        series: series.to_vec(),
+        held_overlay,
+    };
+    fig.more = vec![
+        panel("Collisions per net metre", &fig.collisions, true),
+        panel("Contact time", &fig.d, false),
+    ];
+    fig.held = fig.collisions.clone();
+    let (png, svg) = (dir.join("fig.png"), dir.join("fig.svg"));
+    learning_figure(&fig, &png, &svg).expect("draw");
+    let titles = axis_titles(&std::fs::read_to_string(&svg).unwrap());
+    let right: Vec<_> = titles.iter().filter(|t| t.3 == 90).collect();
+    assert_eq!(right.len(), 2, "two panels carry the overlay: {titles:?}");
+    let mut checked = 0;
+    for r in right {
+        for l in titles.iter().filter(|t| t.3 == 270 && t.0 > r.0) {
+            // Side by side when their vertical spans overlap.
+            if (l.1 - r.1).abs() < 200.0 {
+                assert!(
+                    l.0 - r.0 >= 1.5 * r.2,
+                    "`{}` at x = {} and `{}` at x = {}: {} px apart at a {} px font",
+                    r.4,
+                    r.0,
+                    l.4,
+                    l.0,
+                    l.0 - r.0,
+                    r.2
+                );
+                checked += 1;
+            }
+        }
+    }
+    assert_eq!(
+        checked, 1,
+        "the bottom-left panel has a neighbour: {checked}"
+    );
+}
+
+/// A point that rests on fewer repeats than the condition ran is drawn as an open circle with
+/// its count, the legend says so, and no band is drawn through it (learning off's collisions
+/// per metre were drawn as 0.00 with a zero-width band where 3 of 5 repeats had a value).
+#[test]
+fn points_resting_on_fewer_repeats_are_marked_and_have_no_band() {
+    let dir = out_dir("partial_points");
+    let polygons = |fig: &LearningFigure| -> usize {
+        let (png, svg) = (dir.join("fig.png"), dir.join("fig.svg"));
+        learning_figure(fig, &png, &svg).expect("draw");
+        std::fs::read_to_string(&svg)
+            .unwrap()
+            .matches("<polygon")
+            .count()
+    };
+    let mut fig = learning();
+    fig.d.truncate(1);
+    fig.collisions.truncate(1);
+    let full = polygons(&fig);
+    // One point in the middle of the collisions curve rests on 3 of 5 repeats: its band is cut
+    // in two.
+    let k = fig.collisions[0].x.len() / 2;
+    let mut n = vec![5; fig.collisions[0].x.len()];
+    n[k] = 3;
+    fig.collisions[0].n = n;
+    assert_eq!(
+        polygons(&fig),
+        full + 1,
+        "the band cut in two at the partial point"
+    );
+    let svg = std::fs::read_to_string(dir.join("fig.svg")).unwrap();
+    assert!(
+        svg.contains("open circle: a window in which fewer repeats"),
+        "the note"
+    );
+    assert!(svg.contains(">\n3\n</text>"), "its count beside it");
+    // Every point partial: no band at all for that curve.
+    fig.collisions[0].n = vec![3; fig.collisions[0].x.len()];
+    assert_eq!(polygons(&fig), full - 1);
+    // A count per point or none.
+    fig.collisions[0].n = vec![3; 2];
+    let err = learning_figure(&fig, &dir.join("x.png"), &dir.join("x.svg")).unwrap_err();
+    assert!(matches!(err, PlotError::CountMismatch { .. }), "{err:?}");
 }

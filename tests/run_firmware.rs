@@ -72,13 +72,13 @@ fn firmware_robots_write_every_output_with_their_cpu_load_and_the_same_for_any_t
     }
     let m = metrics(&a);
     assert!(m.starts_with(
-        "condition,repeat,step,mean_d,collisions_per_robot,contact_percent,stuck_percent,moving_percent,moved_mm,gap_cv,cpu_load_percent,energy_per_robot_mj"
+        "condition,repeat,step,mean_d,collisions_per_robot,contact_percent,held_percent,shuttling_percent,circling_percent,exploring_percent,moving_percent,moved_mm,net_mm,msd_1_cm2,msd_10_cm2,msd_100_cm2,fresh_cells,new_cells,gap_cv,robots_touching,cpu_load_percent,energy_per_robot_mj"
     ));
     // Every step's CPU load: the ticks and the step at least (about 0.1 %), a save about 5 %.
     let loads: Vec<f64> = m
         .lines()
         .skip(1)
-        .map(|l| l.split(',').nth(10).unwrap().parse().unwrap())
+        .map(|l| l.split(',').nth(20).unwrap().parse().unwrap())
         .collect();
     assert!(loads.iter().all(|&l| l > 0.05 && l < 10.0), "{loads:?}");
     assert!(loads.iter().any(|&l| l > 4.0), "a step with a save");

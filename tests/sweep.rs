@@ -486,3 +486,143 @@ fn the_readme_example_plans() {
     assert_eq!(first["id"], "p0000-eta0.001-history0-s1");
     assert_eq!(first["scenario"]["steps"], 2000);
 }
+
+/// The confirmation stage: a map of two cells on seed 1, one cell confirmed on seed 21 (the
+/// map's point with only its seed and name changed), merged beside the map; the reserved seeds
+/// and a map that is not finished are refused.
+#[test]
+fn a_confirmation_reruns_chosen_cells_on_new_seeds_and_merge_reports_both() {
+    let root = fresh("confirm");
+    let map = root.join("map");
+    let file = root.join("c.toml");
+    let sweep = r#"
+name = "conf"
+seeds = [1]
+[set]
+steps = 30
+window = 10
+repeats = 1
+controls.learning_off = false
+[grid]
+"learner.eta" = [0.01, 0.03]
+[confirm]
+seeds = [21]
+cells = [{ "learner.eta" = 0.03 }]
+"#;
+    std::fs::write(&file, sweep).unwrap();
+    ok(&["sweep", "plan", s(&file), "--out", s(&map)]);
+    // Not before the map is finished.
+    let (code, err) = fails(&["sweep", "confirm", s(&map)], &[]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("not complete"), "{err}");
+    ok(&["sweep", "run", s(&map), "--threads", "1"]);
+    ok(&["sweep", "merge", s(&map)]);
+    let text = ok(&["sweep", "confirm", s(&map)]);
+    assert!(
+        text.contains("1 cells") && text.contains("learner.eta = 0.03"),
+        "{text}"
+    );
+    let cdir = map.join("confirm");
+    let list = std::fs::read_to_string(cdir.join("points.jsonl")).unwrap();
+    let lines: Vec<serde_json::Value> = list
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(lines.len(), 1);
+    assert_eq!(lines[0]["seed"], 21);
+    // The map's point of that cell, but for its seed and name.
+    let map_list = std::fs::read_to_string(map.join("points.jsonl")).unwrap();
+    let mut src: serde_json::Value =
+        serde_json::from_str(map_list.lines().nth(1).unwrap()).unwrap();
+    let mut got = lines[0]["scenario"].clone();
+    for v in [&mut src["scenario"], &mut got] {
+        v.as_object_mut().unwrap().remove("seed");
+        v.as_object_mut().unwrap().remove("name");
+    }
+    assert_eq!(got, src["scenario"]);
+    // Planning it again is allowed (the same run list); the merge before it is run lists it
+    // as missing.
+    ok(&["sweep", "confirm", s(&map)]);
+    let text = ok(&["sweep", "merge", s(&map)]);
+    assert!(text.contains("MISSING p0000"), "{text}");
+    assert!(text.contains("INCOMPLETE (0 of 1 points)"), "{text}");
+    ok(&["sweep", "run", s(&cdir), "--threads", "1"]);
+    let text = ok(&["sweep", "merge", s(&map), "--require-complete"]);
+    assert!(
+        text.contains("confirmation of `conf` on seeds 21"),
+        "{text}"
+    );
+    assert!(
+        text.contains("no cell is confirmed") || text.contains("the rule's default"),
+        "{text}"
+    );
+    let table = std::fs::read_to_string(map.join("merged/confirmation.csv")).unwrap();
+    assert_eq!(table.lines().count(), 2, "{table}");
+    assert!(table.starts_with("rank,cell,learner.eta,"), "{table}");
+    assert!(map.join("merged/confirm/sweep.csv").is_file());
+    // The same bytes when merged again.
+    ok(&["sweep", "merge", s(&map)]);
+    assert_eq!(
+        table,
+        std::fs::read_to_string(map.join("merged/confirmation.csv")).unwrap()
+    );
+    // A tampered confirm.json or run list is one line and status 2, not a panic (a point's
+    // position outside the grid indexed past the map's cells).
+    let record = cdir.join("confirm.json");
+    let good = std::fs::read_to_string(&record).unwrap();
+    std::fs::write(
+        &record,
+        good.replace("\"cells\": [\n    1\n  ]", "\"cells\": [\n    9\n  ]"),
+    )
+    .unwrap();
+    let (code, err) = fails(&["sweep", "merge", s(&map)], &[]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("names cell 9"), "{err}");
+    // Map and confirmation are one commit: the map's half is not written either.
+    let elsewhere = root.join("elsewhere");
+    let (code, err) = fails(&["sweep", "merge", s(&map), "--out", s(&elsewhere)], &[]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        !elsewhere.join("sweep.csv").exists(),
+        "the map's merge was committed without its confirmation"
+    );
+    let left: Vec<_> = std::fs::read_dir(&root)
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.contains("partial"))
+        .collect();
+    assert!(left.is_empty(), "staging left behind: {left:?}");
+    std::fs::write(&record, good).unwrap();
+    let list_path = map.join("points.jsonl");
+    let list = std::fs::read_to_string(&list_path).unwrap();
+    std::fs::write(
+        &list_path,
+        list.replacen("\"coords\":[1]", "\"coords\":[7]", 1),
+    )
+    .unwrap();
+    let (code, err) = fails(&["sweep", "merge", s(&map)], &[]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("lie outside the plan's axes"), "{err}");
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    std::fs::write(&list_path, list).unwrap();
+    // Seeds 11-20 are refused by plan; and a sweep without [confirm] has nothing to confirm.
+    let bad = root.join("bad.toml");
+    std::fs::write(&bad, sweep.replace("seeds = [21]", "seeds = [21, 13]")).unwrap();
+    let (code, err) = fails(
+        &["sweep", "plan", s(&bad), "--out", s(&root.join("bad"))],
+        &[],
+    );
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("seed 13") && err.contains("reserved"), "{err}");
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    let plain = root.join("plain.toml");
+    let cut = sweep.find("[confirm]").unwrap();
+    std::fs::write(&plain, &sweep[..cut]).unwrap();
+    let pdir = root.join("plain");
+    ok(&["sweep", "plan", s(&plain), "--out", s(&pdir)]);
+    ok(&["sweep", "run", s(&pdir), "--threads", "1"]);
+    let (code, err) = fails(&["sweep", "confirm", s(&pdir)], &[]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("no [confirm] section"), "{err}");
+}

@@ -18,6 +18,7 @@ use std::time::{Duration, Instant};
 
 use serde_json::{Value, json};
 use swarm::experiment::Swarm;
+use swarm::motion::{MotionClass, MotionTracker};
 use swarm::robot::Condition;
 use swarm::scenario::Scenario;
 
@@ -222,17 +223,39 @@ fn ready(tab: &mut Tab) {
 }
 
 /// The robots' poses at step `k` of the learning run's repeat 0, from the library.
-fn truth(s: &Scenario, images: Option<&swarm::robot::Images>, k: u32) -> Vec<(f64, f64, f64)> {
+/// Each robot's pose (x, y, heading) at a step instant.
+type Poses = Vec<(f64, f64, f64)>;
+
+/// Where the robots are at step `k`'s instant, and the motion class of each one's step
+/// before it (none at step 0), as the run's own trackers classify them.
+fn truth(
+    s: &Scenario,
+    images: Option<&swarm::robot::Images>,
+    k: u32,
+) -> (Poses, Vec<Option<MotionClass>>) {
     let mut swarm = Swarm::new(s, Condition::Learning, 0, false, images).unwrap();
-    for _ in 0..=k {
-        swarm.step().unwrap();
+    let mut trackers = vec![MotionTracker::new(); s.robots];
+    let mut classes = vec![None; s.robots];
+    for (i, t) in trackers.iter_mut().enumerate() {
+        let p = swarm.world().pose(i).unwrap();
+        t.start(p.x_m, p.y_m);
     }
-    (0..s.robots)
+    for step in 0..=k {
+        swarm.step().unwrap();
+        if step > 0 {
+            for (i, t) in trackers.iter_mut().enumerate() {
+                let p = swarm.world().pose(i).unwrap();
+                classes[i] = Some(t.record(p.x_m, p.y_m).class);
+            }
+        }
+    }
+    let poses = (0..s.robots)
         .map(|i| {
             let p = swarm.world().pose(i).unwrap();
             (p.x_m, p.y_m, p.heading_rad)
         })
-        .collect()
+        .collect();
+    (poses, classes)
 }
 
 fn angle_gap(a: f64, b: f64) -> f64 {
@@ -258,7 +281,7 @@ fn check_page(browser: &Browser, dir: &Path, s: &Scenario, k: u32, controller: &
     );
     let drawn = tab.eval("h8.drawn()");
     let images = swarm::robot::Images::load(s).unwrap();
-    let truth = truth(s, images.as_ref(), k);
+    let (truth, classes) = truth(s, images.as_ref(), k);
     for (i, (x, y, h)) in truth.iter().enumerate() {
         let d = &drawn[i];
         let (dx, dy, dh) = (
@@ -305,9 +328,14 @@ fn check_page(browser: &Browser, dir: &Path, s: &Scenario, k: u32, controller: &
         .iter()
         .map(|v| v.to_string())
         .collect();
+    let facts = insp["facts"].as_str().unwrap();
+    assert!(facts.contains(&p.join(" / ")), "{insp} {rec}");
+    // The motion class the run gave robot 1's last step, and where it went.
+    let want = classes[1].map_or("(from the first step on)", MotionClass::name);
+    assert!(facts.contains(&format!("motion     {want}")), "{facts}");
     assert!(
-        insp["facts"].as_str().unwrap().contains(&p.join(" / ")),
-        "{insp} {rec}"
+        facts.contains("net, path  ") && facts.contains("cells      "),
+        "{facts}"
     );
     // A click on robot 1's drawn centre selects it too.
     tab.eval("h8.select(-1)");
@@ -370,7 +398,7 @@ fn the_viewer_shows_the_run_as_recorded() {
     ready(&mut tab);
     assert_eq!(tab.eval("h8.setFrame(20); h8.step()"), 40);
     let drawn = tab.eval("h8.drawn()");
-    for (i, (x, y, _)) in truth(&s, None, 40).iter().enumerate() {
+    for (i, (x, y, _)) in truth(&s, None, 40).0.iter().enumerate() {
         let (dx, dy) = (
             drawn[i]["x_m"].as_f64().unwrap(),
             drawn[i]["y_m"].as_f64().unwrap(),

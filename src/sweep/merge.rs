@@ -6,7 +6,7 @@
 //!   that is neither finished nor failed), one column per swept key, `seed`; then for every
 //!   condition and window of the points' summary.json the mean and 95 % interval of each
 //!   statistic (`learning.last.collisions_per_m.mean`, `….lo`, `….hi`) and of each condition's
-//!   robots (`learning.robots.ending_stuck_percent.mean`, `learning.robots.ending_stuck`, …);
+//!   robots (`learning.robots.ending_held_percent.mean`, `learning.robots.ending_held`, …);
 //!   then for every claim (column names from its text, `claim.<words>.…`): `outcome` (`holds`,
 //!   `unsure`, `fails`, `undecided`), `means_agree`, `apart` (intervals apart), `a` and `b`
 //!   (the two means compared: the claim is "a below b"), `effect` = b − a (positive when the
@@ -37,16 +37,21 @@ use super::points::{PointState, host_name, is_dead_leftover, point_state, read_s
 use swarm::text::printable;
 
 /// The statistics of a window in the order the table lists them (others follow, sorted).
-const STAT_ORDER: [&str; 9] = [
+const STAT_ORDER: [&str; 14] = [
     "mean_d",
     "collisions_per_robot",
+    "collisions_per_net_m",
     "collisions_per_m",
-    "collisions_per_moving_step",
     "contact_percent",
-    "stuck_percent",
-    "moving_percent",
+    "held_percent",
+    "shuttling_percent",
+    "circling_percent",
+    "exploring_percent",
+    "net_mm",
     "moved_mm",
+    "fresh_cells_per_100_steps",
     "gap_cv",
+    "touching_percent",
 ];
 
 /// A claim's words as a column name: lower case, runs of anything but letters and digits as
@@ -236,28 +241,108 @@ fn earlier_figures(out: &Path) -> Vec<String> {
         .collect()
 }
 
-/// Merges the sweep in `dir` into `out` (default `DIR/merged`); returns what to print and
-/// whether every point finished.
+/// Merges the sweep in `dir` into `out` (default `DIR/merged`) and, when `dir` holds a
+/// confirmation ([`super::confirm`]), it into `out/confirm` with the two side by side; returns
+/// what to print and whether every point of both finished. Every file of both is written into
+/// one staging folder and moved into place in one commit ([`crate::stage`]): a failure leaves
+/// `out` as it was, map and confirmation alike.
 ///
 /// # Errors
 /// Not a sweep folder (input); an output that cannot be written (tool).
 pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepError> {
-    let (plan, lines, m) = collect(dir)?;
     let out: PathBuf = out.map_or_else(|| dir.join("merged"), Path::to_path_buf);
-    let plots = out.join("plots");
-    // Every file is written into a staging folder beside `out` and moved into place in one
-    // commit (crate::stage): a failure (a full disk) leaves `out` as it was. Only merge's own
-    // files are replaced: the figures of an earlier merge into `out` (its sweep.json lists
-    // them) that this one does not draw again are removed; anything else in `out` or
-    // `out/plots` is the user's and stays.
-    let earlier = earlier_figures(&out);
     let stage = crate::stage::Stage::new("--out", &out).map_err(|e| SweepError::tool(e.0))?;
-    let staged_plots = stage.path("plots");
+    let mut done = merge_into(dir, &stage, "")?;
+    // Merge's own files of an earlier merge into `out` that this one may not write again: the
+    // confirmation's (a map merged without one leaves no stale confirmation beside it).
+    let confirm_prefix = format!("{}/", super::confirm::CONFIRM_DIR);
+    done.ours.extend(
+        ["confirmation.csv", "confirmation.json"]
+            .into_iter()
+            .map(str::to_string),
+    );
+    done.ours.extend(
+        ["sweep.csv", "sweep.json"]
+            .into_iter()
+            .map(|f| format!("{confirm_prefix}{f}")),
+    );
+    done.ours.extend(
+        earlier_figures(&out.join(super::confirm::CONFIRM_DIR))
+            .into_iter()
+            .map(|f| format!("{confirm_prefix}{f}")),
+    );
+    if dir
+        .join(super::confirm::CONFIRM_DIR)
+        .join("plan.json")
+        .is_file()
+    {
+        let _ = writeln!(done.text);
+        let c = super::confirm::merge_confirmation(dir, &stage)?;
+        done.text.push_str(&c.text);
+        done.complete &= c.complete;
+        done.files.extend(c.files);
+        done.folders.extend(c.folders);
+    }
+    stage
+        .commit(&crate::stage::Commit {
+            files: done.files,
+            ours: done.ours,
+            folders: done.folders,
+        })
+        .map_err(|e| {
+            SweepError::tool(format!(
+                "the merge into `{}` could not be moved into place: {e}",
+                out.display()
+            ))
+        })?;
+    Ok((done.text, done.complete))
+}
+
+/// What one merge staged ([`merge_into`]): the text to print, whether every point finished,
+/// and the staged files, merge's earlier files to remove and the folders, as the stage's
+/// commit takes them.
+pub(super) struct Staged {
+    /// What to print.
+    pub text: String,
+    /// Whether every point finished.
+    pub complete: bool,
+    /// Staged files, relative to the output folder.
+    pub files: Vec<String>,
+    /// Merge's files of an earlier merge that go when not written again.
+    pub ours: Vec<String>,
+    /// Folders that exist after the commit.
+    pub folders: Vec<String>,
+}
+
+/// Merges the sweep in `dir` into the staging folder `stage` under `prefix` (`""` for the
+/// output folder itself, `"confirm/"` for the confirmation's sub-folder): `sweep.csv`,
+/// `sweep.json` and the figures in `plots/`. Nothing is committed.
+///
+/// # Errors
+/// Not a sweep folder (input); a file that cannot be written (tool).
+pub(super) fn merge_into(
+    dir: &Path,
+    stage: &crate::stage::Stage,
+    prefix: &str,
+) -> Result<Staged, SweepError> {
+    let (plan, lines, m) = collect(dir)?;
+    let out = stage.out().join(prefix);
+    let plots = out.join("plots");
+    // Every file is written into the staging folder and moved into place in one commit
+    // (crate::stage): a failure (a full disk) leaves `out` as it was. Only merge's own files
+    // are replaced: the figures of an earlier merge into `out` (its sweep.json lists them) that
+    // this one does not draw again are removed; anything else in `out` or `out/plots` is the
+    // user's and stays.
+    let earlier: Vec<String> = earlier_figures(&out)
+        .into_iter()
+        .map(|f| format!("{prefix}{f}"))
+        .collect();
+    let staged_plots = stage.path(&format!("{prefix}plots"));
     std::fs::create_dir_all(&staged_plots).map_err(|e| {
         SweepError::tool(format!("cannot create `{}`: {e}", staged_plots.display()))
     })?;
 
-    write_csv(&m, &stage.path("sweep.csv"))?;
+    write_csv(&m, &stage.path(&format!("{prefix}sweep.csv")))?;
     let csv_path = out.join("sweep.csv");
 
     let series = claim_series(&m);
@@ -294,22 +379,10 @@ pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepErro
     let text = serde_json::to_string_pretty(&doc)
         .map_err(|e| SweepError::tool(format!("writing sweep.json: {e}")))?
         + "\n";
-    std::fs::write(stage.path("sweep.json"), text.as_bytes())
+    std::fs::write(stage.path(&format!("{prefix}sweep.json")), text.as_bytes())
         .map_err(|e| SweepError::tool(format!("cannot write `{}`: {e}", json_path.display())))?;
-    let mut files = vec!["sweep.csv".to_string(), "sweep.json".to_string()];
-    files.extend(figure_names.iter().cloned());
-    stage
-        .commit(&crate::stage::Commit {
-            files,
-            ours: earlier,
-            folders: vec!["plots".into()],
-        })
-        .map_err(|e| {
-            SweepError::tool(format!(
-                "the merge into `{}` could not be moved into place: {e}",
-                out.display()
-            ))
-        })?;
+    let mut files = vec![format!("{prefix}sweep.csv"), format!("{prefix}sweep.json")];
+    files.extend(figure_names.iter().map(|f| format!("{prefix}{f}")));
 
     let mut t = String::new();
     let _ = writeln!(
@@ -323,6 +396,7 @@ pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepErro
         m.broken.len()
     );
     render_points(&mut t, &m, dir);
+    render_repeat_warning(&mut t, &plan, &lines);
     for (slug, text, _) in &m.claims {
         let col = format!("claim.{slug}.outcome");
         let with: Vec<&str> = m
@@ -338,6 +412,7 @@ pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepErro
             printable(text)
         );
     }
+    render_power(&mut t, &plan, &coords, &paper);
     if !paper.is_empty() {
         let cells: usize = plan.axes.iter().map(|a| a.values.len()).product();
         let _ = writeln!(
@@ -370,7 +445,21 @@ pub fn merge(dir: &Path, out: Option<&Path>) -> Result<(String, bool), SweepErro
         let _ = writeln!(t, "(no claim had values to draw)");
     }
     let complete = m.failed.is_empty() && m.missing.is_empty() && m.broken.is_empty();
-    Ok((t, complete))
+    let folders = if prefix.is_empty() {
+        vec!["plots".to_string()]
+    } else {
+        vec![
+            prefix.trim_end_matches('/').to_string(),
+            format!("{prefix}plots"),
+        ]
+    };
+    Ok(Staged {
+        text: t,
+        complete,
+        files,
+        ours: earlier,
+        folders,
+    })
 }
 
 /// Writes the merged table to `path` (rendered in memory, then written in one step).
@@ -391,7 +480,7 @@ fn write_csv(m: &Merged, path: &Path) -> Result<(), SweepError> {
 
 /// Each claim's result per point (its repeats for, against and tied, and its effect), for the
 /// figures.
-fn claim_series(m: &Merged) -> Vec<ClaimSeries> {
+pub(super) fn claim_series(m: &Merged) -> Vec<ClaimSeries> {
     m.claims
         .iter()
         .map(|(slug, text, paper)| ClaimSeries {
@@ -420,6 +509,91 @@ fn claim_series(m: &Merged) -> Vec<ClaimSeries> {
                 .collect(),
         })
         .collect()
+}
+
+/// The warning `h8swarm run` gives when a point's repeats cannot reach p < 0.05, for the
+/// points of the plan, and whether a cell's pooled repeats can.
+fn render_repeat_warning(
+    t: &mut String,
+    plan: &super::plan::Plan,
+    lines: &[super::plan::PlanLine],
+) {
+    let repeats: Vec<i64> = lines
+        .iter()
+        .filter_map(|l| l.scenario.get("repeats").and_then(toml::Value::as_integer))
+        .collect();
+    let Some(&fewest) = repeats.iter().min() else {
+        return;
+    };
+    let min_needed = 5;
+    if fewest >= min_needed {
+        return;
+    }
+    let pooled = fewest * plan.seeds.len() as i64;
+    let _ = writeln!(
+        t,
+        "WARNING points of {fewest} repeats: a point's own one-sided sign test needs at least {min_needed} repeats all going one way to reach p < 0.05, so no claim can hold in a point{}",
+        if pooled >= min_needed {
+            format!(
+                "; the maps pool a cell's {} seeds ({pooled} repeats), which can",
+                plan.seeds.len()
+            )
+        } else {
+            format!(
+                "; nor in a cell of the maps ({} seeds x {fewest} = {pooled} repeats)",
+                plan.seeds.len()
+            )
+        }
+    );
+}
+
+/// Per claim of the paper's, its cells by pooled outcome, and the repeats a cell would need at
+/// the effect it shows where it is not yet decided (the median over those cells).
+fn render_power(
+    t: &mut String,
+    plan: &super::plan::Plan,
+    coords: &[Vec<usize>],
+    paper: &[&ClaimSeries],
+) {
+    use super::figures::{CellOutcome, cells};
+    for s in paper {
+        let cs = cells(&plan.axes, coords, s);
+        let count = |o: CellOutcome| cs.iter().filter(|c| c.outcome() == o).count();
+        let mut needed: Vec<u32> = cs
+            .iter()
+            .filter(|c| c.outcome() == CellOutcome::Unsure)
+            .filter_map(|c| {
+                let untied = c.for_ + c.against;
+                swarm::summary::Power::of(&swarm::summary::Paired {
+                    for_: c.for_,
+                    against: c.against,
+                    tied: c.defined - untied,
+                    undefined: 0,
+                    p: swarm::summary::sign_test_p(c.for_, untied),
+                    p_opposite: swarm::summary::sign_test_p(c.against, untied),
+                })
+                .repeats_needed
+            })
+            .collect();
+        needed.sort_unstable();
+        let unsure = count(CellOutcome::Unsure);
+        let need = match needed.get(needed.len() / 2) {
+            Some(n) if unsure > 0 => format!(
+                " (at the effect they show, a median of {n} repeats a cell would decide them)"
+            ),
+            _ => String::new(),
+        };
+        let words = s.text.split(':').next().unwrap_or(&s.text);
+        let _ = writeln!(
+            t,
+            "cells (pooled over seeds): {} holds in {}, unsure in {unsure}{need}, fails in {}, the opposite in {}, no data in {}",
+            printable(words),
+            count(CellOutcome::Holds),
+            count(CellOutcome::Fails),
+            count(CellOutcome::Opposite),
+            count(CellOutcome::NoData)
+        );
+    }
 }
 
 /// The report's lines on the points that did not finish: failed, missing, broken, and the
@@ -562,6 +736,8 @@ fn claim_cells(
             ("tied", r["tied"].clone()),
             ("undefined", r["undefined"].clone()),
             ("p", r["p"].clone()),
+            ("towards", c["power"]["towards"].clone()),
+            ("repeats_needed", c["power"]["repeats_needed"].clone()),
         ];
         for (part, v) in cells {
             let col = format!("claim.{slug}.{part}");

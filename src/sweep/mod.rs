@@ -8,9 +8,12 @@
 //!   `SLURM_ARRAY_TASK_ID` under Slurm; every point without either), each into its own folder
 //!   atomically, skipping those finished before, so a requeued or resubmitted task loses
 //!   nothing and redoes only what is missing or broken.
+//! * `h8swarm sweep confirm DIR` ([`confirm`]): the cells chosen from a finished map on master
+//!   seeds it never used, planned into `DIR/confirm` (run like any sweep folder).
 //! * `h8swarm sweep merge DIR` ([`merge`]): one table of every point's claims and first/last
 //!   window statistics (CSV and JSON), figures of each claim's effect against the swept keys
-//!   ([`figures`]), and the failed and missing points listed.
+//!   ([`figures`]), and the failed and missing points listed; with a confirmation, it too and
+//!   the two side by side.
 //!
 //! A point's results depend only on its scenario (its master seed included: every stream is
 //! derived from it by [`swarm::seeds`]), so the merged table is the same byte for byte however
@@ -21,6 +24,7 @@
 //! point that is not ok), 1 when the tool fails (a folder that cannot be
 //! written) or, for `run`, when a point failed (it is recorded, and `merge` lists it).
 
+pub mod confirm;
 pub mod exec;
 pub mod figures;
 pub mod merge;
@@ -117,8 +121,18 @@ pub enum SweepCommand {
         #[arg(long)]
         threads: Option<usize>,
     },
+    /// Plan the confirmation of a finished map: the cells its [confirm] section chooses, on
+    /// seeds the map never used, into DIR/confirm (run it like any sweep folder).
+    Confirm {
+        /// The map's sweep folder.
+        dir: PathBuf,
+        /// The h8swarm binary the job runs (default: this one).
+        #[arg(long, value_name = "PATH")]
+        bin: Option<PathBuf>,
+    },
     /// Merge every point's claims and window statistics into DIR/merged (sweep.csv,
-    /// sweep.json, plots/), listing failed and missing points.
+    /// sweep.json, plots/), listing failed and missing points; with a confirmation in
+    /// DIR/confirm, it too and the two side by side (confirmation.csv).
     Merge {
         /// The sweep folder.
         dir: PathBuf,
@@ -165,6 +179,11 @@ pub fn command(args: &SweepArgs) -> (String, Result<(), SweepError>) {
                     "some points failed (each says why in its status.json; `h8swarm sweep merge` lists them)",
                 )),
             ),
+            Err(e) => (String::new(), Err(e)),
+        },
+        SweepCommand::Confirm { dir, bin } => match confirm::plan_confirmation(dir, bin.as_deref())
+        {
+            Ok(text) => (text, Ok(())),
             Err(e) => (String::new(), Err(e)),
         },
         SweepCommand::Merge {

@@ -104,6 +104,11 @@ pub struct Plan {
     pub seeds: Vec<u64>,
     /// Number of points.
     pub points: usize,
+    /// The cells of the axes' grid (index, the first axis slowest) the plan runs, in
+    /// increasing order, when not all of them: a confirmation ([`super::confirm`]) runs the
+    /// map's grid in chosen cells only.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cells: Option<Vec<usize>>,
     /// Points per array task.
     pub points_per_task: usize,
     /// Number of array tasks (0 to `tasks` − 1).
@@ -527,6 +532,7 @@ fn plan_of(sweep: &Sweep) -> Result<Plan, SweepError> {
         axes: sweep.axes.clone(),
         seeds: sweep.seeds.clone(),
         points: sweep.count,
+        cells: None,
         points_per_task: per_task,
         tasks,
         max_parallel,
@@ -535,7 +541,7 @@ fn plan_of(sweep: &Sweep) -> Result<Plan, SweepError> {
 }
 
 /// The sweep folder `dir`, created if need be, as an absolute path.
-fn plan_folder(dir: &Path) -> Result<PathBuf, SweepError> {
+pub(super) fn plan_folder(dir: &Path) -> Result<PathBuf, SweepError> {
     // One rule for output folders (as `run`'s and `merge`'s): a folder with a name of its own.
     crate::stage::check_out_folder("--out", dir).map_err(|e| SweepError::tool(e.0))?;
     std::fs::create_dir_all(dir).map_err(|e| {
@@ -631,7 +637,7 @@ fn write_list(sweep: &Sweep, per_task: usize, path: &Path) -> Result<(), SweepEr
 }
 
 /// Whether two files hold the same bytes (read a block at a time).
-fn same_file_bytes(a: &Path, b: &Path) -> Result<bool, SweepError> {
+pub(super) fn same_file_bytes(a: &Path, b: &Path) -> Result<bool, SweepError> {
     let open = |p: &Path| {
         std::fs::File::open(p)
             .map(std::io::BufReader::new)
@@ -717,6 +723,16 @@ pub fn read_plan(dir: &Path) -> Result<(Plan, Vec<PlanLine>), SweepError> {
                 ),
             ));
         }
+        if let Some(list) = &plan.cells
+            && list
+                .binary_search(&super::figures::cell_index(&plan.axes, &line.coords))
+                .is_err()
+        {
+            return Err(not(
+                &at,
+                &format!("its coords {:?} lie outside the plan's cells", line.coords),
+            ));
+        }
         if !ids.insert(line.id.clone()) {
             return Err(not(
                 &at,
@@ -765,6 +781,14 @@ fn check_plan_sizes(plan: &Plan) -> Result<(), String> {
             .checked_mul(a.values.len())
             .filter(|&c| c <= super::spec::MAX_POINTS)
             .ok_or_else(|| format!("its axes make more than {} cells", super::spec::MAX_POINTS))?;
+    }
+    if let Some(list) = &plan.cells {
+        if list.windows(2).any(|w| w[0] >= w[1]) || list.last().is_some_and(|&c| c >= cells) {
+            return Err(format!(
+                "its cells must be distinct, in increasing order and below the grid's {cells}"
+            ));
+        }
+        cells = list.len();
     }
     let want = cells.checked_mul(plan.seeds.len());
     if want != Some(plan.points) {

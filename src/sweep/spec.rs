@@ -20,6 +20,10 @@
 //! [slurm]                       # all optional: see `SlurmSpec`
 //! points_per_task = 2
 //! max_parallel = 50
+//!
+//! [confirm]                     # optional: what `h8swarm sweep confirm` re-runs (see
+//! seeds = [21, 22, 23]          # `Confirm`): cells of the map on seeds it never used
+//! cells = "region"
 //! ```
 //!
 //! Keys are the scenario's own (`robots`, `steps`, `learner.eta`, `world.substep_s`, …, as
@@ -90,6 +94,46 @@ struct SweepFile {
     grid: Option<toml::Table>,
     zip: Option<Vec<toml::Table>>,
     slurm: Option<SlurmSpec>,
+    confirm: Option<toml::Table>,
+}
+
+/// Master seeds kept for checks made from outside the project: a confirmation refuses them
+/// unless its `allow_reserved_seeds` says it is such a check.
+pub const RESERVED_SEEDS: std::ops::RangeInclusive<u64> = 11..=20;
+
+/// The `[confirm]` section as written.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ConfirmFile {
+    seeds: Option<toml::Value>,
+    cells: Option<toml::Value>,
+    repeats: Option<i64>,
+    allow_reserved_seeds: Option<bool>,
+}
+
+/// Which cells of the map a confirmation re-runs.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum CellChoice {
+    /// The cells where the paper's text claims all hold on the map (pooled over its seeds).
+    Region,
+    /// Those and their neighbours (one step along one axis), so that the confirmation judges
+    /// how robust the region is too.
+    RegionAndNeighbours,
+    /// The cells listed, by their position on each axis.
+    Listed(Vec<Vec<usize>>),
+}
+
+/// What `h8swarm sweep confirm` re-runs: cells of the map on master seeds the map never used.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Confirm {
+    /// The confirmation's master seeds (none of the map's; none of [`RESERVED_SEEDS`] unless
+    /// allowed).
+    pub seeds: Vec<u64>,
+    /// The cells.
+    pub cells: CellChoice,
+    /// Repeats per point, when not the map's.
+    pub repeats: Option<u32>,
 }
 
 /// One axis of the grid: one key (a `[grid]` entry) or several that move together (a `[[zip]]`
@@ -131,6 +175,8 @@ pub struct Sweep {
     pub seeds: Vec<u64>,
     /// The Slurm settings.
     pub slurm: SlurmSpec,
+    /// The confirmation stage, when the file has a `[confirm]` section.
+    pub confirm: Option<Confirm>,
     /// How many points: the seeds times every axis' length.
     pub count: usize,
     /// The base scenario with the `[set]` changes, as a table: every point starts from it.
@@ -150,7 +196,6 @@ impl Sweep {
     /// A key that cannot be set (a value where a table is needed).
     pub fn point(&self, index: usize) -> Result<Point, SweepError> {
         let where_ = &self.where_;
-        let digits = self.count.saturating_sub(1).to_string().len().max(4);
         let mut coords = vec![0usize; self.axes.len()];
         let mut rest = index / self.seeds.len();
         for (c, a) in coords.iter_mut().zip(&self.axes).rev() {
@@ -159,30 +204,16 @@ impl Sweep {
         }
         let seed = self.seeds[index % self.seeds.len()];
         let mut t = self.table.clone();
-        let mut slug = String::new();
         for (a, &c) in self.axes.iter().zip(&coords) {
             for (k, v) in a.keys.iter().zip(&a.values[c]) {
                 set_key(&mut t, k, v.clone())
                     .map_err(|e| SweepError::input(format!("{where_}: `{k}`: {e}")))?;
-                let short = k.rsplit('.').next().unwrap_or(k);
-                let _ = write!(slug, "-{short}{}", value_text(v));
             }
         }
         if self.clamp_window {
             clamp_window(&mut t);
         }
-        let _ = write!(slug, "-s{seed}");
-        let prefix = format!("p{index:0digits$}");
-        let id = format!(
-            "{prefix}{}",
-            sanitize(&slug, MAX_ID_CHARS.saturating_sub(prefix.len()))
-        );
-        // `sanitize` never starts with `.` or `_`, so put the dash back when it trimmed it.
-        let id = if id.len() > prefix.len() && !id[prefix.len()..].starts_with('-') {
-            format!("{prefix}-{}", &id[prefix.len()..])
-        } else {
-            id
-        };
+        let id = point_id(index, self.count, &self.axes, &coords, seed);
         t.insert("name".into(), toml::Value::String(id.clone()));
         t.insert(
             "seed".into(),
@@ -263,6 +294,43 @@ impl Point {
             ))
         })
     }
+}
+
+/// A point's id: `p` and its number (at least four digits, as many as the largest of
+/// `count` points needs), then its values on the axes and its seed, reduced to
+/// `[A-Za-z0-9.+-]` and at most [`MAX_ID_CHARS`] characters.
+#[must_use]
+pub fn point_id(index: usize, count: usize, axes: &[Axis], coords: &[usize], seed: u64) -> String {
+    let digits = count.saturating_sub(1).to_string().len().max(4);
+    let mut slug = String::new();
+    for (a, &c) in axes.iter().zip(coords) {
+        for (k, v) in a.keys.iter().zip(&a.values[c]) {
+            let short = k.rsplit('.').next().unwrap_or(k);
+            let _ = write!(slug, "-{short}{}", value_text(v));
+        }
+    }
+    let _ = write!(slug, "-s{seed}");
+    let prefix = format!("p{index:0digits$}");
+    let id = format!(
+        "{prefix}{}",
+        sanitize(&slug, MAX_ID_CHARS.saturating_sub(prefix.len()))
+    );
+    // `sanitize` never starts with `.` or `_`, so put the dash back when it trimmed it.
+    if id.len() > prefix.len() && !id[prefix.len()..].starts_with('-') {
+        format!("{prefix}-{}", &id[prefix.len()..])
+    } else {
+        id
+    }
+}
+
+/// The `[slurm]` section of a sweep file's text (the defaults when it has none or cannot be
+/// read: `sweep plan` checked it).
+#[must_use]
+pub fn slurm_section(text: &str) -> SlurmSpec {
+    toml::from_str::<SweepFile>(text)
+        .ok()
+        .and_then(|f| f.slurm)
+        .unwrap_or_default()
 }
 
 /// Cuts a point's `window` to its `steps` (a point that shortens the run without naming a
@@ -486,6 +554,7 @@ pub fn parse(text: &str, file: &Path) -> Result<Sweep, SweepError> {
     }
     let swept = swept_once(&axes, &where_)?;
     let seeds = seeds(f.seeds.as_ref(), base.seed, &where_)?;
+    let confirm = confirm_of(f.confirm.as_ref(), &axes, &seeds, &where_)?;
 
     let mut count: usize = seeds.len();
     for a in &axes {
@@ -502,6 +571,7 @@ pub fn parse(text: &str, file: &Path) -> Result<Sweep, SweepError> {
         axes,
         seeds,
         slurm: f.slurm.unwrap_or_default(),
+        confirm,
         count,
         clamp_window: !window_given && !swept.contains("window"),
         table,
@@ -630,6 +700,179 @@ fn swept_once(axes: &[Axis], where_: &str) -> Result<BTreeSet<String>, SweepErro
         }
     }
     Ok(seen)
+}
+
+/// The `[confirm]` section of a sweep file's text (`file` names it in messages), checked
+/// against the map's axes and seeds; none without one. `sweep confirm` reads it from the copy
+/// `sweep plan` keeps.
+///
+/// # Errors
+/// Malformed TOML, or a bad `[confirm]` section (see [`parse`]'s errors).
+pub fn confirm_section(
+    text: &str,
+    file: &Path,
+    axes: &[Axis],
+    map_seeds: &[u64],
+) -> Result<Option<Confirm>, SweepError> {
+    let where_ = format!("sweep file `{}`", file.display());
+    let f: SweepFile = toml::from_str(text)
+        .map_err(|e| SweepError::input(format!("{where_}, {}", toml_error(text, &e))))?;
+    confirm_of(f.confirm.as_ref(), axes, map_seeds, &where_)
+}
+
+/// The confirmation of a `[confirm]` table: its seeds (a list, or a count: the first that the
+/// map did not use, skipping [`RESERVED_SEEDS`]), its cells (`"region"`,
+/// `"region+neighbours"`, or a list of tables giving every swept key a value of its axis) and
+/// its repeats.
+fn confirm_of(
+    t: Option<&toml::Table>,
+    axes: &[Axis],
+    map_seeds: &[u64],
+    where_: &str,
+) -> Result<Option<Confirm>, SweepError> {
+    let Some(t) = t else {
+        return Ok(None);
+    };
+    let at = format!("{where_}, [confirm]");
+    let f: ConfirmFile =
+        toml::Value::Table(t.clone())
+            .try_into()
+            .map_err(|e: toml::de::Error| {
+                SweepError::input(format!("{at}: {}", one_line(e.message())))
+            })?;
+    let allow = f.allow_reserved_seeds.unwrap_or(false);
+    let reserved = |s: u64| !allow && RESERVED_SEEDS.contains(&s);
+    let seeds = match &f.seeds {
+        None => {
+            return Err(SweepError::input(format!(
+                "{at}: no `seeds`: give the confirmation's master seeds, seeds the map did not use (e.g. seeds = [21, 22, 23, 24, 25]), or a count"
+            )));
+        }
+        Some(toml::Value::Integer(n)) if (1..=1000).contains(n) => (1u64..)
+            .filter(|s| !map_seeds.contains(s) && !RESERVED_SEEDS.contains(s))
+            .take(*n as usize)
+            .collect(),
+        Some(toml::Value::Array(_)) => {
+            let list = seeds(f.seeds.as_ref(), 0, &at)?;
+            if let Some(s) = list.iter().find(|s| map_seeds.contains(s)) {
+                return Err(SweepError::input(format!(
+                    "{at}: seed {s} is one of the map's seeds: a confirmation runs on seeds the map never used"
+                )));
+            }
+            if let Some(s) = list.iter().find(|&&s| reserved(s)) {
+                return Err(SweepError::input(format!(
+                    "{at}: seed {s}: master seeds {}-{} are reserved for checks from outside the project; choose others (e.g. 21 on), or set allow_reserved_seeds = true if this is such a check",
+                    RESERVED_SEEDS.start(),
+                    RESERVED_SEEDS.end()
+                )));
+            }
+            list
+        }
+        Some(other) => {
+            return Err(SweepError::input(format!(
+                "{at}: `seeds` = {other}: give a list of master seeds the map did not use, like [21, 22, 23], or a count from 1 to 1000"
+            )));
+        }
+    };
+    let cells = match &f.cells {
+        None => CellChoice::Region,
+        Some(toml::Value::String(s)) if s == "region" => CellChoice::Region,
+        Some(toml::Value::String(s)) if s == "region+neighbours" => CellChoice::RegionAndNeighbours,
+        Some(toml::Value::Array(list)) if !list.is_empty() => {
+            let mut out = Vec::new();
+            for (i, c) in list.iter().enumerate() {
+                out.push(listed_cell(c, axes, &format!("{at}, cell {}", i + 1))?);
+            }
+            CellChoice::Listed(out)
+        }
+        Some(other) => {
+            return Err(SweepError::input(format!(
+                "{at}: `cells` = {other}: give \"region\", \"region+neighbours\" or a list of cells like [{{ \"learner.eta\" = 0.03, \"learner.threshold\" = 10 }}]"
+            )));
+        }
+    };
+    let repeats = match f.repeats {
+        None => None,
+        Some(r) if (1..=100_000).contains(&r) => Some(r as u32),
+        Some(r) => {
+            return Err(SweepError::input(format!(
+                "{at}: `repeats` = {r} is out of range: valid is 1 to 100000"
+            )));
+        }
+    };
+    Ok(Some(Confirm {
+        seeds,
+        cells,
+        repeats,
+    }))
+}
+
+/// Whether two values of a key are the same (a whole number equals the same real).
+fn same_value(a: &toml::Value, b: &toml::Value) -> bool {
+    match (a, b) {
+        (toml::Value::Integer(x), toml::Value::Float(y))
+        | (toml::Value::Float(y), toml::Value::Integer(x)) => (*x as f64) == *y,
+        _ => a == b,
+    }
+}
+
+/// The position on each axis of a listed cell: a table that gives every swept key one of its
+/// axis' values.
+fn listed_cell(c: &toml::Value, axes: &[Axis], at: &str) -> Result<Vec<usize>, SweepError> {
+    let toml::Value::Table(t) = c else {
+        return Err(SweepError::input(format!(
+            "{at} is {c}: give a table of the swept keys' values"
+        )));
+    };
+    let mut given = Vec::new();
+    flatten("", t, &mut given);
+    let swept: Vec<&String> = axes.iter().flat_map(|a| &a.keys).collect();
+    if let Some((k, _)) = given.iter().find(|(k, _)| !swept.contains(&k)) {
+        return Err(SweepError::input(format!(
+            "{at}: `{k}` is not a swept key: the cell's keys are {}",
+            swept
+                .iter()
+                .map(|k| format!("`{k}`"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        )));
+    }
+    let mut coords = Vec::new();
+    for a in axes {
+        let vals: Vec<&toml::Value> = a
+            .keys
+            .iter()
+            .map(|k| {
+                given
+                    .iter()
+                    .find(|(g, _)| g == k)
+                    .map(|(_, v)| v)
+                    .ok_or_else(|| {
+                        SweepError::input(format!("{at}: no value for the swept key `{k}`"))
+                    })
+            })
+            .collect::<Result<_, _>>()?;
+        let pos = a
+            .values
+            .iter()
+            .position(|vs| vs.iter().zip(&vals).all(|(v, g)| same_value(v, g)))
+            .ok_or_else(|| {
+                SweepError::input(format!(
+                    "{at}: {} = {} is not a value of the map's axis (valid: {})",
+                    a.name(),
+                    vals.iter()
+                        .map(|v| value_text(v))
+                        .collect::<Vec<_>>()
+                        .join(", "),
+                    (0..a.values.len())
+                        .map(|i| a.label(i))
+                        .collect::<Vec<_>>()
+                        .join("; ")
+                ))
+            })?;
+        coords.push(pos);
+    }
+    Ok(coords)
 }
 
 /// The master seeds: the base's when `seeds` is absent, 1 to n for a count n, else the listed
@@ -771,5 +1014,60 @@ mod tests {
         }
         assert_eq!(sanitize("eta0.001", 40), "eta0.001");
         assert_eq!(sanitize("a b//c", 40), "a_b_c");
+    }
+
+    #[test]
+    fn a_confirmation_runs_on_seeds_the_map_never_used_and_never_on_the_reserved_ones() {
+        let base = "seeds = [1, 2]\n[set]\nsteps = 50\n[grid]\n\"learner.eta\" = [0.01, 0.03]\n";
+        let with = |confirm: &str| sweep(&format!("{base}[confirm]\n{confirm}\n"));
+        let c = with("seeds = [21, 22]\ncells = \"region+neighbours\"")
+            .unwrap()
+            .confirm
+            .unwrap();
+        assert_eq!(c.seeds, vec![21, 22]);
+        assert_eq!(c.cells, CellChoice::RegionAndNeighbours);
+        // A count takes the first seeds the map did not use, skipping 11-20.
+        let c = with("seeds = 3").unwrap().confirm.unwrap();
+        assert_eq!(c.seeds, vec![3, 4, 5]);
+        assert_eq!(c.cells, CellChoice::Region);
+        let axes = vec![Axis {
+            keys: vec!["learner.eta".into()],
+            values: vec![vec![toml::Value::Float(0.01)]],
+        }];
+        let ten: Vec<u64> = (1..=10).collect();
+        let c = confirm_section("[confirm]\nseeds = 3\n", Path::new("t.toml"), &axes, &ten)
+            .unwrap()
+            .unwrap();
+        assert_eq!(c.seeds, vec![21, 22, 23]);
+        // The reserved seeds are refused, unless this is the check from outside.
+        let e = with("seeds = [21, 15]").unwrap_err();
+        assert!(
+            e.contains("seed 15") && e.contains("11-20") && e.contains("reserved"),
+            "{e}"
+        );
+        let c = with("seeds = [15]\nallow_reserved_seeds = true")
+            .unwrap()
+            .confirm
+            .unwrap();
+        assert_eq!(c.seeds, vec![15]);
+        // The map's own seeds are refused.
+        let e = with("seeds = [2, 21]").unwrap_err();
+        assert!(e.contains("seed 2") && e.contains("never used"), "{e}");
+        // Listed cells name a value of every axis.
+        let c = with("seeds = [21]\ncells = [{ \"learner.eta\" = 0.03 }]")
+            .unwrap()
+            .confirm
+            .unwrap();
+        assert_eq!(c.cells, CellChoice::Listed(vec![vec![1]]));
+        let e = with("seeds = [21]\ncells = [{ \"learner.eta\" = 0.5 }]").unwrap_err();
+        assert!(e.contains("not a value") && e.contains("0.01; 0.03"), "{e}");
+        let e = with("seeds = [21]\ncells = [{ \"learner.threshold\" = 10 }]").unwrap_err();
+        assert!(e.contains("not a swept key"), "{e}");
+        let e = with("seeds = [21]\ncells = \"everywhere\"").unwrap_err();
+        assert!(e.contains("region"), "{e}");
+        let e = with("cells = \"region\"").unwrap_err();
+        assert!(e.contains("no `seeds`"), "{e}");
+        let e = with("seeds = [21]\nrepeat = 3").unwrap_err();
+        assert!(e.contains("repeat"), "{e}");
     }
 }

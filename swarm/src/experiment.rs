@@ -36,7 +36,8 @@ use anyhow::{Context, Result};
 use rayon::prelude::*;
 use world::{Arena, SensorMount, SubstepPlan, World, WorldParams};
 
-use crate::collisions::{ContactMeter, RobotTally, StuckDetector};
+use crate::collisions::ContactMeter;
+use crate::motion::{MotionClass, MotionStep, MotionTracker, RobotTally};
 
 use crate::robot::{Condition, Images, Robot};
 use crate::scenario::{ArenaKind, Scenario};
@@ -49,9 +50,12 @@ pub const PARALLEL_ROBOTS: usize = 64;
 pub const SNAPSHOT_STEPS: usize = 200;
 /// At most this many robots' paths are recorded for the arena figure.
 pub const TRACKED_ROBOTS: usize = 40;
+/// Corridor: neighbours closer than this touch, metres (in contact, or a push away); the gap
+/// CV is undefined at a step in which any two do (the spacing of a jam means nothing).
+pub const GAP_TOUCH_M: f64 = 0.01;
 
 /// The metrics of one step of one run (docs/design.md §5).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct StepMetrics {
     /// Mean over robots of D(t), du.
     pub mean_d: f64,
@@ -60,11 +64,17 @@ pub struct StepMetrics {
     /// Mean over robots of the share of this step's behaviour spent with a bumper pressed
     /// (time in contact, weighted by sub-step length), percent.
     pub contact_percent: f64,
-    /// Share of the robots stuck at the end of this step's behaviour, percent: moved less than
-    /// 1 mm over the last 100 steps while their motors drove (see [`crate::collisions`]).
-    pub stuck_percent: f64,
+    /// Share of the robots held in place at the end of this step's behaviour, percent (see
+    /// [`crate::motion`]).
+    pub held_percent: f64,
+    /// Share of the robots shuttling, percent.
+    pub shuttling_percent: f64,
+    /// Share of the robots circling, percent.
+    pub circling_percent: f64,
+    /// Share of the robots exploring, percent.
+    pub exploring_percent: f64,
     /// Share of the robots that moved at least [`crate::collisions::MOVING_MIN_MM`] during
-    /// this step's behaviour, percent.
+    /// this step's behaviour, percent (a reference: shuttlers move every step).
     pub moving_percent: f64,
     /// Mean over robots of how far the body's centre moved during this step's behaviour
     /// (straight-line distance between the two step instants), millimetres: 0 for a robot held
@@ -72,8 +82,22 @@ pub struct StepMetrics {
     /// arena. Not in the paper; it tells a robot that avoids obstacles from one that is stuck
     /// (both make no new collisions).
     pub moved_mm: f64,
-    /// Corridor only: coefficient of variation of the gaps between neighbours at the step.
+    /// Mean over robots of the net displacement over the last [`crate::motion::LAG_STEPS`]
+    /// steps per step ([`MotionStep::net_m`]), millimetres per step: the net progress.
+    pub net_mm: f64,
+    /// Mean over robots of the squared displacement over each of [`crate::motion::MSD_LAGS`] steps, cm², once
+    /// the run is that long: the mean squared displacement.
+    pub msd_cm2: [Option<f64>; 3],
+    /// Mean over robots of the cells entered in the step that the robot had not been in for
+    /// [`crate::motion::FRESH_STEPS`] steps.
+    pub fresh_cells: f64,
+    /// Mean over robots of the cells entered in the step that the robot had never been in.
+    pub new_cells: f64,
+    /// Corridor only: coefficient of variation of the gaps between neighbours at the step;
+    /// none while two of them touch ([`GAP_TOUCH_M`]).
     pub gap_cv: Option<f64>,
+    /// Corridor only: whether two neighbours touch at the step.
+    pub touching: Option<bool>,
     /// Mean over robots of their MCU's CPU load over this step's period (percent): busy
     /// states (the step, the tick interrupts, the main loop; not the time asleep) over the
     /// period's states, as the robots' own clocks count them.
@@ -179,16 +203,36 @@ pub struct WindowSums {
     pub collisions_per_robot: f64,
     /// Sum of [`StepMetrics::contact_percent`].
     pub contact_percent: f64,
-    /// Sum of [`StepMetrics::stuck_percent`].
-    pub stuck_percent: f64,
+    /// Sum of [`StepMetrics::held_percent`].
+    pub held_percent: f64,
+    /// Sum of [`StepMetrics::shuttling_percent`].
+    pub shuttling_percent: f64,
+    /// Sum of [`StepMetrics::circling_percent`].
+    pub circling_percent: f64,
+    /// Sum of [`StepMetrics::exploring_percent`].
+    pub exploring_percent: f64,
     /// Sum of [`StepMetrics::moving_percent`].
     pub moving_percent: f64,
     /// Sum of [`StepMetrics::moved_mm`].
     pub moved_mm: f64,
+    /// Sum of [`StepMetrics::net_mm`].
+    pub net_mm: f64,
+    /// Sums of [`StepMetrics::msd_cm2`] over the steps that have them.
+    pub msd_cm2: [f64; 3],
+    /// Steps that have each of them.
+    pub msd_steps: [u32; 3],
+    /// Sum of [`StepMetrics::fresh_cells`].
+    pub fresh_cells: f64,
+    /// Sum of [`StepMetrics::new_cells`].
+    pub new_cells: f64,
     /// Sum of [`StepMetrics::gap_cv`] over the steps that have one.
     pub gap_cv: f64,
-    /// Steps that have a gap CV (all of them in the corridor, none in the square).
+    /// Steps that have a gap CV (in the corridor, those in which no neighbours touch).
     pub gap_cv_steps: u32,
+    /// Corridor steps (none in the square).
+    pub corridor_steps: u32,
+    /// Corridor steps in which two neighbours touch.
+    pub touching_steps: u32,
     /// Sum of [`StepMetrics::cpu_load_percent`].
     pub cpu_load_percent: f64,
     /// Sum of [`StepMetrics::energy_per_robot_mj`].
@@ -202,21 +246,37 @@ impl WindowSums {
         self.mean_d += m.mean_d;
         self.collisions_per_robot += m.collisions_per_robot;
         self.contact_percent += m.contact_percent;
-        self.stuck_percent += m.stuck_percent;
+        self.held_percent += m.held_percent;
+        self.shuttling_percent += m.shuttling_percent;
+        self.circling_percent += m.circling_percent;
+        self.exploring_percent += m.exploring_percent;
         self.moving_percent += m.moving_percent;
         self.moved_mm += m.moved_mm;
+        self.net_mm += m.net_mm;
+        for (l, v) in m.msd_cm2.iter().enumerate() {
+            if let Some(v) = v {
+                self.msd_cm2[l] += v;
+                self.msd_steps[l] += 1;
+            }
+        }
+        self.fresh_cells += m.fresh_cells;
+        self.new_cells += m.new_cells;
         if let Some(g) = m.gap_cv {
             self.gap_cv += g;
             self.gap_cv_steps += 1;
+        }
+        if let Some(t) = m.touching {
+            self.corridor_steps += 1;
+            self.touching_steps += u32::from(t);
         }
         self.cpu_load_percent += m.cpu_load_percent;
         self.energy_per_robot_mj += m.energy_per_robot_mj;
     }
 
-    /// Whether every step summed had a gap CV (and there was at least one step).
+    /// Whether the steps summed are a corridor's (they have a gap metric, defined or not).
     #[must_use]
-    pub fn all_have_gap_cv(&self) -> bool {
-        self.steps > 0 && self.gap_cv_steps == self.steps
+    pub fn is_corridor(&self) -> bool {
+        self.corridor_steps > 0
     }
 }
 
@@ -271,11 +331,21 @@ impl RunMetrics {
             mean_d: 0.0,
             collisions_per_robot: 0.0,
             contact_percent: 0.0,
-            stuck_percent: 0.0,
+            held_percent: 0.0,
+            shuttling_percent: 0.0,
+            circling_percent: 0.0,
+            exploring_percent: 0.0,
             moving_percent: 0.0,
             moved_mm: 0.0,
+            net_mm: 0.0,
+            msd_cm2: [0.0; 3],
+            msd_steps: [0; 3],
+            fresh_cells: 0.0,
+            new_cells: 0.0,
             gap_cv: 0.0,
             gap_cv_steps: 0,
+            corridor_steps: 0,
+            touching_steps: 0,
             cpu_load_percent: 0.0,
             energy_per_robot_mj: 0.0,
         };
@@ -294,22 +364,102 @@ impl RunMetrics {
     }
 }
 
-/// The columns of `metrics.csv`, one row per step of every run.
-pub const METRICS_HEADER: [&str; 13] = [
+/// The columns of `metrics.csv`, one row per step of every run (the MSD columns' lags are
+/// [`crate::motion::MSD_LAGS`]).
+pub const METRICS_HEADER: [&str; 23] = [
     "condition",
     "repeat",
     "step",
     "mean_d",
     "collisions_per_robot",
     "contact_percent",
-    "stuck_percent",
+    "held_percent",
+    "shuttling_percent",
+    "circling_percent",
+    "exploring_percent",
     "moving_percent",
     "moved_mm",
+    "net_mm",
+    "msd_1_cm2",
+    "msd_10_cm2",
+    "msd_100_cm2",
+    "fresh_cells",
+    "new_cells",
     "gap_cv",
+    "robots_touching",
     "cpu_load_percent",
     "energy_per_robot_mj",
     "dead_robots",
 ];
+
+/// Step `k`'s row of `metrics.csv` (see [`METRICS_HEADER`]) written into `buf` (cleared
+/// first), field after field; `dead` robots had died by its end (`--keep-going`). Returns where
+/// each field ends. A run writes its rows this way,
+/// through one buffer, rather than a string per field.
+pub fn metrics_fields(
+    condition: Condition,
+    repeat: u32,
+    k: u32,
+    m: &StepMetrics,
+    dead: usize,
+    buf: &mut String,
+) -> [usize; 23] {
+    use std::fmt::Write as _;
+    buf.clear();
+    let mut ends = [0usize; 23];
+    let mut field = 0;
+    let mut end = |buf: &String| {
+        ends[field] = buf.len();
+        field += 1;
+    };
+    buf.push_str(condition.name());
+    end(buf);
+    let _ = write!(buf, "{repeat}");
+    end(buf);
+    let _ = write!(buf, "{k}");
+    end(buf);
+    let opt = |buf: &mut String, v: Option<f64>| {
+        if let Some(v) = v {
+            let _ = write!(buf, "{v}");
+        }
+    };
+    for v in [
+        m.mean_d,
+        m.collisions_per_robot,
+        m.contact_percent,
+        m.held_percent,
+        m.shuttling_percent,
+        m.circling_percent,
+        m.exploring_percent,
+        m.moving_percent,
+        m.moved_mm,
+        m.net_mm,
+    ] {
+        let _ = write!(buf, "{v}");
+        end(buf);
+    }
+    for v in m.msd_cm2 {
+        opt(buf, v);
+        end(buf);
+    }
+    for v in [m.fresh_cells, m.new_cells] {
+        let _ = write!(buf, "{v}");
+        end(buf);
+    }
+    opt(buf, m.gap_cv);
+    end(buf);
+    if let Some(t) = m.touching {
+        buf.push(if t { '1' } else { '0' });
+    }
+    end(buf);
+    for v in [m.cpu_load_percent, m.energy_per_robot_mj] {
+        let _ = write!(buf, "{v}");
+        end(buf);
+    }
+    let _ = write!(buf, "{dead}");
+    end(buf);
+    ends
+}
 
 /// Step `k`'s row of `metrics.csv` (see [`METRICS_HEADER`]); `dead` robots had died by its
 /// end (`--keep-going`).
@@ -320,28 +470,18 @@ pub fn metrics_row(
     k: u32,
     m: &StepMetrics,
     dead: usize,
-) -> [String; 13] {
-    [
-        condition.name().to_string(),
-        repeat.to_string(),
-        k.to_string(),
-        format!("{}", m.mean_d),
-        format!("{}", m.collisions_per_robot),
-        format!("{}", m.contact_percent),
-        format!("{}", m.stuck_percent),
-        format!("{}", m.moving_percent),
-        format!("{}", m.moved_mm),
-        m.gap_cv.map(|v| format!("{v}")).unwrap_or_default(),
-        format!("{}", m.cpu_load_percent),
-        format!("{}", m.energy_per_robot_mj),
-        dead.to_string(),
-    ]
+) -> [String; 23] {
+    let mut buf = String::new();
+    let ends = metrics_fields(condition, repeat, k, m, dead, &mut buf);
+    std::array::from_fn(|i| buf[if i == 0 { 0 } else { ends[i - 1] }..ends[i]].to_string())
 }
 
 /// A run's rows of `metrics.csv`, written as the steps complete.
 struct Rows {
     path: std::path::PathBuf,
     w: csv::Writer<std::io::BufWriter<std::fs::File>>,
+    /// The row being written, field after field.
+    buf: String,
 }
 
 /// The arena of a scenario (the square scaled to keep the paper's density for other than 3
@@ -408,13 +548,12 @@ pub struct Swarm {
     world: World,
     robots: Vec<Robot>,
     meters: Vec<ContactMeter>,
-    stuck: Vec<StuckDetector>,
+    /// Each robot's recent positions and cells.
+    motion: Vec<MotionTracker>,
     /// Each robot's record over the run.
     tallies: Vec<RobotTally>,
     /// Collisions counted for each robot since its last tally.
     collided: Vec<u64>,
-    /// Whether each robot's motors drove through the step being run.
-    drove: Vec<bool>,
     /// The step period in clock states.
     period_states: u64,
     /// Steps begun.
@@ -430,8 +569,8 @@ pub struct Swarm {
     snapshots: [u32; 4],
     saves: u64,
     parallel: bool,
-    /// Every robot's centre at the latest step instant.
-    last_xy: Vec<(f64, f64)>,
+    /// The corridor's gaps, reused step to step.
+    gaps: Vec<f64>,
     /// Go on when a robot's controller fails: the robot is dead from then on (its motors
     /// coast; it is left out of the means).
     keep_going: bool,
@@ -507,10 +646,9 @@ impl Swarm {
             world,
             robots,
             meters: vec![ContactMeter::new(nominal_substep_states(s)); n],
-            stuck: vec![StuckDetector::default(); n],
+            motion: vec![MotionTracker::new(); n],
             tallies: vec![RobotTally::new(s.window); n],
             collided: vec![0; n],
-            drove: vec![false; n],
             period_states: period_states(s),
             started: 0,
             pending: None,
@@ -525,7 +663,7 @@ impl Swarm {
             },
             saves: 0,
             parallel: n >= PARALLEL_ROBOTS,
-            last_xy: Vec::new(),
+            gaps: Vec::new(),
             keep_going: false,
             dead: vec![None; n],
             recorder: None,
@@ -549,6 +687,7 @@ impl Swarm {
                 path.display()
             )))?;
         self.rows = Some(Rows {
+            buf: String::with_capacity(256),
             path: path.to_path_buf(),
             w: csv::WriterBuilder::new()
                 .has_headers(false)
@@ -653,21 +792,26 @@ impl Swarm {
         self.pending_charge = (tally.charge_uc, tally.live);
         let live_f = tally.live.max(1) as f64;
         let mean_d = tally.sum_d / live_f;
-        let gap_cv = match self.scenario.arena {
-            ArenaKind::Corridor => self.world.corridor_gap_cv()?,
-            ArenaKind::Square => None,
+        let (gap_cv, touching) = match self.scenario.arena {
+            ArenaKind::Corridor => {
+                self.world.corridor_gaps_m(&mut self.gaps)?;
+                let touching = self.gaps.iter().any(|&g| g < GAP_TOUCH_M);
+                let cv = if touching {
+                    None
+                } else {
+                    world::coefficient_of_variation(&self.gaps)
+                };
+                (cv, Some(touching))
+            }
+            ArenaKind::Square => (None, None),
         };
         self.started += 1;
         self.pending = Some(StepMetrics {
             mean_d,
-            collisions_per_robot: 0.0,
-            contact_percent: 0.0,
-            stuck_percent: 0.0,
-            moving_percent: 0.0,
-            moved_mm: 0.0,
             gap_cv,
+            touching,
             cpu_load_percent: tally.sum_load / live_f,
-            energy_per_robot_mj: 0.0,
+            ..StepMetrics::default()
         });
         Ok(())
     }
@@ -816,14 +960,6 @@ impl Swarm {
             } else {
                 r.wheels()
             };
-            let drives = |w: &world::WheelCommand| {
-                w.duty > 0.0
-                    && matches!(
-                        w.direction,
-                        world::Direction::Forward | world::Direction::Reverse
-                    )
-            };
-            self.drove[i] = drives(&left) || drives(&right);
             if recording {
                 behaviours.push(crate::recording::behaviour_of(&left, &right));
             }
@@ -856,7 +992,8 @@ impl Swarm {
                 bumpers: senses[i].1,
                 p: self.robots[i].readings_du(),
                 d,
-                stuck: self.tallies[i].stuck_now(),
+                held: self.tallies[i].held_now(),
+                motion: self.tallies[i].last_class,
                 saved,
                 dead: self.dead[i].is_some(),
                 load_percent: load,
@@ -867,8 +1004,7 @@ impl Swarm {
     }
 
     /// Advances the world to `t_states` (the behaviour of the latest step runs to its end)
-    /// and completes that step's metrics: collisions, contact time, distance moved, stuck
-    /// robots.
+    /// and completes that step's metrics: collisions, contact time, where the robots went.
     fn close_step(&mut self, t_states: u64) -> Result<()> {
         let dt = t_states.saturating_sub(self.world.elapsed_states());
         let par = self.par();
@@ -887,28 +1023,21 @@ impl Swarm {
             self.energy.add(&q);
         }
         let n = self.robots.len();
-        let moved = self.moved()?;
+        let steps = self.motion_steps()?;
         if let Some(mut last) = self.pending.take() {
             let k = self.started - 1;
             let in_last = k >= self.scenario.steps.saturating_sub(self.scenario.window);
-            let (mut sum_m, mut stuck, mut moving) = (0.0, 0usize, 0usize);
-            for (i, &(d, is_stuck)) in moved.iter().enumerate() {
+            for (i, m) in steps.iter().enumerate() {
                 let c = std::mem::take(&mut self.collided[i]);
-                self.tallies[i].record(k, d, c, is_stuck, in_last);
-                sum_m += d;
-                stuck += usize::from(is_stuck);
-                moving += usize::from(d * 1000.0 >= crate::collisions::MOVING_MIN_MM);
+                self.tallies[i].record(k, m, c, in_last);
             }
-            let share = |count: usize| 100.0 * count as f64 / n as f64;
             last.collisions_per_robot = collided as f64 / n as f64;
             last.contact_percent = if dt == 0 {
                 0.0
             } else {
                 100.0 * contact_states as f64 / (dt as f64 * n as f64)
             };
-            last.moved_mm = 1000.0 * sum_m / n as f64;
-            last.stuck_percent = share(stuck);
-            last.moving_percent = share(moving);
+            motion_metrics(&mut last, &steps);
             let (electronics_uc, live) = std::mem::take(&mut self.pending_charge);
             last.energy_per_robot_mj = if live == 0 {
                 0.0
@@ -917,14 +1046,15 @@ impl Swarm {
             };
             self.metrics.add(k, &last);
             if let Some(rows) = self.rows.as_mut() {
+                let dead = self.dead.iter().flatten().filter(|d| d.0 <= k).count();
+                let ends =
+                    metrics_fields(self.condition, self.repeat, k, &last, dead, &mut rows.buf);
+                let buf = &rows.buf;
                 rows.w
-                    .write_record(metrics_row(
-                        self.condition,
-                        self.repeat,
-                        k,
-                        &last,
-                        self.dead.iter().flatten().filter(|d| d.0 <= k).count(),
-                    ))
+                    .write_record(
+                        (0..ends.len())
+                            .map(|i| &buf[if i == 0 { 0 } else { ends[i - 1] }..ends[i]]),
+                    )
                     .map_err(anyhow::Error::new)
                     .with_context(|| {
                         crate::output_error::OutputError(format!(
@@ -944,23 +1074,17 @@ impl Swarm {
         &self.metrics
     }
 
-    /// How far each robot's centre moved since the previous call (metres, 0 on the first)
-    /// and whether it is stuck now, remembering where the robots are.
-    fn moved(&mut self) -> Result<Vec<(f64, bool)>> {
-        let n = self.robots.len();
-        let first = self.last_xy.is_empty();
-        self.last_xy.resize(n, (0.0, 0.0));
-        let mut out = Vec::with_capacity(n);
-        for (i, xy) in self.last_xy.iter_mut().enumerate() {
+    /// Each robot's step since the previous call as its tracker sees it (where it is now
+    /// recorded); none on the first call, which records where the robots start.
+    fn motion_steps(&mut self) -> Result<Vec<MotionStep>> {
+        let mut out = Vec::with_capacity(self.robots.len());
+        for (i, t) in self.motion.iter_mut().enumerate() {
             let p = self.world.pose(i)?;
-            if first {
-                out.push((0.0, false));
+            if t.started() {
+                out.push(t.record(p.x_m, p.y_m));
             } else {
-                let d = libm::hypot(p.x_m - xy.0, p.y_m - xy.1);
-                let stuck = self.stuck[i].record(d, self.drove[i] && self.dead[i].is_none());
-                out.push((d, stuck));
+                t.start(p.x_m, p.y_m);
             }
-            *xy = (p.x_m, p.y_m);
         }
         Ok(out)
     }
@@ -980,8 +1104,9 @@ impl Swarm {
                 .context(crate::output_error::OutputError::cannot_write(&rows.path))?;
         }
         let dead = self.dead();
-        for t in &mut self.tallies {
-            t.finish();
+        let last_from = self.scenario.steps.saturating_sub(self.scenario.window);
+        for (t, m) in self.tallies.iter_mut().zip(&self.motion) {
+            t.finish(m, last_from);
         }
         let recorded = match self.recorder.take() {
             Some((rec, _)) => Some(rec.finish()?),
@@ -1204,6 +1329,44 @@ fn vcd_info(
 /// What a robot's board shows its MCU for a step: each sensor's true distance (mm, `None`
 /// beyond range) and the bumper switches (front, rear, left, right).
 type Senses = ([Option<f64>; 4], [bool; 4]);
+
+/// Fills the motion part of a step's metrics from every robot's step as its tracker saw it:
+/// the class shares, the moving share, the path and net progress, the mean squared
+/// displacements (once every robot has one) and the cells.
+pub fn motion_metrics(m: &mut StepMetrics, steps: &[MotionStep]) {
+    let n = steps.len().max(1) as f64;
+    let mut classes = [0u32; 4];
+    let (mut step_m, mut net_m, mut moving) = (0.0, 0.0, 0u32);
+    let (mut msd, mut msd_robots) = ([0.0; 3], [0usize; 3]);
+    let (mut fresh, mut new) = (0u32, 0u32);
+    for s in steps {
+        step_m += s.step_m;
+        net_m += s.net_m;
+        classes[s.class.code() as usize] += 1;
+        moving += u32::from(s.step_m * 1000.0 >= crate::collisions::MOVING_MIN_MM);
+        for (l, v) in s.sq_disp_m2.iter().enumerate() {
+            if let Some(v) = v {
+                msd[l] += v;
+                msd_robots[l] += 1;
+            }
+        }
+        fresh += s.fresh_cells;
+        new += s.new_cells;
+    }
+    let share = |c: MotionClass| 100.0 * f64::from(classes[c.code() as usize]) / n;
+    m.held_percent = share(MotionClass::Held);
+    m.shuttling_percent = share(MotionClass::Shuttling);
+    m.circling_percent = share(MotionClass::Circling);
+    m.exploring_percent = share(MotionClass::Exploring);
+    m.moving_percent = 100.0 * f64::from(moving) / n;
+    m.moved_mm = 1000.0 * step_m / n;
+    m.net_mm = 1000.0 * net_m / n;
+    m.msd_cm2 = std::array::from_fn(|l| {
+        (!steps.is_empty() && msd_robots[l] == steps.len()).then(|| 1e4 * msd[l] / n)
+    });
+    m.fresh_cells = f64::from(fresh) / n;
+    m.new_cells = f64::from(new) / n;
+}
 
 /// What the live robots' steps add up to in one swarm step.
 #[derive(Default)]
@@ -1465,6 +1628,7 @@ fn record(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::motion::MSD_LAGS;
     use world::{Behaviour, Pose};
 
     /// The picosecond case: a robot pushing the end wall of the corridor for 500 steps of
@@ -1674,10 +1838,22 @@ mod tests {
             mean_d: 700.0 + libm::sin(x * 0.37) * 50.0,
             collisions_per_robot: f64::from(k % 7) / 3.0,
             contact_percent: 100.0 * libm::cos(x * 0.11).abs(),
-            stuck_percent: f64::from(k % 5) * 20.0,
+            held_percent: f64::from(k % 5) * 20.0,
+            shuttling_percent: f64::from(k % 4) * 10.0,
+            circling_percent: f64::from(k % 2) * 5.0,
+            exploring_percent: 30.0 + f64::from(k % 7),
             moving_percent: f64::from(k % 3) * 50.0,
             moved_mm: 70.0 / (1.0 + x),
-            gap_cv: gap.then_some(0.1 + x * 1e-4),
+            net_mm: 30.0 / (1.0 + x),
+            msd_cm2: [
+                Some(x),
+                (k >= 10).then_some(2.0 * x),
+                (k >= 100).then_some(3.0 * x),
+            ],
+            fresh_cells: f64::from(k % 11) / 3.0,
+            new_cells: f64::from(k % 13) / 7.0,
+            gap_cv: (gap && !k.is_multiple_of(9)).then_some(0.1 + x * 1e-4),
+            touching: gap.then_some(k.is_multiple_of(9)),
             cpu_load_percent: 0.3 + x * 1e-6,
             energy_per_robot_mj: 3500.0 + libm::cos(x),
         }
@@ -1717,7 +1893,15 @@ mod tests {
                 let w = w as u32;
                 assert_eq!(*got, sum(w * win..(w + 1) * win));
             }
-            assert_eq!(m.whole.all_have_gap_cv(), gap);
+            assert_eq!(m.whole.is_corridor(), gap);
+            if gap {
+                assert_eq!(m.whole.touching_steps, steps.div_ceil(9));
+                assert_eq!(m.whole.gap_cv_steps + m.whole.touching_steps, steps);
+            }
+            assert_eq!(
+                m.whole.msd_steps,
+                [steps, steps.saturating_sub(10), steps.saturating_sub(100)]
+            );
         }
     }
 
@@ -1781,19 +1965,34 @@ mod tests {
             assert_eq!(r[0], "learning");
             assert_eq!(r[2], k.to_string());
             let f = |i: usize| r[i].parse::<f64>().unwrap();
+            let opt = |i: usize| (!r[i].is_empty()).then(|| f(i));
+            assert_eq!(r.len(), METRICS_HEADER.len());
             again.add(
                 k as u32,
                 &StepMetrics {
                     mean_d: f(3),
                     collisions_per_robot: f(4),
                     contact_percent: f(5),
-                    stuck_percent: f(6),
-                    moving_percent: f(7),
-                    moved_mm: f(8),
-                    gap_cv: (!r[9].is_empty()).then(|| f(9)),
-                    cpu_load_percent: f(10),
-                    energy_per_robot_mj: f(11),
+                    held_percent: f(6),
+                    shuttling_percent: f(7),
+                    circling_percent: f(8),
+                    exploring_percent: f(9),
+                    moving_percent: f(10),
+                    moved_mm: f(11),
+                    net_mm: f(12),
+                    msd_cm2: [opt(13), opt(14), opt(15)],
+                    fresh_cells: f(16),
+                    new_cells: f(17),
+                    gap_cv: opt(18),
+                    touching: opt(19).map(|t| t != 0.0),
+                    cpu_load_percent: f(20),
+                    energy_per_robot_mj: f(21),
                 },
+            );
+            let classes = f(6) + f(7) + f(8) + f(9);
+            assert!(
+                (classes - 100.0).abs() < 1e-9,
+                "step {k}: classes sum to {classes}"
             );
         }
         assert_eq!(out.metrics, again);
@@ -1807,6 +2006,21 @@ mod tests {
             out.metrics.whole.collisions_per_robot > 0.0,
             "something happened"
         );
+        assert_eq!(
+            METRICS_HEADER[13..16],
+            MSD_LAGS.map(|l| format!("msd_{l}_cm2"))[..],
+            "the MSD columns name their lags"
+        );
+        assert_eq!(
+            out.metrics.whole.msd_steps,
+            MSD_LAGS.map(|l| 451 - l as u32)
+        );
+        // Every robot's tally adds up to its steps, and it was somewhere.
+        for t in &out.robots {
+            assert_eq!(t.class_steps.iter().sum::<u32>(), 450);
+            assert!(t.cells_visited >= 1 && t.last_window_cells >= 1);
+            assert!(t.net_m <= t.distance_m + 1e-9);
+        }
         let t = out.track.unwrap();
         assert!(t.early.iter().all(|p| p.len() == SNAPSHOT_STEPS));
         assert!(t.late.iter().all(|p| p.len() == SNAPSHOT_STEPS));

@@ -2,7 +2,8 @@
 //!
 //! The library under the `h8swarm` tool: what a scenario is ([`scenario`]), a robot with its
 //! controller on the emulated MCU ([`robot`]), the swarm that runs them in the world
-//! ([`experiment`]), its contacts and stuck robots ([`collisions`]), the charge meter
+//! ([`experiment`]), its contacts ([`collisions`]), where its robots go: held, shuttling,
+//! circling or exploring, and how far ([`motion`]), the charge meter
 //! ([`energy`]) and the battery life ([`battery`]), the window statistics and the paper's
 //! claims ([`summary`]), the recording of runs for the viewer ([`recording`]), the seed
 //! streams ([`seeds`]) and the fit verdict of docs/design.md §6 ([`fit`]). It writes no
@@ -16,6 +17,7 @@ pub mod collisions;
 pub mod energy;
 pub mod experiment;
 pub mod fit;
+pub mod motion;
 pub mod output_error;
 pub mod recording;
 pub mod robot;

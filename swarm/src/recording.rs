@@ -2,7 +2,7 @@
 //!
 //! A [`Recorder`] is handed each step of one run (condition and repeat) and keeps every
 //! `stride`-th step as a **frame**: for every robot its pose, the behaviour its motors run, its
-//! four readings in du, its bumper switches, E = D(t) − D(t−1), whether it is stuck, whether it
+//! four readings in du, its bumper switches, E = D(t) − D(t−1), whether it is held and how it moves, whether it
 //! saved a record, whether it is dead, and its CPU load; and every `weights_every`-th frame its
 //! weights (when the controller's are readable). Frames go to a file of the run's own in the
 //! staging folder as they are made, so recording holds no more memory than one frame.
@@ -72,12 +72,17 @@ pub mod behaviour {
 
 /// Flag bits of a frame besides the behaviour.
 pub mod flag {
-    /// The stuck detector says so.
-    pub const STUCK: u8 = 1 << 3;
+    /// Held in place ([`crate::motion`]).
+    pub const HELD: u8 = 1 << 3;
     /// The robot wrote an EEPROM record in the step.
     pub const SAVED: u8 = 1 << 4;
     /// The robot's controller failed (`--keep-going`).
     pub const DEAD: u8 = 1 << 5;
+    /// The two high bits: the step's motion class ([`crate::motion::MotionClass::code`]: 0
+    /// exploring, 1 shuttling, 2 circling, 3 held), shifted by [`MOTION_SHIFT`].
+    pub const MOTION: u8 = 0b1100_0000;
+    /// Where the motion class sits in the flags.
+    pub const MOTION_SHIFT: u32 = 6;
 }
 
 /// The behaviour code of a pair of wheel commands (see [`behaviour`]).
@@ -110,8 +115,10 @@ pub struct RobotStep {
     pub p: [u8; 4],
     /// D(t), du.
     pub d: i16,
-    /// Stuck now.
-    pub stuck: bool,
+    /// Held now.
+    pub held: bool,
+    /// The class of its latest completed step (none before the first).
+    pub motion: Option<crate::motion::MotionClass>,
     /// Saved a record in the step.
     pub saved: bool,
     /// Dead.
@@ -268,7 +275,8 @@ impl Recorder {
             bufs[2].push(c.2.wrapping_sub(p.2));
             bufs[3].push(
                 (r.behaviour & 7)
-                    | if r.stuck { flag::STUCK } else { 0 }
+                    | if r.held { flag::HELD } else { 0 }
+                    | r.motion.map_or(0, |m| m.code() << flag::MOTION_SHIFT)
                     | if r.saved { flag::SAVED } else { 0 }
                     | if r.dead { flag::DEAD } else { 0 },
             );
