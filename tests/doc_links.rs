@@ -5,23 +5,13 @@
 //! fetched. The Markdown is parsed with `pulldown-cmark`, so links in code are not links and
 //! reference-style links count.
 
-use pulldown_cmark::{Event, Options, Parser, Tag, TagEnd};
+#[path = "common/guide.rs"]
+mod guide;
+
+use guide::{options, root};
+use pulldown_cmark::{Event, Parser, Tag, TagEnd};
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Component, Path, PathBuf};
-
-/// The repository's root (this package is the workspace root).
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-/// GitHub-flavoured Markdown's extensions that change where links and headings are.
-fn options() -> Options {
-    Options::ENABLE_TABLES
-        | Options::ENABLE_FOOTNOTES
-        | Options::ENABLE_STRIKETHROUGH
-        | Options::ENABLE_TASKLISTS
-        | Options::ENABLE_HEADING_ATTRIBUTES
-}
 
 /// GitHub's anchor for a heading's text: lower case; letters, digits, `-` and `_` kept, spaces
 /// to `-`, everything else dropped. (Duplicates are numbered by [`anchors`].)
@@ -85,7 +75,11 @@ fn scan(text: &str) -> (BTreeSet<String>, Vec<Link>) {
                     } else {
                         let base = slug(&words);
                         let n = seen.entry(base.clone()).or_insert(0);
-                        let anchor = if *n == 0 { base.clone() } else { format!("{base}-{n}") };
+                        let anchor = if *n == 0 {
+                            base.clone()
+                        } else {
+                            format!("{base}-{n}")
+                        };
                         *n += 1;
                         anchors.insert(anchor);
                     }
@@ -97,8 +91,12 @@ fn scan(text: &str) -> (BTreeSet<String>, Vec<Link>) {
                 }
             }
             Event::Html(h) | Event::InlineHtml(h) => anchors.extend(html_ids(&h)),
-            Event::Start(Tag::Link { dest_url, .. }) | Event::Start(Tag::Image { dest_url, .. }) => {
-                links.push(Link { dest: dest_url.to_string(), line: line_of(range.start) });
+            Event::Start(Tag::Link { dest_url, .. })
+            | Event::Start(Tag::Image { dest_url, .. }) => {
+                links.push(Link {
+                    dest: dest_url.to_string(),
+                    line: line_of(range.start),
+                });
             }
             _ => {}
         }
@@ -161,11 +159,17 @@ fn broken_links(root: &Path, files: &[PathBuf]) -> Vec<String> {
         for link in links {
             let at = format!("{}:{}: ({})", file.display(), link.line, link.dest);
             let dest = link.dest.as_str();
-            if dest.starts_with("http://") || dest.starts_with("https://") || dest.starts_with("mailto:") {
+            if dest.starts_with("http://")
+                || dest.starts_with("https://")
+                || dest.starts_with("mailto:")
+            {
                 continue;
             }
             if let Some(colon) = dest.find(':') {
-                if dest[..colon].chars().all(|c| c.is_ascii_alphanumeric() || c == '+') {
+                if dest[..colon]
+                    .chars()
+                    .all(|c| c.is_ascii_alphanumeric() || c == '+')
+                {
                     problems.push(format!("{at}: a scheme the check does not know"));
                     continue;
                 }
@@ -203,7 +207,11 @@ fn broken_links(root: &Path, files: &[PathBuf]) -> Vec<String> {
             let Some(anchor) = anchor else { continue };
             let anchor = percent_decode(anchor);
             if target.extension().is_some_and(|e| e == "md") {
-                let known = if target == *file { Some(own.clone()) } else { anchors_of(&target) };
+                let known = if target == *file {
+                    Some(own.clone())
+                } else {
+                    anchors_of(&target)
+                };
                 match known {
                     Some(set) if set.contains(&anchor) => {}
                     Some(_) => problems.push(format!(
@@ -223,48 +231,10 @@ fn broken_links(root: &Path, files: &[PathBuf]) -> Vec<String> {
     problems
 }
 
-/// Every Markdown file under `dir` (relative to `root`), sorted.
-fn markdown_under(root: &Path, dir: &Path, out: &mut Vec<PathBuf>) {
-    let mut entries: Vec<_> = std::fs::read_dir(root.join(dir))
-        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
-        .map(|e| e.expect("directory entry").file_name())
-        .collect();
-    entries.sort();
-    for name in entries {
-        let rel = dir.join(&name);
-        if root.join(&rel).is_dir() {
-            markdown_under(root, &rel, out);
-        } else if rel.extension().is_some_and(|e| e == "md") {
-            out.push(rel);
-        }
-    }
-}
-
-/// The files the check reads: README.md, CONTRIBUTING.md, docs/**/*.md, and each folder's
-/// README.md that the guide links to.
-fn guide_files() -> Vec<PathBuf> {
-    let root = root();
-    let mut files: Vec<PathBuf> = ["README.md"].iter().map(PathBuf::from).collect();
-    markdown_under(&root, Path::new("docs"), &mut files);
-    for readme in [
-        "emu/core/README.md",
-        "emu/tests/programs/README.md",
-        "firmware/README.md",
-        "eeprom/README.md",
-        "scripts/kilombo/README.md",
-    ] {
-        files.push(PathBuf::from(readme));
-    }
-    files
-}
-
 #[test]
 fn every_relative_link_and_anchor_in_the_guide_resolves() {
     let root = root();
-    let files = guide_files();
-    for f in &files {
-        assert!(root.join(f).is_file(), "{} is missing", f.display());
-    }
+    let files = guide::files();
     let problems = broken_links(&root, &files);
     assert!(
         problems.is_empty(),
@@ -282,11 +252,16 @@ fn slugs_follow_github() {
     assert_eq!(slug("snake_case and (parens)"), "snake_case-and-parens");
     assert_eq!(slug("Über η = 0.03"), "über-η--003");
     let (anchors, _) = scan("# A\n\n## A\n\n### A\n\n## `code` *in* [a link](x.md)\n");
-    let want: BTreeSet<String> =
-        ["a", "a-1", "a-2", "code-in-a-link"].iter().map(|s| s.to_string()).collect();
+    let want: BTreeSet<String> = ["a", "a-1", "a-2", "code-in-a-link"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
     assert_eq!(anchors, want);
     let (anchors, _) = scan("<a id=\"s1\"></a>\n\n## Titled {#custom}\n");
-    assert!(anchors.contains("s1") && anchors.contains("custom"), "{anchors:?}");
+    assert!(
+        anchors.contains("s1") && anchors.contains("custom"),
+        "{anchors:?}"
+    );
 }
 
 /// The checker itself finds what it is for, on a small tree of its own.
