@@ -133,9 +133,13 @@ struct Shown {
     command: Option<String>,
 }
 
-/// Whether a line (trimmed) is one of the tool's diagnostics.
+/// Whether a line (trimmed) is one of the tool's diagnostics: `error:` or `warning:` and a
+/// message (the bare words, as prose names them, are not).
 fn is_diagnostic(line: &str) -> bool {
-    line.starts_with("error:") || line.starts_with("warning:")
+    ["error:", "warning:"].iter().any(|p| {
+        line.strip_prefix(p)
+            .is_some_and(|rest| !rest.trim().is_empty())
+    })
 }
 
 /// Every diagnostic line the guide's files show, in code blocks and inline code.
@@ -307,6 +311,8 @@ fn elisions_stand_for_any_text_and_nothing_else_does() {
     assert!(!matches("error: a … c", "warning: a b c"));
     assert!(!matches("error: exact", "error: exact and more"));
     assert!(!matches("error: ab…ba", "error: aba"));
+    assert!(is_diagnostic("error: …") && is_diagnostic("warning: x"));
+    assert!(!is_diagnostic("error:") && !is_diagnostic("warning: ") && !is_diagnostic("errors: x"));
 }
 
 /// The scan finds diagnostics where the guide shows them, and the command above them.
