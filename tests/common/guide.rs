@@ -38,7 +38,10 @@ fn markdown_under(root: &Path, dir: &Path, out: &mut Vec<PathBuf>) {
 /// the folders' READMEs that the guide links to. Each must exist.
 pub fn files() -> Vec<PathBuf> {
     let root = root();
-    let mut files: Vec<PathBuf> = ["README.md"].iter().map(PathBuf::from).collect();
+    let mut files: Vec<PathBuf> = ["README.md", "CONTRIBUTING.md"]
+        .iter()
+        .map(PathBuf::from)
+        .collect();
     markdown_under(&root, Path::new("docs"), &mut files);
     for readme in [
         "emu/core/README.md",
