@@ -110,12 +110,15 @@ fn percent_decode(s: &str) -> String {
     let mut out = Vec::with_capacity(bytes.len());
     let mut i = 0;
     while i < bytes.len() {
-        if bytes[i] == b'%' && i + 2 < bytes.len() {
-            if let Ok(b) = u8::from_str_radix(&s[i + 1..i + 3], 16) {
-                out.push(b);
-                i += 3;
-                continue;
-            }
+        let hex = bytes
+            .get(i + 1..i + 3)
+            .and_then(|h| std::str::from_utf8(h).ok());
+        if bytes[i] == b'%'
+            && let Some(b) = hex.and_then(|h| u8::from_str_radix(h, 16).ok())
+        {
+            out.push(b);
+            i += 3;
+            continue;
         }
         out.push(bytes[i]);
         i += 1;
@@ -165,14 +168,13 @@ fn broken_links(root: &Path, files: &[PathBuf]) -> Vec<String> {
             {
                 continue;
             }
-            if let Some(colon) = dest.find(':') {
-                if dest[..colon]
+            if let Some(colon) = dest.find(':')
+                && dest[..colon]
                     .chars()
                     .all(|c| c.is_ascii_alphanumeric() || c == '+')
-                {
-                    problems.push(format!("{at}: a scheme the check does not know"));
-                    continue;
-                }
+            {
+                problems.push(format!("{at}: a scheme the check does not know"));
+                continue;
             }
             let (path_part, anchor) = match dest.split_once('#') {
                 Some((p, a)) => (p, Some(a)),
@@ -251,6 +253,9 @@ fn slugs_follow_github() {
     assert_eq!(slug("run --help"), "run---help");
     assert_eq!(slug("snake_case and (parens)"), "snake_case-and-parens");
     assert_eq!(slug("Über η = 0.03"), "über-η--003");
+    assert_eq!(percent_decode("a%20b.md"), "a b.md");
+    assert_eq!(percent_decode("100%"), "100%");
+    assert_eq!(percent_decode("%zz%é"), "%zz%é");
     let (anchors, _) = scan("# A\n\n## A\n\n### A\n\n## `code` *in* [a link](x.md)\n");
     let want: BTreeSet<String> = ["a", "a-1", "a-2", "code-in-a-link"]
         .iter()
