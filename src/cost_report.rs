@@ -157,9 +157,9 @@ pub struct CostReport {
     pub ram_bytes: u32,
 }
 
-/// The most steps `cost` measures: 10 000 000 take about 4 s here (the meter runs about
-/// 2.6 M learner steps a second); 2^32 - 1, which the streamed statistics could hold, would run
-/// for half an hour.
+/// The most steps `cost` measures. The streamed statistics could hold 2^32 - 1, but a run of
+/// that many would take over 400 times as long as one at this bound (the time at the bound:
+/// docs/limits-and-failures.md).
 pub const MAX_COST_STEPS: u32 = 10_000_000;
 
 /// Runs the learner with the H8 meter and collects the report.

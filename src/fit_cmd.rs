@@ -1,5 +1,6 @@
-//! `h8swarm fit`: the verdict of docs/design.md §6 for the default network and the paper's two settings,
-//! what-ifs, and the largest network within a CPU budget, all measured by running the
+//! `h8swarm fit`: the verdict of docs/design.md §6 for the paper's network in its two settings
+//! (which the built-in runs may not use: each heading says), what-ifs, and the largest network
+//! within a CPU budget, all measured by running the
 //! controller on the emulated H8/3052F ([`swarm::fit`]): by default the robot firmware on the
 //! H8/300H core, with the Rust model's figures beside each phase.
 
@@ -20,13 +21,87 @@ use swarm::fit::{
 };
 use swarm::scenario::ControllerKind;
 
-/// Which of the paper's settings to start from.
+/// Which of the paper's settings to start from: the paper's network (its own η), which is not
+/// always the network the built-in run of the same name uses (the run's network).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum Setting {
-    /// Paper env. 2: four behaviours, η = 0.001, 0.45 s steps (the default network).
+    /// Paper env. 2: four behaviours, η = 0.001, 0.45 s steps (the paper's network; `run arena`
+    /// runs η = 0.03).
     Arena,
     /// Paper env. 1: forward and backward, η = 0.1, 0.60 s steps.
     Corridor,
+}
+
+impl Setting {
+    /// The name of the setting and of the built-in scenario.
+    fn name(self) -> &'static str {
+        match self {
+            Setting::Arena => "arena",
+            Setting::Corridor => "corridor",
+        }
+    }
+
+    /// The paper's η for this setting, as the paper gives it (the network uses it in Q15).
+    fn paper_eta(self) -> f64 {
+        match self {
+            Setting::Arena => 0.001,
+            Setting::Corridor => 0.1,
+        }
+    }
+
+    /// The built-in scenario of the same name, whose network a run uses.
+    fn scenario(self) -> swarm::scenario::Scenario {
+        match self {
+            Setting::Arena => swarm::scenario::Scenario::arena(),
+            Setting::Corridor => swarm::scenario::Scenario::corridor(),
+        }
+    }
+
+    /// The heading of a report on the paper's network in this setting, naming the run's
+    /// network when the built-in run uses another one (and how it differs).
+    fn heading(self, seed: u64) -> Result<String> {
+        let paper = base_config(self, seed);
+        let scenario = self.scenario();
+        let run = swarm::robot::controller_config(&scenario, fit_weight_seed(seed))?;
+        let (name, env) = (self.name(), if self == Setting::Arena { 2 } else { 1 });
+        let head = format!(
+            "{name} (paper env. {env}): the paper's network, eta {}",
+            self.paper_eta()
+        );
+        if run == paper {
+            return Ok(format!("{head}, which `h8swarm run {name}` runs too"));
+        }
+        let mut differs = Vec::new();
+        if run.params.eta() != paper.params.eta() {
+            differs.push(format!("eta {}", scenario.learner.eta));
+        }
+        if run.params.threshold() != paper.params.threshold() {
+            differs.push(format!("T {}", run.params.threshold()));
+        }
+        if run.behaviours != paper.behaviours {
+            differs.push(format!("{} behaviours", run.behaviours));
+        }
+        if run.layout != paper.layout {
+            differs.push(format!(
+                "history {}, bias {}",
+                run.layout.history(),
+                if run.layout.bias() { "on" } else { "off" }
+            ));
+        }
+        if run.save_every_steps != paper.save_every_steps {
+            differs.push(format!("a record every {} steps", run.save_every_steps));
+        }
+        if run.step_period_s != paper.step_period_s {
+            differs.push(format!("step {} s", run.step_period_s));
+        }
+        if run.clock_hz != paper.clock_hz || run.sensor_channels != paper.sensor_channels {
+            differs.push("other board settings".to_string());
+        }
+        Ok(format!(
+            "{head}; `h8swarm run {name}` runs the run's network ({}), measured in its fit.json",
+            differs.join(", ")
+        ))
+    }
 }
 
 /// Which controller to measure.
@@ -314,11 +389,13 @@ pub fn run(a: &FitArgs) -> Result<String> {
         if let Some(e) = report.energy.as_mut() {
             *e = e.with_pack(pack);
         }
-        let name = match (setting, a.what_if()) {
-            (Setting::Arena, false) => "arena (paper env. 2; the default network)".to_string(),
-            (Setting::Corridor, false) => "corridor (paper env. 1)".to_string(),
-            (Setting::Arena, true) => "what-if, from the arena's settings".to_string(),
-            (Setting::Corridor, true) => "what-if, from the corridor's settings".to_string(),
+        let name = if a.what_if() {
+            format!(
+                "what-if, from the paper's network in the {}",
+                setting.name()
+            )
+        } else {
+            setting.heading(a.seed)?
         };
         reports.push((name, report));
     }
@@ -598,6 +675,25 @@ fn render_energy(s: &mut String, e: &swarm::fit::EnergyReport) {
                 s,
                 "motor current cut to the drive voltage's bound {how} in {} of {} driven wheel-sub-steps",
                 cap.capped_wheel_substeps, cap.driven_wheel_substeps
+            );
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The η the headings give for the paper's network is the one it runs, in Q15.
+    #[test]
+    fn the_paper_eta_named_is_the_one_measured() {
+        for setting in [Setting::Arena, Setting::Corridor] {
+            let mut s = setting.scenario();
+            s.learner.eta = setting.paper_eta();
+            assert_eq!(
+                Some(base_config(setting, 1).params.eta().to_bits()),
+                i16::try_from(s.eta_q15()).ok(),
+                "{setting:?}"
             );
         }
     }

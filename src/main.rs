@@ -137,8 +137,7 @@ struct CostArgs {
     /// Dead-zone threshold T in distance units.
     #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(i32).range(0..=32767))]
     threshold: i32,
-    /// Steps to measure (at most 10 000 000, about 4 s here; the statistics settle long
-    /// before).
+    /// Steps to measure (at most 10 000 000; the statistics settle long before).
     #[arg(long, default_value_t = 10_000, value_parser = clap::value_parser!(u32).range(1..=i64::from(h8swarm::cost_report::MAX_COST_STEPS)))]
     steps: u32,
     /// Seed of the proximities and initial weights.

@@ -27,22 +27,35 @@ use swarm::robot::{Condition, controller_config};
 use swarm::scenario::Scenario;
 use swarm::summary::{Analysis, Claim, ConditionStats, Estimate, Pairing, Quantity, analyse};
 
+/// An option's help with its default, which comes from the scenario (an option given overrides
+/// it; not given, the scenario's value stands, so clap must not hold a default of its own):
+/// `WHAT [default: the scenario's: arena A, corridor C, a file's own or its base's]`, the values
+/// read from the built-ins themselves.
+fn scenario_default(what: &str, value: fn(&Scenario) -> String) -> String {
+    format!(
+        "{what} [default: the scenario's: arena {}, corridor {}, a file's own or its base's]",
+        value(&Scenario::arena()),
+        value(&Scenario::corridor())
+    )
+}
+
 /// Options of `h8swarm run`.
 #[derive(Args, Debug, Default, Clone)]
 pub struct RunArgs {
     /// `arena` (default), `corridor`, or a scenario file (.toml).
     pub scenario: Option<String>,
-    /// Robots (the square arena is scaled to keep the paper's density).
-    #[arg(long)]
+    /// Robots (the square arena is scaled to keep the paper's density). Default: the
+    /// scenario's.
+    #[arg(long, help = scenario_default("Robots (the square arena is scaled to keep the paper's density)", |s| s.robots.to_string()))]
     pub robots: Option<usize>,
-    /// Steps per run.
-    #[arg(long)]
+    /// Steps per run. Default: the scenario's.
+    #[arg(long, help = scenario_default("Steps per run", |s| s.steps.to_string()))]
     pub steps: Option<u32>,
-    /// Repeats of each condition.
-    #[arg(long)]
+    /// Repeats of each condition. Default: the scenario's.
+    #[arg(long, help = scenario_default("Repeats of each condition", |s| s.repeats.to_string()))]
     pub repeats: Option<u32>,
-    /// Master seed.
-    #[arg(long)]
+    /// Master seed. Default: the scenario's.
+    #[arg(long, help = scenario_default("Master seed", |s| s.seed.to_string()))]
     pub seed: Option<u64>,
     /// Worker threads (default: all cores). The output does not depend on it.
     #[arg(long)]

@@ -702,3 +702,51 @@ fn replay_changes_no_other_output_and_is_the_same_for_any_thread_count() {
         assert!(err.contains(expected), "{args:?}: {err}");
     }
 }
+
+/// `run --help` (and `-h`) gives the defaults of --robots, --steps, --repeats and --seed: the
+/// built-in scenarios' own values, which a run without the option uses.
+#[test]
+fn run_help_shows_the_scenario_defaults() {
+    use swarm::scenario::Scenario;
+    let (arena, corridor) = (Scenario::arena(), Scenario::corridor());
+    for flag in ["--help", "-h"] {
+        let o = h8swarm(&["run", flag], None);
+        assert_eq!(o.status.code(), Some(0));
+        let help = String::from_utf8_lossy(&o.stdout);
+        for (option, a, c) in [
+            (
+                "--robots",
+                arena.robots.to_string(),
+                corridor.robots.to_string(),
+            ),
+            (
+                "--steps",
+                arena.steps.to_string(),
+                corridor.steps.to_string(),
+            ),
+            (
+                "--repeats",
+                arena.repeats.to_string(),
+                corridor.repeats.to_string(),
+            ),
+            ("--seed", arena.seed.to_string(), corridor.seed.to_string()),
+        ] {
+            let want = format!(
+                "[default: the scenario's: arena {a}, corridor {c}, a file's own or its base's]"
+            );
+            let at = help
+                .find(&format!("{option} <"))
+                .unwrap_or_else(|| panic!("{option}"));
+            let next = help[at + 2..]
+                .find("\n      --")
+                .map_or(help.len(), |n| at + 2 + n);
+            assert!(
+                help[at..next].contains(&want),
+                "{flag}: {option}: {}",
+                &help[at..next]
+            );
+        }
+    }
+    // The built-ins differ in steps, so the help cannot be showing one value for both.
+    assert_ne!(arena.steps, corridor.steps);
+}

@@ -217,3 +217,36 @@ fn the_default_fit_is_the_firmware_with_the_model_beside() {
             .contains("the Rust model of the controller; beside it: firmware/robot.mot")
     );
 }
+
+/// `fit` names the network it measures: the paper's (η = 0.001 in the arena), and says that
+/// `run arena` runs another one, the run's network (η = 0.03), which a run's fit.json measures;
+/// the corridor's run uses the paper's network.
+#[test]
+fn fit_says_which_network_it_measures() {
+    let out = h8swarm(&["fit", "--steps", "20"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    let headings: Vec<&str> = text.lines().filter(|l| l.starts_with("== ")).collect();
+    assert_eq!(
+        headings,
+        [
+            "== arena (paper env. 2): the paper's network, eta 0.001; `h8swarm run arena` runs the run's network (eta 0.03), measured in its fit.json",
+            "== corridor (paper env. 1): the paper's network, eta 0.1, which `h8swarm run corridor` runs too",
+        ],
+        "{text}"
+    );
+    assert!(!text.contains("default network"), "{text}");
+    // The measured network is the paper's: η 0.001 is 33 in Q15; the run's 0.03 is 983.
+    let arena = &text[..text.find("== corridor").unwrap()];
+    assert!(arena.contains(", eta 33 (Q15),"), "{arena}");
+    let out = h8swarm(&["fit", "--history", "2", "--steps", "20"]);
+    assert!(out.status.success());
+    assert!(
+        String::from_utf8_lossy(&out.stdout)
+            .contains("== what-if, from the paper's network in the arena\n")
+    );
+}

@@ -1,5 +1,6 @@
 //! Property tests of h8swarm live in `tests/`; this library holds only what they share: how
 //! many cases each property runs.
+#![forbid(unsafe_code)]
 
 /// The number of cases each property runs when `PROPTEST_CASES` is not set.
 pub const DEFAULT_CASES: u32 = 10_000;

@@ -1,87 +1,25 @@
 //! The H8/300H CPU core in advanced mode (24-bit addresses, 32-bit ER0–ER7, ER7 = SP).
 //!
-//! Split as in moa: [`mod@decode`] turns instruction words into an [`decode::Instr`], `exec`
-//! carries it out, [`timing`] holds the manual's internal-state counts, and [`disasm`] prints
-//! instructions the way `h8300-hms-objdump -d` does.
+//! [`mod@decode`] turns instruction words into an [`decode::Instr`], `exec` carries it out,
+//! [`timing`] holds the manual's internal-state counts, [`disasm`] prints instructions as
+//! `h8300-hms-objdump -d` does, and [`stack`] is the stack guard
+//! ([`Cpu::set_stack_guard`]).
 //!
-//! The core is generic over [`Bus`] (static dispatch). Time is right by construction, as in
-//! mooneye-gb: every instruction fetch and data access goes through the bus, which charges the
-//! states of the area it touches, and the internal states N are charged with
-//! [`Bus::internal`]. An instruction therefore costs `I·S_I + J·S_J + K·S_K + L·S_L + M·S_M +
-//! N·S_N` states (programming manual, Appendix A).
+//! The core is generic over [`Bus`] (static dispatch). Every fetch and data access goes
+//! through the bus, which charges the states of the area it touches; the internal states are
+//! charged with [`Bus::internal`]. Two paths run the same instructions to the same states:
+//! [`Cpu::step_reference`] (every word fetched through the bus, one generic executor) and
+//! [`Cpu::step`] (per-form handlers for ROM code, `fast`, when the bus shows a
+//! [`FastPathHints::code_generation`] token; off with [`Cpu::set_fast_path`]). [`Cpu::run`]
+//! and [`Cpu::run_until`] step up to a deadline and fast-forward loops (`ffwd`, off with
+//! [`Cpu::set_fast_forward`]) within the bus's promises
+//! ([`FastPathHints::reads_stable_until`], [`FastPathHints::irq_stable_until`]); the skipped
+//! work is counted in [`Cpu::skipped_instructions`]. [`Cpu::step`] never skips. The decode
+//! caches are emptied when the bus's token changes and by [`Cpu::flush_decode_cache`].
 //!
-//! Speed: two paths run the same instructions to the same states.
-//! - The reference path ([`Cpu::step_reference`]) is the plain one: every instruction word is
-//!   fetched through [`Bus::read16`] (ROM instructions are decoded once and kept in a cache
-//!   indexed by address, but their fetch cycles still go through the bus), and the decoded
-//!   [`decode::Instr`] is executed by one generic executor.
-//! - The fast path ([`Cpu::step`], unless [`Cpu::set_fast_path`] turned it off) runs when the
-//!   bus shows a [`FastPathHints::code_generation`] token, i.e. promises that fetching from ROM or RAM
-//!   has no effect but the clock: each ROM instruction is decoded once into a handler of its
-//!   own form (`fast`: register moves and ALU operations by size and source, loads and stores
-//!   by size, branches with their target, condition mask and prefetch states precomputed,
-//!   calls and returns), its fetch cycles are charged as one [`Bus::internal`] lump of
-//!   `words × ROM word states`, and the handler does the operation with the reference path's
-//!   own helpers (flags, operands, memory) and the same bus accesses in the same order. Forms
-//!   without a handler of their own, code in RAM and everything around sleep mode go through
-//!   the reference executor. Interrupts are checked before every instruction on both paths.
-//! - [`Cpu::run`] is [`Cpu::step`] in a loop up to a deadline, with one difference in how, not
-//!   what: it carries PC from one instruction to the next in a local, so that after an
-//!   instruction that can only go on to the next the CPU need not wait for the PC it just
-//!   stored (the store-to-load latency is the fast path's longest chain).
-//! - [`Cpu::run_until`] (and `run`) also fast-forward loops (`ffwd`, on unless
-//!   [`Cpu::set_fast_forward`] turns it off): a delay loop (INC/DEC/ADD/SUB #imm on one
-//!   register and a BNE back) is advanced to its last iteration in closed form, and a loop
-//!   whose watched iteration wrote nothing, came back to its head with every register and CCR
-//!   unchanged and read only what the bus promises stays the same ([`FastPathHints::reads_stable_until`]:
-//!   ROM, RAM, the A/D converter until its next event) is skipped to where something can change:
-//!   the deadline, the next possible interrupt request ([`FastPathHints::irq_stable_until`]), the end of
-//!   its reads' promises. The skipped iterations' states and instructions are counted
-//!   ([`Cpu::skipped_instructions`]); registers, flags, clock and memory are what stepping
-//!   reaches at the same instruction boundary. [`Cpu::step`] never skips.
-//!
-//! The stack guard ([`stack`], [`Cpu::set_stack_guard`]) checks every stack access (pushes,
-//! calls, returns, interrupt entries, loads and stores through ER7) and every instruction that
-//! sets SP against the stack's room, on both paths: the fast path gives loads and stores
-//! through ER7 handlers of their own and leaves the instructions that set SP as a register to
-//! the reference executor, so no other instruction pays for it.
-//!
-//! The decode caches are emptied whenever the bus's token changes (the flash was written:
-//! loading an image, poking), and by [`Cpu::flush_decode_cache`]. Tests run random programs,
-//! the C programs and the robot firmware both ways and compare the complete state after every
-//! instruction.
-//!
-//! DIVXS.B/DIVXS.W flags (programming manual, 2.2.26 (1) and (2)). The condition-code table
-//! says "N: Set to 1 if the quotient is negative; otherwise cleared to 0. Z: Set to 1 if the
-//! divisor is zero; otherwise cleared to 0." (H, V, C unchanged), and the page's notes make N
-//! precise: "The N flag is set to 1 if the dividend and divisor have different signs, and
-//! cleared to 0 if they have the same sign. The N flag may therefore be set to 1 when the
-//! quotient is zero." This core follows the notes for both widths and every operand: N = the
-//! dividend's sign bit XOR the divisor's sign bit (so -1 / 5 and -3 / 100 give quotient 0 with
-//! N = 1, and 0 / -5 gives N = 1), Z = (divisor = 0). GDB's simulator sets N from the
-//! quotient instead (N = 0 for a zero quotient). DIVXU sets N from the
-//! divisor's top bit ("N: Set to 1 if the divisor is negative").
-//!
-//! Choices where the manual leaves the result open (documented behaviour of this core):
-//! - DIVXU/DIVXS by zero or with overflow: the manual says only "Valid results are not assured
-//!   if division by zero is attempted or an overflow occurs". By zero the destination register
-//!   is left unchanged (flags as above: Z = 1; N from the divisor's top bit, i.e. 0, for DIVXU
-//!   and from the signs, i.e. the dividend's sign, for DIVXS); on overflow the low 8/16 bits of
-//!   the quotient and of the remainder are stored, with the flags as above.
-//! - DAA/DAS leave H and V unchanged (the manual: "undetermined").
-//! - STC to memory writes the CCR to both bytes of the word.
-//! - `MOV Rn,@-ERn` with the same register stores the value before the decrement.
-//! - JSR/BSR push the 24-bit return address as a longword whose top byte is 0; interrupts and
-//!   TRAPA push CCR in the top byte (advanced-mode stack frame).
-//! - CCR.UI is treated as a user bit (SYSCR.UE = 1, the reset value): only CCR.I masks
-//!   interrupts, NMI (vector 7) is never masked. Interrupts are not accepted right after LDC,
-//!   ANDC, ORC, XORC (H8/3052F hardware manual, "Instructions that disable interrupts").
-//! - MOVFPE/MOVTPE decode and disassemble but stop the program with
-//!   [`CpuError::Unsupported`]: they need the E clock, which the H8/3052F does not provide.
-//! - Interrupt entry costs the priority decision (1 state internal, 2 external) plus 16 states
-//!   (stack 2 words, vector 2 words, 2 prefetches, 4 internal): H8/3052F hardware manual Table
-//!   5-5 without the "wait for the end of the current instruction", which this core overlaps
-//!   with the instruction (interrupts are taken between instructions).
+//! What the manual leaves open and what this core does (DIVXS's N flag, division by zero,
+//! DAA/DAS, MOVFPE/MOVTPE as [`CpuError::Unsupported`], interrupt entry), the paths and how
+//! tests hold them together: docs/emulator-accuracy.md.
 
 pub mod decode;
 pub mod disasm;
