@@ -16,10 +16,10 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
 
-/// The robot's clock φ in Hz (the board's, `emu::board::board::CLOCK_HZ`; docs/design.md §4.1):
+/// The robot's clock φ in Hz (the board's, `robot_board::board::CLOCK_HZ`; docs/design.md §4.1):
 /// the firmware's states become microseconds at it.
 fn phi_hz() -> f64 {
-    f64::from(emu::board::board::CLOCK_HZ)
+    f64::from(robot_board::board::CLOCK_HZ)
 }
 
 /// What to measure.
@@ -173,11 +173,11 @@ pub fn measure(cfg: &CostConfig) -> Result<CostReport> {
             cfg.steps
         );
     }
-    if !emu::board::model::step_period_ok(cfg.step_period_s) {
+    if !robot_board::model::step_period_ok(cfg.step_period_s) {
         bail!(
             "--step-period-s {}: valid is {}",
             swarm::text::number(cfg.step_period_s),
-            emu::board::model::STEP_PERIOD_VALID
+            robot_board::model::STEP_PERIOD_VALID
         );
     }
     let layout = InputLayout::new(cfg.history, cfg.bias).context("--history")?;

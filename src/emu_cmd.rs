@@ -1,16 +1,16 @@
 //! `h8swarm emu IMAGE.mot [--max-states N] [--trace] [--stats] [--vcd FILE] [--gdb ADDR]
 //! [--symbols FILE]`: runs a program on the emulated H8/3052F (docs/design.md §7) on the robot's
-//! board (`emu::board::board::RobotBoard`: its two EEPROMs on port 4, seed 0, and nothing else
+//! board (`robot_board::board::RobotBoard`: its two EEPROMs on port 4, seed 0, and nothing else
 //! connected: the analog inputs at 0 V, port 2 released), so that programs that use the
 //! EEPROMs run as on the robot. SCI1 is the console
 //! (standard output); `--trace` writes one line per instruction (address, disassembly, states,
 //! and the function it is in when the image has symbols) and `--stats` a JSON summary, both on
-//! standard error. `--vcd` writes a pin trace of the whole run (`emu::chip::vcd`); `--gdb`
+//! standard error. `--vcd` writes a pin trace of the whole run (`h8_3052f::vcd`); `--gdb`
 //! waits for a GDB client on a loopback address before the program's first instruction
-//! (`emu::chip::gdb`). Symbols (for the phase names): `--symbols`, else IMAGE.sym beside the
+//! (`h8_3052f::gdb`). Symbols (for the phase names): `--symbols`, else IMAGE.sym beside the
 //! image if present.
 //!
-//! The stack guard (`emu::core::cpu::stack`) watches every stack access: its room runs from
+//! The stack guard (`h8300h::cpu::stack`) watches every stack access: its room runs from
 //! the end of the image's data to its stack's top when the symbols say where they are
 //! (`__bss_end`, `__stack_top`), else over the whole on-chip RAM. By default the first access
 //! outside stops the program with a one-line error naming the instruction, its function, SP
@@ -27,18 +27,18 @@ use std::io::{self, BufWriter, Write};
 use std::path::Path;
 use std::sync::Arc;
 
-use emu::board::board::{RobotBoard, RobotConfig, robot_mcu};
-use emu::board::symbols::SymbolTable;
-use emu::chip::gdb::{Debugger, GdbError, GdbListener};
-use emu::chip::mcu::{IoReport, Mcu};
-use emu::chip::pins::NullBoard;
-use emu::chip::profile::StackProfile;
-use emu::chip::run::{Outcome, Probes, RunOptions, drain_into, run_mcu_probed};
-use emu::chip::trace::{CodeNames, PhaseRecorder};
-use emu::chip::vcd::{VcdInfo, VcdStream};
-use emu::core::bus::Bus;
-use emu::core::cpu::{Cpu, StackGuard, StackGuardMode, StackRoom};
-use emu::core::srec;
+use h8_3052f::gdb::{Debugger, GdbError, GdbListener};
+use h8_3052f::mcu::{IoReport, Mcu};
+use h8_3052f::pins::NullBoard;
+use h8_3052f::profile::StackProfile;
+use h8_3052f::run::{Outcome, Probes, RunOptions, drain_into, run_mcu_probed};
+use h8_3052f::trace::{CodeNames, PhaseRecorder};
+use h8_3052f::vcd::{VcdInfo, VcdStream};
+use h8300h::bus::Bus;
+use h8300h::cpu::{Cpu, StackGuard, StackGuardMode, StackRoom};
+use h8300h::srec;
+use robot_board::board::{RobotBoard, RobotConfig, robot_mcu};
+use robot_board::symbols::SymbolTable;
 
 use crate::Failure;
 
@@ -95,8 +95,8 @@ fn symbols(image: &str, given: Option<&Path>) -> Result<Option<SymbolTable>, Fai
             p
         }
     };
-    let max = emu::board::firmware::Firmware::MAX_FILE_BYTES;
-    let text = emu::board::firmware::read_bounded(&path, max)
+    let max = robot_board::firmware::Firmware::MAX_FILE_BYTES;
+    let text = robot_board::firmware::read_bounded(&path, max)
         .and_then(|b| String::from_utf8(b).map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e)))
         .map_err(|e| {
         input(format!(
@@ -220,7 +220,7 @@ pub fn run(o: &EmuOptions<'_>) -> Result<(), Failure> {
 /// A report of the chip as one line, its function named when the image has symbols.
 fn describe(r: &IoReport, names: Option<&SymbolTable>) -> String {
     match names {
-        Some(n) => emu::board::firmware::describe_io(n, r),
+        Some(n) => robot_board::firmware::describe_io(n, r),
         None => r.describe(None),
     }
 }
@@ -245,9 +245,9 @@ fn create_profile(
 
 /// The image loaded into a fresh MCU on the robot's board.
 fn load(image: &str) -> Result<EmuMcu, Failure> {
-    let max = emu::board::firmware::Firmware::MAX_FILE_BYTES;
+    let max = robot_board::firmware::Firmware::MAX_FILE_BYTES;
     let bytes =
-        emu::board::firmware::read_bounded(std::path::Path::new(image), max).map_err(|e| {
+        robot_board::firmware::read_bounded(std::path::Path::new(image), max).map_err(|e| {
             input(format!(
                 "cannot read image `{image}`: {e} (give a Motorola S-record file, .mot)"
             ))
@@ -319,7 +319,7 @@ fn start_vcd(
     }
     let (start, initial) = mcu
         .trace_beginning()
-        .unwrap_or((0, [false; emu::chip::trace::SIGNAL_COUNT]));
+        .unwrap_or((0, [false; h8_3052f::trace::SIGNAL_COUNT]));
     let stream = VcdStream::start(
         Box::new(file),
         mcu.clock_hz(),

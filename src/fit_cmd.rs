@@ -10,10 +10,10 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
-use emu::board::firmware::Firmware;
-use emu::board::model::ControllerConfig;
-use emu::board::profile::PhaseDef;
 use nn_q15::InputLayout;
+use robot_board::firmware::Firmware;
+use robot_board::model::ControllerConfig;
+use robot_board::profile::PhaseDef;
 use serde::Serialize;
 use swarm::fit::{
     Budget, FirmwareUnderTest, FitConfig, FitReport, fit_weight_seed, largest_fitting, measure,
@@ -244,11 +244,11 @@ fn apply_what_ifs(mut cfg: ControllerConfig, a: &FitArgs) -> Result<ControllerCo
         cfg.save_every_steps = s;
     }
     if let Some(p) = a.step_period_s {
-        if !emu::board::model::step_period_ok(p) {
+        if !robot_board::model::step_period_ok(p) {
             bail!(
                 "--step-period-s {}: valid is {}",
                 swarm::text::number(p),
-                emu::board::model::STEP_PERIOD_VALID
+                robot_board::model::STEP_PERIOD_VALID
             );
         }
         cfg.step_period_s = p;

@@ -96,11 +96,11 @@ enum GuardArg {
     Warn,
 }
 
-impl From<GuardArg> for emu::core::cpu::StackGuardMode {
+impl From<GuardArg> for h8300h::cpu::StackGuardMode {
     fn from(g: GuardArg) -> Self {
         match g {
-            GuardArg::Stop => emu::core::cpu::StackGuardMode::Stop,
-            GuardArg::Warn => emu::core::cpu::StackGuardMode::Warn,
+            GuardArg::Stop => h8300h::cpu::StackGuardMode::Stop,
+            GuardArg::Warn => h8300h::cpu::StackGuardMode::Warn,
         }
     }
 }
@@ -321,7 +321,7 @@ fn learn(args: &LearnArgs) -> Result<(), Failure> {
     let stdout = io::stdout();
     let mut out = BufWriter::new(stdout.lock());
     let engine = if args.on_core {
-        let fw = emu::board::firmware::Firmware::robot()
+        let fw = robot_board::firmware::Firmware::robot()
             .map_err(|e| Failure::Tool(anyhow::Error::new(e).context("the built-in firmware")))?;
         replay::Engine::OnCore(Box::new(fw))
     } else {

@@ -150,11 +150,11 @@ pub enum StackGuardArg {
     Warn,
 }
 
-impl From<StackGuardArg> for emu::core::cpu::StackGuardMode {
+impl From<StackGuardArg> for h8300h::cpu::StackGuardMode {
     fn from(g: StackGuardArg) -> Self {
         match g {
-            StackGuardArg::Stop => emu::core::cpu::StackGuardMode::Stop,
-            StackGuardArg::Warn => emu::core::cpu::StackGuardMode::Warn,
+            StackGuardArg::Stop => h8300h::cpu::StackGuardMode::Stop,
+            StackGuardArg::Warn => h8300h::cpu::StackGuardMode::Warn,
         }
     }
 }
@@ -323,7 +323,7 @@ fn probes(a: &RunArgs, s: &Scenario, stage: &mut Stage) -> Result<swarm::experim
     }
     if let Some(addr) = &a.gdb {
         let robot = probed_robot("--gdb-robot", a.gdb_robot.unwrap_or(0), s)?;
-        let listener = emu::chip::gdb::GdbListener::bind(addr).context("--gdb")?;
+        let listener = h8_3052f::gdb::GdbListener::bind(addr).context("--gdb")?;
         let at = listener.local_addr();
         eprintln!(
             "h8swarm run: GDB stub listening on {at} for robot {robot} of the learning run (repeat 0); waiting for a client (target remote {at})"
@@ -423,7 +423,7 @@ pub fn run(a: &RunArgs) -> Result<String> {
         Path::new("out").join(name)
     });
     let trace_buffers = if a.vcd.is_some() {
-        emu::chip::vcd::STREAM_BUFFER_BYTES
+        h8_3052f::vcd::STREAM_BUFFER_BYTES
     } else {
         0
     };

@@ -326,10 +326,10 @@ fn a_robots_profile_adds_up_to_its_clock() {
 fn fit_minibot(strict_io: bool) -> Result<swarm::fit::FitReport, swarm::fit::FitError> {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("emu/tests/programs/chip");
     let firmware =
-        emu::board::firmware::Firmware::load(&dir.join("minibot.mot"), &dir.join("minibot.sym"))
+        robot_board::firmware::Firmware::load(&dir.join("minibot.mot"), &dir.join("minibot.sym"))
             .unwrap();
     swarm::fit::measure(&swarm::fit::FitConfig {
-        controller: emu::board::model::ControllerConfig::arena(1),
+        controller: robot_board::model::ControllerConfig::arena(1),
         steps: 3,
         seed: 1,
         kind: swarm::scenario::ControllerKind::Firmware,

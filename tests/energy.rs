@@ -3,7 +3,7 @@
 //! not its stall current; a free one its no-load current; the swarm's `energy_per_robot_mj`
 //! adds up to the robots' charge; the fit's energy report by part.
 
-use emu::board::model::ControllerConfig;
+use robot_board::model::ControllerConfig;
 use swarm::energy::{DriveMeter, Pack, Part};
 use swarm::experiment::{Swarm, world_params};
 use swarm::fit::{FirmwareUnderTest, FitConfig, fit_weight_seed, measure};

@@ -26,7 +26,7 @@ fn scenario(corridor: bool) -> Scenario {
 /// The learner's state a firmware robot holds (weights, the input vector x and the outputs O),
 /// read from its RAM through the firmware's symbols (each a pointer to a boot-sized array).
 fn firmware_learner(r: &Robot, n_in: usize, m: usize) -> (Vec<i16>, Vec<i8>, Vec<i16>) {
-    let fw = emu::board::firmware::Firmware::robot().unwrap();
+    let fw = robot_board::firmware::Firmware::robot().unwrap();
     let peek = |a: u32| r.mcu.peek(a);
     let array = |name: &str| {
         let at = fw.symbols.addr(name).unwrap();

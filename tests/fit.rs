@@ -4,8 +4,8 @@
 
 use std::process::Command;
 
-use emu::board::model::ControllerConfig;
 use nn_q15::InputLayout;
+use robot_board::model::ControllerConfig;
 use swarm::fit::{FirmwareUnderTest, FitConfig, fit_weight_seed, measure};
 use swarm::scenario::ControllerKind;
 
@@ -89,7 +89,7 @@ fn the_firmware_fits_with_ram_rom_and_stack_measured() {
     // The model places the firmware's measured stack in its RAM map.
     assert_eq!(
         stack,
-        emu::board::model::MODEL_STACK_BYTES,
+        robot_board::model::MODEL_STACK_BYTES,
         "the firmware's stack changed"
     );
     // The network's arrays as the firmware carved them: 2NM + 2N + 4M + 2M + N (even).

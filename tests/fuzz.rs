@@ -260,7 +260,7 @@ fn srec_text() -> impl Strategy<Value = Vec<u8>> {
 
 #[test]
 fn s_records_never_panic_and_images_that_load_run_to_a_stop() {
-    use emu::chip::run::{RunOptions, run_image};
+    use h8_3052f::run::{RunOptions, run_image};
     let (loaded, refused) = (Cell::new(0u32), Cell::new(0u32));
     runner()
         .run(&srec_text(), |bytes| {
@@ -862,11 +862,11 @@ fn rsp_reply(s: &mut std::net::TcpStream) -> Option<String> {
 
 #[test]
 fn raw_gdb_sessions_get_protocol_answers_and_never_hang_the_stub() {
-    use emu::board::firmware::Firmware;
-    use emu::chip::gdb::GdbListener;
-    use emu::chip::mcu::{Mcu, McuConfig};
-    use emu::chip::pins::NullBoard;
-    use emu::chip::run::{Probes, RunOptions, run_mcu_probed};
+    use h8_3052f::gdb::GdbListener;
+    use h8_3052f::mcu::{Mcu, McuConfig};
+    use h8_3052f::pins::NullBoard;
+    use h8_3052f::run::{Probes, RunOptions, run_mcu_probed};
+    use robot_board::firmware::Firmware;
     use std::io::Write;
     let fw = Firmware::robot().unwrap();
     let (alive, ended) = (Cell::new(0u32), Cell::new(0u32));
@@ -878,7 +878,7 @@ fn raw_gdb_sessions_get_protocol_answers_and_never_hang_the_stub() {
             let run = std::thread::spawn(move || {
                 let mut debugger = listener.accept().unwrap();
                 let mut mcu = Mcu::new(McuConfig::default(), NullBoard).unwrap();
-                let mut cpu = emu::core::cpu::Cpu::new();
+                let mut cpu = h8300h::cpu::Cpu::new();
                 fw.install(&mut mcu, &mut cpu, None).unwrap();
                 run_mcu_probed(
                     &mut cpu,

@@ -243,7 +243,7 @@ fn a_trace_file_is_untouched_by_a_run_that_never_ran_or_failed() {
 /// An S-record image whose reset vector points at `BRA .` at H'000100 (it never starts the
 /// A/D converter, so the robot's step watchdog stops it).
 fn spin_image() -> String {
-    use emu::core::srec::{Chunk, SrecImage, write_s3};
+    use h8300h::srec::{Chunk, SrecImage, write_s3};
     let img = SrecImage {
         header: None,
         chunks: vec![

@@ -193,7 +193,7 @@ fn run_under_gdb_stops_at_a_breakpoint_and_detaches_to_the_same_results() {
         .unwrap_or_else(|| panic!("no address in {line:?}"));
     let mut gdb = gdb_client::Client::connect(addr.parse().unwrap());
     gdb.handshake();
-    let fw = emu::board::firmware::Firmware::robot().unwrap();
+    let fw = robot_board::firmware::Firmware::robot().unwrap();
     let forward = fw.symbols.addr("learner_forward").unwrap();
     let steps = fw.symbols.addr("steps").unwrap();
     assert_eq!(gdb.ask(&format!("Z0,{forward:x},2")), "OK");

@@ -4,8 +4,8 @@
 use std::io::Cursor;
 use std::process::Command;
 
-use emu::board::firmware::Firmware;
 use h8swarm::replay::{self, Engine};
+use robot_board::firmware::Firmware;
 
 fn replay_text(input: &str, engine: &Engine, states: bool) -> String {
     let mut out = Vec::new();

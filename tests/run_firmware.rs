@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use emu::core::srec::{Chunk, SrecImage, write_s3};
+use h8300h::srec::{Chunk, SrecImage, write_s3};
 
 fn h8swarm(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_h8swarm"))

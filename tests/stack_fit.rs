@@ -5,9 +5,9 @@
 
 use std::path::Path;
 
-use emu::board::firmware::Firmware;
-use emu::board::model::ControllerConfig;
-use emu::board::profile::PhaseDef;
+use robot_board::firmware::Firmware;
+use robot_board::model::ControllerConfig;
+use robot_board::profile::PhaseDef;
 use swarm::fit::{FirmwareUnderTest, FitConfig, fit_weight_seed, measure};
 use swarm::scenario::ControllerKind;
 

@@ -16,11 +16,11 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use emu::board::board::{CLOCK_HZ, RobotBoard, RobotConfig, robot_mcu};
-use emu::board::model::{Controller, ControllerConfig};
-use emu::chip::mcu::Mcu;
-use emu::chip::pins::Board;
-use emu::core::bus::Bus;
+use h8_3052f::mcu::Mcu;
+use h8_3052f::pins::Board;
+use h8300h::bus::Bus;
+use robot_board::board::{CLOCK_HZ, RobotBoard, RobotConfig, robot_mcu};
+use robot_board::model::{Controller, ControllerConfig};
 
 struct Wave;
 

@@ -15,10 +15,10 @@
 //! second"; the goal is at least 500 M states/s on the fast path (20 × real time at φ = 25 MHz).
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use emu::chip::machine::Machine;
-use emu::core::bus::Bus;
-use emu::core::cpu::Cpu;
-use emu::core::srec;
+use h8_3052f::machine::Machine;
+use h8300h::bus::Bus;
+use h8300h::cpu::Cpu;
+use h8300h::srec;
 
 /// States emulated per benchmark iteration.
 const STATES_PER_ITER: u64 = 2_000_000;

@@ -6,14 +6,14 @@
 //! including the bus cycle's clock advance and the peripheral's lazy catch-up).
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use emu::chip::mcu::{Mcu, McuConfig};
-use emu::chip::periph::adc::{ADCSR, ADCSR_ADST, ADCSR_SCAN, ADDRA};
-use emu::chip::periph::itu::{
+use h8_3052f::mcu::{Mcu, McuConfig};
+use h8_3052f::periph::adc::{ADCSR, ADCSR_ADST, ADCSR_SCAN, ADDRA};
+use h8_3052f::periph::itu::{
     CHANNEL_BASE, IMFA, OFF_GRA, OFF_GRB, OFF_TCNT, OFF_TCR, OFF_TIER, OFF_TSR, TMDR, TSTR,
 };
-use emu::chip::periph::ports::{P2DR, P2PCR, P4DDR, P4PCR};
-use emu::chip::pins::NullBoard;
-use emu::core::bus::Bus;
+use h8_3052f::periph::ports::{P2DR, P2PCR, P4DDR, P4PCR};
+use h8_3052f::pins::NullBoard;
+use h8300h::bus::Bus;
 use std::hint::black_box;
 
 const ACCESSES: u64 = 1000;

@@ -12,13 +12,13 @@
 //! ratio of the `on` and `off` lines is its cost.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use emu::board::firmware::{ConfigBlock, Firmware, FirmwareController};
-use emu::chip::machine::Machine;
-use emu::chip::mcu::{Mcu, McuConfig};
-use emu::chip::pins::NullBoard;
-use emu::core::bus::Bus;
-use emu::core::cpu::{Cpu, StackGuard, StackGuardMode, StackRoom};
-use emu::core::srec;
+use h8_3052f::machine::Machine;
+use h8_3052f::mcu::{Mcu, McuConfig};
+use h8_3052f::pins::NullBoard;
+use h8300h::bus::Bus;
+use h8300h::cpu::{Cpu, StackGuard, StackGuardMode, StackRoom};
+use h8300h::srec;
+use robot_board::firmware::{ConfigBlock, Firmware, FirmwareController};
 
 /// States emulated per iteration of the compute workloads.
 const STATES_PER_ITER: u64 = 2_000_000;

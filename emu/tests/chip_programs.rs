@@ -9,18 +9,18 @@ use std::collections::BTreeMap;
 use std::path::Path;
 use std::sync::Arc;
 
-use emu::board::symbols::SymbolTable;
-use emu::chip::machine::Machine;
-use emu::chip::mcu::{Mcu, McuConfig};
-use emu::chip::periph::ports::{ExternalPins, PortId};
-use emu::chip::periph::wdt;
-use emu::chip::pins::{Board, NullBoard};
-use emu::chip::profile::StackProfile;
-use emu::chip::run::{Outcome, Probes, RunOptions, run_mcu_probed};
-use emu::chip::trace::CodeNames;
-use emu::core::bus::Bus;
-use emu::core::cpu::{Cpu, Event};
-use emu::core::srec;
+use h8_3052f::machine::Machine;
+use h8_3052f::mcu::{Mcu, McuConfig};
+use h8_3052f::periph::ports::{ExternalPins, PortId};
+use h8_3052f::periph::wdt;
+use h8_3052f::pins::{Board, NullBoard};
+use h8_3052f::profile::StackProfile;
+use h8_3052f::run::{Outcome, Probes, RunOptions, run_mcu_probed};
+use h8_3052f::trace::CodeNames;
+use h8300h::bus::Bus;
+use h8300h::cpu::{Cpu, Event};
+use h8300h::srec;
+use robot_board::symbols::SymbolTable;
 
 /// A chip program's image and symbols.
 fn program(name: &str) -> (Vec<u8>, SymbolTable) {
@@ -42,7 +42,7 @@ fn boot(image: &[u8]) -> (Cpu, Machine) {
 
 /// Runs `name` to its end on a machine with nothing connected, with its symbols; returns the
 /// console text and the report.
-fn run(name: &str, options: &RunOptions) -> (String, emu::chip::run::RunReport) {
+fn run(name: &str, options: &RunOptions) -> (String, h8_3052f::run::RunReport) {
     let (image, syms) = program(name);
     let (mut cpu, mut m) = boot(&image);
     let mut console = Vec::new();
@@ -89,7 +89,7 @@ fn the_watchdog_resets_a_program_that_stops_writing_it_and_the_program_sees_wrst
     let (mut cpu, mut m) = boot(&image);
     let mut overflow = None;
     loop {
-        if overflow.is_none() && m.pending_irq() == Some(emu::core::bus::RESET_REQUEST) {
+        if overflow.is_none() && m.pending_irq() == Some(h8300h::bus::RESET_REQUEST) {
             // The request appeared during the last instruction: the overflow was at most its
             // states ago, at a multiple of 4096.
             overflow = Some(m.now() / 4096 * 4096);
@@ -164,7 +164,7 @@ fn fast_against_stepping(image: &[u8], chunk: u64, until: u64) -> (Cpu, Mcu<Null
             mb.wdt().tcnt_at(mb.now()),
             "TCNT at {deadline}"
         );
-        for a in (emu::core::memmap::RAM_START..=emu::core::memmap::RAM_END).step_by(4) {
+        for a in (h8300h::memmap::RAM_START..=h8300h::memmap::RAM_END).step_by(4) {
             assert_eq!(ma.peek(a), mb.peek(a), "RAM H'{a:06X} at {deadline}");
         }
         if ca.halted() {
@@ -312,7 +312,7 @@ fn unmodelled_accesses_are_reported_with_the_instruction_and_its_function() {
     let lines: Vec<String> = report
         .io_reports
         .iter()
-        .map(|r| emu::board::firmware::describe_io(&syms, r))
+        .map(|r| robot_board::firmware::describe_io(&syms, r))
         .collect();
     assert_eq!(lines.len(), 3, "{lines:#?}");
     let pcs: Vec<u32> = report.io_reports.iter().map(|r| r.pc.unwrap()).collect();
@@ -341,8 +341,8 @@ fn unmodelled_accesses_are_reported_with_the_instruction_and_its_function() {
     for r in &report.io_reports {
         let pc = r.pc.unwrap();
         let bytes: Vec<u8> = (0..10).map(|i| m.peek(pc + i)).collect();
-        let d = emu::core::cpu::decode::decode_bytes(&bytes).unwrap();
-        let text = emu::core::cpu::disasm::format_instr(d, pc);
+        let d = h8300h::cpu::decode::decode_bytes(&bytes).unwrap();
+        let text = h8300h::cpu::disasm::format_instr(d, pc);
         assert!(text.starts_with("mov.b"), "{text}");
         assert!(
             text.contains(&format!("{:x}", r.addr & 0xFF)),

@@ -5,12 +5,12 @@
 // models within tolerances, and its own output is not a promised result.
 #![allow(clippy::disallowed_methods)]
 
-use emu::board::board::{CLOCK_HZ, RobotBoard, RobotConfig, robot_mcu};
-use emu::board::model::{Controller, ControllerConfig, ModelBus, StepReport};
-use emu::chip::mcu::Mcu;
-use emu::chip::pins::Board;
-use emu::core::bus::{Bus, FastPathHints};
+use h8_3052f::mcu::Mcu;
+use h8_3052f::pins::Board;
+use h8300h::bus::{Bus, FastPathHints};
 use nn_q15::Q15;
+use robot_board::board::{CLOCK_HZ, RobotBoard, RobotConfig, robot_mcu};
+use robot_board::model::{Controller, ControllerConfig, ModelBus, StepReport};
 
 /// A board whose four sensors read voltages that change with time (so the learner sees
 /// rewards, punishments and dead zones).
@@ -342,9 +342,9 @@ fn fast_forward_case(corridor: bool, save_every: u32, steps: u32) {
 /// step, not read back from the timer's registers; and the H-bridge inputs on port B.
 #[test]
 fn each_behaviour_drives_the_pins_with_its_duty_and_direction() {
-    use emu::board::wiring::{Bridge, motor_pins};
     use nn_q15::Behaviour;
-    let period = u64::from(emu::board::model::PWM_PERIOD_COUNTS) * 8;
+    use robot_board::wiring::{Bridge, motor_pins};
+    let period = u64::from(robot_board::model::PWM_PERIOD_COUNTS) * 8;
     for (b, duty, bridge) in [
         (Behaviour::Forward, (1.0, 1.0), Bridge::Forward),
         (Behaviour::Backward, (1.0, 1.0), Bridge::Reverse),

@@ -8,7 +8,7 @@
 
 use std::path::{Path, PathBuf};
 
-use emu::chip::run::{Outcome, RunOptions, run_image};
+use h8_3052f::run::{Outcome, RunOptions, run_image};
 
 /// A generous state budget per program (the programs are meant to stay under 50 M states).
 const MAX_STATES_PER_PROGRAM: u64 = 500_000_000;

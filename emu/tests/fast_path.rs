@@ -13,18 +13,18 @@
 //! seconds on an MCU with nothing connected (its tick interrupt, the A/D converter, bit-banged
 //! I²C to the EEPROMs). Also: the decode caches follow every write to the flash.
 
-use emu::board::firmware::{ConfigBlock, Firmware};
-use emu::chip::machine::Machine;
-use emu::chip::mcu::{Mcu, McuConfig};
-use emu::chip::pins::{Board, NullBoard};
-use emu::core::bus::{Bus, FastPathHints};
-use emu::core::cpu::decode::{Decoded, Instr, decode_bytes};
-use emu::core::cpu::disasm::format_instr;
-use emu::core::cpu::{Cpu, CpuError, Event};
-use emu::core::memmap::{Area, RAM_BYTES, RAM_START};
-use emu::core::srec;
+use h8_3052f::machine::Machine;
+use h8_3052f::mcu::{Mcu, McuConfig};
+use h8_3052f::pins::{Board, NullBoard};
+use h8300h::bus::{Bus, FastPathHints};
+use h8300h::cpu::decode::{Decoded, Instr, decode_bytes};
+use h8300h::cpu::disasm::format_instr;
+use h8300h::cpu::{Cpu, CpuError, Event};
+use h8300h::memmap::{Area, RAM_BYTES, RAM_START};
+use h8300h::srec;
 use proptest::prelude::*;
 use proptest::strategy::ValueTree;
+use robot_board::firmware::{ConfigBlock, Firmware};
 
 /// A bus access some device or memory could see: writes anywhere, reads of I/O and unmapped
 /// addresses (reads of ROM and RAM have no effect but the clock; instruction fetches, which
@@ -719,7 +719,7 @@ fn the_robot_firmware_runs_alike_on_both_paths() {
     let fw = Firmware::robot().expect("the committed firmware");
     // On the robot's board: its EEPROMs on port 4, nothing else connected.
     let mut ma =
-        emu::board::board::robot_mcu(NullBoard, &emu::board::board::RobotConfig::default())
+        robot_board::board::robot_mcu(NullBoard, &robot_board::board::RobotConfig::default())
             .expect("default MCU");
     let mut ca = Cpu::new();
     // A step every 10 ticks (0.1 s) and a record saved over I2C every 2 steps, so that a few
@@ -772,7 +772,7 @@ fn the_robot_firmware_runs_alike_on_both_paths() {
 fn robots_sharing_decoded_firmware_run_as_with_tables_of_their_own() {
     let fw = Firmware::robot().expect("the committed firmware");
     let robot = || {
-        emu::board::board::robot_mcu(NullBoard, &emu::board::board::RobotConfig::default())
+        robot_board::board::robot_mcu(NullBoard, &robot_board::board::RobotConfig::default())
             .expect("default MCU")
     };
     let block = ConfigBlock {
@@ -888,7 +888,7 @@ fn run_is_step_in_a_loop() {
     // The firmware: interrupts, sleep, I/O.
     let fw = Firmware::robot().expect("the committed firmware");
     let mut ma =
-        emu::board::board::robot_mcu(NullBoard, &emu::board::board::RobotConfig::default())
+        robot_board::board::robot_mcu(NullBoard, &robot_board::board::RobotConfig::default())
             .expect("default MCU");
     let mut ca = Cpu::new();
     let block = ConfigBlock {

@@ -2,11 +2,11 @@
 //! bit-exact step for step (weights, y, O, winner), and the H8 meter's states against the
 //! states the core counts (the calibration of docs/design.md §2.7's cost model).
 
-use emu::board::firmware::Firmware;
-use emu::board::oncore::LearnerOnCore;
 use nn_q15::{
     DynLearner, H8Meter, InputLayout, Params, Phase, Q7, Q15, Shape, forward_slice, update_slice,
 };
+use robot_board::firmware::Firmware;
+use robot_board::oncore::LearnerOnCore;
 
 /// A small seeded generator for test inputs (SplitMix64).
 struct Gen(u64);

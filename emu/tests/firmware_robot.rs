@@ -2,15 +2,15 @@
 //! configuration block, boot, steps, motors, EEPROM records, restore after a power cut.
 
 use eeprom::persist::RecordLayout;
-use emu::board::board::{CLOCK_HZ, RobotBoard, RobotConfig, robot_mcu};
-use emu::board::firmware::{
+use h8_3052f::mcu::{Mcu, McuConfig};
+use h8_3052f::pins::{Board, NullBoard};
+use h8300h::bus::Bus;
+use h8300h::cpu::Cpu;
+use robot_board::board::{CLOCK_HZ, RobotBoard, RobotConfig, robot_mcu};
+use robot_board::firmware::{
     CONFIG_BLOCK_ADDR, ConfigBlock, ConfigStatus, FLAG_RANDOM_WALK, Firmware, run_until,
 };
-use emu::board::wiring::{Bridge, motor_pins};
-use emu::chip::mcu::{Mcu, McuConfig};
-use emu::chip::pins::{Board, NullBoard};
-use emu::core::bus::Bus;
-use emu::core::cpu::Cpu;
+use robot_board::wiring::{Bridge, motor_pins};
 
 mod boards;
 use boards::Wandering;
@@ -284,8 +284,8 @@ fn a_fault_halts_with_the_vector_named() {
 /// wiring and the weight seed (the firmware's fresh weights are the model's).
 #[test]
 fn the_model_controllers_settings_reach_the_firmware_through_the_block() {
-    use emu::board::model::{ControllerConfig, fresh_weights};
     use nn_q15::{InputLayout, Params};
+    use robot_board::model::{ControllerConfig, fresh_weights};
     let mut cfg = ControllerConfig::corridor(0x1234_5678_9ABC_DEF0);
     cfg.behaviours = 3;
     cfg.layout = InputLayout::new(2, true).unwrap().with_spare(5);
@@ -300,7 +300,7 @@ fn the_model_controllers_settings_reach_the_firmware_through_the_block() {
         ConfigBlock {
             outputs: 3,
             history: 2,
-            flags: emu::board::firmware::FLAG_BIAS,
+            flags: robot_board::firmware::FLAG_BIAS,
             spare: 5,
             eta: 1000,
             threshold: 17,
@@ -403,8 +403,8 @@ struct Trace {
 }
 
 fn controller_trace(fast_forward: bool, steps: usize) -> (Trace, u64, u64) {
-    use emu::board::firmware::FirmwareController;
-    use emu::core::memmap::{RAM_BYTES, RAM_START};
+    use h8300h::memmap::{RAM_BYTES, RAM_START};
+    use robot_board::firmware::FirmwareController;
     let fw = firmware();
     let mut mcu = robot_mcu(Wandering, &RobotConfig::default()).unwrap();
     let block = ConfigBlock {

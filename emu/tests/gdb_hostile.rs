@@ -9,12 +9,12 @@ use std::net::TcpStream;
 use std::thread::JoinHandle;
 use std::time::Duration;
 
-use emu::board::firmware::Firmware;
-use emu::chip::gdb::{GdbListener, MAX_PACKET_BYTES};
-use emu::chip::mcu::{Mcu, McuConfig};
-use emu::chip::pins::NullBoard;
-use emu::chip::run::{Outcome, Probes, RunOptions, RunReport, run_mcu_probed};
-use emu::core::cpu::Cpu;
+use h8_3052f::gdb::{GdbListener, MAX_PACKET_BYTES};
+use h8_3052f::mcu::{Mcu, McuConfig};
+use h8_3052f::pins::NullBoard;
+use h8_3052f::run::{Outcome, Probes, RunOptions, RunReport, run_mcu_probed};
+use h8300h::cpu::Cpu;
+use robot_board::firmware::Firmware;
 
 /// The firmware under a stub on a free loopback port, and a raw connection to it.
 fn session() -> (TcpStream, JoinHandle<RunReport>) {

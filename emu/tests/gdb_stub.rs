@@ -1,4 +1,4 @@
-//! The GDB stub (`emu::chip::gdb`) driven over loopback by a protocol client written for the
+//! The GDB stub (`h8_3052f::gdb`) driven over loopback by a protocol client written for the
 //! test (`gdb_client`): the robot firmware on the emulated H8/3052F, stopped at a breakpoint
 //! at `learner_forward`, stepped, watched and read, each answer compared with a second
 //! emulator that runs the same firmware without a debugger.
@@ -7,15 +7,15 @@ mod gdb_client;
 
 use std::thread::JoinHandle;
 
-use emu::board::board::{RobotBoard, RobotConfig, robot_mcu};
-use emu::board::firmware::Firmware;
-use emu::chip::gdb::GdbListener;
-use emu::chip::mcu::Mcu;
-use emu::chip::pins::NullBoard;
-use emu::chip::run::{Outcome, Probes, RunOptions, RunReport, run_mcu_probed};
-use emu::core::bus::Bus;
-use emu::core::cpu::Cpu;
 use gdb_client::Client;
+use h8_3052f::gdb::GdbListener;
+use h8_3052f::mcu::Mcu;
+use h8_3052f::pins::NullBoard;
+use h8_3052f::run::{Outcome, Probes, RunOptions, RunReport, run_mcu_probed};
+use h8300h::bus::Bus;
+use h8300h::cpu::Cpu;
+use robot_board::board::{RobotBoard, RobotConfig, robot_mcu};
+use robot_board::firmware::Firmware;
 
 /// Two seconds of emulated time: the firmware's first steps.
 const BUDGET_STATES: u64 = 50_000_000;

@@ -2,10 +2,10 @@
 //! table ([`nn_q15::cost::Insn`]) is run on the H8/300H core from on-chip flash with on-chip RAM
 //! operands, and the states the core counts must be the table's.
 
-use emu::chip::mcu::{Mcu, McuConfig};
-use emu::chip::pins::NullBoard;
-use emu::core::bus::Bus;
-use emu::core::cpu::Cpu;
+use h8_3052f::mcu::{Mcu, McuConfig};
+use h8_3052f::pins::NullBoard;
+use h8300h::bus::Bus;
+use h8300h::cpu::Cpu;
 use nn_q15::cost::Insn;
 
 /// Where the instruction is placed (flash) and where its pointers point (RAM, word-aligned).
@@ -30,7 +30,7 @@ fn every_insn_form_costs_on_the_core_what_the_table_says() {
         let t0 = mcu.now();
         cpu.step(&mut mcu, u64::MAX)
             .unwrap_or_else(|e| panic!("{insn:?} ({text}): {e}"));
-        let decoded = emu::core::cpu::disasm::format_instr(cpu.last_executed(), CODE);
+        let decoded = h8300h::cpu::disasm::format_instr(cpu.last_executed(), CODE);
         assert_eq!(
             mcu.now() - t0,
             u64::from(insn.states()),

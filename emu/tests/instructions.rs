@@ -6,10 +6,10 @@
 mod common;
 
 use common::{CODE, DATA, exec, machine, peek16, peek32};
-use emu::chip::machine::Machine;
-use emu::chip::periph::sci::{SCI1_SCR, SCR_TE, SCR_TIE, VECTOR_TXI1};
-use emu::core::bus::Bus;
-use emu::core::cpu::{CCR_C, CCR_H, CCR_I, CCR_N, CCR_U, CCR_UI, CCR_V, CCR_Z, CpuError, Event};
+use h8_3052f::machine::Machine;
+use h8_3052f::periph::sci::{SCI1_SCR, SCR_TE, SCR_TIE, VECTOR_TXI1};
+use h8300h::bus::Bus;
+use h8300h::cpu::{CCR_C, CCR_H, CCR_I, CCR_N, CCR_U, CCR_UI, CCR_V, CCR_Z, CpuError, Event};
 
 const HNZVC: u8 = CCR_H | CCR_N | CCR_Z | CCR_V | CCR_C;
 
@@ -860,11 +860,7 @@ fn sleep_with_mask_set_halts_and_with_mask_clear_waits() {
 
 /// Runs `program` from CODE with SCI1's TXI requested (TE and TIE set) and the TXI vector
 /// pointing at a handler at H'3000 (`nop`), for `steps` steps; returns the events.
-fn run_with_txi(
-    program: &[u8],
-    ccr: u8,
-    steps: usize,
-) -> (Vec<Event>, emu::core::cpu::Cpu, Machine) {
+fn run_with_txi(program: &[u8], ccr: u8, steps: usize) -> (Vec<Event>, h8300h::cpu::Cpu, Machine) {
     let (mut cpu, mut m) = machine();
     m.poke(CODE, program);
     m.poke(u32::from(VECTOR_TXI1) * 4, &0x3000u32.to_be_bytes());
@@ -994,7 +990,7 @@ fn code_runs_from_ram_too() {
 
 #[test]
 fn sleep_fast_forwards_to_the_sci_interrupt_that_wakes_it() {
-    use emu::chip::periph::sci::{SCI1_SSR, SCI1_TDR, SSR_TDRE};
+    use h8_3052f::periph::sci::{SCI1_SSR, SCI1_TDR, SSR_TDRE};
     let (mut cpu, mut m) = machine();
     m.poke(CODE, &[0x01, 0x80]); // sleep
     m.poke(u32::from(VECTOR_TXI1) * 4, &0x3000u32.to_be_bytes());

@@ -13,8 +13,8 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use emu::core::cpu::decode::decode_bytes;
-use emu::core::cpu::disasm::format_instr;
+use h8300h::cpu::decode::decode_bytes;
+use h8300h::cpu::disasm::format_instr;
 
 const BYTE_REGS: [&str; 16] = [
     "r0h", "r1h", "r2h", "r3h", "r4h", "r5h", "r6h", "r7h", "r0l", "r1l", "r2l", "r3l", "r4l",

@@ -2,16 +2,16 @@
 //! that state, the input sampled at the sampling instant (a board whose voltage changes with
 //! time), scan order and repetition, ADI, the ADF clearing rule and the ADDR byte order.
 
-use emu::chip::mcu::{Mcu, McuConfig};
-use emu::chip::periph::adc::{
+use h8_3052f::mcu::{Mcu, McuConfig};
+use h8_3052f::periph::adc::{
     ADCR, ADCSR, ADCSR_ADF, ADCSR_ADIE, ADCSR_ADST, ADCSR_CKS, ADCSR_SCAN, ADDRA, ADDRB, ADDRC,
     ADDRD, CONV_STATES_CKS0, CONV_STATES_CKS1, SAMPLE_OFFSET_CKS0, SAMPLE_OFFSET_CKS1,
     SCAN_CONV_STATES_CKS0, VECTOR_ADI,
 };
-use emu::chip::periph::intc::{IPRA, IPRA_ITU0, IPRB, IPRB_AD};
-use emu::chip::pins::Board;
-use emu::core::bus::Bus;
-use emu::core::memmap::IO_ACCESS_STATES;
+use h8_3052f::periph::intc::{IPRA, IPRA_ITU0, IPRB, IPRB_AD};
+use h8_3052f::pins::Board;
+use h8300h::bus::Bus;
+use h8300h::memmap::IO_ACCESS_STATES;
 use sensors::adc10_code;
 
 /// A board whose channel n reads `base[n] + slope · t` volts and that records every question.
@@ -266,7 +266,7 @@ fn addr_low_byte_comes_from_the_temporary_register() {
 /// every transition voltage, one ulp either side of it, and across the range.
 #[test]
 fn the_chips_transfer_function_is_the_sensor_models() {
-    use emu::chip::periph::adc::{addr_register, code10};
+    use h8_3052f::periph::adc::{addr_register, code10};
     let mut volts = vec![f64::NAN, -1.0, 0.0, 5.0, 6.0, f64::INFINITY];
     for k in 0..=1024u32 {
         let t = f64::from(k) * 5.0 / 1024.0;

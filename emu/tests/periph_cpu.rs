@@ -2,13 +2,13 @@
 //! clock fast-forwarded (one jump, not stepped), interrupt entry through vector 24 with the
 //! manual's state count, and the run API on the same MCU.
 
-use emu::chip::machine::Machine;
-use emu::chip::mcu::{Mcu, McuConfig};
-use emu::chip::periph::itu;
-use emu::chip::pins::NullBoard;
-use emu::core::bus::{Bus, FastPathHints};
-use emu::core::cpu::{CCR_I, Cpu, Event};
-use emu::core::memmap::ADDRESS_MASK;
+use h8_3052f::machine::Machine;
+use h8_3052f::mcu::{Mcu, McuConfig};
+use h8_3052f::periph::itu;
+use h8_3052f::pins::NullBoard;
+use h8300h::bus::{Bus, FastPathHints};
+use h8300h::cpu::{CCR_I, Cpu, Event};
+use h8300h::memmap::ADDRESS_MASK;
 
 /// The tick program (assembled once with h8300-hms-as 2.16.1, `.h8300h`):
 /// ```text
@@ -200,17 +200,17 @@ fn machine_runs_on_the_mcu_with_its_peripherals() {
     let mut cpu = Cpu::new();
     cpu.reset(&mut m);
     let mut out = Vec::new();
-    let report = emu::chip::run::run_machine(
+    let report = h8_3052f::run::run_machine(
         &mut cpu,
         &mut m,
-        &emu::chip::run::RunOptions::default(),
+        &h8_3052f::run::RunOptions::default(),
         &mut out,
         None,
     )
     .unwrap();
     assert_eq!(
         report.outcome,
-        emu::chip::run::Outcome::Halted { exit_status: 0x2a }
+        h8_3052f::run::Outcome::Halted { exit_status: 0x2a }
     );
     assert_eq!(report.stats.interrupts, 1);
     assert!(report.stats.states > GRA * 8);

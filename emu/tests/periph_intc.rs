@@ -1,13 +1,13 @@
 //! The interrupt controller through the MCU: among the requests enabled at their source, the
 //! higher IPR level wins, then the lower vector number; IPRA/IPRB read back.
 
-use emu::chip::mcu::{Mcu, McuConfig};
-use emu::chip::periph::adc::{ADCSR, ADCSR_ADIE, ADCSR_ADST};
-use emu::chip::periph::intc::{IPRA, IPRA_ITU0, IPRA_ITU2, IPRB, IPRB_AD, IPRB_SCI1};
-use emu::chip::periph::itu::{CHANNEL_BASE, IMFA, OFF_GRA, OFF_TCR, OFF_TIER, OFF_TSR, TSTR};
-use emu::chip::periph::sci::{SCI1_SCR, SCR_TE, SCR_TIE};
-use emu::chip::pins::NullBoard;
-use emu::core::bus::Bus;
+use h8_3052f::mcu::{Mcu, McuConfig};
+use h8_3052f::periph::adc::{ADCSR, ADCSR_ADIE, ADCSR_ADST};
+use h8_3052f::periph::intc::{IPRA, IPRA_ITU0, IPRA_ITU2, IPRB, IPRB_AD, IPRB_SCI1};
+use h8_3052f::periph::itu::{CHANNEL_BASE, IMFA, OFF_GRA, OFF_TCR, OFF_TIER, OFF_TSR, TSTR};
+use h8_3052f::periph::sci::{SCI1_SCR, SCR_TE, SCR_TIE};
+use h8_3052f::pins::NullBoard;
+use h8300h::bus::Bus;
 
 /// ITU0 and ITU2 compare match A, the A/D end and SCI1 TXI all requested at once.
 fn four_requests() -> Mcu<NullBoard> {

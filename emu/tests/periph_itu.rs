@@ -2,16 +2,16 @@
 //! timing, the flag clearing rule, interrupt vectors, and the lazily computed counter against a
 //! state-by-state reference model.
 
-use emu::board::wiring::{Bridge, ITU_MOTOR_LEFT, ITU_MOTOR_RIGHT, motor_pins};
-use emu::chip::mcu::{Mcu, McuConfig};
-use emu::chip::periph::itu::{
+use h8_3052f::mcu::{Mcu, McuConfig};
+use h8_3052f::periph::itu::{
     self, CHANNEL_BASE, IMFA, IMFB, Itu, OFF_GRA, OFF_GRB, OFF_TCNT, OFF_TCR, OFF_TIER, OFF_TIOR,
     OFF_TSR, OVF, TMDR, TSTR,
 };
-use emu::chip::periph::ports::{PBDDR, PBDR};
-use emu::chip::pins::NullBoard;
-use emu::core::bus::Bus;
+use h8_3052f::periph::ports::{PBDDR, PBDR};
+use h8_3052f::pins::NullBoard;
+use h8300h::bus::Bus;
 use proptest::prelude::*;
+use robot_board::wiring::{Bridge, ITU_MOTOR_LEFT, ITU_MOTOR_RIGHT, motor_pins};
 
 /// TCR: counter cleared by GRA, φ/8 (the controller's setting, docs/design.md §3.5).
 const TCR_GRA_PHI8: u8 = 0x23;

@@ -2,15 +2,15 @@
 //! from the board, and port 4 as the open-drain master of the I²C bus on the robot's board (a
 //! START and an address byte acknowledged by a 24LC256), and with nothing on port 4.
 
-use emu::board::board::{RobotBoard, RobotConfig, robot_mcu};
-use emu::board::wiring::{P2_BUMPER_FRONT, P2_BUMPER_LEFT, P2_BUMPERS};
-use emu::chip::mcu::{Mcu, McuConfig};
-use emu::chip::periph::ports::{
+use h8_3052f::mcu::{Mcu, McuConfig};
+use h8_3052f::periph::ports::{
     DDR_READ_VALUE, P2DDR, P2DR, P2PCR, P4_SCL, P4_SDA, P4DDR, P4DR, P4PCR, PADDR, PADR, PBDDR,
     PBDR,
 };
-use emu::chip::pins::{Board, NullBoard};
-use emu::core::bus::Bus;
+use h8_3052f::pins::{Board, NullBoard};
+use h8300h::bus::Bus;
+use robot_board::board::{RobotBoard, RobotConfig, robot_mcu};
+use robot_board::wiring::{P2_BUMPER_FRONT, P2_BUMPER_LEFT, P2_BUMPERS};
 use sensors::{Bumper, BumperSet, port2_pins};
 
 /// A board whose bumpers change with time: front pressed from state 1000, left from 2000.

@@ -1,19 +1,19 @@
-//! Pin traces (`emu::chip::trace`) of the robot firmware on the emulated H8/3052F: every edge
+//! Pin traces (`h8_3052f::trace`) of the robot firmware on the emulated H8/3052F: every edge
 //! at its exact state, the same with the core's shortcuts on and off, written as VCD and read
 //! back, and the phase signal naming what `--trace` names.
 
 use std::sync::Arc;
 
-use emu::board::board::{RobotBoard, RobotConfig, robot_mcu};
-use emu::board::firmware::{ConfigBlock, FLAG_RANDOM_WALK, Firmware, FirmwareController};
-use emu::chip::mcu::Mcu;
-use emu::chip::periph::itu::PwmWave;
-use emu::chip::pins::NullBoard;
-use emu::chip::run::{Probes, RunOptions, run_mcu_probed};
-use emu::chip::trace::{PhaseRecorder, PinTrace, Signal};
-use emu::chip::vcd::{VcdInfo, write_vcd};
-use emu::core::bus::Bus;
-use emu::core::cpu::Cpu;
+use h8_3052f::mcu::Mcu;
+use h8_3052f::periph::itu::PwmWave;
+use h8_3052f::pins::NullBoard;
+use h8_3052f::run::{Probes, RunOptions, run_mcu_probed};
+use h8_3052f::trace::{PhaseRecorder, PinTrace, Signal};
+use h8_3052f::vcd::{VcdInfo, write_vcd};
+use h8300h::bus::Bus;
+use h8300h::cpu::Cpu;
+use robot_board::board::{RobotBoard, RobotConfig, robot_mcu};
+use robot_board::firmware::{ConfigBlock, FLAG_RANDOM_WALK, Firmware, FirmwareController};
 
 mod boards;
 use boards::Wandering;

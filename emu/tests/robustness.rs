@@ -2,13 +2,13 @@
 //! the run API panic; and the add/subtract flags agree with a reference computed in wide
 //! integers.
 
-use emu::chip::machine::Machine;
-use emu::chip::run::{RunOptions, run_image};
-use emu::core::bus::Bus;
-use emu::core::cpu::decode::{Size, decode_bytes};
-use emu::core::cpu::disasm::{disassemble, format_instr};
-use emu::core::cpu::{CCR_C, CCR_H, CCR_N, CCR_V, CCR_Z, Cpu};
-use emu::core::srec::{self, Chunk, SrecImage};
+use h8_3052f::machine::Machine;
+use h8_3052f::run::{RunOptions, run_image};
+use h8300h::bus::Bus;
+use h8300h::cpu::decode::{Size, decode_bytes};
+use h8300h::cpu::disasm::{disassemble, format_instr};
+use h8300h::cpu::{CCR_C, CCR_H, CCR_N, CCR_V, CCR_Z, Cpu};
+use h8300h::srec::{self, Chunk, SrecImage};
 use proptest::prelude::*;
 
 proptest! {

@@ -1,9 +1,9 @@
 //! The run API: halting and exit status, console output through SCI1, the state budget, core
 //! errors as outcomes, load errors as errors, traces and statistics.
 
-use emu::chip::run::{Outcome, RunError, RunOptions, run_image};
-use emu::core::cpu::CpuError;
-use emu::core::srec::{self, Chunk, SrecImage};
+use h8_3052f::run::{Outcome, RunError, RunOptions, run_image};
+use h8300h::cpu::CpuError;
+use h8300h::srec::{self, Chunk, SrecImage};
 
 /// `hi.s`, assembled with h8300-hms-as 2.16.1 and converted with objcopy: reset vector →
 /// H'000100; set up SCI1 (SMR = 0, BRR = 19, SCR = TE), print "hi\n" polling TDRE (BTST on

@@ -9,13 +9,13 @@ use std::collections::BTreeMap;
 use std::process::Command;
 use std::sync::Arc;
 
-use emu::board::board::{RobotBoard, RobotConfig, robot_mcu};
-use emu::board::firmware::{ConfigBlock, FLAG_RANDOM_WALK, Firmware, FirmwareController};
-use emu::chip::mcu::Mcu;
-use emu::chip::periph::itu::PwmWave;
-use emu::chip::trace::{PinTrace, Signal};
-use emu::chip::vcd::{VcdInfo, write_vcd};
-use emu::core::bus::Bus;
+use h8_3052f::mcu::Mcu;
+use h8_3052f::periph::itu::PwmWave;
+use h8_3052f::trace::{PinTrace, Signal};
+use h8_3052f::vcd::{VcdInfo, write_vcd};
+use h8300h::bus::Bus;
+use robot_board::board::{RobotBoard, RobotConfig, robot_mcu};
+use robot_board::firmware::{ConfigBlock, FLAG_RANDOM_WALK, Firmware, FirmwareController};
 
 mod boards;
 use boards::Wandering;
@@ -91,9 +91,9 @@ fn traced() -> Traced {
                 }
             }
         }
-        let w = emu::board::firmware::peek_be::<_, 4>(&mcu, net_w) as u32;
+        let w = robot_board::firmware::peek_be::<_, 4>(&mcu, net_w) as u32;
         let n =
-            emu::board::firmware::peek_be::<_, 2>(&mcu, n_in) as u32 * u32::from(mcu.peek(n_out));
+            robot_board::firmware::peek_be::<_, 2>(&mcu, n_in) as u32 * u32::from(mcu.peek(n_out));
         let weights = (0..2 * n).map(|i| mcu.peek(w + i)).collect();
         let wave = |mcu: &mut Mcu<RobotBoard<Wandering>>, ch| mcu.tioca(ch).wave.unwrap();
         let waves = (wave(&mut mcu, 1), wave(&mut mcu, 2));

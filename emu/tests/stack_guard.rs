@@ -1,4 +1,4 @@
-//! The stack guard (`emu::core::cpu::stack`): every kind of stack access stopped at the
+//! The stack guard (`h8300h::cpu::stack`): every kind of stack access stopped at the
 //! instruction that leaves the room, on the fast path and the reference path alike, with the
 //! CPU left as it was before the instruction; the warning guard lets it run and keeps the
 //! first fault; and three C programs (`tests/programs/stack/`, built by
@@ -10,16 +10,16 @@
 
 use std::path::{Path, PathBuf};
 
-use emu::board::symbols::SymbolTable;
-use emu::chip::machine::Machine;
-use emu::chip::periph::itu::{CHANNEL_BASE, IMFA, OFF_GRA, OFF_TCR, OFF_TIER, TSTR};
-use emu::chip::run::{Outcome, Probes, RunOptions, run_image, run_mcu_probed};
-use emu::chip::trace::CodeNames;
-use emu::core::bus::Bus;
-use emu::core::cpu::{
+use h8_3052f::machine::Machine;
+use h8_3052f::periph::itu::{CHANNEL_BASE, IMFA, OFF_GRA, OFF_TCR, OFF_TIER, TSTR};
+use h8_3052f::run::{Outcome, Probes, RunOptions, run_image, run_mcu_probed};
+use h8_3052f::trace::CodeNames;
+use h8300h::bus::Bus;
+use h8300h::cpu::{
     Cpu, CpuError, Event, StackAccess, StackFault, StackGuard, StackGuardMode, StackRoom,
 };
-use emu::core::srec;
+use h8300h::srec;
+use robot_board::symbols::SymbolTable;
 
 /// The room of the hand-assembled cases.
 const ROOM: StackRoom = StackRoom {
@@ -496,9 +496,9 @@ fn the_differential_programs_run_under_the_guard_untouched() {
 
 #[test]
 fn the_robot_firmware_s_room_takes_in_its_boot_sized_arrays_and_is_never_left() {
-    use emu::board::board::{RobotConfig, robot_mcu};
-    use emu::board::firmware::{ConfigBlock, Firmware, FirmwareController, peek_be};
-    use emu::chip::pins::NullBoard;
+    use h8_3052f::pins::NullBoard;
+    use robot_board::board::{RobotConfig, robot_mcu};
+    use robot_board::firmware::{ConfigBlock, Firmware, FirmwareController, peek_be};
     let fw = Firmware::robot().unwrap();
     // On the robot's board: the saves reach the EEPROMs.
     let mut mcu = robot_mcu(NullBoard, &RobotConfig::default()).unwrap();

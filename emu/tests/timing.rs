@@ -407,7 +407,7 @@ fn states_match_spec_4_2_and_the_manual() {
 fn branches_take_the_same_states_taken_or_not() {
     // beq .+2 (d:8): 4 states; beq d:16: 6 states (docs/design.md §4.2), whatever Z is.
     for z in [false, true] {
-        let ccr = if z { emu::core::cpu::CCR_Z } else { 0 };
+        let ccr = if z { h8300h::cpu::CCR_Z } else { 0 };
         let s = exec("beq\t.+2 (0x1004)", &[0x47, 0x02], |c, _| c.set_ccr(ccr));
         assert_eq!(s.states, 4);
         assert_eq!(s.cpu.pc(), if z { 0x1004 } else { 0x1002 });

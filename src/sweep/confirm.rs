@@ -88,7 +88,7 @@ type Map = (Plan, Vec<PlanLine>, Vec<ClaimSeries>, Vec<usize>);
 
 /// The map's paper-claim series and its region (cells where they all hold, pooled).
 fn map_region(dir: &Path) -> Result<Map, SweepError> {
-    let (plan, lines, m) = super::merge::collect(dir)?;
+    let (plan, lines, m) = super::table::collect(dir)?;
     let not_ok = m.failed.len() + m.missing.len() + m.broken.len();
     if not_ok > 0 {
         return Err(SweepError::input(format!(
@@ -97,7 +97,7 @@ fn map_region(dir: &Path) -> Result<Map, SweepError> {
             plan.points
         )));
     }
-    let series: Vec<ClaimSeries> = super::merge::claim_series(&m)
+    let series: Vec<ClaimSeries> = super::table::claim_series(&m)
         .into_iter()
         .filter(|s| s.paper)
         .collect();
@@ -393,9 +393,9 @@ fn outcome_words(c: &Cell) -> String {
 pub(super) fn merge_confirmation(
     dir: &Path,
     stage: &crate::stage::Stage,
-) -> Result<super::merge::Staged, SweepError> {
+) -> Result<super::table::Staged, SweepError> {
     let cdir = dir.join(CONFIRM_DIR);
-    let mut staged = super::merge::merge_into(&cdir, stage, &format!("{CONFIRM_DIR}/"))?;
+    let mut staged = super::table::merge_into(&cdir, stage, &format!("{CONFIRM_DIR}/"))?;
     let t = &mut staged.text;
     let record: ConfirmRecord = std::fs::read_to_string(cdir.join("confirm.json"))
         .ok()
@@ -423,7 +423,7 @@ pub(super) fn merge_confirmation(
             dir.display()
         )));
     }
-    let (cplan, clines, cm) = super::merge::collect(&cdir)?;
+    let (cplan, clines, cm) = super::table::collect(&cdir)?;
     if clines.iter().any(|l| {
         l.coords.len() != plan.axes.len()
             || l.coords
@@ -437,7 +437,7 @@ pub(super) fn merge_confirmation(
             dir.display()
         )));
     }
-    let cseries = super::merge::claim_series(&cm);
+    let cseries = super::table::claim_series(&cm);
     let ccoords: Vec<Vec<usize>> = clines.iter().map(|l| l.coords.clone()).collect();
     let coords: Vec<Vec<usize>> = lines.iter().map(|l| l.coords.clone()).collect();
     let axes = &plan.axes;

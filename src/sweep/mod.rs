@@ -31,6 +31,7 @@ pub mod merge;
 pub mod plan;
 pub mod points;
 pub mod spec;
+pub mod table;
 
 use std::path::{Path, PathBuf};
 

@@ -8,24 +8,24 @@
 //! whole account):
 //! - the H8/3052F: its running current over the states the CPU is busy, its sleep current over
 //!   the rest, and the A/D converter's analog and reference currents over the states it
-//!   converts ([`emu::chip::power`]);
+//!   converts ([`h8_3052f::power`]);
 //! - the four GP2D12 IR sensors: their supply current all the time ([`sensors::SUPPLY_CURRENT_MA`]);
 //! - the two 24LC256: standby all the time, a charge per SCL clock they take part in, their
 //!   write current through every write cycle ([`eeprom::DeviceStats::charge_since_uc`]);
 //! - the 5 V regulator's quiescent current ([`REGULATOR_QUIESCENT_MA`]);
 //! - the two TA7291P bridges: their supply current in the mode their inputs select
-//!   ([`emu::board::wiring::Bridge::supply_current_ma`]);
+//!   ([`robot_board::wiring::Bridge::supply_current_ma`]);
 //! - the two FA-130 motors: the DC motor model of [`world::dc_motor`], from the PWM duty, the
 //!   direction, the world's wheel speed and the force the wheel transmitted to the floor, sub-step
 //!   by sub-step: a free robot at a steady speed draws the no-load current, one spinning its
 //!   wheels up more, and a robot pressed against a wall (its wheels slipping at the floor's
 //!   traction) the current that holds the slipping wheel's friction torque.
 
-use emu::board::board::RobotBoard;
-use emu::board::wiring::Bridge;
-use emu::chip::mcu::Mcu;
-use emu::chip::pins::Board;
-use emu::core::bus::Bus;
+use h8_3052f::mcu::Mcu;
+use h8_3052f::pins::Board;
+use h8300h::bus::Bus;
+use robot_board::board::RobotBoard;
+use robot_board::wiring::Bridge;
 use serde::Serialize;
 use world::dc_motor::DcMotor;
 use world::{Direction, WheelCommand, WorldParams};
@@ -228,7 +228,7 @@ impl ElectronicsMeter {
         let clock_hz = mcu.clock_hz();
         let interval = now.saturating_sub(self.last_states);
         let converting = mcu.adc().converting_states(now);
-        let q = emu::chip::power::mcu_charge_uc(
+        let q = h8_3052f::power::mcu_charge_uc(
             interval,
             busy_states,
             converting.saturating_sub(self.last_converting),
@@ -480,7 +480,7 @@ mod tests {
 
     /// One drive wheel's traction with the world's defaults, μ_floor · m·g/2 = 1.4710 N.
     fn traction_n() -> f64 {
-        WorldParams::with_clock(u64::from(emu::board::board::CLOCK_HZ)).wheel_traction_n()
+        WorldParams::with_clock(u64::from(robot_board::board::CLOCK_HZ)).wheel_traction_n()
     }
 
     #[test]
@@ -558,7 +558,7 @@ mod tests {
     fn free_wheels_settle_to_the_no_load_current_and_held_ones_to_the_friction_current() {
         let params = WorldParams {
             motor_gain_spread: 0.0,
-            ..WorldParams::with_clock(u64::from(emu::board::board::CLOCK_HZ))
+            ..WorldParams::with_clock(u64::from(robot_board::board::CLOCK_HZ))
         };
         let mut d = DriveMeter::new(0.15, [1.0, 1.0]);
         d.set_commands(WheelCommand::forward(1.0), WheelCommand::forward(0.3));

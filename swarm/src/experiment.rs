@@ -703,7 +703,7 @@ impl Swarm {
 
     /// What the firmware robots' stack guards do when a stack access leaves the stack's room:
     /// stop the robot with an error (the default) or warn ([`RunOutput::stack_warnings`]).
-    pub fn set_stack_guard_mode(&mut self, mode: emu::core::cpu::StackGuardMode) {
+    pub fn set_stack_guard_mode(&mut self, mode: h8300h::cpu::StackGuardMode) {
         for r in &mut self.robots {
             r.set_stack_guard_mode(mode);
         }
@@ -1170,7 +1170,7 @@ pub struct RobotProbes {
     pub vcd: Option<VcdProbe>,
     /// A GDB stub for a robot, waiting for its client: (robot, listener). The run waits for
     /// the client before its first step and pauses while it has the robot stopped.
-    pub gdb: Option<(usize, emu::chip::gdb::GdbListener)>,
+    pub gdb: Option<(usize, h8_3052f::gdb::GdbListener)>,
     /// A profile of where one firmware robot's states go by call stack, written as folded
     /// stacks when the run ends.
     pub profile: Option<ProfileProbe>,
@@ -1204,7 +1204,7 @@ pub struct RunOptions {
     /// Record the run for the viewer: the recorder and how many robots it records.
     pub replay: Option<(crate::recording::Recorder, usize)>,
     /// What the firmware robots' stack guards do ([`Swarm::set_stack_guard_mode`]).
-    pub stack_guard: emu::core::cpu::StackGuardMode,
+    pub stack_guard: h8300h::cpu::StackGuardMode,
     /// Stop a firmware robot at its first access to what the chip does not model
     /// ([`Swarm::set_strict_io`]).
     pub strict_io: bool,
@@ -1312,8 +1312,8 @@ fn vcd_info(
     s: &Scenario,
     condition: Condition,
     repeat: u32,
-) -> emu::chip::vcd::VcdInfo {
-    emu::chip::vcd::VcdInfo {
+) -> h8_3052f::vcd::VcdInfo {
+    h8_3052f::vcd::VcdInfo {
         source: format!(
             "robot {} of h8swarm run {} ({} run, repeat {repeat}, seed {}), steps {} to {}",
             v.robot,
@@ -1909,7 +1909,7 @@ mod tests {
     /// them; before, the pins read released whatever the world did).
     #[test]
     fn the_board_shows_the_world_s_bumpers_on_port_2() {
-        use emu::chip::pins::Board;
+        use h8_3052f::pins::Board;
         let mut s = Scenario::arena();
         s.robots = 10;
         s.steps = 300;

@@ -1,6 +1,6 @@
 //! "Does it fit the H8/3052?" (docs/design.md §6), measured by running the controller on the emulated
 //! MCU: by default the robot firmware (`firmware/robot.mot`, docs/design.md §8) on the H8/300H core,
-//! with the Rust model of the controller (`emu::board::model`) measured beside it.
+//! with the Rust model of the controller (`robot_board::model`) measured beside it.
 //!
 //! [`measure`] builds an MCU with four modelled IR sensors (`sensors::IrSensor`, datasheet
 //! spread and noise, their own seeds) whose true distances follow a seeded random walk between
@@ -12,7 +12,7 @@
 //! step's first phase, `ad_scan` for the robot firmware); the step periods are counted from
 //! there, one window of K ticks each, so each holds one step and the ticks and idle time up to
 //! the next. States are attributed to phases by PC through the image's symbol table,
-//! each phase a function with its callees ([`emu::board::profile`]); a window's busy states are
+//! each phase a function with its callees ([`robot_board::profile`]); a window's busy states are
 //! all but those asleep. RAM is the image's `.data` and `.bss` (every variable, sized from the
 //! symbol table), the network's arrays carved at boot (from the firmware's own pointers), and
 //! the stack's high-water mark (the lowest SP the run saw). ROM is the image's bytes.
@@ -30,17 +30,17 @@ use rand_chacha::ChaCha8Rng;
 use seeding::Purpose;
 use serde::Serialize;
 
-use emu::board::board::{BoardError, RobotBoard, RobotConfig, robot_mcu};
-use emu::board::firmware::{
+use h8_3052f::mcu::Mcu;
+use h8_3052f::pins::Board;
+use h8300h::bus::Bus;
+use h8300h::cpu::{Cpu, CpuError, Event, StackFault, StackGuard};
+use h8300h::memmap::{RAM_BYTES, ROM_BYTES};
+use robot_board::board::{BoardError, RobotBoard, RobotConfig, robot_mcu};
+use robot_board::firmware::{
     BlockError, ConfigBlock, ConfigStatus, Firmware, FirmwareError, RunError, halted,
 };
-use emu::board::model::{Controller, ControllerConfig, ControllerError, PhaseStates};
-use emu::board::profile::{PhaseDef, Profiler, UnknownFunction};
-use emu::chip::mcu::Mcu;
-use emu::chip::pins::Board;
-use emu::core::bus::Bus;
-use emu::core::cpu::{Cpu, CpuError, Event, StackFault, StackGuard};
-use emu::core::memmap::{RAM_BYTES, ROM_BYTES};
+use robot_board::model::{Controller, ControllerConfig, ControllerError, PhaseStates};
+use robot_board::profile::{PhaseDef, Profiler, UnknownFunction};
 
 use crate::energy::{
     Charge, DriveMeter, ElectronicsMeter, FreeWheels, PAPER_BATTERY_LIFE_H, Pack, Part,
@@ -251,7 +251,7 @@ pub struct EepromLine {
     pub save_max_states: u64,
 }
 
-/// The stack's room and what the firmware left of it ([`emu::core::cpu::stack`]).
+/// The stack's room and what the firmware left of it ([`h8300h::cpu::stack`]).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct StackLine {
     /// The room's low end: the end of the firmware's data and of the arrays it carves at
@@ -468,7 +468,13 @@ pub struct FitBoard {
 impl Board for FitBoard {
     fn analog_volts(&mut self, channel: u8, now_states: u64) -> f64 {
         let d = self.distance_mm.map(Some);
-        emu::board::wiring::sensor_volts(&mut self.sensors, &d, &self.channels, channel, now_states)
+        robot_board::wiring::sensor_volts(
+            &mut self.sensors,
+            &d,
+            &self.channels,
+            channel,
+            now_states,
+        )
     }
 
     fn port2_pins(&mut self, _now_states: u64) -> u8 {
@@ -579,7 +585,7 @@ struct FitMeter {
 
 impl FitMeter {
     fn new<W: Board>(mcu: &Mcu<RobotBoard<W>>) -> FitMeter {
-        let params = world::WorldParams::with_clock(u64::from(emu::board::board::CLOCK_HZ));
+        let params = world::WorldParams::with_clock(u64::from(robot_board::board::CLOCK_HZ));
         let top = params.top_speed_m_per_s;
         let wheels = || FreeWheels::new(&params);
         FitMeter {
@@ -593,7 +599,7 @@ impl FitMeter {
     /// A step period of `seconds` has run under the motor commands its step set (the motor
     /// pins now, before the next step sets them).
     fn period<B: Board>(&mut self, mcu: &mut Mcu<B>, seconds: f64) {
-        let pins = emu::board::wiring::motor_pins(mcu);
+        let pins = robot_board::wiring::motor_pins(mcu);
         let (l, r) = (
             crate::robot::wheel(&pins.left),
             crate::robot::wheel(&pins.right),
@@ -667,7 +673,7 @@ fn measure_firmware(cfg: &FitConfig) -> Result<Measured, FitError> {
     let stack_top = fw
         .symbols
         .addr("_stack_top")
-        .unwrap_or(emu::core::memmap::RAM_END + 1);
+        .unwrap_or(h8300h::memmap::RAM_END + 1);
     let stack_high_water = stack_top.saturating_sub(run.profiler.min_sp());
     let stack = run.stack_line(fw, fault.as_ref());
     let unmodelled = run
@@ -748,7 +754,7 @@ struct FirmwareRun {
     /// Stop at the first access to what the chip does not model ([`FitConfig::strict_io`]).
     strict_io: bool,
     /// The image's symbols, to name that access's function.
-    symbols: emu::board::symbols::SymbolTable,
+    symbols: robot_board::symbols::SymbolTable,
 }
 
 impl FirmwareRun {
@@ -803,7 +809,7 @@ impl FirmwareRun {
                     .io_reports()
                     .last()
                     .map_or_else(String::new, |r| {
-                        emu::board::firmware::describe_io(&self.symbols, r)
+                        robot_board::firmware::describe_io(&self.symbols, r)
                     });
                 Err(FitError::Run {
                     at,
@@ -966,7 +972,7 @@ fn firmware_ram<B: Board>(fw: &Firmware, mcu: &Mcu<B>, stack: u32) -> Vec<MemLin
         sym("_data_start").or(sym("_bss_start")),
         sym("_bss_end").or(sym("_heap_start")),
     ) {
-        let vars: Vec<&emu::board::symbols::Symbol> = fw
+        let vars: Vec<&robot_board::symbols::Symbol> = fw
             .symbols
             .symbols()
             .iter()
@@ -1008,7 +1014,7 @@ fn firmware_ram<B: Board>(fw: &Firmware, mcu: &Mcu<B>, stack: u32) -> Vec<MemLin
             });
         }
     }
-    let top = sym("_stack_top").unwrap_or(emu::core::memmap::RAM_END + 1);
+    let top = sym("_stack_top").unwrap_or(h8300h::memmap::RAM_END + 1);
     lines.push(MemLine {
         item: "stack (high-water mark measured)".to_string(),
         addr: top - stack,
@@ -1229,8 +1235,8 @@ fn rom_lines(fw: &Firmware) -> Vec<MemLine> {
     if fw.has_config_block() {
         rom.push(MemLine {
             item: "of which the configuration block".to_string(),
-            addr: emu::board::firmware::CONFIG_BLOCK_ADDR,
-            bytes: emu::board::firmware::CONFIG_BLOCK_BYTES as u32,
+            addr: robot_board::firmware::CONFIG_BLOCK_ADDR,
+            bytes: robot_board::firmware::CONFIG_BLOCK_BYTES as u32,
         });
     }
     rom

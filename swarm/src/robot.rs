@@ -1,5 +1,5 @@
 //! One robot: the emulated H8/3052F on the robot's board (its two EEPROMs on the MCU's port 4,
-//! `emu::board::board`) with its controller, four IR sensors and, in the world, its body.
+//! `robot_board::board`) with its controller, four IR sensors and, in the world, its body.
 //!
 //! Every random draw comes from its own stream: the sensors (one each), the EEPROMs, the
 //! initial weights and the random-walk control each get a seed from the run's seed, the
@@ -9,21 +9,21 @@
 use std::sync::Arc;
 
 use anyhow::{Context, Result};
-use emu::board::board::{RobotBoard, RobotConfig, robot_mcu};
-use emu::board::firmware::{
-    ConfigBlock, ConfigStatus, FLAG_RANDOM_WALK, Firmware, FirmwareController,
-};
-use emu::board::model::{Controller, ControllerConfig};
-use emu::board::wiring::{Bridge, MotorDrive};
-use emu::chip::gdb::Debugger;
-use emu::chip::mcu::Mcu;
-use emu::chip::pins::Board;
-use emu::chip::trace::CodeNames;
-use emu::chip::vcd::{VcdInfo, VcdStream};
-use emu::core::bus::Bus;
+use h8_3052f::gdb::Debugger;
+use h8_3052f::mcu::Mcu;
+use h8_3052f::pins::Board;
+use h8_3052f::trace::CodeNames;
+use h8_3052f::vcd::{VcdInfo, VcdStream};
+use h8300h::bus::Bus;
 use nn_q15::{Behaviour, InputLayout, Params};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use robot_board::board::{RobotBoard, RobotConfig, robot_mcu};
+use robot_board::firmware::{
+    ConfigBlock, ConfigStatus, FLAG_RANDOM_WALK, Firmware, FirmwareController,
+};
+use robot_board::model::{Controller, ControllerConfig};
+use robot_board::wiring::{Bridge, MotorDrive};
 use seeding::Purpose;
 use sensors::{BumperSet, IrParams, IrSensor, port2_pins};
 use world::{Direction, WheelCommand};
@@ -47,7 +47,7 @@ pub struct Senses {
 
 impl Board for Senses {
     fn analog_volts(&mut self, channel: u8, now_states: u64) -> f64 {
-        emu::board::wiring::sensor_volts(
+        robot_board::wiring::sensor_volts(
             &mut self.sensors,
             &self.distance_mm,
             &self.channels,
@@ -150,7 +150,7 @@ fn finish_stream(
     vcd: Option<VcdStream<'static>>,
 ) -> Option<std::io::Result<()>> {
     let mut v = vcd?;
-    let drained = emu::chip::run::drain_into(&mut v, mcu, c.phases_mut());
+    let drained = h8_3052f::run::drain_into(&mut v, mcu, c.phases_mut());
     let rest = mcu.finish_trace()?;
     let phases = c.take_phases();
     Some(drained.and_then(|()| v.finish(&rest.changes, &phases, rest.end)))
@@ -354,14 +354,14 @@ impl Robot {
                 self.busy_states += r.busy_states;
                 // The model's step begins sensing this much later (its ADST write), where a
                 // firmware robot's run stops.
-                return Ok(self.mcu.now() + emu::board::model::SENSING_OFFSET_STATES);
+                return Ok(self.mcu.now() + robot_board::model::SENSING_OFFSET_STATES);
             }
             Brain::Firmware(c) => {
                 c.run_to_sensing(&mut self.mcu)?;
                 self.busy_states += c.take_busy();
                 // The trace's step goes to its file; it is never held longer.
                 if let Some(v) = self.vcd.as_mut()
-                    && let Err(e) = emu::chip::run::drain_into(v, &mut self.mcu, c.phases_mut())
+                    && let Err(e) = h8_3052f::run::drain_into(v, &mut self.mcu, c.phases_mut())
                 {
                     self.vcd = None;
                     self.finished_trace = Some(Err(e));
@@ -410,11 +410,11 @@ impl Robot {
         let phase = c
             .phases_mut()
             .and_then(|p| p.drain_before(now + 1).pop())
-            .map_or_else(|| emu::chip::trace::UNNAMED_PHASE.to_string(), |(_, n)| n);
+            .map_or_else(|| h8_3052f::trace::UNNAMED_PHASE.to_string(), |(_, n)| n);
         let (start, initial) = self
             .mcu
             .trace_beginning()
-            .unwrap_or((0, [false; emu::chip::trace::SIGNAL_COUNT]));
+            .unwrap_or((0, [false; h8_3052f::trace::SIGNAL_COUNT]));
         self.vcd = Some(VcdStream::start(
             out,
             self.mcu.clock_hz(),
@@ -572,7 +572,7 @@ impl Robot {
 
     /// What a firmware robot's stack guard does when a stack access leaves the stack's room
     /// (see [`FirmwareController::set_stack_guard_mode`]); a model robot has no stack to guard.
-    pub fn set_stack_guard_mode(&mut self, mode: emu::core::cpu::StackGuardMode) {
+    pub fn set_stack_guard_mode(&mut self, mode: h8300h::cpu::StackGuardMode) {
         if let Brain::Firmware(c) = &mut self.brain {
             c.set_stack_guard_mode(mode);
         }
@@ -581,7 +581,7 @@ impl Robot {
     /// The first stack access of a firmware robot that left the stack's room (under a
     /// warning guard).
     #[must_use]
-    pub fn stack_fault(&self) -> Option<emu::core::cpu::StackFault> {
+    pub fn stack_fault(&self) -> Option<h8300h::cpu::StackFault> {
         match &self.brain {
             Brain::Firmware(c) => c.stack_fault(),
             Brain::Model(_) => None,
@@ -597,7 +597,7 @@ impl Robot {
     }
 
     /// The first access to each address the chip does not model, one line each, named from
-    /// the firmware's symbols ([`emu::chip::mcu::IoReport`]).
+    /// the firmware's symbols ([`h8_3052f::mcu::IoReport`]).
     #[must_use]
     pub fn io_reports(&self) -> Vec<String> {
         self.mcu
@@ -635,7 +635,7 @@ impl Robot {
 
     /// The wheel commands the motor pins give now.
     pub fn wheels(&mut self) -> (WheelCommand, WheelCommand) {
-        let pins = emu::board::wiring::motor_pins(&mut self.mcu);
+        let pins = robot_board::wiring::motor_pins(&mut self.mcu);
         (wheel(&pins.left), wheel(&pins.right))
     }
 }

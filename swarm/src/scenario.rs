@@ -244,12 +244,12 @@ pub const MAX_FILE_BYTES: u64 = 1 << 20;
 pub const MAX_NAME_CHARS: usize = 200;
 
 /// A text file a user named, at most `limit` bytes of UTF-8 (see
-/// [`emu::board::firmware::read_bounded`]).
+/// [`robot_board::firmware::read_bounded`]).
 ///
 /// # Errors
 /// The file cannot be read, is larger, or is not UTF-8.
 pub fn read_text(path: &Path, limit: u64) -> std::io::Result<String> {
-    let bytes = emu::board::firmware::read_bounded(path, limit)?;
+    let bytes = robot_board::firmware::read_bounded(path, limit)?;
     String::from_utf8(bytes).map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e))
 }
 
@@ -323,7 +323,7 @@ impl Default for SensorSpec {
             noise_sigma_v: sensors::ir::NOISE_SIGMA_VOLTS,
             spike_probability: sensors::ir::SPIKE_PROBABILITY,
             spread: true,
-            channels: emu::board::model::DEFAULT_SENSOR_CHANNELS,
+            channels: robot_board::model::DEFAULT_SENSOR_CHANNELS,
         }
     }
 }
@@ -391,7 +391,7 @@ impl Scenario {
             },
             timing: TimingSpec {
                 step_period_s: 0.45,
-                clock_hz: emu::board::board::CLOCK_HZ,
+                clock_hz: robot_board::board::CLOCK_HZ,
             },
             world: WorldSpec {
                 mu_wall: ARENA_MU_WALL,
@@ -528,7 +528,7 @@ impl Scenario {
     /// The first value out of range.
     pub fn check(&self) -> Result<()> {
         self.check_name()?;
-        if let Err(e) = emu::board::model::check_sensor_channels(&self.sensors.channels) {
+        if let Err(e) = robot_board::model::check_sensor_channels(&self.sensors.channels) {
             bail!("`sensors.channels` = {:?}: {e}", self.sensors.channels);
         }
         self.check_run_and_learner()?;
@@ -586,18 +586,18 @@ impl Scenario {
 
     /// The step period (a whole number of ticks) and the clock.
     fn check_timing(&self) -> Result<()> {
-        if !emu::board::model::step_period_ok(self.timing.step_period_s) {
+        if !robot_board::model::step_period_ok(self.timing.step_period_s) {
             bail!(
                 "`timing.step_period_s` = {}: valid is {}",
                 crate::text::number(self.timing.step_period_s),
-                emu::board::model::STEP_PERIOD_VALID
+                robot_board::model::STEP_PERIOD_VALID
             );
         }
         range(
             "timing.clock_hz",
             self.timing.clock_hz,
-            emu::board::model::CLOCK_MIN_HZ,
-            emu::board::model::CLOCK_MAX_HZ,
+            robot_board::model::CLOCK_MIN_HZ,
+            robot_board::model::CLOCK_MAX_HZ,
         )?;
         Ok(())
     }

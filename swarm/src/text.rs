@@ -58,7 +58,7 @@ pub fn printable(text: &str) -> String {
     out
 }
 
-pub use emu::board::symbols::is_format_char;
+pub use robot_board::symbols::is_format_char;
 
 /// A number as messages show it: as Rust prints it, but in exponent form when it is very
 /// large or very small (`1e308`, `1e-320`), never hundreds of digits.

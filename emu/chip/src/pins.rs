@@ -5,8 +5,6 @@
 //! The chip knows its pins, not the parts on them: what sits on a pin (a sensor, a bumper, an
 //! EEPROM) is the board layer's business (`robot_board::wiring`, `robot_board::board`).
 
-use crate::periph::ports::{ExternalPins, PortId};
-
 /// The robot outside the chip, as the MCU's pins see it.
 ///
 /// Every instant a board is given is not earlier than one it was given before and not later
@@ -107,4 +105,50 @@ impl Board for NullBoard {
     fn port2_pins(&mut self, _now_states: u64) -> u8 {
         0xFF
     }
+}
+
+/// One of the chip's eleven I/O ports.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum PortId {
+    /// Port 1 (address bus A7–A0 in the expanded modes).
+    P1,
+    /// Port 2 (the robot's bumpers).
+    P2,
+    /// Port 3.
+    P3,
+    /// Port 4 (the robot's EEPROM bus).
+    P4,
+    /// Port 5 (P5.0–3).
+    P5,
+    /// Port 6 (P6.0–6).
+    P6,
+    /// Port 7 (input only; the analog inputs AN0–AN7).
+    P7,
+    /// Port 8 (P8.0–4; IRQ0–IRQ3 on P8.0–3).
+    P8,
+    /// Port 9 (P9.0–5; the SCIs' pins, IRQ4/IRQ5 on P9.4–5).
+    P9,
+    /// Port A (the ITU's TIOCA0–2, the robot's motor PWM).
+    PA,
+    /// Port B (TIOCA3/TIOCA4, the robot's H-bridge inputs).
+    PB,
+}
+
+/// What the outside drives on a port's pins ([`Board::port_pins`]): where `driven` has a 1,
+/// the pin is held at the level of the same bit of `levels`; the other pins are left alone (an
+/// input pin then reads high only through its pull-up, else floats and reads 0).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ExternalPins {
+    /// The pins something outside drives.
+    pub driven: u8,
+    /// Their levels.
+    pub levels: u8,
+}
+
+impl ExternalPins {
+    /// Nothing connected.
+    pub const NONE: ExternalPins = ExternalPins {
+        driven: 0,
+        levels: 0,
+    };
 }

@@ -1,6 +1,6 @@
 //! Boards shared by the tests that run the robot firmware on the chip.
 
-use emu::chip::pins::Board;
+use h8_3052f::pins::Board;
 
 /// A board whose four IR voltages wander (a different slow triangle per channel, 0.4-2.6 V), so
 /// that the learner sees rewards and punishments; the bumpers (port 2) read released.

@@ -4,11 +4,11 @@
 //! each test are known to encode what the test says).
 #![allow(dead_code)]
 
-use emu::chip::machine::Machine;
-use emu::core::bus::Bus;
-use emu::core::cpu::decode::decode_bytes;
-use emu::core::cpu::disasm::format_instr;
-use emu::core::cpu::{CCR_I, Cpu, CpuError, Event};
+use h8_3052f::machine::Machine;
+use h8300h::bus::Bus;
+use h8300h::cpu::decode::decode_bytes;
+use h8300h::cpu::disasm::format_instr;
+use h8300h::cpu::{CCR_I, Cpu, CpuError, Event};
 
 /// Where the instruction under test sits.
 pub const CODE: u32 = 0x1000;

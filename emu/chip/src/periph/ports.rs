@@ -43,6 +43,9 @@
 use super::Peripheral;
 use super::itu::Itu;
 use crate::pins::Board;
+// The port identifiers and what the outside drives are the pins' words (`crate::pins`); named here too,
+// where the ports are.
+pub use crate::pins::{ExternalPins, PortId};
 
 /// Address of P2DDR, port 2 data direction register (write-only; docs/design.md §4.1: H'FFFFC1).
 pub const P2DDR: u32 = 0xFF_FFC1;
@@ -188,33 +191,6 @@ pub const PORTS_FIRST: u32 = 0xFF_FFC0;
 /// Last address of the port block: P5PCR (H'FFFFDB).
 pub const PORTS_LAST: u32 = 0xFF_FFDB;
 
-/// One of the chip's eleven I/O ports.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
-pub enum PortId {
-    /// Port 1 (address bus A7–A0 in the expanded modes).
-    P1,
-    /// Port 2 (the robot's bumpers).
-    P2,
-    /// Port 3.
-    P3,
-    /// Port 4 (the robot's EEPROM bus).
-    P4,
-    /// Port 5 (P5.0–3).
-    P5,
-    /// Port 6 (P6.0–6).
-    P6,
-    /// Port 7 (input only; the analog inputs AN0–AN7).
-    P7,
-    /// Port 8 (P8.0–4; IRQ0–IRQ3 on P8.0–3).
-    P8,
-    /// Port 9 (P9.0–5; the SCIs' pins, IRQ4/IRQ5 on P9.4–5).
-    P9,
-    /// Port A (the ITU's TIOCA0–2, the robot's motor PWM).
-    PA,
-    /// Port B (TIOCA3/TIOCA4, the robot's H-bridge inputs).
-    PB,
-}
-
 impl PortId {
     /// Every port, in the order of [`PortId::index`].
     pub const ALL: [PortId; 11] = [
@@ -312,25 +288,6 @@ pub enum PortReg {
     Dr,
     /// The input pull-up control register.
     Pcr,
-}
-
-/// What the outside drives on a port's pins ([`Board::port_pins`]): where `driven` has a 1,
-/// the pin is held at the level of the same bit of `levels`; the other pins are left alone (an
-/// input pin then reads high only through its pull-up, else floats and reads 0).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct ExternalPins {
-    /// The pins something outside drives.
-    pub driven: u8,
-    /// Their levels.
-    pub levels: u8,
-}
-
-impl ExternalPins {
-    /// Nothing connected.
-    pub const NONE: ExternalPins = ExternalPins {
-        driven: 0,
-        levels: 0,
-    };
 }
 
 /// The IRQ inputs' pins: (port, bit) of IRQ0–IRQ5 (section 5, IRQ pins; section 9: P8.0–P8.3
