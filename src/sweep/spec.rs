@@ -97,8 +97,9 @@ struct SweepFile {
     confirm: Option<toml::Table>,
 }
 
-/// Master seeds kept for checks made from outside the project: a confirmation refuses them
-/// unless its `allow_reserved_seeds` says it is such a check.
+/// Master seeds kept for checks made from outside the project: a confirmation never runs on
+/// them (a count skips them, a list naming one is refused). The project's own tests, maps and
+/// confirmations never use them; an outside check brings its own sweep.
 pub const RESERVED_SEEDS: std::ops::RangeInclusive<u64> = 11..=20;
 
 /// The `[confirm]` section as written.
@@ -108,7 +109,6 @@ struct ConfirmFile {
     seeds: Option<toml::Value>,
     cells: Option<toml::Value>,
     repeats: Option<i64>,
-    allow_reserved_seeds: Option<bool>,
 }
 
 /// Which cells of the map a confirmation re-runs.
@@ -740,8 +740,6 @@ fn confirm_of(
             .map_err(|e: toml::de::Error| {
                 SweepError::input(format!("{at}: {}", one_line(e.message())))
             })?;
-    let allow = f.allow_reserved_seeds.unwrap_or(false);
-    let reserved = |s: u64| !allow && RESERVED_SEEDS.contains(&s);
     let seeds = match &f.seeds {
         None => {
             return Err(SweepError::input(format!(
@@ -759,9 +757,9 @@ fn confirm_of(
                     "{at}: seed {s} is one of the map's seeds: a confirmation runs on seeds the map never used"
                 )));
             }
-            if let Some(s) = list.iter().find(|&&s| reserved(s)) {
+            if let Some(s) = list.iter().find(|&&s| RESERVED_SEEDS.contains(&s)) {
                 return Err(SweepError::input(format!(
-                    "{at}: seed {s}: master seeds {}-{} are reserved for checks from outside the project; choose others (e.g. 21 on), or set allow_reserved_seeds = true if this is such a check",
+                    "{at}: seed {s}: master seeds {}-{} are reserved for checks from outside the project; choose others (e.g. 21 on)",
                     RESERVED_SEEDS.start(),
                     RESERVED_SEEDS.end()
                 )));
@@ -1039,17 +1037,15 @@ mod tests {
             .unwrap()
             .unwrap();
         assert_eq!(c.seeds, vec![21, 22, 23]);
-        // The reserved seeds are refused, unless this is the check from outside.
+        // A list naming a reserved seed is refused (nothing runs: the plan is refused), and no
+        // key lets a confirmation take one.
         let e = with("seeds = [21, 15]").unwrap_err();
         assert!(
             e.contains("seed 15") && e.contains("11-20") && e.contains("reserved"),
             "{e}"
         );
-        let c = with("seeds = [15]\nallow_reserved_seeds = true")
-            .unwrap()
-            .confirm
-            .unwrap();
-        assert_eq!(c.seeds, vec![15]);
+        let e = with("seeds = [21]\nallow_reserved_seeds = true").unwrap_err();
+        assert!(e.contains("allow_reserved_seeds"), "{e}");
         // The map's own seeds are refused.
         let e = with("seeds = [2, 21]").unwrap_err();
         assert!(e.contains("seed 2") && e.contains("never used"), "{e}");
