@@ -13,6 +13,7 @@ use proptest::prelude::*;
 
 mod common;
 use common::fuzzing::*;
+use common::tmpfs::Tmpfs;
 
 /// The real binary, run in `dir`, its standard input closed.
 fn h8swarm_in(dir: &Path, args: &[String]) -> std::process::Output {
@@ -324,41 +325,6 @@ fn format_characters_never_reach_the_terminal_raw() {
         .unwrap();
     let _ = std::fs::remove_dir_all(&root);
     eprintln!("fuzz: format characters: {} cases", n.get());
-}
-
-/// A tmpfs mounted at `at`, unmounted when dropped.
-struct Tmpfs(PathBuf);
-
-impl Tmpfs {
-    fn mount(at: &Path, kib: u64) -> Option<Tmpfs> {
-        std::fs::create_dir_all(at).ok()?;
-        let ok = Command::new("mount")
-            .args(["-t", "tmpfs", "-o", &format!("size={kib}k"), "tmpfs"])
-            .arg(at)
-            .stderr(Stdio::null())
-            .status()
-            .is_ok_and(|s| s.success());
-        ok.then(|| Tmpfs(at.to_path_buf()))
-    }
-
-    fn free(&self) -> u64 {
-        let out = Command::new("df")
-            .args(["-B1", "--output=avail"])
-            .arg(&self.0)
-            .output()
-            .unwrap();
-        String::from_utf8_lossy(&out.stdout)
-            .lines()
-            .nth(1)
-            .and_then(|l| l.trim().parse().ok())
-            .unwrap_or(0)
-    }
-}
-
-impl Drop for Tmpfs {
-    fn drop(&mut self) {
-        let _ = Command::new("umount").arg(&self.0).status();
-    }
 }
 
 /// Every file under `dir` with its bytes, sorted by path.
