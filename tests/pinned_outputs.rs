@@ -16,7 +16,7 @@ use sha1::{Digest, Sha1};
 const PINS: [(&str, &str); 4] = [
     ("metrics.csv", "f646aa02e11acf31d21ceeea66b662c89d7d8038"),
     ("robots.csv", "53f634bf64190e9a45d8cccb158c0e0a1d85d6f1"),
-    ("summary.json", "ff1776148ee9682938bc2dfecbfb39a6328adc32"),
+    ("summary.json", "85cd37f906f080a4386f461cab1aacd0dde94788"),
     ("fit.json", "0172f8332da3660f07c700771f93d0946ece65f9"),
 ];
 

@@ -463,8 +463,9 @@ pub struct Claim {
     pub apart: bool,
     /// In words, with the repeats and the p-value.
     pub verdict: String,
-    /// The two values compared (means over the repeats that have one), in the claim's order;
-    /// for a claim of parts, the share of repeats against it and for it (percent).
+    /// The two values compared (means over the repeats that have one) in the order the claim's
+    /// words name them ("learning above learning off": learning's first, whichever way the
+    /// claim goes); for a claim of parts, the share of repeats against it and for it (percent).
     pub values: [f64; 2],
     /// Their 95 % intervals (none with a single repeat, nor for a claim of parts).
     pub intervals: [[Option<f64>; 2]; 2],
@@ -575,6 +576,23 @@ impl Claim {
             parts: Vec::new(),
             sides,
         }
+    }
+
+    /// The claim "`subject` above `reference`", each given per repeat: the claim "`reference`
+    /// below `subject`" with its values and intervals in the words' order (`subject` first).
+    #[must_use]
+    pub fn paired_above(
+        claim: &str,
+        paper: bool,
+        quantity: Quantity,
+        subject: &[Option<f64>],
+        reference: &[Option<f64>],
+        seed: u64,
+    ) -> Claim {
+        let mut c = Claim::paired(claim, paper, quantity, reference, subject, seed);
+        c.values.swap(0, 1);
+        c.intervals.swap(0, 1);
+        c
     }
 
     /// The claim that every one of `parts` holds, repeat by repeat: a repeat goes for it when
@@ -1135,13 +1153,16 @@ pub fn claims(runs: &[RunOutput], robots: usize, seed: u64) -> Vec<Claim> {
     let claim = |text: &str, paper: bool, q: Quantity, a: Vec<Option<f64>>, b: Vec<Option<f64>>| {
         Claim::paired(text, paper, q, &a, &b, seed)
     };
+    let above = |text: &str, paper: bool, q: Quantity, a: Vec<Option<f64>>, b: Vec<Option<f64>>| {
+        Claim::paired_above(text, paper, q, &a, &b, seed)
+    };
     use Quantity as Q;
-    let d_rises = claim(
+    let d_rises = above(
         "D rises: mean D in the last window above the first (learning)",
         true,
         Q::MeanD,
-        first(Q::MeanD),
         last(Q::MeanD),
+        first(Q::MeanD),
     );
     let collisions_fall = claim(
         "collisions fall: collisions per net metre in the last window below the first (learning)",
@@ -1160,17 +1181,17 @@ pub fn claims(runs: &[RunOutput], robots: usize, seed: u64) -> Vec<Claim> {
         vec![Some(KEEP_EXPLORING_MAX_HELD_PERCENT); n],
     );
     let walk_net = of(&walk, Q::NetMm, last_window);
-    let explore_part = claim(
+    let explore_part = above(
         &format!(
             "part of keep exploring: net progress in the last window at least {KEEP_EXPLORING_FRACTION} of the random walk's (learning; below: {KEEP_EXPLORING_FRACTION} x the random walk's)"
         ),
         false,
         Q::NetMm,
+        last(Q::NetMm),
         walk_net
             .iter()
             .map(|v| v.map(|v| KEEP_EXPLORING_FRACTION * v))
             .collect(),
-        last(Q::NetMm),
     );
     let keep_exploring = Claim::all_of(&keep_exploring_text(), true, &[&held_part, &explore_part]);
     let mut out = vec![d_rises, collisions_fall, keep_exploring];
@@ -1233,19 +1254,19 @@ pub fn claims(runs: &[RunOutput], robots: usize, seed: u64) -> Vec<Claim> {
         ));
     }
     if !off.is_empty() {
-        out.push(claim(
+        out.push(above(
             "mean D in the last window: learning above learning off",
             false,
             Q::MeanD,
-            of(&off, Q::MeanD, last_window),
             last(Q::MeanD),
+            of(&off, Q::MeanD, last_window),
         ));
-        out.push(claim(
+        out.push(above(
             "net progress in the last window: learning above learning off",
             false,
             Q::NetMm,
-            of(&off, Q::NetMm, last_window),
             last(Q::NetMm),
+            of(&off, Q::NetMm, last_window),
         ));
         out.push(claim(
             "held robot-steps in the last window: learning below learning off",
@@ -1368,6 +1389,22 @@ mod tests {
         assert_eq!((p.for_, p.against, p.tied, p.undefined), (2, 1, 1, 1));
         assert_eq!(p.defined(), 4);
         assert!((p.p - sign_test_p(2, 3)).abs() < 1e-15);
+    }
+
+    #[test]
+    fn a_claim_lists_its_values_in_the_order_its_words_name_them() {
+        let q = Quantity::MeanD;
+        let (hi, lo) = (constant(800.0, 5), constant(600.0, 5));
+        // "hi above lo": the subject's value first, and it holds.
+        let above = Claim::paired_above("x above y", true, q, &hi, &lo, 1);
+        assert_eq!(above.values, [800.0, 600.0]);
+        assert_eq!(above.intervals[0][0], Some(800.0));
+        assert_eq!(above.outcome, Outcome::Holds);
+        // The same comparison stated as "lo below hi" holds with lo's value first.
+        let below = Claim::paired("y below x", true, q, &lo, &hi, 1);
+        assert_eq!(below.values, [600.0, 800.0]);
+        assert_eq!(below.outcome, Outcome::Holds);
+        assert_eq!(above.repeats.for_, below.repeats.for_);
     }
 
     fn constant(v: f64, n: usize) -> Vec<Option<f64>> {
