@@ -29,12 +29,9 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::SweepError;
 use super::spec::Axis;
+use crate::plot::canvas::{FONT_FAMILY, INK, register_font, write_png};
 use swarm::summary::{SIGNIFICANCE, sign_test_p};
 
-/// The font family the run's figures register (DejaVu Sans, embedded).
-const FONT: &str = "sans-serif";
-/// Text and axes.
-const INK: RGBColor = RGBColor(34, 34, 34);
 /// Where a claim holds (Okabe–Ito blue).
 const HOLDS: RGBColor = RGBColor(0, 114, 178);
 /// Where more repeats go the claimed way, not enough to say so.
@@ -255,7 +252,7 @@ pub fn claim_figures(
     series: &[ClaimSeries],
     dir: &Path,
 ) -> Result<Vec<PathBuf>, SweepError> {
-    crate::plot::register_font().map_err(|e| tool(dir, e))?;
+    register_font().map_err(|e| tool(dir, e))?;
     let mut written = Vec::new();
     if axes.is_empty() {
         return Ok(written);
@@ -493,7 +490,7 @@ fn draw_map(path: &Path, g: &Grid, map: &Map<'_>) -> Result<(), SweepError> {
         draw_map_on(&root, g, &title_lines, map, top).map_err(|e| tool(path, e))?;
         root.present().map_err(|e| tool(path, e))?;
     }
-    crate::plot::write_png(path, size, &rgb).map_err(|e| tool(path, e))
+    write_png(path, size, &rgb).map_err(|e| tool(path, e))
 }
 
 /// Draws `map` on `root`: the title's lines, the key, the panels from `top` down, the note.
@@ -507,12 +504,12 @@ fn draw_map_on(
     let (labels, fills, key, note) = (&map.labels, &map.fills, &map.key, map.note);
     let e = |e: DrawingAreaErrorKind<_>| e.to_string();
     root.fill(&WHITE).map_err(e)?;
-    let title_font = (FONT, 20).into_font().color(&INK);
+    let title_font = (FONT_FAMILY, 20).into_font().color(&INK);
     for (i, l) in title_lines.iter().enumerate() {
         root.draw_text(l, &title_font, (20, 16 + 26 * i as i32))
             .map_err(e)?;
     }
-    let small = (FONT, 14).into_font().color(&INK);
+    let small = (FONT_FAMILY, 14).into_font().color(&INK);
     let left_text = small.pos(Pos::new(HPos::Left, VPos::Center));
     // The key, and which axis runs where.
     let mut kx = 20;
@@ -543,7 +540,7 @@ fn draw_map_on(
     let panel_w = PANEL_LEFT + nc as i32 * CELL_W;
     let panel_h = PANEL_TOP + nr as i32 * CELL_H + 30;
     let centred = |ink: &RGBColor, px: i32| {
-        (FONT, px)
+        (FONT_FAMILY, px)
             .into_font()
             .color(ink)
             .pos(Pos::new(HPos::Center, VPos::Center))
@@ -551,7 +548,7 @@ fn draw_map_on(
     for (p, name) in g.panels.iter().enumerate() {
         let px = 20 + (p % g.per_row) as i32 * (panel_w + PANEL_GAP);
         let py = top + (p / g.per_row) as i32 * (panel_h + PANEL_GAP);
-        let panel_font = (FONT, 14).into_font().color(&INK);
+        let panel_font = (FONT_FAMILY, 14).into_font().color(&INK);
         for (k, l) in wrap(name, (panel_w as usize / 8).max(20))
             .iter()
             .take(2)
