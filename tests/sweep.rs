@@ -626,3 +626,73 @@ cells = [{ "learner.eta" = 0.03 }]
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("no [confirm] section"), "{err}");
 }
+
+/// `sweep merge` warns, in `h8swarm run`'s own words, when a point's repeats are too few for a
+/// one-sided sign test to reach p < 0.05 (one repeat, or 2 to 4), and says whether a cell of
+/// the maps, which pools its seeds, can; with 5 repeats neither warns.
+#[test]
+fn merge_warns_as_run_does_when_the_repeats_cannot_reach_significance() {
+    let base = fresh("repeat-warning");
+    for (repeats, seeds, pooled) in [
+        (1, "[1]", "its 1 seed (1 repeat), too few to reach p < 0.05"),
+        (
+            3,
+            "[1, 2]",
+            "its 2 seeds (6 repeats), which can reach p < 0.05",
+        ),
+        (5, "[1]", ""),
+    ] {
+        let out = base.join(format!("run-{repeats}"));
+        let run = ok(&[
+            "run",
+            "--steps",
+            "20",
+            "--repeats",
+            &repeats.to_string(),
+            "--out",
+            s(&out),
+        ]);
+        // Run's warning about its repeats, without its advice on the option to give.
+        let run_warning = run
+            .lines()
+            .find(|l| l.contains("repeat") && l.starts_with("WARNING "))
+            .map(|l| l.split(" (use --repeats").next().unwrap_or(l).to_string());
+
+        let file = base.join(format!("w{repeats}.toml"));
+        std::fs::write(
+            &file,
+            format!(
+                "name = \"w{repeats}\"\nseeds = {seeds}\n[set]\nsteps = 20\nwindow = 10\n\
+                 repeats = {repeats}\n[grid]\n\"learner.eta\" = [0.01]\n"
+            ),
+        )
+        .unwrap();
+        let dir = base.join(format!("w{repeats}"));
+        ok(&["sweep", "plan", s(&file), "--out", s(&dir)]);
+        ok(&["sweep", "run", s(&dir), "--threads", "2"]);
+        let merge = ok(&["sweep", "merge", s(&dir)]);
+        let merge_warnings: Vec<&str> = merge
+            .lines()
+            .filter(|l| l.starts_with("WARNING "))
+            .collect();
+        match run_warning {
+            None => {
+                assert_eq!(
+                    repeats, 5,
+                    "run gave no warning for {repeats} repeats:\n{run}"
+                );
+                assert!(merge_warnings.is_empty(), "{merge}");
+            }
+            Some(w) => {
+                assert!(repeats < 5, "run warned for {repeats} repeats: {w}");
+                assert_eq!(merge_warnings.len(), 1, "{merge}");
+                assert!(
+                    merge_warnings[0].starts_with(&w),
+                    "merge's warning\n  {}\ndoes not say run's\n  {w}",
+                    merge_warnings[0]
+                );
+                assert!(merge_warnings[0].ends_with(pooled), "{}", merge_warnings[0]);
+            }
+        }
+    }
+}
