@@ -195,7 +195,8 @@ fn the_table_is_the_same_however_the_points_are_split() {
     );
     assert_eq!(*header.last().unwrap(), "error");
     assert_eq!(csv.lines().count(), 9);
-    // A row's zipped values move together and its effect is b - a.
+    // A row's zipped values move together; a claim's effect is the difference of its values,
+    // positive when the means agree with it, whichever way the claim goes.
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(a.join("merged/sweep.json")).unwrap())
             .unwrap();
@@ -208,19 +209,37 @@ fn the_table_is_the_same_however_the_points_are_split() {
             row[format!("{c}.b")].as_f64().unwrap(),
             row[format!("{c}.effect")].as_f64().unwrap(),
         );
-        // (serde_json reads decimals to within an ulp, so b - a of the values read back may
+        // "a above b": the effect is a - b, positive when the means agree with the claim.
+        // (serde_json reads decimals to within an ulp, so a - b of the values read back may
         // differ from the effect in the last digit.)
         assert!(
-            (e - (y - x)).abs() <= 1e-12 * x.abs().max(y.abs()).max(1.0),
-            "{c}: effect {e}, b - a = {}",
-            y - x
+            (e - (x - y)).abs() <= 1e-12 * x.abs().max(y.abs()).max(1.0),
+            "{c}: effect {e}, a - b = {}",
+            x - y
         );
-        assert_eq!(row[format!("{c}.means_agree")].as_bool().unwrap(), x < y);
+        assert_eq!(row[format!("{c}.means_agree")].as_bool().unwrap(), x > y);
         // The repeat counts add up to the point's repeats (1 here).
         let n = |part: &str| row[format!("{c}.{part}")].as_u64().unwrap();
         assert_eq!(n("for") + n("against") + n("tied") + n("undefined"), 1);
         let outcome = row[format!("{c}.outcome")].as_str().unwrap();
         assert!(["holds", "unsure", "fails", "undecided"].contains(&outcome));
+        for slug in json["claims"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| c["column"].as_str().unwrap())
+        {
+            let v = |part: &str| row[format!("{slug}.{part}")].as_f64();
+            let (Some(x), Some(y), Some(e)) = (v("a"), v("b"), v("effect")) else {
+                continue;
+            };
+            let agree = row[format!("{slug}.means_agree")].as_bool().unwrap();
+            assert!(
+                ((e.abs() - (x - y).abs()).abs() <= 1e-12 * x.abs().max(y.abs()).max(1.0))
+                    && (x == y || (e > 0.0) == agree),
+                "{slug}: a {x}, b {y}, effect {e}, means agree {agree}"
+            );
+        }
     }
     // A map a claim, and the region of the paper's text claims.
     let plots = std::fs::read_dir(a.join("merged/plots")).unwrap().count();

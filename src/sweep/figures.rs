@@ -1,13 +1,13 @@
 //! The sweep's figures, drawn with `plotters`: a **claim map** for every claim and a **region**
 //! figure for the paper's text claims together.
 //!
-//! A claim says "a below b", checked in every point repeat by repeat ([`swarm::summary`]). A
+//! A claim says "a below b" (or "a above b"), checked in every point repeat by repeat ([`swarm::summary`]). A
 //! map's cell is one combination of the swept values; it pools the points that differ only in
 //! their master seed: their repeats' counts for and against the claim are added and judged by
 //! the same one-sided exact sign test at the same level, so a cell of 5 seeds × 10 repeats is
 //! judged on 50 paired repeats. The cell is coloured by that pooled outcome ([`CellOutcome`])
 //! and labelled with it, the repeats for it out of those with a value, and the mean over its
-//! points of the effect b − a.
+//! points of the effect (positive where the means agree with the claim).
 //!
 //! Layout: the first swept axis runs down a panel, the second across; every combination of the
 //! further axes gets a panel of its own, in a grid (one axis alone: one row of cells). The
@@ -52,7 +52,8 @@ pub struct PointClaim {
     pub against: u32,
     /// Repeats with a value on both sides.
     pub defined: u32,
-    /// b − a of the point's means, when both have one.
+    /// The difference of the point's two means, positive when they agree with the claim, when
+    /// both have one.
     pub effect: Option<f64>,
 }
 
@@ -321,7 +322,7 @@ fn claim_map(text: &str, cells: &[Cell]) -> Map<'static> {
             )
         })
         .collect();
-    let note = "each cell pools its seeds: outcome of the one-sided sign test on all their repeats (holds, unsure, fails, opposite), repeats for the claim / repeats with a value, mean effect b - a over its points";
+    let note = "each cell pools its seeds: outcome of the one-sided sign test on all their repeats (holds, unsure, fails, opposite), repeats for the claim / repeats with a value, mean effect over its points (positive: the means agree with the claim)";
     let key: Vec<(RGBColor, &str)> = [
         CellOutcome::Holds,
         CellOutcome::Unsure,

@@ -11,8 +11,8 @@
 //!   robots (`learning.robots.ending_held_percent.mean`, `learning.robots.ending_held`, …);
 //!   then for every claim (column names from its text, `claim.<words>.…`): `outcome` (`holds`,
 //!   `unsure`, `fails`, `undecided`), `means_agree`, `apart` (intervals apart), `a` and `b`
-//!   (the two means compared: the claim is "a below b"), `effect` = b − a (positive when the
-//!   means agree with the claim), and the repeat-by-repeat counts `for`, `against`, `tied`,
+//!   (the two means compared, in the order the claim's words name them), `effect` (their
+//!   difference, positive when the means agree with the claim), and the repeat-by-repeat counts `for`, `against`, `tied`,
 //!   `undefined` with the sign test's `p`; last `error`. A point that did not finish has empty
 //!   cells.
 //! * `sweep.json`: the same rows (objects keyed by column), the column order, the claims' full
@@ -649,6 +649,19 @@ fn condition_cells(summary: &Value, row: &mut Map<String, Value>, cols: &mut Col
     }
 }
 
+/// A claim's effect: the difference of its two values (in the order its words name them),
+/// positive when the means agree with the claim, whichever way it goes ("a below b" or
+/// "a above b").
+fn effect(a: Option<f64>, b: Option<f64>, means_agree: Option<bool>) -> Value {
+    match (a, b, means_agree) {
+        (Some(a), Some(b), Some(agree)) => {
+            let d = (b - a).abs();
+            num(if agree || d == 0.0 { d } else { -d })
+        }
+        _ => Value::Null,
+    }
+}
+
 /// A finished point's claims into `row`: outcome, values, effect and repeats per claim, under
 /// a column slug of the claim's (new claims added to `claims`, their columns to `cols`).
 fn claim_cells(
@@ -684,13 +697,7 @@ fn claim_cells(
             ("apart", c["apart"].clone()),
             ("a", a.map_or(Value::Null, num)),
             ("b", b.map_or(Value::Null, num)),
-            (
-                "effect",
-                match (a, b) {
-                    (Some(a), Some(b)) => num(b - a),
-                    _ => Value::Null,
-                },
-            ),
+            ("effect", effect(a, b, c["means_agree"].as_bool())),
             ("for", r["for"].clone()),
             ("against", r["against"].clone()),
             ("tied", r["tied"].clone()),
