@@ -29,6 +29,7 @@ use super::{MAX_ABS_COORD_M, PlotError, ROBOT_PALETTE, draw_error, tick_label};
 /// Colour of arena walls.
 const WALL_COLOUR: RGBColor = RGBColor(40, 40, 40);
 
+/// The paper's Fig. 8: the arena from above with every robot's trajectory and its outline at a
 /// few instants. All coordinates are in metres.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ArenaFigure {
@@ -42,7 +43,6 @@ pub struct ArenaFigure {
     pub outlines: Vec<Outline>,
 }
 
-/// The corridor seen over time: each robot's position along the corridor against the learning
 /// Largest width of the arena's plotting area, pixels.
 const ARENA_MAX_W_PX: f64 = 1000.0;
 /// Largest height of the arena's plotting area, pixels.

@@ -112,7 +112,6 @@ pub struct Panel {
     pub held_overlay: bool,
 }
 
-/// The paper's Fig. 8: the arena from above with every robot's trajectory and its outline at a
 /// Height of the title strip of the learning figure, pixels.
 const LEARNING_TITLE_PX: u32 = 56;
 /// Length of a legend's line sample, pixels.

@@ -14,6 +14,7 @@ use plotters::prelude::*;
 use super::canvas::{FONT_FAMILY, INK, check_png_name, register_font, write_png};
 use super::{MAX_ABS_COORD_M, MAX_ABS_VALUE, PlotError, ROBOT_PALETTE, draw_error, tick_label};
 
+/// The corridor seen over time: each robot's position along the corridor against the learning
 /// step, its body drawn as a band (its centre ± half its length), so the gaps between
 /// neighbours are the white space between the bands and an even spacing shows as parallel
 /// bands.
