@@ -1,6 +1,6 @@
 //! The arena figure, the paper's Fig. 8: the arena seen from above, in metres at equal aspect
 //! ratio, with every robot's trajectory and its outline at a few instants
-//! ([`Outline`](swarm::experiment::Outline)).
+//! ([`Outline`]).
 //!
 //! * **Colours.** Robots take the ten-colour "tab10" palette by index, cycled for larger
 //!   swarms.

@@ -1,5 +1,5 @@
 //! A sweep's table: every point's claims and first/last-window statistics, collected from the
-//! points' folders and staged with its figures ([`merge_into`]); `h8swarm sweep merge`
+//! points' folders and staged with its figures (`merge_into`); `h8swarm sweep merge`
 //! ([`super::merge`]) commits a map's and its confirmation's together.
 //!
 //! Written to `DIR/merged/` (or `--out`):
