@@ -16,7 +16,7 @@
 //!
 //! Two engines compute the lines: `nn_q15` (the default; states from its H8 meter) and, with
 //! `--on-core`, the robot firmware's own routines `learner_forward` and `learner_update` run on
-//! the emulated H8/300H ([`robot_board::oncore`]; states as the core counts them, each routine
+//! the emulated H8/300H ([`robot_board::firmware_learner`]; states as the core counts them, each routine
 //! from its first instruction to its RTS). The two print the same lines for any input.
 
 use std::fmt;
@@ -24,7 +24,7 @@ use std::io::{self, BufRead, Read, Write};
 
 use nn_q15::{H8Meter, Params, Phase, Q7, Q15, Shape, forward_slice, update_slice};
 use robot_board::firmware::Firmware;
-use robot_board::oncore::{LearnerOnCore, OnCoreError};
+use robot_board::firmware_learner::{LearnerOnCore, OnCoreError};
 use serde::Serialize;
 use serde_json::{Map, Value};
 

@@ -1,4 +1,4 @@
-//! Tests of the figures module (`src/plot.rs`) through its public API: files written and valid,
+//! Tests of the figures (`src/plot/`) through their public API: files written and valid,
 //! output bytes deterministic, bad data and bad paths reported as errors.
 
 // A test, example or bench may use the host's f64 functions (clippy.toml): it checks the

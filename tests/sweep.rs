@@ -195,7 +195,8 @@ fn the_table_is_the_same_however_the_points_are_split() {
     );
     assert_eq!(*header.last().unwrap(), "error");
     assert_eq!(csv.lines().count(), 9);
-    // A row's zipped values move together and its effect is b - a.
+    // A row's zipped values move together; a claim's effect is the difference of its values,
+    // positive when the means agree with it, whichever way the claim goes.
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(a.join("merged/sweep.json")).unwrap())
             .unwrap();
@@ -208,19 +209,37 @@ fn the_table_is_the_same_however_the_points_are_split() {
             row[format!("{c}.b")].as_f64().unwrap(),
             row[format!("{c}.effect")].as_f64().unwrap(),
         );
-        // (serde_json reads decimals to within an ulp, so b - a of the values read back may
+        // "a above b": the effect is a - b, positive when the means agree with the claim.
+        // (serde_json reads decimals to within an ulp, so a - b of the values read back may
         // differ from the effect in the last digit.)
         assert!(
-            (e - (y - x)).abs() <= 1e-12 * x.abs().max(y.abs()).max(1.0),
-            "{c}: effect {e}, b - a = {}",
-            y - x
+            (e - (x - y)).abs() <= 1e-12 * x.abs().max(y.abs()).max(1.0),
+            "{c}: effect {e}, a - b = {}",
+            x - y
         );
-        assert_eq!(row[format!("{c}.means_agree")].as_bool().unwrap(), x < y);
+        assert_eq!(row[format!("{c}.means_agree")].as_bool().unwrap(), x > y);
         // The repeat counts add up to the point's repeats (1 here).
         let n = |part: &str| row[format!("{c}.{part}")].as_u64().unwrap();
         assert_eq!(n("for") + n("against") + n("tied") + n("undefined"), 1);
         let outcome = row[format!("{c}.outcome")].as_str().unwrap();
         assert!(["holds", "unsure", "fails", "undecided"].contains(&outcome));
+        for slug in json["claims"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| c["column"].as_str().unwrap())
+        {
+            let v = |part: &str| row[format!("{slug}.{part}")].as_f64();
+            let (Some(x), Some(y), Some(e)) = (v("a"), v("b"), v("effect")) else {
+                continue;
+            };
+            let agree = row[format!("{slug}.means_agree")].as_bool().unwrap();
+            assert!(
+                ((e.abs() - (x - y).abs()).abs() <= 1e-12 * x.abs().max(y.abs()).max(1.0))
+                    && (x == y || (e > 0.0) == agree),
+                "{slug}: a {x}, b {y}, effect {e}, means agree {agree}"
+            );
+        }
     }
     // A map a claim, and the region of the paper's text claims.
     let plots = std::fs::read_dir(a.join("merged/plots")).unwrap().count();
@@ -625,4 +644,74 @@ cells = [{ "learner.eta" = 0.03 }]
     let (code, err) = fails(&["sweep", "confirm", s(&pdir)], &[]);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("no [confirm] section"), "{err}");
+}
+
+/// `sweep merge` warns, in `h8swarm run`'s own words, when a point's repeats are too few for a
+/// one-sided sign test to reach p < 0.05 (one repeat, or 2 to 4), and says whether a cell of
+/// the maps, which pools its seeds, can; with 5 repeats neither warns.
+#[test]
+fn merge_warns_as_run_does_when_the_repeats_cannot_reach_significance() {
+    let base = fresh("repeat-warning");
+    for (repeats, seeds, pooled) in [
+        (1, "[1]", "its 1 seed (1 repeat), too few to reach p < 0.05"),
+        (
+            3,
+            "[1, 2]",
+            "its 2 seeds (6 repeats), which can reach p < 0.05",
+        ),
+        (5, "[1]", ""),
+    ] {
+        let out = base.join(format!("run-{repeats}"));
+        let run = ok(&[
+            "run",
+            "--steps",
+            "20",
+            "--repeats",
+            &repeats.to_string(),
+            "--out",
+            s(&out),
+        ]);
+        // Run's warning about its repeats, without its advice on the option to give.
+        let run_warning = run
+            .lines()
+            .find(|l| l.contains("repeat") && l.starts_with("WARNING "))
+            .map(|l| l.split(" (use --repeats").next().unwrap_or(l).to_string());
+
+        let file = base.join(format!("w{repeats}.toml"));
+        std::fs::write(
+            &file,
+            format!(
+                "name = \"w{repeats}\"\nseeds = {seeds}\n[set]\nsteps = 20\nwindow = 10\n\
+                 repeats = {repeats}\n[grid]\n\"learner.eta\" = [0.01]\n"
+            ),
+        )
+        .unwrap();
+        let dir = base.join(format!("w{repeats}"));
+        ok(&["sweep", "plan", s(&file), "--out", s(&dir)]);
+        ok(&["sweep", "run", s(&dir), "--threads", "2"]);
+        let merge = ok(&["sweep", "merge", s(&dir)]);
+        let merge_warnings: Vec<&str> = merge
+            .lines()
+            .filter(|l| l.starts_with("WARNING "))
+            .collect();
+        match run_warning {
+            None => {
+                assert_eq!(
+                    repeats, 5,
+                    "run gave no warning for {repeats} repeats:\n{run}"
+                );
+                assert!(merge_warnings.is_empty(), "{merge}");
+            }
+            Some(w) => {
+                assert!(repeats < 5, "run warned for {repeats} repeats: {w}");
+                assert_eq!(merge_warnings.len(), 1, "{merge}");
+                assert!(
+                    merge_warnings[0].starts_with(&w),
+                    "merge's warning\n  {}\ndoes not say run's\n  {w}",
+                    merge_warnings[0]
+                );
+                assert!(merge_warnings[0].ends_with(pooled), "{}", merge_warnings[0]);
+            }
+        }
+    }
 }

@@ -6,7 +6,7 @@ use nn_q15::{
     DynLearner, H8Meter, InputLayout, Params, Phase, Q7, Q15, Shape, forward_slice, update_slice,
 };
 use robot_board::firmware::Firmware;
-use robot_board::oncore::LearnerOnCore;
+use robot_board::firmware_learner::LearnerOnCore;
 
 /// A small seeded generator for test inputs (SplitMix64).
 struct Gen(u64);

@@ -60,7 +60,7 @@ fn forward_states(n: usize, m: usize, w: &[i16], x: &[i8]) -> (H8Meter, nn_q15::
 // ---------------------------------------------------------------------------------------------
 // States measured on the firmware. Each number below is what the emulated H8/300H counted from
 // the routine's first instruction to its RTS, running firmware/learner.c as committed
-// (firmware/robot.mot; `robot_board::oncore::LearnerOnCore`, the engine of
+// (firmware/robot.mot; `robot_board::firmware_learner::LearnerOnCore`, the engine of
 // `h8swarm learn --replay --on-core --states`), for the same inputs.
 
 #[test]

@@ -1,13 +1,13 @@
 //! The sweep's figures, drawn with `plotters`: a **claim map** for every claim and a **region**
 //! figure for the paper's text claims together.
 //!
-//! A claim says "a below b", checked in every point repeat by repeat ([`swarm::summary`]). A
+//! A claim says "a below b" (or "a above b"), checked in every point repeat by repeat ([`swarm::summary`]). A
 //! map's cell is one combination of the swept values; it pools the points that differ only in
 //! their master seed: their repeats' counts for and against the claim are added and judged by
 //! the same one-sided exact sign test at the same level, so a cell of 5 seeds × 10 repeats is
 //! judged on 50 paired repeats. The cell is coloured by that pooled outcome ([`CellOutcome`])
 //! and labelled with it, the repeats for it out of those with a value, and the mean over its
-//! points of the effect b − a.
+//! points of the effect (positive where the means agree with the claim).
 //!
 //! Layout: the first swept axis runs down a panel, the second across; every combination of the
 //! further axes gets a panel of its own, in a grid (one axis alone: one row of cells). The
@@ -29,12 +29,9 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::SweepError;
 use super::spec::Axis;
+use crate::plot::canvas::{FONT_FAMILY, INK, register_font, write_png};
 use swarm::summary::{SIGNIFICANCE, sign_test_p};
 
-/// The font family the run's figures register (DejaVu Sans, embedded).
-const FONT: &str = "sans-serif";
-/// Text and axes.
-const INK: RGBColor = RGBColor(34, 34, 34);
 /// Where a claim holds (Okabe–Ito blue).
 const HOLDS: RGBColor = RGBColor(0, 114, 178);
 /// Where more repeats go the claimed way, not enough to say so.
@@ -55,7 +52,8 @@ pub struct PointClaim {
     pub against: u32,
     /// Repeats with a value on both sides.
     pub defined: u32,
-    /// b − a of the point's means, when both have one.
+    /// The difference of the point's two means, positive when they agree with the claim, when
+    /// both have one.
     pub effect: Option<f64>,
 }
 
@@ -255,7 +253,7 @@ pub fn claim_figures(
     series: &[ClaimSeries],
     dir: &Path,
 ) -> Result<Vec<PathBuf>, SweepError> {
-    crate::plot::register_font().map_err(|e| tool(dir, e))?;
+    register_font().map_err(|e| tool(dir, e))?;
     let mut written = Vec::new();
     if axes.is_empty() {
         return Ok(written);
@@ -324,7 +322,7 @@ fn claim_map(text: &str, cells: &[Cell]) -> Map<'static> {
             )
         })
         .collect();
-    let note = "each cell pools its seeds: outcome of the one-sided sign test on all their repeats (holds, unsure, fails, opposite), repeats for the claim / repeats with a value, mean effect b - a over its points";
+    let note = "each cell pools its seeds: outcome of the one-sided sign test on all their repeats (holds, unsure, fails, opposite), repeats for the claim / repeats with a value, mean effect over its points (positive: the means agree with the claim)";
     let key: Vec<(RGBColor, &str)> = [
         CellOutcome::Holds,
         CellOutcome::Unsure,
@@ -493,7 +491,7 @@ fn draw_map(path: &Path, g: &Grid, map: &Map<'_>) -> Result<(), SweepError> {
         draw_map_on(&root, g, &title_lines, map, top).map_err(|e| tool(path, e))?;
         root.present().map_err(|e| tool(path, e))?;
     }
-    crate::plot::write_png(path, size, &rgb).map_err(|e| tool(path, e))
+    write_png(path, size, &rgb).map_err(|e| tool(path, e))
 }
 
 /// Draws `map` on `root`: the title's lines, the key, the panels from `top` down, the note.
@@ -507,12 +505,12 @@ fn draw_map_on(
     let (labels, fills, key, note) = (&map.labels, &map.fills, &map.key, map.note);
     let e = |e: DrawingAreaErrorKind<_>| e.to_string();
     root.fill(&WHITE).map_err(e)?;
-    let title_font = (FONT, 20).into_font().color(&INK);
+    let title_font = (FONT_FAMILY, 20).into_font().color(&INK);
     for (i, l) in title_lines.iter().enumerate() {
         root.draw_text(l, &title_font, (20, 16 + 26 * i as i32))
             .map_err(e)?;
     }
-    let small = (FONT, 14).into_font().color(&INK);
+    let small = (FONT_FAMILY, 14).into_font().color(&INK);
     let left_text = small.pos(Pos::new(HPos::Left, VPos::Center));
     // The key, and which axis runs where.
     let mut kx = 20;
@@ -543,7 +541,7 @@ fn draw_map_on(
     let panel_w = PANEL_LEFT + nc as i32 * CELL_W;
     let panel_h = PANEL_TOP + nr as i32 * CELL_H + 30;
     let centred = |ink: &RGBColor, px: i32| {
-        (FONT, px)
+        (FONT_FAMILY, px)
             .into_font()
             .color(ink)
             .pos(Pos::new(HPos::Center, VPos::Center))
@@ -551,7 +549,7 @@ fn draw_map_on(
     for (p, name) in g.panels.iter().enumerate() {
         let px = 20 + (p % g.per_row) as i32 * (panel_w + PANEL_GAP);
         let py = top + (p / g.per_row) as i32 * (panel_h + PANEL_GAP);
-        let panel_font = (FONT, 14).into_font().color(&INK);
+        let panel_font = (FONT_FAMILY, 14).into_font().color(&INK);
         for (k, l) in wrap(name, (panel_w as usize / 8).max(20))
             .iter()
             .take(2)

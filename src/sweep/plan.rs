@@ -12,16 +12,18 @@
 //! so results of one grid never mix with another's.
 //!
 //! **Requests.** Every task of an array asks for the same resources, so they are computed for
-//! the largest point and the fullest task (estimates on the safe side, from measurements on a
-//! loaded 2-core machine; any of them can be set in `[slurm]`):
+//! the largest point and the fullest task, on the safe side (any of them can be set in
+//! `[slurm]`):
 //! * CPUs: the point's parallel work, its runs (conditions × repeats, one thread each), times
-//!   ⌈robots / 64⌉ for swarms that step their robots in parallel, at most `max_cpus` (8);
-//! * memory: 64 MB for the process, plus per concurrent run 0.5 MB a model robot or 2 MB a
-//!   firmware robot (512 KB of flash and its decode caches), plus 72 bytes a run-step of
-//!   metrics and 16 bytes a tracked robot-step of paths, times 1.5, rounded up to 64 MB;
-//! * time: 20 s a point (the fit report, the figures) plus its robot-steps at 3 000 a second a
-//!   CPU for model robots or 800 for firmware robots, summed over the task's points, times 3,
-//!   plus 5 minutes.
+//!   ⌈robots / 64⌉ for swarms that step their robots in parallel, at most `max_cpus`;
+//! * memory: [`BASE_MEM_MB`], plus per concurrent run [`MODEL_ROBOT_MB`] a model robot or
+//!   [`FIRMWARE_ROBOT_MB`] a firmware robot, plus 72 bytes a run-step of metrics and 16 bytes a
+//!   tracked robot-step of paths, times 1.5, rounded up to 64 MB;
+//! * time: 20 s a point (the fit report, the figures) plus its robot-steps at
+//!   [`MODEL_ROBOT_STEPS_PER_S`] or [`FIRMWARE_ROBOT_STEPS_PER_S`] a CPU, summed over the
+//!   task's points, times 3, plus 5 minutes.
+//!
+//! What was measured when these were set: docs/performance.md, "A sweep's requests".
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -38,15 +40,15 @@ pub const DEFAULT_POINTS_PER_TASK: usize = 1;
 pub const DEFAULT_MAX_PARALLEL: usize = 100;
 /// Default upper bound of the computed CPUs per task.
 pub const DEFAULT_MAX_CPUS: usize = 8;
-/// Memory of the process itself, MB (measured ≈ 30 MB for 3 robots).
+/// Memory of the process itself, MB.
 pub const BASE_MEM_MB: f64 = 64.0;
-/// Memory of one model robot, MB (measured ≈ 0.2 MB).
+/// Memory of one model robot, MB.
 pub const MODEL_ROBOT_MB: f64 = 0.5;
-/// Memory of one firmware robot, MB (measured ≈ 0.8 MB: flash, RAM, decode caches).
+/// Memory of one firmware robot, MB (flash, RAM, decode caches).
 pub const FIRMWARE_ROBOT_MB: f64 = 2.0;
-/// Robot-steps a second on one CPU, model robots (measured 9 000-14 000 on a loaded machine).
+/// Robot-steps a second on one CPU, model robots (well below what a loaded machine runs).
 pub const MODEL_ROBOT_STEPS_PER_S: f64 = 3000.0;
-/// Robot-steps a second on one CPU, firmware robots (measured ≈ 3 100).
+/// Robot-steps a second on one CPU, firmware robots (well below what a loaded machine runs).
 pub const FIRMWARE_ROBOT_STEPS_PER_S: f64 = 800.0;
 
 /// One line of `points.jsonl`.

@@ -1,5 +1,5 @@
 //! A sweep's table: every point's claims and first/last-window statistics, collected from the
-//! points' folders and staged with its figures ([`merge_into`]); `h8swarm sweep merge`
+//! points' folders and staged with its figures (`merge_into`); `h8swarm sweep merge`
 //! ([`super::merge`]) commits a map's and its confirmation's together.
 //!
 //! Written to `DIR/merged/` (or `--out`):
@@ -11,8 +11,8 @@
 //!   robots (`learning.robots.ending_held_percent.mean`, `learning.robots.ending_held`, …);
 //!   then for every claim (column names from its text, `claim.<words>.…`): `outcome` (`holds`,
 //!   `unsure`, `fails`, `undecided`), `means_agree`, `apart` (intervals apart), `a` and `b`
-//!   (the two means compared: the claim is "a below b"), `effect` = b − a (positive when the
-//!   means agree with the claim), and the repeat-by-repeat counts `for`, `against`, `tied`,
+//!   (the two means compared, in the order the claim's words name them), `effect` (their
+//!   difference, positive when the means agree with the claim), and the repeat-by-repeat counts `for`, `against`, `tied`,
 //!   `undefined` with the sign test's `p`; last `error`. A point that did not finish has empty
 //!   cells.
 //! * `sweep.json`: the same rows (objects keyed by column), the column order, the claims' full
@@ -456,8 +456,13 @@ pub(super) fn claim_series(m: &Merged) -> Vec<ClaimSeries> {
         .collect()
 }
 
-/// The warning `h8swarm run` gives when a point's repeats cannot reach p < 0.05, for the
-/// points of the plan, and whether a cell's pooled repeats can.
+/// Fewest repeats a one-sided sign test at [`swarm::summary::SIGNIFICANCE`] can decide on:
+/// 5 repeats all going one way give p = 1/32.
+const MIN_DECIDING_REPEATS: i64 = 5;
+
+/// The warning `h8swarm run` gives when a run's repeats cannot reach p < 0.05 (in the same
+/// words, `tests/sweep.rs` holds them together), for the points of the plan with the fewest
+/// repeats; and whether a cell of the maps, which pools its seeds, can.
 fn render_repeat_warning(
     t: &mut String,
     plan: &super::plan::Plan,
@@ -467,27 +472,37 @@ fn render_repeat_warning(
         .iter()
         .filter_map(|l| l.scenario.get("repeats").and_then(toml::Value::as_integer))
         .collect();
-    let Some(&fewest) = repeats.iter().min() else {
+    let (Some(&fewest), Some(&most)) = (repeats.iter().min(), repeats.iter().max()) else {
         return;
     };
-    let min_needed = 5;
-    if fewest >= min_needed {
+    if fewest >= MIN_DECIDING_REPEATS {
         return;
     }
-    let pooled = fewest * plan.seeds.len() as i64;
+    let in_a_point = if fewest == most {
+        "in a point".to_string()
+    } else {
+        format!("in a point of {fewest}")
+    };
+    let head = if fewest < 2 {
+        format!(
+            "one repeat: no intervals and no paired test {in_a_point} (set repeats = {MIN_DECIDING_REPEATS} or more)"
+        )
+    } else {
+        format!(
+            "{fewest} repeats: a one-sided sign test needs at least {MIN_DECIDING_REPEATS} repeats all going one way to reach p < 0.05, so no claim can hold {in_a_point}"
+        )
+    };
+    let seeds = plan.seeds.len() as i64;
+    let pooled = fewest * seeds;
     let _ = writeln!(
         t,
-        "WARNING points of {fewest} repeats: a point's own one-sided sign test needs at least {min_needed} repeats all going one way to reach p < 0.05, so no claim can hold in a point{}",
-        if pooled >= min_needed {
-            format!(
-                "; the maps pool a cell's {} seeds ({pooled} repeats), which can",
-                plan.seeds.len()
-            )
+        "WARNING {head}; a cell of the maps pools its {seeds} seed{} ({pooled} repeat{}), {}",
+        if seeds == 1 { "" } else { "s" },
+        if pooled == 1 { "" } else { "s" },
+        if pooled >= MIN_DECIDING_REPEATS {
+            "which can reach p < 0.05"
         } else {
-            format!(
-                "; nor in a cell of the maps ({} seeds x {fewest} = {pooled} repeats)",
-                plan.seeds.len()
-            )
+            "too few to reach p < 0.05"
         }
     );
 }
@@ -634,6 +649,19 @@ fn condition_cells(summary: &Value, row: &mut Map<String, Value>, cols: &mut Col
     }
 }
 
+/// A claim's effect: the difference of its two values (in the order its words name them),
+/// positive when the means agree with the claim, whichever way it goes ("a below b" or
+/// "a above b").
+fn effect(a: Option<f64>, b: Option<f64>, means_agree: Option<bool>) -> Value {
+    match (a, b, means_agree) {
+        (Some(a), Some(b), Some(agree)) => {
+            let d = (b - a).abs();
+            num(if agree || d == 0.0 { d } else { -d })
+        }
+        _ => Value::Null,
+    }
+}
+
 /// A finished point's claims into `row`: outcome, values, effect and repeats per claim, under
 /// a column slug of the claim's (new claims added to `claims`, their columns to `cols`).
 fn claim_cells(
@@ -669,13 +697,7 @@ fn claim_cells(
             ("apart", c["apart"].clone()),
             ("a", a.map_or(Value::Null, num)),
             ("b", b.map_or(Value::Null, num)),
-            (
-                "effect",
-                match (a, b) {
-                    (Some(a), Some(b)) => num(b - a),
-                    _ => Value::Null,
-                },
-            ),
+            ("effect", effect(a, b, c["means_agree"].as_bool())),
             ("for", r["for"].clone()),
             ("against", r["against"].clone()),
             ("tied", r["tied"].clone()),
@@ -689,5 +711,18 @@ fn claim_cells(
             cols.add(&col);
             row.insert(col, v);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::MIN_DECIDING_REPEATS;
+    use swarm::summary::{SIGNIFICANCE, sign_test_p};
+
+    #[test]
+    fn the_fewest_deciding_repeats_are_those_of_the_sign_test() {
+        let n = MIN_DECIDING_REPEATS as u32;
+        assert!(sign_test_p(n, n) < SIGNIFICANCE);
+        assert!(sign_test_p(n - 1, n - 1) >= SIGNIFICANCE);
     }
 }

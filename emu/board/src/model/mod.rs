@@ -18,7 +18,7 @@
 //! 5. back to SLEEP until the next step's tick.
 //!
 //! Every register access goes through the bus and is charged by area; instruction fetches and
-//! register-only code are charged from their instruction sequences ([`fw`]); the learner's
+//! register-only code are charged from their instruction sequences ([`charging`]); the learner's
 //! arithmetic from `nn_q15`'s H8 meter. The tick interrupt is taken whenever it is pending
 //! between two charges (interrupts are enabled after boot), and its states are reported apart.
 //!
@@ -39,9 +39,9 @@
 //!   the previous behaviour.
 //! - The record's payload is the weight matrix as the H8 holds it: row by row, big-endian i16.
 
-pub mod fast;
-pub mod fw;
+pub mod charging;
 pub mod regs;
+pub mod timeline_save;
 
 use eeprom::persist::{Persistence, Record, RecordLayout};
 use eeprom::{I2cMaster, MasterTiming};
@@ -53,12 +53,12 @@ use nn_q15::{
 
 use crate::board::RobotBoard;
 use crate::ram::{RamMap, RamOverflow};
-use fast::SaveTimelines;
-use fw::{FETCH_STATES, Fw, FwPins, SLEEP_STATES};
+use charging::{FETCH_STATES, Fw, FwPins, SLEEP_STATES};
 use h8_3052f::mcu::Mcu;
 use h8_3052f::pins::Board;
 use h8300h::bus::FastPathHints;
 use regs::*;
+use timeline_save::SaveTimelines;
 
 /// What the model asks of the MCU besides the bus: the EEPROM bus for its transaction-level
 /// save ([`ControllerConfig::fast_forward`]), which no program on the chip could reach and
@@ -68,8 +68,8 @@ use regs::*;
 /// answers neither (the defaults, as a test's wrapper around an MCU may) runs the model
 /// register by register and I²C pin by pin, with the same results.
 pub trait ModelBus: FastPathHints {
-    /// The EEPROM bus behind port 4, for the fast save that acts on the chips at transaction
-    /// level with exactly the pin-level outcome ([`fast`]). `None`: pin-level access only.
+    /// The EEPROM bus behind port 4, for the timeline save that acts on the chips at transaction
+    /// level with exactly the pin-level outcome ([`timeline_save`]). `None`: pin-level access only.
     fn eeprom_bus(&mut self) -> Option<&mut eeprom::I2cBus> {
         None
     }
@@ -371,7 +371,7 @@ pub struct Controller {
     booted: bool,
     /// The next tick's instant, once known (see [`ControllerConfig::fast_forward`]).
     next_tick_at: Option<u64>,
-    /// The fast save's timelines (with [`ControllerConfig::fast_forward`]).
+    /// The timeline save's timelines (with [`ControllerConfig::fast_forward`]).
     timelines: Option<std::sync::Arc<SaveTimelines>>,
     /// States of one tick interrupt (entry to RTE), as measured on this MCU.
     isr_states: Option<u64>,
@@ -986,7 +986,7 @@ impl Controller {
             self.isr_states,
             fw.bus.eeprom_bus().is_some(),
         ) {
-            fast::save(fw, &self.persistence, timelines, isr, &record)?
+            timeline_save::save(fw, &self.persistence, timelines, isr, &record)?
         } else {
             let mut pins = FwPins {
                 fw,

@@ -27,12 +27,12 @@ mod exec;
 mod fast;
 mod ffwd;
 mod idle;
-mod shared;
+mod shared_code;
 pub mod stack;
 pub mod timing;
 
 pub use idle::{IdleRun, MAX_CYCLE};
-pub use shared::SharedCode;
+pub use shared_code::SharedCode;
 pub use stack::{StackAccess, StackFault, StackGuard, StackGuardMode, StackRoom};
 
 use std::sync::Arc;
@@ -506,7 +506,7 @@ impl Cpu {
             }
             let d = self.decode_through_bus(bus)?;
             if Area::of(pc + d.len_bytes() - 1) == Area::Rom {
-                *shared::own_slot(&mut self.cache, idx, EMPTY_SLOT) = d;
+                *shared_code::own_slot(&mut self.cache, idx, EMPTY_SLOT) = d;
             }
             return Ok(d);
         }
@@ -798,8 +798,8 @@ impl Cpu {
         let d = self.decode_through_bus(bus)?;
         if Area::of(pc) == Area::Rom && Area::of(pc + d.len_bytes() - 1) == Area::Rom {
             let slot = fast::Slot::new(d, pc);
-            *shared::own_slot(&mut self.cache, idx, EMPTY_SLOT) = d;
-            *shared::own_slot(&mut self.fast, idx, fast::Slot::EMPTY) = slot;
+            *shared_code::own_slot(&mut self.cache, idx, EMPTY_SLOT) = d;
+            *shared_code::own_slot(&mut self.fast, idx, fast::Slot::EMPTY) = slot;
             return self.exec_fast(bus, pc, idx, slot.next);
         }
         self.execute(bus, d)

@@ -1,11 +1,11 @@
-//! The fast save: the pin-level save's outcome and states, computed from timelines.
+//! The timeline save: the pin-level save's outcome and states, computed from timelines.
 //!
 //! The bit-banging master's pin sequence does not depend on the bytes it sends, only on how
 //! many and on the ACK bits it reads, so each piece of a save has a fixed timeline: a page
 //! write of n bytes; the START that opens ACK polling; one unanswered poll (the control byte and
 //! the repeated START of the next); the answered poll (the control byte and the STOP). Each
 //! timeline is recorded once, by running the real master ([`eeprom::I2cMaster`]) against
-//! recording pins that charge exactly what the port-4 pins charge ([`super::fw::FwPins`]: 7
+//! recording pins that charge exactly what the port-4 pins charge ([`super::charging::FwPins`]: 7
 //! states per pin operation, the tick taken at the end of each operation and each wait), and
 //! noting the points where the tick could be taken, the instants the chip decides on a control
 //! byte (the fall of SCL after its eighth bit) and the STOP edge.
@@ -25,7 +25,7 @@ use eeprom::{I2cMaster, I2cPins, MasterTiming};
 
 use super::ControllerError;
 use super::ModelBus;
-use super::fw::{Fw, PIN_OP_STATES};
+use super::charging::{Fw, PIN_OP_STATES};
 
 /// Of a pin read's 7 states, those up to the end of its bus access (`MOV.B @P4DR:8` = 2 + 3):
 /// the first point the tick can be taken at.
