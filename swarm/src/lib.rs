@@ -24,4 +24,4 @@ pub mod robot;
 pub mod scenario;
 pub mod seeds;
 pub mod summary;
-pub mod text;
+pub mod terminal_text;
