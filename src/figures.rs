@@ -9,6 +9,39 @@ use swarm::robot::Condition;
 use swarm::scenario::Scenario;
 use swarm::summary::{Estimate, Quantity};
 
+/// Every figure of a run: the learning curves, and the tracked robots' figure (the corridor's
+/// space-time figure, or the arena's paths) when the learning run's first repeat was tracked.
+pub struct Figures {
+    /// The learning curves.
+    pub learning: LearningFigure,
+    /// The tracked robots' figure.
+    pub track: Option<TrackFigure>,
+}
+
+/// The tracked robots' figure.
+pub enum TrackFigure {
+    /// The corridor's: the robots along it over the run.
+    SpaceTime(SpaceTimeFigure),
+    /// The arena's: the first and last steps' paths.
+    Arena(Vec<ArenaFigure>),
+}
+
+/// The figures of `runs`.
+#[must_use]
+pub fn of(s: &Scenario, runs: &[RunOutput]) -> Figures {
+    let track = runs.iter().find_map(|r| r.track.as_ref()).map(|track| {
+        if s.arena == swarm::scenario::ArenaKind::Corridor {
+            TrackFigure::SpaceTime(spacetime(s, track))
+        } else {
+            TrackFigure::Arena(arena(s, track))
+        }
+    });
+    Figures {
+        learning: learning(s, runs),
+        track,
+    }
+}
+
 /// The learning figure: per condition, mean D and collisions per robot per window (the
 /// paper's two panels), then collisions per net metre, net progress, collisions per path metre
 /// (a reference), the area covered, contact time, exploring robot-steps and, in the corridor,
@@ -17,7 +50,7 @@ use swarm::summary::{Estimate, Quantity};
 /// alone with one repeat); a window in which no repeat has a value (collisions per net metre of
 /// robots that went nowhere) has no point, and one in which only some have a value is drawn
 /// as an open circle with their number beside it, without a band.
-pub(crate) fn learning(s: &Scenario, runs: &[RunOutput]) -> LearningFigure {
+fn learning(s: &Scenario, runs: &[RunOutput]) -> LearningFigure {
     let win = s.window.max(1);
     let windows = runs
         .iter()
@@ -156,7 +189,7 @@ pub(crate) fn learning(s: &Scenario, runs: &[RunOutput]) -> LearningFigure {
 
 /// The corridor's space-time figure: each tracked robot's position along the corridor over
 /// the run (learning, repeat 0).
-pub(crate) fn spacetime(s: &Scenario, t: &swarm::experiment::Track) -> SpaceTimeFigure {
+fn spacetime(s: &Scenario, t: &swarm::experiment::Track) -> SpaceTimeFigure {
     let length_m = t
         .walls
         .iter()
@@ -176,7 +209,7 @@ pub(crate) fn spacetime(s: &Scenario, t: &swarm::experiment::Track) -> SpaceTime
 /// The arena figure as the paper's Fig. 8 shows learning: the first and the last
 /// [`swarm::experiment::SNAPSHOT_STEPS`] steps' paths in two panels, with the outlines at the
 /// start and the end of each.
-pub(crate) fn arena(s: &Scenario, t: &swarm::experiment::Track) -> Vec<ArenaFigure> {
+fn arena(s: &Scenario, t: &swarm::experiment::Track) -> Vec<ArenaFigure> {
     let k = swarm::experiment::SNAPSHOT_STEPS.min(s.steps as usize);
     let n = s.steps as usize;
     let first_of = |from: usize, to: usize| -> ArenaFigure {

@@ -6,13 +6,90 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use serde::Serialize;
 
-use crate::figures;
-use crate::plot::{Series, arena_figure_panels, learning_figure, spacetime_figure};
+use crate::figures::{self, TrackFigure};
+use crate::plot::{LearningFigure, Series, arena_figure_panels, learning_figure, spacetime_figure};
 use crate::stage::Stage;
 use swarm::experiment::RunOutput;
 use swarm::output_error::OutputError;
+use swarm::runner::Analysed;
 use swarm::scenario::Scenario;
 use swarm::summary::{Claim, ConditionStats, Pairing};
+
+/// Writes every file of the run into the staging folder: metrics.csv (from the runs' row
+/// files), robots.csv, summary.json, fit.json, the figures and the viewer page when the plan
+/// asks for one; returns the files written, in [`OUTPUT_FILES`]' order.
+///
+/// # Errors
+/// A file that cannot be written or drawn ([`OutputError`]).
+pub fn write(
+    stage: &Stage,
+    s: &Scenario,
+    r: &Analysed,
+    replay: Option<&swarm::recording::ReplayPlan>,
+) -> Result<Vec<String>> {
+    write_metrics(&stage.path("metrics.csv"), &r.rows)?;
+    write_robots(&stage.path("robots.csv"), &r.runs)?;
+    let summary = Summary {
+        h8swarm_version: env!("CARGO_PKG_VERSION"),
+        scenario: s,
+        window_steps: s.window,
+        units: UNITS,
+        eeprom_records_written: r.saves,
+        warnings: &r.warnings,
+        conditions: &r.analysis.conditions,
+        pairings: &r.analysis.pairings,
+        claims: &r.analysis.claims,
+        dead_robots: r
+            .runs
+            .iter()
+            .flat_map(|run| {
+                run.dead.iter().map(|d| DeadEntry {
+                    condition: run.condition.name(),
+                    repeat: run.repeat,
+                    robot: d,
+                })
+            })
+            .collect(),
+        image_configured: r.image_configured,
+        battery: &r.battery,
+    };
+    write_json(&stage.path("summary.json"), &summary)?;
+    write_json(&stage.path("fit.json"), &r.fit)?;
+    write_figures(s, stage, replay, r)
+}
+
+/// Moves the staged files into place; returns the line that says where they went.
+///
+/// # Errors
+/// The move failed ([`OutputError`]; the folder is as it was).
+pub fn commit(stage: Stage, names: &[String]) -> Result<String> {
+    let out = stage.out().to_path_buf();
+    let commit = crate::stage::Commit {
+        files: names.to_vec(),
+        ours: OUTPUT_FILES.iter().map(|n| (*n).to_string()).collect(),
+        folders: Vec::new(),
+    };
+    stage.commit(&commit).map_err(|e| {
+        anyhow::Error::new(OutputError(e.0)).context(format!(
+            "the run into `{}` could not be moved into place",
+            out.display()
+        ))
+    })?;
+    let (files, plots): (Vec<&String>, Vec<&String>) = names
+        .iter()
+        .partition(|n| !n.ends_with(".png") && !n.ends_with(".svg"));
+    let list = |v: &[&String]| v.iter().map(|n| n.as_str()).collect::<Vec<_>>().join(", ");
+    let plots: Vec<String> = plots
+        .iter()
+        .map(|n| out.join(n).display().to_string())
+        .collect();
+    Ok(format!(
+        "wrote {} ({}); plots: {}\n",
+        out.display(),
+        list(&files),
+        plots.join(", ")
+    ))
+}
 
 /// Every file `h8swarm run` writes into its output folder (`arena.png` for the square arena,
 /// `spacetime.png` for the corridor; the others always).
@@ -29,39 +106,39 @@ pub const OUTPUT_FILES: [&str; 9] = [
 ];
 
 #[derive(Serialize)]
-pub(crate) struct Summary<'a> {
-    pub(crate) h8swarm_version: &'static str,
-    pub(crate) scenario: &'a Scenario,
-    pub(crate) window_steps: u32,
-    pub(crate) units: Units,
-    pub(crate) eeprom_records_written: u64,
-    pub(crate) warnings: &'a [String],
-    pub(crate) conditions: &'a [ConditionStats],
-    pub(crate) pairings: &'a [Pairing],
-    pub(crate) claims: &'a [Claim],
+struct Summary<'a> {
+    h8swarm_version: &'static str,
+    scenario: &'a Scenario,
+    window_steps: u32,
+    units: Units,
+    eeprom_records_written: u64,
+    warnings: &'a [String],
+    conditions: &'a [ConditionStats],
+    pairings: &'a [Pairing],
+    claims: &'a [Claim],
     /// The robots that died in each run (`--keep-going`); their repeats are left out of the
     /// claims and the window statistics.
-    pub(crate) dead_robots: Vec<DeadEntry<'a>>,
+    dead_robots: Vec<DeadEntry<'a>>,
     /// `false` when the user's image has no configuration block (it ran with its own
     /// settings, not the scenario's); absent otherwise.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub(crate) image_configured: Option<bool>,
-    pub(crate) battery: &'a swarm::battery::BatteryReport,
+    image_configured: Option<bool>,
+    battery: &'a swarm::battery::BatteryReport,
 }
 
 /// A dead robot as summary.json lists it.
 #[derive(Serialize)]
-pub(crate) struct DeadEntry<'a> {
-    pub(crate) condition: &'static str,
-    pub(crate) repeat: u32,
+struct DeadEntry<'a> {
+    condition: &'static str,
+    repeat: u32,
     #[serde(flatten)]
-    pub(crate) robot: &'a swarm::experiment::DeadRobot,
+    robot: &'a swarm::experiment::DeadRobot,
 }
 
 /// The unit of every quantity the outputs hold (the same on screen, in the CSV files, in
 /// summary.json and in the figures).
 #[derive(Serialize)]
-pub(crate) struct Units {
+struct Units {
     mean_d: &'static str,
     collisions_per_robot: &'static str,
     collisions_per_net_m: &'static str,
@@ -87,7 +164,7 @@ pub(crate) struct Units {
     cells_visited: &'static str,
 }
 
-pub(crate) const UNITS: Units = Units {
+const UNITS: Units = Units {
     mean_d: "du (1 du = 80/255 cm), mean over robots and steps",
     collisions_per_robot: "collisions per robot over the window",
     collisions_per_net_m: "collisions per net metre: the robots' net displacement over 20 steps, per step, summed (none below 1 m)",
@@ -114,7 +191,7 @@ pub(crate) const UNITS: Units = Units {
 };
 
 /// Writes `value` as pretty JSON with a final newline to `path`.
-pub(crate) fn write_json(path: &Path, value: &impl Serialize) -> Result<()> {
+fn write_json(path: &Path, value: &impl Serialize) -> Result<()> {
     std::fs::write(path, serde_json::to_string_pretty(value)? + "\n")
         .map_err(anyhow::Error::new)
         .context(OutputError::cannot_write(path))
@@ -145,7 +222,7 @@ pub const ROBOTS_HEADER: [&str; 20] = [
 ];
 
 /// Writes every robot's record of every run (in run order, robots in index order).
-pub(crate) fn write_robots(path: &Path, runs: &[RunOutput]) -> Result<()> {
+fn write_robots(path: &Path, runs: &[RunOutput]) -> Result<()> {
     let write = || -> Result<()> {
         let mut w = csv::Writer::from_path(path)?;
         w.write_record(ROBOTS_HEADER)?;
@@ -192,11 +269,11 @@ pub(crate) fn write_robots(path: &Path, runs: &[RunOutput]) -> Result<()> {
 }
 
 /// Joins the runs' row files (in run order) under the header into `path`, removing them.
-pub(crate) fn write_metrics(path: &Path, parts: &[PathBuf]) -> Result<()> {
+fn write_metrics(path: &Path, parts: &[PathBuf]) -> Result<()> {
     write_metrics_csv(path, parts).context(OutputError::cannot_write(path))
 }
 
-pub(crate) fn write_metrics_csv(path: &Path, parts: &[PathBuf]) -> Result<()> {
+fn write_metrics_csv(path: &Path, parts: &[PathBuf]) -> Result<()> {
     let mut w = csv::Writer::from_path(path)?;
     w.write_record(swarm::experiment::METRICS_HEADER)?;
     let mut out = w
@@ -212,21 +289,20 @@ pub(crate) fn write_metrics_csv(path: &Path, parts: &[PathBuf]) -> Result<()> {
     Ok(())
 }
 
-/// Draws the figures (the learning curves; the arena's paths or the corridor's space-time
-/// figure) and writes the viewer page when the plan asks for one; returns every file written
-/// so far, in [`OUTPUT_FILES`]' order up to the figures.
-pub(crate) fn write_figures(
+/// Draws the figures and writes the viewer page when the plan asks for one; returns every file
+/// written so far, in [`OUTPUT_FILES`]' order up to the figures.
+fn write_figures(
     s: &Scenario,
     stage: &Stage,
     replay: Option<&swarm::recording::ReplayPlan>,
-    floor: &world::Arena,
-    runs: &[RunOutput],
+    r: &Analysed,
 ) -> Result<Vec<String>> {
+    let figs = figures::of(s, &r.runs);
     let (png, svg) = (stage.path("learning.png"), stage.path("learning.svg"));
     let drawn = |e: crate::plot::PlotError| {
         anyhow::Error::new(e).context(OutputError("cannot draw the figures".into()))
     };
-    learning_figure(&figures::learning(s, runs), &png, &svg).map_err(drawn)?;
+    learning_figure(&figs.learning, &png, &svg).map_err(drawn)?;
     let mut names: Vec<String> = [
         "metrics.csv",
         "robots.csv",
@@ -238,41 +314,34 @@ pub(crate) fn write_figures(
     .map(String::from)
     .to_vec();
     if let Some(plan) = replay {
-        write_replay(
-            s,
-            &stage.path("replay.html"),
-            stage.dir(),
-            plan,
-            floor,
-            runs,
-        )?;
+        write_replay(s, stage, plan, r, &figs.learning)?;
         names.push("replay.html".into());
     }
-    if let Some(track) = runs.iter().find_map(|r| r.track.as_ref()) {
-        if s.arena == swarm::scenario::ArenaKind::Corridor {
-            spacetime_figure(&figures::spacetime(s, track), &stage.path("spacetime.png"))
-                .map_err(drawn)?;
+    match &figs.track {
+        Some(TrackFigure::SpaceTime(fig)) => {
+            spacetime_figure(fig, &stage.path("spacetime.png")).map_err(drawn)?;
             names.push("spacetime.png".into());
-        } else {
-            arena_figure_panels(&figures::arena(s, track), &stage.path("arena.png"))
-                .map_err(drawn)?;
+        }
+        Some(TrackFigure::Arena(panels)) => {
+            arena_figure_panels(panels, &stage.path("arena.png")).map_err(drawn)?;
             names.push("arena.png".into());
         }
+        None => {}
     }
     Ok(names)
 }
 
 /// Writes the viewer page with the recorded runs (in run order).
-pub(crate) fn write_replay(
+fn write_replay(
     s: &Scenario,
-    html: &Path,
-    stage: &Path,
+    stage: &Stage,
     plan: &swarm::recording::ReplayPlan,
-    arena: &world::Arena,
-    runs: &[RunOutput],
+    r: &Analysed,
+    fig: &LearningFigure,
 ) -> Result<()> {
     use crate::viewer::{CurveHeader, Header, MountHeader, RunHeader};
     use swarm::recording::part_paths;
+    let (html, arena, runs) = (stage.path("replay.html"), &r.arena, &r.runs);
     let mut headers = Vec::new();
     let mut parts = Vec::new();
     for r in runs {
@@ -283,10 +352,9 @@ pub(crate) fn write_replay(
                 frames: *frames,
                 weight_frames: weight_frames.clone(),
             });
-            parts.push(part_paths(stage, r.condition, r.repeat));
+            parts.push(part_paths(stage.dir(), r.condition, r.repeat));
         }
     }
-    let fig = figures::learning(s, runs);
     let find = |panel: &[Series], label: &str| -> Vec<f64> {
         panel
             .iter()
@@ -355,5 +423,5 @@ pub(crate) fn write_replay(
         runs: headers,
         curves,
     };
-    crate::viewer::write_viewer(html, &header, &parts)
+    crate::viewer::write_viewer(&html, &header, &parts)
 }

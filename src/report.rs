@@ -5,11 +5,37 @@
 use std::fmt::Write as _;
 
 use swarm::experiment::RunOutput;
+use swarm::runner::Analysed;
 use swarm::scenario::Scenario;
 use swarm::summary::{Analysis, Claim, Estimate};
 
+/// The report of a run on `threads` threads: what ran and how fast, the warnings, the battery
+/// lines, the tables and the claims, the robots that died or strayed, the fit verdict.
+#[must_use]
+pub fn render(s: &Scenario, r: &Analysed, threads: usize) -> String {
+    let mut t = String::new();
+    render_header(
+        &mut t,
+        s,
+        r.conditions.len(),
+        r.runs.len(),
+        threads,
+        r.wall_s,
+    );
+    for w in &r.warnings {
+        let _ = writeln!(t, "WARNING {w}");
+    }
+    render_battery(&mut t, &r.battery);
+    let _ = writeln!(t);
+    report(&mut t, s, &r.analysis);
+    render_failures(&mut t, &r.runs);
+    let _ = writeln!(t);
+    let _ = writeln!(t, "fit: {}", r.fit.verdict);
+    t
+}
+
 /// The report's first lines: what ran, and how fast.
-pub(crate) fn render_header(
+fn render_header(
     t: &mut String,
     s: &Scenario,
     conditions: usize,
@@ -41,7 +67,7 @@ pub(crate) fn render_header(
 }
 
 /// A real-time factor with two significant digits below 10 (0.28, 3.1), whole above.
-pub(crate) fn factor_text(f: f64) -> String {
+fn factor_text(f: f64) -> String {
     if f >= 10.0 {
         format!("{f:.0}")
     } else if f >= 1.0 {
@@ -51,43 +77,9 @@ pub(crate) fn factor_text(f: f64) -> String {
     }
 }
 
-/// What the run's shape makes unreliable, said on screen and in summary.json.
-pub(crate) fn warnings(s: &Scenario) -> Vec<String> {
-    let mut w = Vec::new();
-    let windows = s.steps / s.window.max(1);
-    if windows < 3 {
-        w.push(format!(
-            "the run has {windows} whole windows of {} steps: the curves' points are marked and are no trend (use more steps or a smaller window)",
-            s.window
-        ));
-    }
-    if s.repeats < 2 {
-        w.push("one repeat: no intervals and no paired test (use --repeats 5 or more)".into());
-    } else if s.repeats < 5 {
-        w.push(format!(
-            "{} repeats: a one-sided sign test needs at least 5 repeats all going one way to reach p < 0.05, so no claim can hold",
-            s.repeats
-        ));
-    }
-    if let Some(sym) = &s.controller.symbols
-        && s.controller.image.is_none()
-    {
-        w.push(format!(
-            "`controller.symbols` = {} is not used: it is the symbol table of `controller.image`, and {}",
-            swarm::terminal_text::printable(sym),
-            if s.controller.kind == swarm::scenario::ControllerKind::Model {
-                "the robots run the Rust model (controller.kind = \"model\")"
-            } else {
-                "the robots run the built-in firmware"
-            }
-        ));
-    }
-    w
-}
-
 /// The battery lines of the summary: each condition's battery life in its first and last
 /// windows, its mean current by part, and what learning costs or saves against the controls.
-pub(crate) fn render_battery(t: &mut String, b: &swarm::battery::BatteryReport) {
+fn render_battery(t: &mut String, b: &swarm::battery::BatteryReport) {
     let _ = writeln!(t);
     let _ = writeln!(
         t,
@@ -142,7 +134,7 @@ pub(crate) fn render_battery(t: &mut String, b: &swarm::battery::BatteryReport) 
 
 /// The printed tables: per condition the first and last window, the robots, the pairings and
 /// the claims.
-pub(crate) fn report(t: &mut String, s: &Scenario, a: &Analysis) {
+fn report(t: &mut String, s: &Scenario, a: &Analysis) {
     report_conditions(t, a);
     if s.repeats < 2 {
         let _ = writeln!(
@@ -163,7 +155,7 @@ pub(crate) fn report(t: &mut String, s: &Scenario, a: &Analysis) {
 
 /// Per condition: the first and last window's measures, and the robots that ended held or
 /// had a lasting held spell.
-pub(crate) fn report_conditions(t: &mut String, a: &Analysis) {
+fn report_conditions(t: &mut String, a: &Analysis) {
     let _ = writeln!(
         t,
         "{:<14} {:>26} {:>26} {:>26}",
@@ -258,7 +250,7 @@ pub(crate) fn report_conditions(t: &mut String, a: &Analysis) {
 }
 
 /// Robot by robot, learning against each control: the robots it frees and traps.
-pub(crate) fn report_pairings(t: &mut String, a: &Analysis) {
+fn report_pairings(t: &mut String, a: &Analysis) {
     for p in &a.pairings {
         let _ = writeln!(
             t,
@@ -277,7 +269,7 @@ pub(crate) fn report_pairings(t: &mut String, a: &Analysis) {
 
 /// The paper's claims, then those against the controls it lacks, and how many of its text
 /// claims hold together.
-pub(crate) fn report_claims(t: &mut String, a: &Analysis) {
+fn report_claims(t: &mut String, a: &Analysis) {
     let _ = writeln!(t);
     let _ = writeln!(
         t,
@@ -339,7 +331,7 @@ pub(crate) fn report_claims(t: &mut String, a: &Analysis) {
 
 /// One claim's line: its outcome, its words, the values compared (or, for a claim of parts,
 /// the repeats that meet all of them), the verdict and what a decision would take.
-pub(crate) fn claim_line(t: &mut String, c: &Claim) {
+fn claim_line(t: &mut String, c: &Claim) {
     let values = if c.parts.is_empty() {
         format!(
             "{} vs {} {}",
@@ -367,7 +359,7 @@ pub(crate) fn claim_line(t: &mut String, c: &Claim) {
 
 /// One line per robot that died and per stack warning, run by run; one per robot and
 /// address its chip does not model, for the first run that touched it.
-pub(crate) fn render_failures(t: &mut String, runs: &[RunOutput]) {
+fn render_failures(t: &mut String, runs: &[RunOutput]) {
     let mut io_seen = std::collections::BTreeSet::new();
     for r in runs {
         for (i, what) in &r.io_warnings {
@@ -402,7 +394,7 @@ pub(crate) fn render_failures(t: &mut String, runs: &[RunOutput]) {
     }
 }
 
-pub(crate) fn fmt_value(v: f64) -> String {
+fn fmt_value(v: f64) -> String {
     if v.is_nan() {
         "none".to_string()
     } else {
@@ -410,7 +402,7 @@ pub(crate) fn fmt_value(v: f64) -> String {
     }
 }
 
-pub(crate) fn fmt_mean(e: &Estimate) -> String {
+fn fmt_mean(e: &Estimate) -> String {
     if e.mean.is_nan() {
         "none".to_string()
     } else {
@@ -418,7 +410,7 @@ pub(crate) fn fmt_mean(e: &Estimate) -> String {
     }
 }
 
-pub(crate) fn fmt_est(e: &Estimate) -> String {
+fn fmt_est(e: &Estimate) -> String {
     match (e.lo, e.hi) {
         _ if e.mean.is_nan() => "none".to_string(),
         (Some(lo), Some(hi)) => format!("{:.2} [{:.2}, {:.2}]", e.mean, lo, hi),

@@ -45,14 +45,14 @@ pub fn estimated_memory(s: &Scenario, threads: usize) -> u64 {
 }
 
 /// The runs of `s` (conditions × repeats) and how many of them go at once on `threads`.
-pub(crate) fn run_counts(s: &Scenario, threads: usize) -> (u64, u64) {
+fn run_counts(s: &Scenario, threads: usize) -> (u64, u64) {
     let conditions = 1 + u64::from(s.controls.learning_off) + u64::from(s.controls.random_walk);
     let runs = conditions.saturating_mul(u64::from(s.repeats));
     (runs, runs.min(threads as u64).max(1))
 }
 
 /// The memory the machine has available now (`MemAvailable` of /proc/meminfo), if known.
-pub(crate) fn available_memory() -> Option<u64> {
+fn available_memory() -> Option<u64> {
     let text = std::fs::read_to_string("/proc/meminfo").ok()?;
     let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
     let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
@@ -176,7 +176,7 @@ pub(crate) fn check_memory(
     check_memory_within(s, threads, max, extra, &ProcessLimits::read())
 }
 
-pub(crate) fn check_memory_within(
+fn check_memory_within(
     s: &Scenario,
     threads: usize,
     max: Option<u64>,

@@ -320,8 +320,8 @@ fn parse_budget(text: &str) -> Result<f64> {
     Ok(v)
 }
 
-/// The most steps `fit` measures (1 million: under 100 MB of per-step states, about two
-/// minutes on the firmware).
+/// The most steps `fit` measures (1 million: under 100 MB of per-step states; the time it
+/// takes: docs/limits-and-failures.md).
 pub const MAX_FIT_STEPS: u32 = 1_000_000;
 
 /// Runs `h8swarm fit`; returns the text to print.

@@ -8,22 +8,18 @@
 use std::fmt::Write as _;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
-use rayon::prelude::*;
 
 use super::Failure;
 use super::args::{ControllerArg, StackGuardArg, parse_bytes, parse_capacity};
-use crate::outputs::{OUTPUT_FILES, Summary};
 use crate::stage::Stage;
-use swarm::experiment::{RunOptions, RunOutput, build_world, run_one};
+use swarm::experiment::build_world;
 use swarm::output_error::OutputError;
-use swarm::robot::{Condition, controller_config};
+use swarm::runner;
 use swarm::scenario::Scenario;
-use swarm::summary::{ConditionStats, analyse};
 
 /// An option's help with its default, which comes from the scenario (an option given overrides
 /// it; not given, the scenario's value stands, so clap must not hold a default of its own):
@@ -306,28 +302,17 @@ pub struct FailedRun {
 /// more robots than the arena holds.
 pub fn run(a: &RunArgs) -> Result<String> {
     let what = a.scenario.as_deref().unwrap_or("arena");
-    let mut s = Scenario::load(what)?;
-    if let Some(k) = a.controller {
-        s.controller.kind = k.into();
-    }
-    if let Some(image) = &a.firmware {
-        if a.controller == Some(ControllerArg::Model) {
-            bail!("--firmware runs an image on the core: it cannot go with --controller model");
-        }
-        s.controller.kind = swarm::scenario::ControllerKind::Firmware;
-        s.controller.image = Some(image.display().to_string());
-    }
-    let s = s.with_overrides(a.robots, a.steps, a.repeats, a.seed)?;
-    parse_capacity(a.capacity_mah)?;
+    let s = scenario(a, what)?;
+    let capacity_mah = parse_capacity(a.capacity_mah)?;
+    let threads = super::args::threads(a.threads)?;
     let images = swarm::robot::Images::load(&s)?;
-    let unconfigured = unconfigured_image(&s, images.as_ref())?;
+    let unconfigured = swarm::robot::unconfigured_image(&s, images.as_ref())?;
     if let Some(image) = &unconfigured {
         eprintln!(
             "warning: {}: the image has no configuration block, so it runs with its own built-in settings, not the scenario's learner, timing and sensor settings (summary.json says \"image_configured\": false); give its symbol table (IMAGE.sym beside it, or controller.symbols) to configure it",
             swarm::terminal_text::printable(image)
         );
     }
-    let threads = super::args::threads(a.threads)?;
     // The folder's name comes from what the user typed (a built-in's name or the file's
     // stem), never from the scenario's `name`, which is data.
     let out = a.out.clone().unwrap_or_else(|| {
@@ -351,49 +336,33 @@ pub fn run(a: &RunArgs) -> Result<String> {
     // (and the trace's file) as it was.
     let mut stage = Stage::new("--out", &out).map_err(|e| anyhow::Error::new(OutputError(e.0)))?;
     let probes = match probes(a, &s, &mut stage) {
-        Ok(p) => std::sync::Mutex::new(Some(p)),
+        Ok(p) => p,
         Err(e) => {
             let _ = stage.abandon();
             return Err(e);
         }
     };
-    let result = run_into(&RunContext {
-        a,
-        s: &s,
-        images: images.as_ref(),
-        probes: &probes,
-        replay: replay.as_ref(),
-        stage: &stage,
+    let options = runner::Options {
         threads,
+        images: images.as_ref(),
+        probes,
+        replay: replay.as_ref(),
+        keep_going: a.keep_going,
+        stack_guard: a.stack_guard.unwrap_or_default().into(),
+        strict_io: a.strict_io,
+        capacity_mah,
+        folder: stage.dir(),
+    };
+    let bar = progress_bar(&s, runner::jobs(&s).1.len(), threads);
+    let analysed = runner::run(&s, options, &|k| bar.inc(k));
+    bar.finish_and_clear();
+    let written = analysed.and_then(|r| {
+        let names = crate::outputs::write(&stage, &s, &r, replay.as_ref())?;
+        Ok((crate::report::render(&s, &r, threads), names, r.all_dead))
     });
-    match result {
-        Ok((mut text, names, dead)) => {
-            let commit = crate::stage::Commit {
-                files: names.clone(),
-                ours: OUTPUT_FILES.iter().map(|n| (*n).to_string()).collect(),
-                folders: Vec::new(),
-            };
-            stage.commit(&commit).map_err(|e| {
-                anyhow::Error::new(OutputError(e.0)).context(format!(
-                    "the run into `{}` could not be moved into place",
-                    out.display()
-                ))
-            })?;
-            let (files, plots): (Vec<&String>, Vec<&String>) = names
-                .iter()
-                .partition(|n| !n.ends_with(".png") && !n.ends_with(".svg"));
-            let list = |v: &[&String]| v.iter().map(|n| n.as_str()).collect::<Vec<_>>().join(", ");
-            let plots: Vec<String> = plots
-                .iter()
-                .map(|n| out.join(n).display().to_string())
-                .collect();
-            let _ = writeln!(
-                text,
-                "wrote {} ({}); plots: {}",
-                out.display(),
-                list(&files),
-                plots.join(", ")
-            );
+    match written {
+        Ok((text, names, dead)) => {
+            let text = text + &crate::outputs::commit(stage, &names)?;
             match dead {
                 // The record is written; the run itself is a failure of the image (bad
                 // input: exit status 2), reported after the run's own text.
@@ -408,34 +377,23 @@ pub fn run(a: &RunArgs) -> Result<String> {
     }
 }
 
-/// The user's image when it has no configuration block (so the scenario cannot configure
-/// it); an error when the scenario's controls need it configured.
-///
-/// The controls differ from learning only through the configuration block: learning off is
-/// η = 0 written into it, the random walk a flag in it. An image without one (a `.mot`
-/// without its `.sym`, or a program of the user's own) would run the same program in all
-/// three conditions and the claims would compare a run with itself, so such a run is refused;
-/// with the controls off it runs, warned about and marked in summary.json.
+/// The scenario the arguments name, with the options that override it.
 ///
 /// # Errors
-/// An image without a configuration block and a control condition on.
-fn unconfigured_image(
-    s: &Scenario,
-    images: Option<&swarm::robot::Images>,
-) -> Result<Option<String>> {
-    let Some((fw, _)) = images.and_then(|i| i.user.as_ref()) else {
-        return Ok(None);
-    };
-    if fw.has_config_block() {
-        return Ok(None);
+/// A scenario that cannot be read or checks out wrong; `--firmware` with `--controller model`.
+fn scenario(a: &RunArgs, what: &str) -> Result<Scenario> {
+    let mut s = Scenario::load(what)?;
+    if let Some(k) = a.controller {
+        s.controller.kind = k.into();
     }
-    let image = s.controller.image.clone().unwrap_or_default();
-    if s.controls.learning_off || s.controls.random_walk {
-        bail!(
-            "`controller.image` = {image}: the image has no configuration block (no symbol table names `config_block` at H'000400: give IMAGE.sym beside the image, or controller.symbols), so the controls cannot reach it: learning off (eta = 0) and the random walk would run the same program as learning. Give the image's symbol table, or turn the controls off (controls.learning_off = false, controls.random_walk = false) to run the image as it is"
-        );
+    if let Some(image) = &a.firmware {
+        if a.controller == Some(ControllerArg::Model) {
+            bail!("--firmware runs an image on the core: it cannot go with --controller model");
+        }
+        s.controller.kind = swarm::scenario::ControllerKind::Firmware;
+        s.controller.image = Some(image.display().to_string());
     }
-    Ok(Some(image))
+    s.with_overrides(a.robots, a.steps, a.repeats, a.seed)
 }
 
 /// The default output folder's name for the scenario argument: a built-in's name, or the
@@ -465,136 +423,6 @@ pub fn default_out_name(what: &str) -> String {
     }
 }
 
-/// The probes of one robot, taken by the first run that asks for them.
-type SharedProbes = std::sync::Mutex<Option<swarm::experiment::RobotProbes>>;
-
-/// What one `run` works with: its options, its scenario, the robots' images, the probes and
-/// the replay plan, the staging folder its files go into, and its worker threads.
-struct RunContext<'r> {
-    a: &'r RunArgs,
-    s: &'r Scenario,
-    images: Option<&'r swarm::robot::Images>,
-    probes: &'r SharedProbes,
-    replay: Option<&'r swarm::recording::ReplayPlan>,
-    stage: &'r Stage,
-    threads: usize,
-}
-
-/// Runs the experiment, writing its files into the staging folder; returns the text to print
-/// and the files written.
-fn run_into(cx: &RunContext) -> Result<(String, Vec<String>, Option<String>)> {
-    let RunContext {
-        a,
-        s,
-        images,
-        replay,
-        stage,
-        threads,
-        ..
-    } = *cx;
-    let (kinds, jobs) = run_jobs(s);
-    let floor = swarm::experiment::arena_of(s)?;
-    let started = Instant::now();
-    let runs = run_all(cx, &jobs, &floor)?;
-    let wall_s = started.elapsed().as_secs_f64();
-
-    let parts: Vec<PathBuf> = jobs.iter().map(|&(c, r)| rows_path(stage, c, r)).collect();
-    crate::outputs::write_metrics(&stage.path("metrics.csv"), &parts)?;
-    crate::outputs::write_robots(&stage.path("robots.csv"), &runs)?;
-    let analysis = analyse(
-        &runs,
-        s.robots,
-        s.steps,
-        s.window,
-        swarm::seeds::bootstrap_seed(s.seed),
-    );
-    let warnings = crate::report::warnings(s);
-    let saves: u64 = runs.iter().map(|r| r.saves).sum();
-    let battery = battery_report(a, s, &analysis.conditions, &runs)?;
-    let summary = Summary {
-        h8swarm_version: env!("CARGO_PKG_VERSION"),
-        scenario: s,
-        window_steps: s.window,
-        units: crate::outputs::UNITS,
-        eeprom_records_written: saves,
-        warnings: &warnings,
-        conditions: &analysis.conditions,
-        pairings: &analysis.pairings,
-        claims: &analysis.claims,
-        dead_robots: runs
-            .iter()
-            .flat_map(|r| {
-                r.dead.iter().map(|d| crate::outputs::DeadEntry {
-                    condition: r.condition.name(),
-                    repeat: r.repeat,
-                    robot: d,
-                })
-            })
-            .collect(),
-        image_configured: images
-            .and_then(|i| i.user.as_ref())
-            .map(|(fw, _)| fw.has_config_block())
-            .filter(|configured| !configured),
-        battery: &battery,
-    };
-    crate::outputs::write_json(&stage.path("summary.json"), &summary)?;
-    let fit = measure_fit(s)?;
-    crate::outputs::write_json(&stage.path("fit.json"), &fit)?;
-    let names = crate::outputs::write_figures(s, stage, replay, &floor, &runs)?;
-
-    let mut t = String::new();
-    crate::report::render_header(&mut t, s, kinds.len(), jobs.len(), threads, wall_s);
-    for w in &warnings {
-        let _ = writeln!(t, "WARNING {w}");
-    }
-    crate::report::render_battery(&mut t, &battery);
-    let _ = writeln!(t);
-    crate::report::report(&mut t, s, &analysis);
-    crate::report::render_failures(&mut t, &runs);
-    let _ = writeln!(t);
-    let _ = writeln!(t, "fit: {}", fit.verdict);
-    Ok((t, names, all_dead(&runs, s.robots)))
-}
-
-/// When every robot of every run died (`--keep-going`): what to say, with the first
-/// robot's reason.
-fn all_dead(runs: &[RunOutput], robots: usize) -> Option<String> {
-    let every = !runs.is_empty() && runs.iter().all(|r| r.dead.len() >= robots);
-    every.then(|| {
-        let why = runs
-            .iter()
-            .flat_map(|r| &r.dead)
-            .next()
-            .map_or_else(String::new, |d| format!(" (the first: {})", d.why));
-        format!(
-            "every robot of every run died{why}: nothing could be judged (every claim is undecided); the outputs name the dead robots"
-        )
-    })
-}
-
-/// The conditions `s` runs (learning, then the controls it asks for) and its runs: every
-/// condition's repeats, condition after condition.
-fn run_jobs(s: &Scenario) -> (Vec<Condition>, Vec<(Condition, u32)>) {
-    let mut kinds = vec![Condition::Learning];
-    if s.controls.learning_off {
-        kinds.push(Condition::LearningOff);
-    }
-    if s.controls.random_walk {
-        kinds.push(Condition::RandomWalk);
-    }
-    let jobs = kinds
-        .iter()
-        .flat_map(|&c| (0..s.repeats).map(move |r| (c, r)))
-        .collect();
-    (kinds, jobs)
-}
-
-/// The file a run writes its rows of metrics.csv into as its steps complete (they are joined
-/// in run order into metrics.csv at the end).
-fn rows_path(stage: &Stage, c: Condition, r: u32) -> PathBuf {
-    stage.path(&format!(".rows-{}-{r}.csv", c.name()))
-}
-
 /// The progress bar of `runs` runs on a terminal (hidden otherwise), counting robot-steps.
 fn progress_bar(s: &Scenario, runs: usize, threads: usize) -> ProgressBar {
     if !std::io::stderr().is_terminal() {
@@ -613,109 +441,6 @@ fn progress_bar(s: &Scenario, runs: usize, threads: usize) -> ProgressBar {
         s.robots
     ));
     b
-}
-
-/// Runs every job on the context's workers, each run writing its rows into the staging folder
-/// (and its frames, when the plan records it); the runs' outputs in job order.
-fn run_all(
-    cx: &RunContext,
-    jobs: &[(Condition, u32)],
-    floor: &world::Arena,
-) -> Result<Vec<RunOutput>> {
-    let RunContext {
-        a,
-        s,
-        images,
-        probes,
-        replay,
-        stage,
-        threads,
-    } = *cx;
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .context("starting the worker threads")?;
-    let bar = progress_bar(s, jobs.len(), threads);
-    // Every condition's runs are recorded in the repeats the plan names.
-    let recorded = |r: u32| replay.is_some_and(|p| p.repeats.contains(&r));
-    let runs = pool.install(|| {
-        jobs.par_iter()
-            .map(|&(c, r)| {
-                let track = c == Condition::Learning && r == 0;
-                // The probes go to the learning run's first repeat.
-                let probes = if track {
-                    probes.lock().ok().and_then(|mut p| p.take())
-                } else {
-                    None
-                };
-                let replay = match replay.filter(|_| recorded(r)) {
-                    Some(p) => Some((
-                        swarm::recording::Recorder::new(
-                            p.opts.clone(),
-                            (floor.width_m(), floor.height_m()),
-                            swarm::recording::part_paths(stage.dir(), c, r),
-                        )?,
-                        p.robots,
-                    )),
-                    None => None,
-                };
-                run_one(
-                    s,
-                    c,
-                    r,
-                    images,
-                    &|k| bar.inc(k),
-                    RunOptions {
-                        record_track: track,
-                        keep_going: a.keep_going,
-                        rows: Some(rows_path(stage, c, r)),
-                        probes: probes.unwrap_or_default(),
-                        replay,
-                        stack_guard: a.stack_guard.unwrap_or_default().into(),
-                        strict_io: a.strict_io,
-                    },
-                )
-            })
-            .collect::<Result<_>>()
-    })?;
-    bar.finish_and_clear();
-    Ok(runs)
-}
-
-/// The fit verdict of the scenario's learner on the robot firmware (400 steps, compared with
-/// the model), for fit.json.
-fn measure_fit(s: &Scenario) -> Result<swarm::fit::FitReport> {
-    Ok(swarm::fit::measure(&swarm::fit::FitConfig {
-        controller: controller_config(s, swarm::fit::fit_weight_seed(s.seed))?,
-        steps: 400,
-        seed: s.seed,
-        kind: swarm::scenario::ControllerKind::Firmware,
-        firmware: swarm::fit::FirmwareUnderTest::robot()?,
-        compare: true,
-        strict_io: false,
-    })?)
-}
-
-/// The battery life of each condition ([`swarm::battery::BatteryReport`]) for the pack
-/// `--capacity-mah` gives.
-fn battery_report(
-    a: &RunArgs,
-    s: &Scenario,
-    stats: &[ConditionStats],
-    runs: &[RunOutput],
-) -> Result<swarm::battery::BatteryReport> {
-    let pack = swarm::energy::Pack::paper(parse_capacity(a.capacity_mah)?);
-    let mut b = swarm::battery::BatteryReport::of(stats, pack, s.timing.step_period_s);
-    let robot_seconds = s.robots as f64 * f64::from(s.steps) * s.timing.step_period_s;
-    for c in stats {
-        let of_c: Vec<&RunOutput> = runs.iter().filter(|r| r.condition == c.condition).collect();
-        b.by_part.push(swarm::battery::ConditionParts::of(
-            c.condition,
-            &of_c,
-            robot_seconds,
-        ));
-    }
-    Ok(b)
 }
 
 /// An error of `run`: a tool failure when some output could not be written

@@ -21,6 +21,7 @@ pub mod motion;
 pub mod output_error;
 pub mod recording;
 pub mod robot;
+pub mod runner;
 pub mod scenario;
 pub mod seeds;
 pub mod summary;

@@ -669,7 +669,7 @@ pub(super) const METER_BATCH: usize = 32;
 
 /// Robots from which the meters are fed beside the world's next sub-step on two or more
 /// threads: below it a join a sub-step costs more than the meters it overlaps (measured in
-/// docs/performance.md, "The meters beside the world").
+/// docs/performance.md, beside the pipelined meters).
 pub(super) const PIPELINE_ROBOTS: usize = 512;
 
 /// Robots from which a sub-step's readings are gathered on the pool: the world's own threshold
