@@ -10,18 +10,8 @@
 //! (`h8_3052f::gdb`). Symbols (for the phase names): `--symbols`, else IMAGE.sym beside the
 //! image if present.
 //!
-//! The stack guard (`h8300h::cpu::stack`) watches every stack access: its room runs from
-//! the end of the image's data to its stack's top when the symbols say where they are
-//! (`__bss_end`, `__stack_top`), else over the whole on-chip RAM. By default the first access
-//! outside stops the program with a one-line error naming the instruction, its function, SP
-//! and the bytes over (exit status 125); `--stack-guard warn` lets it run on and prints the
-//! first one as a warning at the end.
-//!
-//! Exit status: the program's (low byte of R0) when it halts with SLEEP under CCR.I = 1; 124
-//! when the state budget runs out; 125 when the core stops on an error (the message names the PC
-//! and the bytes); 126 when the program sleeps with interrupts enabled and nothing that could
-//! wake it; 137 when a GDB client kills it; 2 when the image, the symbol file or an option is
-//! bad (a VCD file that cannot be created, a GDB address that is not loopback).
+//! The stack guard (`--stack-guard`) and the exit statuses: docs/design.md §7 (and
+//! [`EXIT_MAX_STATES`], [`EXIT_CORE_ERROR`], [`EXIT_SLEPT_FOREVER`], [`EXIT_KILLED`]).
 
 use std::io::{self, BufWriter, Write};
 use std::path::Path;

@@ -1,6 +1,16 @@
 //! The firmware measured on the H8/300H core: boot, the step periods counted from the first
 //! step, states attributed to phases by PC, RAM from the symbol table and the stack's
 //! high-water mark.
+//!
+//! With the firmware, the settings reach it through its configuration block (written into the
+//! flash at load); boot runs from reset until the first step begins (the first entry into the
+//! step's first phase, `ad_scan` for the robot firmware); the step periods are counted from
+//! there, one window of K ticks each, so each holds one step and the ticks and idle time up to
+//! the next. States are attributed to phases by PC through the image's symbol table,
+//! each phase a function with its callees ([`robot_board::profile`]); a window's busy states are
+//! all but those asleep. RAM is the image's `.data` and `.bss` (every variable, sized from the
+//! symbol table), the network's arrays carved at boot (from the firmware's own pointers), and
+//! the stack's high-water mark (the lowest SP the run saw). ROM is the image's bytes.
 
 use super::config::{BOOT_LIMIT_S, FitConfig, FitError, PHASE_BOOT, PHASE_OTHER};
 use super::meter::{FitMeter, Measured, Rig};

@@ -1,5 +1,8 @@
 //! [`measure`]: runs the controller (the firmware on the core, or the Rust model) on the rig,
 //! and the other beside it when asked, and reports.
+//!
+//! With the model, the phases are the model's own accounting; RAM is its placement of the same
+//! items and ROM the firmware image's size (the model has no image of its own).
 
 use super::config::{
     FitConfig, FitError, PHASE_ADC, PHASE_FORWARD, PHASE_INPUT, PHASE_MOTORS, PHASE_OTHER,

@@ -1,5 +1,10 @@
 //! From the measured run to the report: the lines per phase, the memory and EEPROM lines, the
 //! margins and the one-line verdict with the tightest of them.
+//!
+//! The report gives the maximum and mean states per phase (with the other controller's mean
+//! and the ratio when both ran), the time at φ against the step period, the RAM items against
+//! the 8 192 bytes, the ROM against the 512 KB of flash, the EEPROM traffic and the lifetime the
+//! endurance allows, and a one-line verdict with the tightest margin.
 
 use super::config::{ENDURANCE_CYCLES, FitConfig, PHASE_SAVE};
 use super::meter::{Measured, Metered};

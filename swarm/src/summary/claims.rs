@@ -1,5 +1,10 @@
 //! The paper's claims and their parts, judged repeat by repeat on the window statistics
 //! (the reasoning is in `docs/claims.md`).
+//!
+//! * **Claims** are judged on quantities a robot held in place, shuttling or circling cannot
+//!   satisfy ([`crate::motion`]): the held share, net progress against the random walk's, and
+//!   collisions per net metre; collisions per path metre and the raw collision count are kept
+//!   as references.
 
 use super::quantities::{Quantity, first_window, last_window, per_repeat, runs_of};
 use super::stats::{Estimate, Paired, Power, SIGNIFICANCE, Side, fmt_p, sides};

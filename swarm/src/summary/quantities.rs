@@ -1,5 +1,10 @@
 //! The quantities measured per window ([`Quantity`]), their statistics per condition over
 //! the repeats, and the robots compared robot by robot ([`Pairing`]).
+//!
+//! * **Units**, one per quantity everywhere (screen, `metrics.csv`, `summary.json`, figures):
+//!   D in du; collisions as counts per robot, per net metre, per path metre and per moving
+//!   robot-step; contact time and the motion classes' shares in percent; path and net progress
+//!   in mm per step; mean squared displacement in cm²; cells per 100 steps and per robot.
 
 use super::stats::{Estimate, mcnemar_p};
 use crate::experiment::{RunOutput, WindowSums};

@@ -1,5 +1,18 @@
 //! The statistics under every claim: estimates over repeats with their bootstrap intervals,
 //! the exact sign and McNemar tests, and the repeats a decision would need (power).
+//!
+//! * **Intervals**: the mean over repeats with the *expanded percentile bootstrap* interval
+//!   ([`Estimate::of`]): seeded resamples of the repeats, their means' percentiles at a tail
+//!   widened for small samples. Such an interval never leaves the range of the repeats'
+//!   values, so a share stays in 0–100 %, a count at or above 0.
+//! * **Paired comparisons**: learning, learning off and the random walk of one repeat share
+//!   the placement (and learning and learning off the initial weights), so every claim compares
+//!   them repeat by repeat with an exact one-sided sign test ([`Paired`]); a claim of parts
+//!   counts a repeat for it only when every part goes its way ([`Side::all`]); robot by robot,
+//!   which robots end the run held under each condition is compared with McNemar's exact test
+//!   ([`super::Pairing`]).
+//! * **Power**: every claim says how many repeats a decision would need at the effect it shows
+//!   ([`Power`], [`repeats_needed`]).
 
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
