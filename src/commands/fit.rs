@@ -656,8 +656,8 @@ fn render_energy(s: &mut String, e: &swarm::fit::EnergyReport) {
 /// `h8swarm fit`: measures and prints the verdict.
 ///
 /// # Errors
-/// Bad options or images ([`super::super::Failure::Input`]), an output that cannot be written
-/// ([`super::super::Failure::Tool`]).
+/// Bad options or images ([`super::Failure::Input`]), an output that cannot be written
+/// ([`super::Failure::Tool`]).
 pub fn command(args: &FitArgs) -> Result<(), super::Failure> {
     let text = run(args).map_err(super::Failure::Input)?;
     super::write_text(&text)

@@ -170,7 +170,7 @@ impl Swarm {
         })
     }
 
-    /// Writes every step's row of `metrics.csv` (no header; [`metrics_row`]) to a new file at
+    /// Writes every step's row of `metrics.csv` (no header; [`super::metrics_row`]) to a new file at
     /// `path` as the step completes.
     ///
     /// # Errors

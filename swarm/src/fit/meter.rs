@@ -1,7 +1,7 @@
 //! The rig a controller is measured on: the MCU with four modelled IR sensors whose distances
 //! follow a seeded random walk, and the meter that attributes its states to phases.
 //!
-//! [`super::measure`] builds an MCU with four modelled IR sensors (`sensors::IrSensor`, datasheet
+//! [`super::measure()`] builds an MCU with four modelled IR sensors (`sensors::IrSensor`, datasheet
 //! spread and noise, their own seeds) whose true distances follow a seeded random walk between
 //! 30 mm and 1 m (so the learner sees rewards, punishments and dead zones, and the readings
 //! include the fold-back), and runs the controller on it for `steps` step periods.

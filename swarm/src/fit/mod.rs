@@ -1,9 +1,9 @@
 //! "Does it fit the H8/3052?" (docs/design.md §6), measured by running the controller on the
-//! emulated MCU ([`measure`]): by default the robot firmware (`firmware/robot.mot`) on the
+//! emulated MCU ([`measure()`]): by default the robot firmware (`firmware/robot.mot`) on the
 //! H8/300H core, with the Rust model of the controller (`robot_board::model`) beside it.
 //!
 //! Its parts: [`config`] (what is measured), [`meter`] (the rig: the MCU and its sensors, and
-//! the phase meter), [`firmware`] (the firmware's run), [`measure`] (both controllers),
+//! the phase meter), [`firmware`] (the firmware's run), [`mod@measure`] (both controllers),
 //! [`verdict`] (the report's lines, margins and verdict), [`report`] (the report's types) and
 //! [`budget`] (the largest network within a CPU budget).
 

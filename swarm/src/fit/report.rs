@@ -85,7 +85,7 @@ pub struct StackLine {
 /// One part's draw from the pack.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct PartLine {
-    /// The part ([`Part::key`]).
+    /// The part ([`crate::energy::Part::key`]).
     pub part: &'static str,
     /// The part in words.
     pub name: &'static str,

@@ -2,7 +2,7 @@
 //! the paper's claims checked against them (the reasoning is in `docs/claims.md`).
 //!
 //! Its parts: [`stats`] (estimates, their intervals, the paired tests, the power),
-//! [`quantities`] (the quantities per window and their statistics per condition), [`claims`]
+//! [`quantities`] (the quantities per window and their statistics per condition), [`mod@claims`]
 //! (the paper's claims judged on them) and [`analysis`] (all of it from an experiment's runs).
 
 pub mod analysis;
