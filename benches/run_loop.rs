@@ -13,8 +13,8 @@
 use std::path::PathBuf;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use h8swarm::fit_cmd::ControllerArg;
-use h8swarm::run_cmd::{RunArgs, run};
+use h8swarm::commands::args::ControllerArg;
+use h8swarm::commands::run::{RunArgs, run};
 
 fn benches(c: &mut Criterion) {
     let mut group = c.benchmark_group("run_loop");

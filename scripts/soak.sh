@@ -4,7 +4,7 @@
 # firmware and with the model, each run twice (1 and 2 threads); the four runs go at once.
 # Checks that every run ends with status 0, that its resident memory stays flat (sampled every
 # 5 s: the largest sample of the last half may exceed the largest of the first half by at most
-# 10 %; a run keeps no per-step history, see swarm/src/experiment.rs), and that the two runs of each
+# 10 %; a run keeps no per-step history, see swarm/src/experiment/metrics.rs), and that the two runs of each
 # controller write byte-identical metrics.csv and summary.json. Then the fuzz suite with many
 # cases.
 #

@@ -18,6 +18,8 @@
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
+use swarm::output_error::OutputError;
+
 /// Why an output could not be staged or committed: the tool failed (exit status 1), with the
 /// message to print.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -169,6 +171,26 @@ impl Stage {
         let registered = crate::cleanup::Staged::register(&staged);
         self.outside
             .push((staged.clone(), dest.to_path_buf(), registered));
+        Ok(staged)
+    }
+
+    /// Stages a file outside the output folder as [`Stage::stage_outside`] does and creates
+    /// it empty now, so that a file that cannot be written fails before the work, not after.
+    ///
+    /// # Errors
+    /// As [`Stage::stage_outside`], or the file cannot be created (both an
+    /// [`OutputError`]: the tool failed).
+    pub fn create_outside(&mut self, option: &str, dest: &Path) -> anyhow::Result<PathBuf> {
+        use anyhow::Context as _;
+        let staged = self
+            .stage_outside(option, dest)
+            .map_err(|e| anyhow::Error::new(OutputError(e.0)))?;
+        std::fs::write(&staged, b"")
+            .map_err(anyhow::Error::new)
+            .context(OutputError(format!(
+                "{option}: cannot create `{}`",
+                dest.display()
+            )))?;
         Ok(staged)
     }
 

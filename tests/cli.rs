@@ -346,7 +346,7 @@ fn run_writes_identical_metrics_for_any_thread_count() {
             );
             let stdout = String::from_utf8_lossy(&out.stdout);
             assert!(stdout.contains("learning.png"), "{stdout}");
-            for f in h8swarm::run_cmd::OUTPUT_FILES
+            for f in h8swarm::outputs::OUTPUT_FILES
                 .iter()
                 .filter(|f| !matches!(**f, "spacetime.png" | "replay.html"))
             {
@@ -501,7 +501,7 @@ fn a_failed_run_leaves_the_earlier_results_untouched() {
         None,
     );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let before: Vec<(String, Vec<u8>)> = h8swarm::run_cmd::OUTPUT_FILES
+    let before: Vec<(String, Vec<u8>)> = h8swarm::outputs::OUTPUT_FILES
         .iter()
         .filter(|f| !matches!(**f, "spacetime.png" | "replay.html"))
         .map(|f| (f.to_string(), std::fs::read(out.join(f)).expect("written")))
@@ -643,7 +643,7 @@ fn replay_changes_no_other_output_and_is_the_same_for_any_thread_count() {
         "replay-on-2b",
         &["--threads", "1", "--replay", "--replay-repeats", "0,1"],
     );
-    for f in h8swarm::run_cmd::OUTPUT_FILES {
+    for f in h8swarm::outputs::OUTPUT_FILES {
         if f == "replay.html" || f == "spacetime.png" {
             continue;
         }

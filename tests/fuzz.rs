@@ -136,7 +136,7 @@ fn scenario_files_never_panic_and_fail_in_one_line() {
                 Ok(s) => {
                     ok.set(ok.get() + 1);
                     // What a run checks next must not panic either.
-                    let _ = h8swarm::run_cmd::estimated_memory(&s, 2);
+                    let _ = h8swarm::resources::estimated_memory(&s, 2);
                     let _ = s.with_overrides(Some(7), Some(3), Some(1), Some(2));
                 }
                 Err(e) => {
@@ -190,7 +190,7 @@ fn replay_text() -> impl Strategy<Value = Vec<u8>> {
 
 #[test]
 fn replay_lines_never_panic_and_fail_at_a_line() {
-    use h8swarm::replay::{Engine, ReplayFailure, run};
+    use h8swarm::commands::learn::{Engine, ReplayFailure, run};
     let (ok, bad) = (Cell::new(0u32), Cell::new(0u32));
     runner()
         .run(&replay_text(), |bytes| {

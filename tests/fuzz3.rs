@@ -260,7 +260,7 @@ fn entry() -> impl Strategy<Value = Entry> {
 /// line end, or a format character).
 fn acts_on_a_terminal(text: &str) -> bool {
     text.chars()
-        .any(|c| (c.is_control() && c != '\n') || swarm::text::is_format_char(c))
+        .any(|c| (c.is_control() && c != '\n') || swarm::terminal_text::is_format_char(c))
 }
 
 #[test]

@@ -4,12 +4,12 @@
 use std::io::Cursor;
 use std::process::Command;
 
-use h8swarm::replay::{self, Engine};
+use h8swarm::commands::learn::{self, Engine};
 use robot_board::firmware::Firmware;
 
 fn replay_text(input: &str, engine: &Engine, states: bool) -> String {
     let mut out = Vec::new();
-    replay::run(&mut Cursor::new(input.as_bytes()), &mut out, states, engine)
+    learn::run(&mut Cursor::new(input.as_bytes()), &mut out, states, engine)
         .unwrap_or_else(|e| panic!("replay failed: {e:?}"));
     String::from_utf8(out).unwrap()
 }

@@ -64,7 +64,7 @@ fn firmware_robots_write_every_output_with_their_cpu_load_and_the_same_for_any_t
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    for f in h8swarm::run_cmd::OUTPUT_FILES
+    for f in h8swarm::outputs::OUTPUT_FILES
         .iter()
         .filter(|f| !matches!(**f, "spacetime.png" | "replay.html"))
     {

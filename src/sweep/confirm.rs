@@ -35,7 +35,7 @@ use super::plan::{Plan, PlanLine, PointCost, requests, sbatch_script};
 use super::spec::{Axis, CellChoice, Confirm, SlurmSpec, confirm_section, point_id, slurm_section};
 use super::{SweepError, write_atomic};
 use swarm::summary::{Paired, Power, sign_test_p};
-use swarm::text::printable;
+use swarm::terminal_text::printable;
 
 /// The confirmation's folder inside the map's.
 pub const CONFIRM_DIR: &str = "confirm";

@@ -1,6 +1,6 @@
 //! `h8swarm sweep run`: one task's share of the points (or all of them).
 //!
-//! Each point is run by `h8swarm run`'s own code ([`crate::run_cmd::run`]) into a temporary
+//! Each point is run by `h8swarm run`'s own code ([`crate::commands::run::run`]) into a temporary
 //! folder `points/.tmp-ID-HOST-PID`, which gets the point's `scenario.toml` first and its
 //! `status.json` last, and is then renamed to `points/ID` in one step: `points/ID` either does
 //! not exist or is complete. A point whose folder holds `status.json` with `"status": "ok"`
@@ -15,7 +15,7 @@
 use super::plan::{PlanLine, read_plan};
 use super::points::{PointState, Status, host_name, is_dead_leftover, point_state};
 use super::{SweepError, write_atomic};
-use crate::run_cmd::{RunArgs, run};
+use crate::commands::run::{RunArgs, run};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -297,7 +297,7 @@ pub fn run_task(
     for name in remove_dead_leftovers(&points)? {
         eprintln!(
             "removed points/{}: left by a task that was killed",
-            swarm::text::printable(&name)
+            swarm::terminal_text::printable(&name)
         );
     }
     let share: Vec<&PlanLine> = lines
@@ -342,7 +342,7 @@ pub fn run_task(
             }
         };
         // One line per point as it ends, for Slurm's log (standard output holds the totals).
-        eprintln!("{}", swarm::text::printable(&line_text));
+        eprintln!("{}", swarm::terminal_text::printable(&line_text));
     }
     let _ = writeln!(
         t,

@@ -484,7 +484,7 @@ pub fn write_plan(
     })?;
     write_atomic(&dir.join("plan.json"), plan_json.as_bytes())?;
     write_atomic(&dir.join("sweep.sbatch"), script.as_bytes())?;
-    let dir_text = swarm::text::printable(&dir.display().to_string());
+    let dir_text = swarm::terminal_text::printable(&dir.display().to_string());
     Ok(plan_summary(&plan, &dir_text))
 }
 

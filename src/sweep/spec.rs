@@ -43,7 +43,7 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use swarm::scenario::{Scenario, ScenarioFile};
-use swarm::text::{one_line, toml_error};
+use swarm::terminal_text::{one_line, toml_error};
 
 use super::SweepError;
 

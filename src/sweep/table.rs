@@ -36,7 +36,7 @@ use super::SweepError;
 use super::figures::{ClaimSeries, PointClaim, cell_values, claim_figures, region};
 use super::plan::read_plan;
 use super::points::{PointState, host_name, is_dead_leftover, point_state, read_summary};
-use swarm::text::printable;
+use swarm::terminal_text::printable;
 
 /// The statistics of a window in the order the table lists them (others follow, sorted).
 const STAT_ORDER: [&str; 14] = [

@@ -127,6 +127,18 @@ pub struct RobotStep {
     pub load_percent: f64,
 }
 
+/// What to record of an experiment's runs (`h8swarm run --replay`): the frames' options, the
+/// repeats recorded (of every condition) and the first robots recorded.
+#[derive(Clone, Debug)]
+pub struct ReplayPlan {
+    /// How each recorded run is recorded.
+    pub opts: RecordOptions,
+    /// The repeats recorded, in increasing order.
+    pub repeats: Vec<u32>,
+    /// The first robots recorded.
+    pub robots: usize,
+}
+
 /// What to record.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct RecordOptions {

@@ -210,6 +210,33 @@ impl Images {
     }
 }
 
+/// The user's image when it has no configuration block (so the scenario cannot configure
+/// it); an error when the scenario's controls need it configured.
+///
+/// The controls differ from learning only through the configuration block: learning off is
+/// η = 0 written into it, the random walk a flag in it. An image without one (a `.mot`
+/// without its `.sym`, or a program of the user's own) would run the same program in all
+/// three conditions and the claims would compare a run with itself, so such a run is refused;
+/// with the controls off it runs, warned about and marked in summary.json.
+///
+/// # Errors
+/// An image without a configuration block and a control condition on.
+pub fn unconfigured_image(s: &Scenario, images: Option<&Images>) -> Result<Option<String>> {
+    let Some((fw, _)) = images.and_then(|i| i.user.as_ref()) else {
+        return Ok(None);
+    };
+    if fw.has_config_block() {
+        return Ok(None);
+    }
+    let image = s.controller.image.clone().unwrap_or_default();
+    if s.controls.learning_off || s.controls.random_walk {
+        anyhow::bail!(
+            "`controller.image` = {image}: the image has no configuration block (no symbol table names `config_block` at H'000400: give IMAGE.sym beside the image, or controller.symbols), so the controls cannot reach it: learning off (eta = 0) and the random walk would run the same program as learning. Give the image's symbol table, or turn the controls off (controls.learning_off = false, controls.random_walk = false) to run the image as it is"
+        );
+    }
+    Ok(Some(image))
+}
+
 /// The controller configuration a scenario asks for.
 ///
 /// # Errors

@@ -362,7 +362,7 @@ fn finite(key: &str, v: f64, lo: f64, hi: f64) -> Result<()> {
     } else {
         bail!(
             "`{key}` = {} is out of range: valid is {lo} to {hi}",
-            crate::text::number(v)
+            crate::terminal_text::number(v)
         )
     }
 }
@@ -466,7 +466,7 @@ impl Scenario {
     pub fn from_toml(text: &str) -> Result<Self> {
         // One line: where (line, column, the line's text) and what.
         let file: ScenarioFile = toml::from_str(text)
-            .map_err(|e| anyhow::anyhow!("{}", crate::text::toml_error(text, &e)))?;
+            .map_err(|e| anyhow::anyhow!("{}", crate::terminal_text::toml_error(text, &e)))?;
         let mut s = Self::builtin(file.base.as_deref().unwrap_or("arena")).context("key `base`")?;
         if let Some(v) = file.name {
             s.name = v;
@@ -555,7 +555,7 @@ impl Scenario {
         if let Some(c) = self
             .name
             .chars()
-            .find(|&c| c.is_control() || crate::text::is_format_char(c))
+            .find(|&c| c.is_control() || crate::terminal_text::is_format_char(c))
         {
             bail!(
                 "`name` holds the control or format character U+{:04X}: give printable text (it is shown on the terminal and in the figures)",
@@ -589,7 +589,7 @@ impl Scenario {
         if !robot_board::model::step_period_ok(self.timing.step_period_s) {
             bail!(
                 "`timing.step_period_s` = {}: valid is {}",
-                crate::text::number(self.timing.step_period_s),
+                crate::terminal_text::number(self.timing.step_period_s),
                 robot_board::model::STEP_PERIOD_VALID
             );
         }

@@ -20,7 +20,12 @@
 //! from its first instruction to its RTS). The two print the same lines for any input.
 
 use std::fmt;
-use std::io::{self, BufRead, Read, Write};
+use std::fs::File;
+use std::io::{self, BufRead, BufReader, BufWriter, Read, Write};
+
+use clap::Args;
+
+use super::{Failure, write_failure};
 
 use nn_q15::{H8Meter, Params, Phase, Q7, Q15, Shape, forward_slice, update_slice};
 use robot_board::firmware::Firmware;
@@ -305,7 +310,7 @@ fn parse_object(text: &str, line: usize) -> Result<Map<String, Value>, ReplayErr
                 field: None,
                 message: format!(
                     "`{}` is not an integer: every number in a replay line is written without a fraction or an exponent",
-                    swarm::text::printable(token)
+                    swarm::terminal_text::printable(token)
                 ),
             }),
             None => Ok(map),
@@ -575,6 +580,66 @@ fn parse_step(
         "an evaluation E (i16)",
     )?;
     Ok((x, e as i16))
+}
+
+/// Options of `h8swarm learn`.
+#[derive(Args, Debug)]
+pub struct LearnArgs {
+    /// The replay file (JSON Lines), or `-` for standard input.
+    #[arg(long, value_name = "FILE")]
+    replay: String,
+    /// Add the H8/300H states of each step's forward pass and update to every output line.
+    #[arg(long)]
+    states: bool,
+    /// Run the robot firmware's own learner routines on the emulated H8/300H instead of
+    /// nn_q15 (the same lines; with --states, the states the core counts).
+    #[arg(long)]
+    on_core: bool,
+}
+
+/// `h8swarm learn`: replays the file (or standard input) to standard output.
+///
+/// # Errors
+/// A malformed or unreadable input ([`Failure::Input`]), a failure of the core or of the
+/// output ([`Failure::Tool`]).
+pub fn command(args: &LearnArgs) -> Result<(), Failure> {
+    let stdin = io::stdin();
+    let mut input: Box<dyn BufRead> = if args.replay == "-" {
+        Box::new(stdin.lock())
+    } else {
+        let file = File::open(&args.replay).map_err(|e| {
+            Failure::Input(anyhow::anyhow!(
+                "cannot open replay file `{}`: {e} (give a JSON Lines file, or - for standard input)",
+                args.replay
+            ))
+        })?;
+        Box::new(BufReader::new(file))
+    };
+    let stdout = io::stdout();
+    let mut out = BufWriter::new(stdout.lock());
+    let engine = if args.on_core {
+        let fw = robot_board::firmware::Firmware::robot()
+            .map_err(|e| Failure::Tool(anyhow::Error::new(e).context("the built-in firmware")))?;
+        Engine::OnCore(Box::new(fw))
+    } else {
+        Engine::Model
+    };
+    let result = run(&mut input, &mut out, args.states, &engine);
+    // Whatever happened, the lines already produced are delivered.
+    let flushed = out.flush();
+    match result {
+        Ok(_) => flushed.or_else(write_failure),
+        Err(ReplayFailure::Input(e)) => Err(Failure::Input(
+            anyhow::Error::new(e).context(format!("replay `{}`", args.replay)),
+        )),
+        Err(ReplayFailure::Core(e)) => Err(Failure::Tool(
+            anyhow::Error::new(e).context(format!("replay `{}` on the core", args.replay)),
+        )),
+        Err(ReplayFailure::Output(e)) => write_failure(e),
+        Err(ReplayFailure::Io(e)) => Err(Failure::Input(
+            anyhow::Error::new(e).context(format!("reading replay `{}`", args.replay)),
+        )),
+    }
 }
 
 #[cfg(test)]

@@ -10,18 +10,8 @@
 //! (`h8_3052f::gdb`). Symbols (for the phase names): `--symbols`, else IMAGE.sym beside the
 //! image if present.
 //!
-//! The stack guard (`h8300h::cpu::stack`) watches every stack access: its room runs from
-//! the end of the image's data to its stack's top when the symbols say where they are
-//! (`__bss_end`, `__stack_top`), else over the whole on-chip RAM. By default the first access
-//! outside stops the program with a one-line error naming the instruction, its function, SP
-//! and the bytes over (exit status 125); `--stack-guard warn` lets it run on and prints the
-//! first one as a warning at the end.
-//!
-//! Exit status: the program's (low byte of R0) when it halts with SLEEP under CCR.I = 1; 124
-//! when the state budget runs out; 125 when the core stops on an error (the message names the PC
-//! and the bytes); 126 when the program sleeps with interrupts enabled and nothing that could
-//! wake it; 137 when a GDB client kills it; 2 when the image, the symbol file or an option is
-//! bad (a VCD file that cannot be created, a GDB address that is not loopback).
+//! The stack guard (`--stack-guard`) and the exit statuses: docs/design.md §7 (and
+//! [`EXIT_MAX_STATES`], [`EXIT_CORE_ERROR`], [`EXIT_SLEPT_FOREVER`], [`EXIT_KILLED`]).
 
 use std::io::{self, BufWriter, Write};
 use std::path::Path;
@@ -40,7 +30,9 @@ use h8300h::srec;
 use robot_board::board::{RobotBoard, RobotConfig, robot_mcu};
 use robot_board::symbols::SymbolTable;
 
-use crate::Failure;
+use clap::Args;
+
+use super::Failure;
 
 /// The MCU `h8swarm emu` runs images on: the robot's board with nothing but its EEPROMs.
 type EmuMcu = Mcu<RobotBoard<NullBoard>>;
@@ -390,4 +382,84 @@ fn exit(
 /// cannot be bound): bad input, status 2.
 fn gdb_failure(e: GdbError) -> Failure {
     Failure::Input(anyhow::Error::new(e).context("--gdb"))
+}
+
+/// Options of `h8swarm emu`.
+#[derive(Args, Debug)]
+pub struct EmuArgs {
+    /// The program: a Motorola S-record image (.mot).
+    image: String,
+    /// Stop after this many states (exit status 124).
+    #[arg(long, value_name = "N")]
+    max_states: Option<u64>,
+    /// Print every instruction, disassembled, with its address and states, on standard error.
+    #[arg(long)]
+    trace: bool,
+    /// Print instructions, states and emulated time as JSON on standard error at the end.
+    #[arg(long)]
+    stats: bool,
+    /// Write a pin trace of the run (PWM, H-bridge, I2C lines, A/D, tick, sleep, the function
+    /// that runs) to FILE as VCD, for GTKWave or sigrok (written as the run goes).
+    #[arg(long, value_name = "FILE")]
+    vcd: Option<std::path::PathBuf>,
+    /// Wait for a GDB client on this loopback address (127.0.0.1:PORT; port 0 picks a free
+    /// one, printed on standard error) and run the program under its control.
+    #[arg(long, value_name = "ADDR")]
+    gdb: Option<String>,
+    /// The image's symbol table (`h8300-hms-nm -n` output) for function names in --trace and
+    /// --vcd and the stack guard's room (default: IMAGE.sym beside the image, if present).
+    #[arg(long, value_name = "FILE")]
+    symbols: Option<std::path::PathBuf>,
+    /// What the stack guard does with the first stack access outside the stack's room (the
+    /// end of the image's data to its stack's top, or the whole RAM without symbols): `stop`
+    /// the program with an error (exit status 125), or `warn` at the end and let it run.
+    #[arg(long, value_enum, value_name = "ACTION", default_value_t = GuardArg::Stop)]
+    stack_guard: GuardArg,
+    /// Write a profile of where the states go by call stack to FILE, as folded stacks
+    /// (`caller;callee;… states`, one stack a line) for speedscope, inferno-flamegraph or
+    /// flamegraph.pl; the lines add up to the run's states.
+    #[arg(long, value_name = "FILE")]
+    profile: Option<std::path::PathBuf>,
+    /// Stop the program (exit status 125) at the first access to a register the chip does
+    /// not model or to a reserved address, instead of warning about each at the end.
+    #[arg(long)]
+    strict_io: bool,
+}
+
+/// What the stack guard does (`--stack-guard`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum GuardArg {
+    /// Stop the program at the instruction, with a one-line error.
+    #[default]
+    Stop,
+    /// Let it run on; print the first fault as a warning.
+    Warn,
+}
+
+impl From<GuardArg> for h8300h::cpu::StackGuardMode {
+    fn from(g: GuardArg) -> Self {
+        match g {
+            GuardArg::Stop => h8300h::cpu::StackGuardMode::Stop,
+            GuardArg::Warn => h8300h::cpu::StackGuardMode::Warn,
+        }
+    }
+}
+
+/// `h8swarm emu`: runs the image as `args` ask.
+///
+/// # Errors
+/// As [`run`].
+pub fn command(args: &EmuArgs) -> Result<(), Failure> {
+    run(&EmuOptions {
+        image: &args.image,
+        max_states: args.max_states,
+        trace: args.trace,
+        stats: args.stats,
+        vcd: args.vcd.as_deref(),
+        gdb: args.gdb.as_deref(),
+        symbols: args.symbols.as_deref(),
+        stack_guard: args.stack_guard.into(),
+        profile: args.profile.as_deref(),
+        strict_io: args.strict_io,
+    })
 }

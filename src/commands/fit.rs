@@ -21,6 +21,8 @@ use swarm::fit::{
 };
 use swarm::scenario::ControllerKind;
 
+use super::args::{ControllerArg, parse_capacity};
+
 /// Which of the paper's settings to start from: the paper's network (its own η), which is not
 /// always the network the built-in run of the same name uses (the run's network).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -102,16 +104,6 @@ impl Setting {
             differs.join(", ")
         ))
     }
-}
-
-/// Which controller to measure.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
-pub enum ControllerArg {
-    /// The robot firmware (or `--firmware IMAGE`) as machine code on the H8/300H core.
-    #[default]
-    Firmware,
-    /// The Rust model of the controller.
-    Model,
 }
 
 /// Options of `h8swarm fit`.
@@ -247,7 +239,7 @@ fn apply_what_ifs(mut cfg: ControllerConfig, a: &FitArgs) -> Result<ControllerCo
         if !robot_board::model::step_period_ok(p) {
             bail!(
                 "--step-period-s {}: valid is {}",
-                swarm::text::number(p),
+                swarm::terminal_text::number(p),
                 robot_board::model::STEP_PERIOD_VALID
             );
         }
@@ -328,24 +320,8 @@ fn parse_budget(text: &str) -> Result<f64> {
     Ok(v)
 }
 
-/// `--capacity-mah`: a capacity from 1 mAh to 100 Ah (default
-/// [`swarm::energy::DEFAULT_CAPACITY_MAH`]).
-///
-/// # Errors
-/// A value outside that range, or not a number.
-pub fn parse_capacity(given: Option<f64>) -> Result<f64> {
-    match given {
-        None => Ok(swarm::energy::DEFAULT_CAPACITY_MAH),
-        Some(c) if c.is_finite() && (1.0..=100_000.0).contains(&c) => Ok(c),
-        Some(c) => bail!(
-            "--capacity-mah {}: give a cell's capacity from 1 to 100000 mAh (AA NiMH cells hold 1 900-2 700 mAh)",
-            swarm::text::number(c)
-        ),
-    }
-}
-
-/// The most steps `fit` measures (1 million: under 100 MB of per-step states, about two
-/// minutes on the firmware).
+/// The most steps `fit` measures (1 million: under 100 MB of per-step states; the time it
+/// takes: docs/limits-and-failures.md).
 pub const MAX_FIT_STEPS: u32 = 1_000_000;
 
 /// Runs `h8swarm fit`; returns the text to print.
@@ -367,10 +343,7 @@ pub fn run(a: &FitArgs) -> Result<String> {
         (None, false) => vec![Setting::Arena, Setting::Corridor],
     };
     let firmware = firmware_under_test(a)?;
-    let kind = match a.controller {
-        ControllerArg::Firmware => ControllerKind::Firmware,
-        ControllerArg::Model => ControllerKind::Model,
-    };
+    let kind = ControllerKind::from(a.controller);
     // A user's image is measured alone: the model is a model of the robot firmware.
     let compare = !a.alone && a.firmware.is_none();
     let config = |controller: ControllerConfig| FitConfig {
@@ -678,6 +651,16 @@ fn render_energy(s: &mut String, e: &swarm::fit::EnergyReport) {
             );
         }
     }
+}
+
+/// `h8swarm fit`: measures and prints the verdict.
+///
+/// # Errors
+/// Bad options or images ([`super::Failure::Input`]), an output that cannot be written
+/// ([`super::Failure::Tool`]).
+pub fn command(args: &FitArgs) -> Result<(), super::Failure> {
+    let text = run(args).map_err(super::Failure::Input)?;
+    super::write_text(&text)
 }
 
 #[cfg(test)]

@@ -11,10 +11,13 @@
 use std::fmt::Write as _;
 
 use anyhow::{Context, Result, bail};
+use clap::Args;
 use nn_q15::{DynLearner, H8Meter, InputLayout, Params, Phase, Q15};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
+
+use super::Failure;
 
 /// The robot's clock φ in Hz (the board's, `robot_board::board::CLOCK_HZ`; docs/design.md §4.1):
 /// the firmware's states become microseconds at it.
@@ -176,7 +179,7 @@ pub fn measure(cfg: &CostConfig) -> Result<CostReport> {
     if !robot_board::model::step_period_ok(cfg.step_period_s) {
         bail!(
             "--step-period-s {}: valid is {}",
-            swarm::text::number(cfg.step_period_s),
+            swarm::terminal_text::number(cfg.step_period_s),
             robot_board::model::STEP_PERIOD_VALID
         );
     }
@@ -326,7 +329,7 @@ pub fn parse_eta(text: &str) -> Result<i32, String> {
         if !(v.is_finite() && v >= 0.0 && q15 <= 32767.0) {
             return Err(format!(
                 "`{}` is out of range: {valid}",
-                swarm::text::printable(t)
+                swarm::terminal_text::printable(t)
             ));
         }
         Ok(q15 as i32)
@@ -337,6 +340,79 @@ pub fn parse_eta(text: &str) -> Result<i32, String> {
             Err(_) => Err(format!("`{t}` is not a learning rate: {valid}")),
         }
     }
+}
+
+/// Options of `h8swarm cost`.
+#[derive(Args, Debug)]
+pub struct CostArgs {
+    /// Enabled behaviours M: 2 (corridor) to 4 (arena).
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u8).range(2..=4))]
+    outputs: u8,
+    /// History depth H: delayed copies of the four proximities (0 to 8).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u8).range(0..=8))]
+    history: u8,
+    /// Add the bias input +127.
+    #[arg(long)]
+    bias: bool,
+    /// Learning rate η: a real number (0.001, as scenarios give it) or a Q15 integer (33);
+    /// 0.001 = 33, 0.1 = 3277.
+    #[arg(long, default_value_t = 33, value_parser = parse_eta)]
+    eta: i32,
+    /// Dead-zone threshold T in distance units.
+    #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(i32).range(0..=32767))]
+    threshold: i32,
+    /// Steps to measure (at most 10 000 000; the statistics settle long before).
+    #[arg(long, default_value_t = 10_000, value_parser = clap::value_parser!(u32).range(1..=i64::from(MAX_COST_STEPS)))]
+    steps: u32,
+    /// Seed of the proximities and initial weights.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Step period in seconds for the CPU share (0.45 s in the arena, 0.60 s in the corridor).
+    #[arg(long, default_value_t = 0.45)]
+    step_period_s: f64,
+    /// Print the report as JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+impl Default for CostArgs {
+    fn default() -> Self {
+        Self {
+            outputs: 4,
+            history: 1,
+            bias: false,
+            eta: 33,
+            threshold: 10,
+            steps: 10_000,
+            seed: 1,
+            step_period_s: 0.45,
+            json: false,
+        }
+    }
+}
+
+/// `h8swarm cost`: measures and prints the report (text or JSON).
+///
+/// # Errors
+/// Bad settings ([`Failure::Input`]), an output that cannot be written ([`Failure::Tool`]).
+pub fn command(args: &CostArgs) -> Result<(), Failure> {
+    let cfg = CostConfig {
+        outputs: usize::from(args.outputs),
+        history: usize::from(args.history),
+        bias: args.bias,
+        eta: args.eta,
+        threshold: args.threshold,
+        steps: args.steps,
+        seed: args.seed,
+        step_period_s: args.step_period_s,
+    };
+    let report = measure(&cfg).map_err(Failure::Input)?;
+    let text = if args.json {
+        serde_json::to_string_pretty(&report).map_err(|e| Failure::Tool(e.into()))? + "\n"
+    } else {
+        render(&report)
+    };
+    super::write_text(&text)
 }
 
 #[cfg(test)]
