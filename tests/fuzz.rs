@@ -643,7 +643,8 @@ fn merges_of_corrupted_sweep_folders_list_what_is_wrong_and_keep_the_users_files
     let text = std::fs::read_to_string(&sweep).unwrap();
     let s = h8swarm::sweep::spec::parse(&text, &sweep).unwrap();
     h8swarm::sweep::plan::write_plan(&s, &text, &pristine, Some(Path::new("/bin/true"))).unwrap();
-    h8swarm::sweep::exec::run_task(&pristine, None, Some(1)).unwrap();
+    h8swarm::sweep::exec::run_task(&pristine, None, Some(1), &h8swarm::commands::run::run_file)
+        .unwrap();
     let ids: Vec<String> = (0..3).map(|i| format!("p000{i}-s{}", i + 1)).collect();
     let files = ["status.json", "scenario.toml", "summary.json"];
     // What merge reads: the plan, the run list, and three files of each point.

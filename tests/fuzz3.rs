@@ -46,7 +46,7 @@ fn pristine_sweep(root: &Path, name: &str, seed: u64) -> PathBuf {
     let s = h8swarm::sweep::spec::parse(&text, &file).unwrap();
     let dir = root.join(name);
     h8swarm::sweep::plan::write_plan(&s, &text, &dir, Some(Path::new("/bin/true"))).unwrap();
-    h8swarm::sweep::exec::run_task(&dir, None, Some(1)).unwrap();
+    h8swarm::sweep::exec::run_task(&dir, None, Some(1), &h8swarm::commands::run::run_file).unwrap();
     dir
 }
 

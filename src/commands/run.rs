@@ -377,6 +377,21 @@ pub fn run(a: &RunArgs) -> Result<String> {
     }
 }
 
+/// Runs the scenario file `scenario` into the folder `out` with `threads` threads (as `h8swarm
+/// run SCENARIO --out OUT --threads T`, every other option at its default); returns the text to
+/// print. A sweep's points are run by it ([`crate::sweep::exec::RunScenario`]).
+///
+/// # Errors
+/// As [`run`].
+pub fn run_file(scenario: &Path, threads: Option<usize>, out: &Path) -> Result<String> {
+    run(&RunArgs {
+        scenario: Some(scenario.display().to_string()),
+        threads,
+        out: Some(out.to_path_buf()),
+        ..RunArgs::default()
+    })
+}
+
 /// The scenario the arguments name, with the options that override it.
 ///
 /// # Errors

@@ -94,16 +94,18 @@ pub fn outcome(args: &SweepArgs) -> (String, Result<(), SweepError>) {
                 Err(e) => (String::new(), Err(e)),
             }
         }
-        SweepCommand::Run { dir, task, threads } => match exec::run_task(dir, *task, *threads) {
-            Ok((text, true)) => (text, Ok(())),
-            Ok((text, false)) => (
-                text,
-                Err(SweepError::tool(
-                    "some points failed (each says why in its status.json; `h8swarm sweep merge` lists them)",
-                )),
-            ),
-            Err(e) => (String::new(), Err(e)),
-        },
+        SweepCommand::Run { dir, task, threads } => {
+            match exec::run_task(dir, *task, *threads, &super::run::run_file) {
+                Ok((text, true)) => (text, Ok(())),
+                Ok((text, false)) => (
+                    text,
+                    Err(SweepError::tool(
+                        "some points failed (each says why in its status.json; `h8swarm sweep merge` lists them)",
+                    )),
+                ),
+                Err(e) => (String::new(), Err(e)),
+            }
+        }
         SweepCommand::Confirm { dir, bin } => match confirm::plan_confirmation(dir, bin.as_deref())
         {
             Ok(text) => (text, Ok(())),

@@ -1,6 +1,7 @@
 //! `h8swarm sweep run`: one task's share of the points (or all of them).
 //!
-//! Each point is run by `h8swarm run`'s own code ([`crate::commands::run::run`]) into a temporary
+//! Each point is run by `h8swarm run`'s own code (the [`RunScenario`] the caller passes:
+//! `h8swarm sweep run` passes [`crate::commands::run::run_file`]) into a temporary
 //! folder `points/.tmp-ID-HOST-PID`, which gets the point's `scenario.toml` first and its
 //! `status.json` last, and is then renamed to `points/ID` in one step: `points/ID` either does
 //! not exist or is complete. A point whose folder holds `status.json` with `"status": "ok"`
@@ -15,10 +16,15 @@
 use super::plan::{PlanLine, read_plan};
 use super::points::{PointState, Status, host_name, is_dead_leftover, point_state};
 use super::{SweepError, write_atomic};
-use crate::commands::run::{RunArgs, run};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
+
+/// How a point is run: its `scenario.toml`, the thread count (as `h8swarm run --threads`) and
+/// the output folder in, the console text out. The sweep machinery sits below the commands, so
+/// the command that runs a sweep hands it `h8swarm run`'s own code
+/// ([`crate::commands::run::run_file`]) rather than the machinery reaching up for it.
+pub type RunScenario<'a> = &'a dyn Fn(&Path, Option<usize>, &Path) -> anyhow::Result<String>;
 
 /// What became of a point in a task.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -46,6 +52,7 @@ pub fn run_point(
     points: &Path,
     line: &PlanLine,
     threads: Option<usize>,
+    run: RunScenario<'_>,
 ) -> Result<Outcome, SweepError> {
     if point_state(points, line) == PointState::Ok {
         return Ok(Outcome::Skipped);
@@ -61,7 +68,7 @@ pub fn run_point(
     let outcome = if point_state(points, line) == PointState::Ok {
         Ok(Outcome::Skipped)
     } else {
-        run_claimed(points, line, threads)
+        run_claimed(points, line, threads, run)
     };
     claim.release();
     outcome
@@ -130,6 +137,7 @@ fn run_claimed(
     points: &Path,
     line: &PlanLine,
     threads: Option<usize>,
+    run: RunScenario<'_>,
 ) -> Result<Outcome, SweepError> {
     let final_dir = points.join(&line.id);
     // Leftovers of this point: a broken or failed folder, temporary folders of killed tasks
@@ -158,13 +166,7 @@ fn run_claimed(
     std::fs::create_dir_all(&tmp).map_err(|e| io_err("create", &tmp, &e))?;
     let scenario_path = tmp.join("scenario.toml");
     write_atomic(&scenario_path, line.point().scenario_toml()?.as_bytes())?;
-    let args = RunArgs {
-        scenario: Some(scenario_path.display().to_string()),
-        threads,
-        out: Some(tmp.clone()),
-        ..RunArgs::default()
-    };
-    let (status, outcome) = match run(&args) {
+    let (status, outcome) = match run(&scenario_path, threads, &tmp) {
         Ok(text) => {
             write_atomic(&tmp.join("run.txt"), text.as_bytes())?;
             (
@@ -273,6 +275,7 @@ pub fn run_task(
     dir: &Path,
     task: Option<usize>,
     threads: Option<usize>,
+    run: RunScenario<'_>,
 ) -> Result<(String, bool), SweepError> {
     let (plan, lines) = read_plan(dir)?;
     if threads == Some(0) {
@@ -318,7 +321,7 @@ pub fn run_task(
     let (mut done, mut skipped, mut failed, mut held) = (0, 0, 0, 0);
     for line in share {
         let started = Instant::now();
-        let outcome = run_point(&points, line, threads)?;
+        let outcome = run_point(&points, line, threads, run)?;
         let line_text = match &outcome {
             Outcome::Skipped => {
                 skipped += 1;
