@@ -1,5 +1,9 @@
-//! CRC-16/CCITT-FALSE, computed bit by bit as the H8 firmware does (no table: 512 bytes of ROM
-//! saved, and a record is only a few hundred bytes).
+//! CRC-16/CCITT-FALSE, as the H8 firmware computes it bit by bit (no table: 512 bytes of ROM
+//! saved, and a record is only a few hundred bytes). The host feeds a byte through a table
+//! built from that bitwise routine at compile time: the eight steps depend only on the top
+//! byte of the register after the byte is XORed in, so a byte costs one look-up, and the
+//! table also holds how many of the eight steps XOR the polynomial (the firmware's state
+//! count). A test checks the table against the bitwise routine for every register and byte.
 //!
 //! Parameters (the Rocksoft/Williams model, as catalogued by Greg Cook's CRC RevEng list):
 //! width 16, poly 0x1021, init 0xFFFF, refin false, refout false, xorout 0x0000,
@@ -21,8 +25,30 @@ pub const fn crc16_update(crc: u16, byte: u8) -> u16 {
 
 /// [`crc16_update`], also counting how many of its eight steps XOR the polynomial: what the
 /// bitwise routine's conditional XOR costs on a CPU that runs it (the firmware's state count).
+/// One look-up in [`BYTE_STEPS`].
 #[must_use]
 pub const fn crc16_update_counting(crc: u16, byte: u8) -> (u16, u32) {
+    let (xor, xors) = BYTE_STEPS[((crc >> 8) as u8 ^ byte) as usize];
+    ((crc << 8) ^ xor, xors as u32)
+}
+
+/// The eight steps of a byte, by the register's top byte after the byte is XORed in: what they
+/// XOR into the register shifted left by eight, and how many of them XOR the polynomial. The
+/// low byte only shifts out of the way, so the steps depend on the top byte alone.
+const BYTE_STEPS: [(u16, u8); 256] = {
+    let mut t = [(0u16, 0u8); 256];
+    let mut top = 0;
+    while top < 256 {
+        let (c, xors) = crc16_update_bitwise((top as u16) << 8, 0);
+        t[top] = (c, xors as u8);
+        top += 1;
+    }
+    t
+};
+
+/// The firmware's routine: the byte into the register's high half, then eight
+/// shift-and-conditionally-XOR steps, MSB first, counting the XORs.
+const fn crc16_update_bitwise(crc: u16, byte: u8) -> (u16, u32) {
     let mut c = crc ^ ((byte as u16) << 8);
     let mut xors = 0;
     let mut i = 0;
@@ -82,6 +108,19 @@ mod tests {
         // step 5 XORs again; the last three shift 0x1231 to 0x9188 without one.
         assert_eq!(crc16_update_counting(0, 0x80), (crc16_update(0, 0x80), 2));
         assert_eq!(crc16_update_counting(0, 0), (0, 0));
+    }
+
+    #[test]
+    fn the_table_is_the_bitwise_routine_for_every_register_and_byte() {
+        for crc in 0..=u16::MAX {
+            for byte in 0..=u8::MAX {
+                assert_eq!(
+                    crc16_update_counting(crc, byte),
+                    crc16_update_bitwise(crc, byte),
+                    "{crc:#06x} {byte:#04x}"
+                );
+            }
+        }
     }
 
     #[test]

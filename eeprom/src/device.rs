@@ -683,14 +683,26 @@ impl Eeprom24lc256 {
     }
 
     /// Ends the write cycle if its time is up.
+    ///
+    /// Called at every bus edge: the test is inlined into the callers, the end of a write
+    /// cycle (rare) is [`Self::end_write_cycle`], out of line.
+    #[inline]
     fn catch_up(&mut self, now: u64) {
         self.now = self.now.max(now);
         if self
             .cycle
             .as_ref()
             .is_some_and(|c| self.now >= c.info.end_states)
-            && let Some(cycle) = self.cycle.take()
         {
+            self.end_write_cycle();
+        }
+    }
+
+    /// Ends the write cycle running: its loaded bytes go into the array.
+    #[cold]
+    #[inline(never)]
+    fn end_write_cycle(&mut self) {
+        if let Some(cycle) = self.cycle.take() {
             let base = usize::from(cycle.info.page) * PAGE_BYTES;
             for (i, &d) in cycle.data.iter().enumerate() {
                 if cycle.loaded & (1 << i) != 0 {

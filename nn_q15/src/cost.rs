@@ -835,12 +835,14 @@ impl Meter for NoopMeter {
 
 /// A meter that charges H8/300H states per phase from [`OP_STATES`] and counts every block.
 ///
-/// It keeps one count per (phase, block) pair, so a charge is a single addition; states are
-/// the counts weighted by [`OP_STATES`] when asked for.
+/// It keeps one count per (phase, block) pair and each phase's states, the counts weighted by
+/// [`OP_STATES`], as it goes: a charge is two additions, and the states are read without
+/// summing the table (the model controller reads every phase's states every step).
 #[derive(Clone, Debug)]
 pub struct H8Meter {
     phase: Phase,
     counts: [[u64; Op::COUNT]; Phase::COUNT],
+    states: [u64; Phase::COUNT],
 }
 
 impl Default for H8Meter {
@@ -856,17 +858,14 @@ impl H8Meter {
         Self {
             phase: Phase::Input,
             counts: [[0; Op::COUNT]; Phase::COUNT],
+            states: [0; Phase::COUNT],
         }
     }
 
     /// States charged to `phase` so far.
     #[must_use]
     pub fn states(&self, phase: Phase) -> u64 {
-        self.counts[phase as usize]
-            .iter()
-            .zip(OP_STATES)
-            .map(|(&n, s)| n * u64::from(s))
-            .sum()
+        self.states[phase as usize]
     }
 
     /// States charged to every phase so far.
@@ -908,6 +907,7 @@ impl Meter for H8Meter {
     #[inline(always)]
     fn charge(&mut self, op: Op, count: u32) {
         self.counts[self.phase as usize][op as usize] += u64::from(count);
+        self.states[self.phase as usize] += u64::from(count) * u64::from(OP_STATES[op as usize]);
     }
 }
 
@@ -966,5 +966,23 @@ mod tests {
         assert_eq!(m.count(Op::FwdMac), 13);
         m.reset();
         assert_eq!(m.total_states(), 0);
+    }
+
+    #[test]
+    fn a_phases_running_states_are_its_counts_weighted_by_the_table() {
+        let mut m = H8Meter::new();
+        for (i, &op) in Op::ALL.iter().enumerate() {
+            m.enter(Phase::ALL[i % Phase::COUNT]);
+            m.charge(op, 1 + (i as u32 * 7) % 5);
+        }
+        m.enter(Phase::Update);
+        m.charge(Op::FwdMac, 3);
+        for p in Phase::ALL {
+            let weighted: u64 = Op::ALL
+                .iter()
+                .map(|&op| m.count_in(p, op) * u64::from(op.states()))
+                .sum();
+            assert_eq!(m.states(p), weighted, "{p:?}");
+        }
     }
 }

@@ -243,16 +243,23 @@ impl ElectronicsMeter {
             IR_SENSORS * sensors::SUPPLY_CURRENT_MA * seconds * 1e3,
         );
         c.add_to(Part::Regulator, REGULATOR_QUIESCENT_MA * seconds * 1e3);
-        let stats = eeprom_stats(mcu);
-        let eeproms: f64 = stats
+        let chips = mcu.board().eeproms().devices();
+        let eeproms: f64 = chips
             .iter()
             .zip(&self.last_eeproms)
-            .map(|(s, before)| s.charge_since_uc(before, interval, clock_hz))
+            .map(|(d, before)| d.stats().charge_since_uc(before, interval, clock_hz))
             .sum();
         c.add_to(Part::Eeproms, eeproms);
         self.last_states = now;
         self.last_converting = converting;
-        self.last_eeproms = stats;
+        // The counters kept in place: a take allocates nothing (it runs once per robot-step).
+        if self.last_eeproms.len() == chips.len() {
+            for (last, d) in self.last_eeproms.iter_mut().zip(chips) {
+                *last = d.stats();
+            }
+        } else {
+            self.last_eeproms = eeprom_stats(mcu);
+        }
         c
     }
 }
