@@ -91,6 +91,10 @@ pub fn commit(stage: Stage, names: &[String]) -> Result<String> {
     ))
 }
 
+/// How many of [`OUTPUT_FILES`], from the first, every run writes (the tables and the learning
+/// figure); the rest depend on the arena and the options.
+const ALWAYS_WRITTEN: usize = 6;
+
 /// Every file `h8swarm run` writes into its output folder (`arena.png` for the square arena,
 /// `spacetime.png` for the corridor; the others always).
 pub const OUTPUT_FILES: [&str; 9] = [
@@ -303,16 +307,10 @@ fn write_figures(
         anyhow::Error::new(e).context(OutputError("cannot draw the figures".into()))
     };
     learning_figure(&figs.learning, &png, &svg).map_err(drawn)?;
-    let mut names: Vec<String> = [
-        "metrics.csv",
-        "robots.csv",
-        "summary.json",
-        "fit.json",
-        "learning.png",
-        "learning.svg",
-    ]
-    .map(String::from)
-    .to_vec();
+    let mut names: Vec<String> = OUTPUT_FILES[..ALWAYS_WRITTEN]
+        .iter()
+        .map(|n| (*n).to_string())
+        .collect();
     if let Some(plan) = replay {
         write_replay(s, stage, plan, r, &figs.learning)?;
         names.push("replay.html".into());
