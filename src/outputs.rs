@@ -378,7 +378,6 @@ fn write_replay(
         })
         .collect();
     let params = swarm::experiment::world_params(s);
-    let n_in = swarm::robot::controller_config(s, 0)?.n_inputs();
     let header = Header {
         version: swarm::recording::VERSION,
         name: s.name.clone(),
@@ -415,7 +414,7 @@ fn write_replay(
             swarm::scenario::ControllerKind::Model => "model".into(),
         },
         seed: s.seed,
-        weights_shape: [n_in, s.learner.behaviours],
+        weights_shape: [r.n_inputs, s.learner.behaviours],
         behaviours: s.learner.behaviours,
         threshold: s.learner.threshold,
         runs: headers,

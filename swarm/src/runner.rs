@@ -9,6 +9,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use rayon::prelude::*;
+use robot_board::model::ControllerConfig;
 use world::Arena;
 
 use crate::battery::{BatteryReport, ConditionParts};
@@ -62,6 +63,8 @@ pub struct Analysed {
     pub fit: FitReport,
     /// What the run's shape makes unreliable.
     pub warnings: Vec<String>,
+    /// The learner's inputs (the rows of its weights).
+    pub n_inputs: usize,
     /// The arena the robots ran in.
     pub arena: Arena,
     /// EEPROM records written over every run.
@@ -101,6 +104,9 @@ pub fn jobs(s: &Scenario) -> (Vec<Condition>, Vec<(Condition, u32)>) {
 /// cannot be written, a probe that fails), or the fit's measurement.
 pub fn run(s: &Scenario, mut o: Options, progress: &(dyn Fn(u64) + Sync)) -> Result<Analysed> {
     let probes = std::mem::take(&mut o.probes);
+    // The scenario's learner, configured once: the fit measures it and the outputs name its
+    // shape.
+    let controller = controller_config(s, crate::fit::fit_weight_seed(s.seed))?;
     let (conditions, jobs) = jobs(s);
     let arena = arena_of(s)?;
     let rows: Vec<PathBuf> = jobs
@@ -137,7 +143,8 @@ pub fn run(s: &Scenario, mut o: Options, progress: &(dyn Fn(u64) + Sync)) -> Res
         all_dead,
         analysis,
         battery,
-        fit: measure_fit(s)?,
+        n_inputs: controller.n_inputs(),
+        fit: measure_fit(s, controller)?,
         arena,
         runs,
         wall_s,
@@ -219,11 +226,11 @@ fn battery_report(
     b
 }
 
-/// The fit verdict of the scenario's learner on the robot firmware (400 steps, compared with
-/// the model).
-fn measure_fit(s: &Scenario) -> Result<FitReport> {
+/// The fit verdict of the scenario's learner (`controller`) on the robot firmware (400 steps,
+/// compared with the model).
+fn measure_fit(s: &Scenario, controller: ControllerConfig) -> Result<FitReport> {
     Ok(crate::fit::measure(&crate::fit::FitConfig {
-        controller: controller_config(s, crate::fit::fit_weight_seed(s.seed))?,
+        controller,
         steps: 400,
         seed: s.seed,
         kind: ControllerKind::Firmware,
