@@ -125,8 +125,8 @@ mod u64_text {
 }
 
 /// Writes the viewer page `html` with `header` and the runs' part files (per run in the
-/// header's order, its planes then its weights, as [`part_paths`] names them; `e` is skipped
-/// when the stride is 1), removing the parts.
+/// header's order, its planes then its weights, as [`swarm::recording::part_paths`] names
+/// them; `e` is skipped when the stride is 1), removing the parts.
 ///
 /// # Errors
 /// A part that cannot be read, or the page that cannot be written (output errors).
@@ -179,7 +179,7 @@ pub struct DecodedRobot {
     pub y_m: f64,
     /// Heading, radians in [0, 2π) (quantised).
     pub heading_rad: f64,
-    /// Flags: behaviour code and [`flag`] bits.
+    /// Flags: behaviour code and [`swarm::recording::flag`] bits.
     pub flags: u8,
     /// Bumper bits (front, rear, left, right from bit 0).
     pub bumpers: u8,
