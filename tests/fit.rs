@@ -234,13 +234,13 @@ fn fit_says_which_network_it_measures() {
     assert_eq!(
         headings,
         [
-            "== arena (paper env. 2): the paper's network, eta 0.001; `h8swarm run arena` runs the run's network (eta 0.03), measured in its fit.json",
+            "== arena (paper env. 2): the paper's network, eta 0.001, which `h8swarm run arena` runs too",
             "== corridor (paper env. 1): the paper's network, eta 0.1, which `h8swarm run corridor` runs too",
         ],
         "{text}"
     );
     assert!(!text.contains("default network"), "{text}");
-    // The measured network is the paper's: η 0.001 is 33 in Q15; the run's 0.03 is 983.
+    // The measured network is the paper's: η 0.001 is 33 in Q15.
     let arena = &text[..text.find("== corridor").unwrap()];
     assert!(arena.contains(", eta 33 (Q15),"), "{arena}");
     let out = h8swarm(&["fit", "--history", "2", "--steps", "20"]);

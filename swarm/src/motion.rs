@@ -19,9 +19,9 @@
 //!   have come back by turning round (a loop, a figure of eight).
 //!
 //! The thresholds are argued in docs/claims.md. Besides the class, every step gives the
-//! exploration quantities ([`MotionStep`]): the net displacement over the lag (per step, so
-//! that summed over steps it is the *net metres*: a straight driver's net metres are its path,
-//! a shuttler's about none), the squared displacement at the lags [`MSD_LAGS`] (their means
+//! exploration quantities ([`MotionStep`]): the net displacement over the lag divided by the
+//! lag (so that summed over steps it is the *net metres*, never more than the path: a straight
+//! driver's are its path but for the lag's first steps, a shuttler's about none), the squared displacement at the lags [`MSD_LAGS`] (their means
 //! are the mean squared displacement: growing as the lag for diffusion, as its square for
 //! straight driving, not at all in confinement), and the **area covered**: the floor is cut
 //! into square cells of [`CELL_M`] (about a body), and a step counts the cells the robot
@@ -117,7 +117,10 @@ pub struct MotionStep {
     /// How far the centre moved in the step (straight line between the step instants), metres.
     pub step_m: f64,
     /// Net displacement over the last [`LAG_STEPS`] steps (fewer at the start of a run) divided
-    /// by the lag, metres per step.
+    /// by [`LAG_STEPS`], metres per step. Always by the whole lag: each step is then counted at
+    /// most [`LAG_STEPS`] times over [`LAG_STEPS`], so a robot's net metres never exceed its
+    /// path (divided by the shorter lag at the start, a robot that drove a few steps and stopped
+    /// had its first steps counted up to 3.6 times).
     pub net_m: f64,
     /// Squared displacement over each of [`MSD_LAGS`], square metres, once the run is that
     /// long.
@@ -258,7 +261,7 @@ impl MotionTracker {
         MotionStep {
             class,
             step_m,
-            net_m: net / f64::from(lag),
+            net_m: net / LAG_STEPS as f64,
             sq_disp_m2,
             fresh_cells,
             new_cells,
@@ -591,13 +594,28 @@ mod tests {
         assert!(v.net_m < 0.2 * v.path_m, "{v:?}");
     }
 
-    /// A straight line at 6 cm a step explores; its net metres are its path.
+    /// A robot that drives five steps and stops: its net metres are its path (dividing the
+    /// start's net displacement by the shorter lag counted its first steps up to 3.6 times: 0.72
+    /// net metres against 0.3 m of path).
+    #[test]
+    fn net_metres_never_exceed_the_path() {
+        let pts: Vec<(f64, f64)> = (0..N).map(|k| (0.06 * k.min(5) as f64, 0.3)).collect();
+        let v = judge(&pts, 0);
+        assert!((v.path_m - 0.3).abs() < 1e-9, "{v:?}");
+        assert!(v.net_m <= v.path_m + 1e-12, "{v:?}");
+        // Each step counted 20 times over 20: exactly its path once the lag has passed.
+        assert!((v.net_m - v.path_m).abs() < 1e-9, "{v:?}");
+    }
+
+    /// A straight line at 6 cm a step explores; its net metres are its path but for the lag's
+    /// first steps (step k < 20 adds k/20 of a step: 9.5 steps short in all).
     #[test]
     fn a_straight_line_explores() {
         let pts: Vec<(f64, f64)> = (0..N).map(|k| (0.06 * k as f64, 0.3)).collect();
         let v = judge(&pts, 0);
         assert_eq!(v.share(MotionClass::Exploring), 1.0, "{v:?}");
-        assert!((v.net_m - v.path_m).abs() < 1e-9, "{v:?}");
+        let ramp = (LAG_STEPS - 1) as f64 / 2.0 * 0.06;
+        assert!((v.net_m - (v.path_m - ramp)).abs() < 1e-9, "{v:?}");
         // A new cell every 0.2 m: 0.06 m a step over 600 steps is 36 m, 180 cells.
         assert!((178..=181).contains(&v.fresh_cells), "{v:?}");
     }
