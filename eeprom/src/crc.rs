@@ -25,7 +25,7 @@ pub const fn crc16_update(crc: u16, byte: u8) -> u16 {
 
 /// [`crc16_update`], also counting how many of its eight steps XOR the polynomial: what the
 /// bitwise routine's conditional XOR costs on a CPU that runs it (the firmware's state count).
-/// One look-up in [`BYTE_STEPS`].
+/// One look-up in a 256-entry table built at compile time.
 #[must_use]
 pub const fn crc16_update_counting(crc: u16, byte: u8) -> (u16, u32) {
     let (xor, xors) = BYTE_STEPS[((crc >> 8) as u8 ^ byte) as usize];
