@@ -683,8 +683,8 @@ fn replay_changes_no_other_output_and_is_the_same_for_any_thread_count() {
             "--replay-stride 0",
         ),
         (
-            vec!["run", "--replay", "--replay-repeats", "25"],
-            "repeat 25 does not exist",
+            vec!["run", "--repeats", "5", "--replay", "--replay-repeats", "7"],
+            "repeat 7 does not exist",
         ),
         (
             vec!["run", "--replay", "--replay-repeats", "x"],

@@ -62,9 +62,14 @@ impl Setting {
     /// The heading of a report on the paper's network in this setting, naming the run's
     /// network when the built-in run uses another one (and how it differs).
     fn heading(self, seed: u64) -> Result<String> {
+        self.heading_against(&self.scenario(), seed)
+    }
+
+    /// [`Setting::heading`] with `scenario` standing for the built-in run (the built-ins run
+    /// the paper's networks today; a test gives another).
+    fn heading_against(self, scenario: &swarm::scenario::Scenario, seed: u64) -> Result<String> {
         let paper = base_config(self, seed);
-        let scenario = self.scenario();
-        let run = swarm::robot::controller_config(&scenario, fit_weight_seed(seed))?;
+        let run = swarm::robot::controller_config(scenario, fit_weight_seed(seed))?;
         let (name, env) = (self.name(), if self == Setting::Arena { 2 } else { 1 });
         let head = format!(
             "{name} (paper env. {env}): the paper's network, eta {}",
@@ -679,5 +684,24 @@ mod tests {
                 "{setting:?}"
             );
         }
+    }
+
+    /// A built-in run on another network than the paper's is named with how it differs; on
+    /// the paper's, the heading says the run runs it too.
+    #[test]
+    fn the_heading_names_how_the_run_differs() {
+        let same = Setting::Arena.heading(1).unwrap();
+        assert!(
+            same.ends_with("which `h8swarm run arena` runs too"),
+            "{same}"
+        );
+        let mut other = Setting::Arena.scenario();
+        other.learner.eta = 0.03;
+        other.learner.threshold = 32;
+        let differs = Setting::Arena.heading_against(&other, 1).unwrap();
+        assert_eq!(
+            differs,
+            "arena (paper env. 2): the paper's network, eta 0.001; `h8swarm run arena` runs the run's network (eta 0.03, T 32), measured in its fit.json"
+        );
     }
 }

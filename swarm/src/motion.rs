@@ -21,8 +21,8 @@
 //! The thresholds are argued in docs/claims.md. Besides the class, every step gives the
 //! exploration quantities ([`MotionStep`]): the net displacement over the lag divided by the
 //! lag (so that summed over steps it is the *net metres*, never more than the path: a straight
-//! driver's are its path but for the lag's first steps, a shuttler's about none), the squared displacement at the lags [`MSD_LAGS`] (their means
-//! are the mean squared displacement: growing as the lag for diffusion, as its square for
+//! driver's are its path but for the lag's first steps, a shuttler's about none), the squared
+//! displacement at the lags [`MSD_LAGS`] (their means are the mean squared displacement: growing as the lag for diffusion, as its square for
 //! straight driving, not at all in confinement), and the **area covered**: the floor is cut
 //! into square cells of [`CELL_M`] (about a body), and a step counts the cells the robot
 //! enters that it had not been in for [`FRESH_STEPS`] steps (*fresh* cells) and those it had
