@@ -153,6 +153,7 @@ impl DcMotor {
     /// the world's wheel speed, the current that holds the motor's friction and spins its rotor
     /// along the world's lag.
     #[must_use]
+    #[inline]
     pub fn speed_current_a(&self, duty: f64, speed_ratio: f64) -> f64 {
         let duty = duty.clamp(0.0, 1.0);
         if duty == 0.0 || !speed_ratio.is_finite() {
@@ -166,6 +167,7 @@ impl DcMotor {
     /// `drive_force_n` between the floor and the body, positive along the direction the motor
     /// drives. Driving: τ_w / (G · η · Kt); braking (negative): −|τ_w| · η / (G · Kt).
     #[must_use]
+    #[inline]
     pub fn load_current_a(&self, drive_force_n: f64) -> f64 {
         let tau_wheel = drive_force_n * self.wheel_radius_m;
         let per_motor_torque = 1.0 / (self.gear_ratio * self.ke_v_s_per_rad);
@@ -182,6 +184,7 @@ impl DcMotor {
     /// the stall current D · V_full / R while the motor turns with its drive, and never below
     /// zero (see the module docs).
     #[must_use]
+    #[inline]
     pub fn current(&self, duty: f64, speed_ratio: f64, drive_force_n: f64) -> MotorCurrent {
         let duty = duty.clamp(0.0, 1.0);
         if duty == 0.0 || !speed_ratio.is_finite() || !drive_force_n.is_finite() {

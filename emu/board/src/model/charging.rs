@@ -38,6 +38,7 @@ pub const SLEEP_STATES: u32 = 2;
 
 /// Sum of the states of an instruction sequence (on-chip operands, docs/design.md §4.2).
 #[must_use]
+#[inline]
 pub const fn states_of(insns: &[Insn]) -> u32 {
     let mut total = 0;
     let mut i = 0;
@@ -99,6 +100,7 @@ impl<'a, B: ModelBus> Fw<'a, B> {
     }
 
     /// Runs register-only code (no I/O access), then takes a pending tick.
+    #[inline]
     pub fn code(&mut self, insns: &[Insn]) {
         self.bus.internal(states_of(insns));
         self.service();
