@@ -203,6 +203,9 @@ fn run_all(
                     replay,
                     stack_guard: o.stack_guard,
                     strict_io: o.strict_io,
+                    // A run alone on its pool keeps the pool's other worker spinning through
+                    // its world's sub-steps; beside other runs the workers have runs to do.
+                    spinning_helper: jobs.len() == 1,
                 },
             )
         })

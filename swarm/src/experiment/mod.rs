@@ -21,6 +21,7 @@ pub mod output;
 pub mod probes;
 pub mod run;
 pub mod setup;
+mod spin;
 pub mod swarm_loop;
 
 pub use metrics::{

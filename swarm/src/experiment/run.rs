@@ -27,6 +27,9 @@ pub struct RunOptions {
     /// Stop a firmware robot at its first access to what the chip does not model
     /// ([`Swarm::set_strict_io`]).
     pub strict_io: bool,
+    /// Keep a second worker spinning through the world's sub-steps
+    /// ([`Swarm::set_spinning_helper`]): only when this run is its pool's only work.
+    pub spinning_helper: bool,
 }
 
 /// Runs one condition of one repeat. `progress` is called with the number of steps done since
@@ -48,6 +51,7 @@ pub fn run_one(
     swarm.set_keep_going(opts.keep_going);
     swarm.set_stack_guard_mode(opts.stack_guard);
     swarm.set_strict_io(opts.strict_io);
+    swarm.set_spinning_helper(opts.spinning_helper);
     if let Some(path) = &opts.rows {
         swarm.set_rows(path)?;
     }

@@ -65,6 +65,8 @@ pub struct Swarm {
     snapshots: [u32; 4],
     saves: u64,
     parallel: bool,
+    /// Keep a second worker spinning through the world's sub-steps ([`Swarm::set_spinning_helper`]).
+    spinning_helper: bool,
     /// The corridor's gaps, reused step to step.
     gaps: Vec<f64>,
     /// Go on when a robot's controller fails: the robot is dead from then on (its motors
@@ -159,6 +161,7 @@ impl Swarm {
             },
             saves: 0,
             parallel: n >= PARALLEL_ROBOTS,
+            spinning_helper: false,
             gaps: Vec::new(),
             keep_going: false,
             dead: vec![None; n],
@@ -261,6 +264,16 @@ impl Swarm {
     /// [`PARALLEL_ROBOTS`] robots on. The results do not depend on it.
     pub fn set_parallel(&mut self, parallel: bool) {
         self.parallel = parallel;
+    }
+
+    /// Whether a second worker of rayon's pool spins through the world's sub-steps, taking
+    /// their parallel jobs as they come, instead of sleeping between them (off by default;
+    /// used from [`PIPELINE_ROBOTS`] robots, when the meters are fed beside each sub-step).
+    /// Only for a swarm that is its pool's only work: two swarms stepped side by side on one
+    /// pool with it could each hold the other's helper and never finish. The results do not
+    /// depend on it.
+    pub fn set_spinning_helper(&mut self, on: bool) {
+        self.spinning_helper = on;
     }
 
     /// Whether this step's per-robot work goes on rayon's pool: [`Swarm::set_parallel`], on a
@@ -504,14 +517,24 @@ impl Swarm {
     fn close_step(&mut self, t_states: u64) -> Result<()> {
         let dt = t_states.saturating_sub(self.world.elapsed_states());
         let par = self.par();
-        let (collided, contact_states) = advance_world(
-            &mut self.world,
-            t_states,
-            (&mut self.meters, &mut self.collided),
-            par,
-            &mut self.drives,
-            &mut self.readings,
-        )?;
+        // The helper pays where the meters are fed beside each sub-step (it has a job every
+        // sub-step); in a smaller swarm it would spin through one-thread stages for nothing.
+        let spin = par && self.spinning_helper && self.meters.len() >= self.readings.pipeline_from;
+        let mut advance = || {
+            advance_world(
+                &mut self.world,
+                t_states,
+                (&mut self.meters, &mut self.collided),
+                par,
+                &mut self.drives,
+                &mut self.readings,
+            )
+        };
+        let (collided, contact_states) = if spin {
+            super::spin::with_spinning_helper(advance)
+        } else {
+            advance()
+        }?;
         let mut drive_uc = 0.0;
         for d in &mut self.drives {
             let q = d.take();

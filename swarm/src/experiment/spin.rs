@@ -1,0 +1,147 @@
+//! A worker that spins through the world's sub-steps instead of sleeping between them.
+//!
+//! A world step is 23 sub-steps, each a few parallel regions (the islands' solve, the meters fed
+//! beside the next sub-step) between one-thread stages. A rayon worker with nothing to do goes
+//! to sleep and takes about a stage to wake; [`with_spinning_helper`] keeps one worker awake for
+//! the length of a call: it takes the caller's parallel jobs as soon as they are pushed.
+//!
+//! It is only safe when the caller is the pool's only work. The helper waits for the caller's
+//! flag, so two callers on one pool could each hold the other's helper: deadlock. The runner
+//! turns it on for a run of a single job ([`super::Swarm::set_spinning_helper`]). It changes
+//! which thread runs a job, never a result: every parallel stage merges in index order.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+/// How long the caller waits for a worker to take the helper before going on without it: far
+/// beyond a sleeping worker's wake-up, far below a step.
+const HELPER_WAIT: Duration = Duration::from_micros(500);
+
+/// Runs `f` on the calling thread while another worker of the current rayon pool spins, taking
+/// any job the pool has, until `f` returns. Without a second worker (a one-thread pool, or none
+/// free within [`HELPER_WAIT`]) `f` runs as it would alone.
+pub(super) fn with_spinning_helper<R: Send>(f: impl FnOnce() -> R + Send) -> R {
+    helped(f).0
+}
+
+/// As [`with_spinning_helper`], and whether a helper spun.
+fn helped<R: Send>(f: impl FnOnce() -> R + Send) -> (R, bool) {
+    if rayon::current_num_threads() < 2 {
+        return (f(), false);
+    }
+    let done = AtomicBool::new(false);
+    let started = AtomicBool::new(false);
+    rayon::scope(|sc| {
+        sc.spawn(|_| {
+            // A helper taken after the caller gave up on it (or finished) has nothing to do.
+            if done.load(Ordering::Acquire) {
+                return;
+            }
+            started.store(true, Ordering::Release);
+            while !done.load(Ordering::Acquire) {
+                if rayon::yield_now() != Some(rayon::Yield::Executed) {
+                    std::hint::spin_loop();
+                }
+            }
+        });
+        // The helper sits on this thread's own queue until another worker steals it; were this
+        // thread to take it back (a join's wait takes local jobs first) it would spin for
+        // itself. So the caller starts only once the helper runs elsewhere, or gives up.
+        let t0 = Instant::now();
+        while !started.load(Ordering::Acquire) && t0.elapsed() < HELPER_WAIT {
+            std::hint::spin_loop();
+        }
+        let helped = started.load(Ordering::Acquire);
+        done.store(!helped, Ordering::Release);
+        let r = f();
+        done.store(true, Ordering::Release);
+        (r, helped)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rayon::prelude::*;
+
+    fn sum_of_squares(n: u64) -> u64 {
+        (0..n).into_par_iter().map(|k| k * k).sum()
+    }
+
+    #[test]
+    fn the_result_is_the_callers_on_any_pool() {
+        for threads in [1, 2, 3, 8] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let (alone, helped) = pool.install(|| {
+                (
+                    sum_of_squares(100_000),
+                    with_spinning_helper(|| {
+                        (0..50).map(|k| sum_of_squares(1_000 + k)).sum::<u64>()
+                            + sum_of_squares(100_000)
+                    }),
+                )
+            });
+            let expect: u64 = (0..50).map(|k| sum_of_squares(1_000 + k)).sum::<u64>() + alone;
+            assert_eq!(helped, expect, "{threads} threads");
+        }
+    }
+
+    #[test]
+    fn a_free_worker_spins_and_a_busy_one_is_not_waited_for() {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap();
+        let one = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
+        // A sleeping worker may be slow to wake on a loaded machine (then the caller goes on
+        // alone, as it should): some of 50 tries find it.
+        let tries: Vec<(u64, bool)> = (0..50)
+            .map(|_| pool.install(|| helped(|| sum_of_squares(1_000))))
+            .collect();
+        assert!(tries.iter().all(|t| t.0 == 332_833_500));
+        assert!(tries.iter().any(|t| t.1), "no helper in 50 tries");
+        assert_eq!(
+            one.install(|| helped(|| sum_of_squares(1_000))),
+            (332_833_500, false)
+        );
+        // The other worker busy with a job of its own: no helper, and no wait beyond
+        // HELPER_WAIT. join runs its first half on the calling worker (busy until released)
+        // and its second on the other worker, which steals it and asks for a helper there.
+        let busy = AtomicBool::new(false);
+        let release = AtomicBool::new(false);
+        let (_, (r, spun)) = pool.install(|| {
+            rayon::join(
+                || {
+                    busy.store(true, Ordering::Release);
+                    while !release.load(Ordering::Acquire) {
+                        std::hint::spin_loop();
+                    }
+                },
+                || {
+                    while !busy.load(Ordering::Acquire) {
+                        std::hint::spin_loop();
+                    }
+                    let t0 = Instant::now();
+                    let out = helped(|| sum_of_squares(1_000));
+                    assert!(t0.elapsed() < HELPER_WAIT * 20, "{:?}", t0.elapsed());
+                    release.store(true, Ordering::Release);
+                    out
+                },
+            )
+        });
+        assert_eq!((r, spun), (332_833_500, false));
+    }
+
+    #[test]
+    fn outside_a_pool_f_runs_alone() {
+        // The global pool: current_num_threads is the machine's, the helper may or may not be
+        // taken; the result is f's either way.
+        assert_eq!(with_spinning_helper(|| 7), 7);
+    }
+}
