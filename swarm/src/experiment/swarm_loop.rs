@@ -512,6 +512,23 @@ impl Swarm {
         rec.step(k, &frame, &mut |i| robots[i].weights())
     }
 
+    /// [`advance_world`] on the pool with a second worker spinning through the sub-steps
+    /// ([`Swarm::set_spinning_helper`]); out of line, so that the path without it stays as it
+    /// was (inlined, it moved the wall time of small swarms: docs/performance.md).
+    #[inline(never)]
+    fn advance_helped(&mut self, t_states: u64) -> Result<(u64, u64)> {
+        super::spin::with_spinning_helper(|| {
+            advance_world(
+                &mut self.world,
+                t_states,
+                (&mut self.meters, &mut self.collided),
+                true,
+                &mut self.drives,
+                &mut self.readings,
+            )
+        })
+    }
+
     /// Advances the world to `t_states` (the behaviour of the latest step runs to its end)
     /// and completes that step's metrics: collisions, contact time, where the robots went.
     fn close_step(&mut self, t_states: u64) -> Result<()> {
@@ -520,7 +537,9 @@ impl Swarm {
         // The helper pays where the meters are fed beside each sub-step (it has a job every
         // sub-step); in a smaller swarm it would spin through one-thread stages for nothing.
         let spin = par && self.spinning_helper && self.meters.len() >= self.readings.pipeline_from;
-        let mut advance = || {
+        let (collided, contact_states) = if spin {
+            self.advance_helped(t_states)?
+        } else {
             advance_world(
                 &mut self.world,
                 t_states,
@@ -528,13 +547,8 @@ impl Swarm {
                 par,
                 &mut self.drives,
                 &mut self.readings,
-            )
+            )?
         };
-        let (collided, contact_states) = if spin {
-            super::spin::with_spinning_helper(advance)
-        } else {
-            advance()
-        }?;
         let mut drive_uc = 0.0;
         for d in &mut self.drives {
             let q = d.take();
