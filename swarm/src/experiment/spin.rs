@@ -21,13 +21,13 @@ const HELPER_WAIT: Duration = Duration::from_micros(500);
 /// any job the pool has, until `f` returns. Without a second worker (a one-thread pool, or none
 /// free within [`HELPER_WAIT`]) `f` runs as it would alone.
 pub(super) fn with_spinning_helper<R: Send>(f: impl FnOnce() -> R + Send) -> R {
-    helped(f).0
+    helped(|_| f()).0
 }
 
-/// As [`with_spinning_helper`], and whether a helper spun.
-fn helped<R: Send>(f: impl FnOnce() -> R + Send) -> (R, bool) {
+/// As [`with_spinning_helper`], telling `f` and the caller whether a helper spins.
+fn helped<R: Send>(f: impl FnOnce(bool) -> R + Send) -> (R, bool) {
     if rayon::current_num_threads() < 2 {
-        return (f(), false);
+        return (f(false), false);
     }
     let done = AtomicBool::new(false);
     let started = AtomicBool::new(false);
@@ -53,10 +53,20 @@ fn helped<R: Send>(f: impl FnOnce() -> R + Send) -> (R, bool) {
         }
         let helped = started.load(Ordering::Acquire);
         done.store(!helped, Ordering::Release);
-        let r = f();
-        done.store(true, Ordering::Release);
-        (r, helped)
+        // Set however `f` ends: were it to panic, the scope would otherwise wait for ever for
+        // a helper spinning on a flag nobody sets.
+        let _release = Release(&done);
+        (f(helped), helped)
     })
+}
+
+/// Sets its flag when dropped.
+struct Release<'a>(&'a AtomicBool);
+
+impl Drop for Release<'_> {
+    fn drop(&mut self) {
+        self.0.store(true, Ordering::Release);
+    }
 }
 
 #[cfg(test)]
@@ -102,12 +112,12 @@ mod tests {
         // A sleeping worker may be slow to wake on a loaded machine (then the caller goes on
         // alone, as it should): some of 50 tries find it.
         let tries: Vec<(u64, bool)> = (0..50)
-            .map(|_| pool.install(|| helped(|| sum_of_squares(1_000))))
+            .map(|_| pool.install(|| helped(|_| sum_of_squares(1_000))))
             .collect();
         assert!(tries.iter().all(|t| t.0 == 332_833_500));
         assert!(tries.iter().any(|t| t.1), "no helper in 50 tries");
         assert_eq!(
-            one.install(|| helped(|| sum_of_squares(1_000))),
+            one.install(|| helped(|_| sum_of_squares(1_000))),
             (332_833_500, false)
         );
         // The other worker busy with a job of its own: no helper, and no wait beyond
@@ -128,7 +138,7 @@ mod tests {
                         std::hint::spin_loop();
                     }
                     let t0 = Instant::now();
-                    let out = helped(|| sum_of_squares(1_000));
+                    let out = helped(|_| sum_of_squares(1_000));
                     assert!(t0.elapsed() < HELPER_WAIT * 20, "{:?}", t0.elapsed());
                     release.store(true, Ordering::Release);
                     out
@@ -136,6 +146,37 @@ mod tests {
             )
         });
         assert_eq!((r, spun), (332_833_500, false));
+    }
+
+    #[test]
+    fn a_panic_in_f_reaches_the_caller_and_the_helper_stops() {
+        let (tx, rx) = std::sync::mpsc::channel();
+        // On a thread of its own, so that a helper left spinning fails the test instead of
+        // hanging it.
+        std::thread::spawn(move || {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(2)
+                .build()
+                .unwrap();
+            // A panic while a helper spins (a try without one, on a worker slow to wake,
+            // is tried again).
+            let panicked = (0..50).any(|_| {
+                std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                    pool.install(|| {
+                        helped(|spins| {
+                            assert!(!spins, "a stage failed");
+                        })
+                    })
+                }))
+                .is_err()
+            });
+            tx.send(panicked).unwrap();
+        });
+        assert_eq!(
+            rx.recv_timeout(Duration::from_secs(60)),
+            Ok(true),
+            "the panic did not come back"
+        );
     }
 
     #[test]
