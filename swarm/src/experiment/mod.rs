@@ -5,7 +5,8 @@
 //! Its parts, in the order a run uses them:
 //! * [`setup`]: the scenario's world: the arena, the parameters, the robots placed;
 //! * [`swarm_loop`]: the [`Swarm`], every robot stepped at the same instants (the steps are
-//!   described there);
+//!   described there); `substeps` advances the world through a step's sub-steps and feeds the
+//!   meters, `spin` keeps a second worker spinning through them;
 //! * [`metrics`]: each step's metrics ([`StepMetrics`]), written as a CSV row and summed per
 //!   window ([`RunMetrics`]);
 //! * [`probes`]: a pin trace, a profile or a GDB client on one firmware robot;
@@ -22,6 +23,7 @@ pub mod probes;
 pub mod run;
 pub mod setup;
 mod spin;
+mod substeps;
 pub mod swarm_loop;
 
 pub use metrics::{

@@ -1,6 +1,7 @@
 use super::*;
 use crate::experiment::metrics::{METRICS_HEADER, WindowSums};
 use crate::experiment::setup::world_params;
+use crate::experiment::substeps::{METER_BATCH, PIPELINE_ROBOTS, Readings, add, advance_world};
 use crate::motion::MSD_LAGS;
 use world::{Arena, SubstepPlan};
 use world::{Behaviour, Pose};
@@ -130,10 +131,8 @@ fn meters_fed_in_batches_count_as_fed_after_every_substep() {
     ] {
         let mut w = w.clone();
         let (mut m, mut c, mut d) = fresh();
-        let mut readings = Readings {
-            pipeline_from,
-            ..Readings::default()
-        };
+        let mut readings = Readings::default();
+        readings.pipeline_from = pipeline_from;
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()
@@ -164,33 +163,6 @@ fn meters_fed_in_batches_count_as_fed_after_every_substep() {
             assert_eq!(a.cap(), b.cap());
         }
     }
-}
-
-/// A large swarm's readings gathered on the pool are the ones gathered in order.
-#[test]
-fn readings_gathered_on_the_pool_are_those_gathered_in_order() {
-    let s = Scenario::arena();
-    let n = GATHER_PAR_ROBOTS + GATHER_CHUNK / 2;
-    let arena = Arena::scaled_square(n).unwrap();
-    let mut w = World::new(arena, world_params(&s), n, 5).unwrap();
-    for i in 0..n {
-        let (l, r) = Behaviour::TurnLeftForward.wheels();
-        w.set_wheels(i, l, r).unwrap();
-    }
-    w.advance_states(50 * nominal_substep_states(&s));
-    let (mut plain, mut pooled) = (Readings::default(), Readings::default());
-    for len in [7, 9] {
-        plain.gather(&w, len, false).unwrap();
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(3)
-            .build()
-            .unwrap();
-        pool.install(|| pooled.gather(&w, len, true)).unwrap();
-    }
-    assert_eq!(plain.lens, pooled.lens);
-    assert_eq!(plain.of.len(), 2 * n);
-    assert!(plain.of.iter().any(|r| r.pressed), "some bumper pressed");
-    assert_eq!(plain.of, pooled.of);
 }
 
 #[test]
