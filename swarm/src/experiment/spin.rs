@@ -41,7 +41,9 @@ fn helped<R: Send>(wait: Duration, f: impl FnOnce(bool) -> R + Send) -> (R, bool
             started.store(true, Ordering::Release);
             while !done.load(Ordering::Acquire) {
                 if rayon::yield_now() != Some(rayon::Yield::Executed) {
-                    std::hint::spin_loop();
+                    // Nothing to take: let the system run another thread on this core if one
+                    // waits (a machine with more threads than cores), else go round at once.
+                    std::thread::yield_now();
                 }
             }
         });
