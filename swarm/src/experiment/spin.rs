@@ -181,9 +181,9 @@ mod tests {
     }
 
     #[test]
-    fn outside_a_pool_f_runs_alone() {
-        // The global pool: current_num_threads is the machine's, the helper may or may not be
-        // taken; the result is f's either way.
-        assert_eq!(with_spinning_helper(|| 7), 7);
+    fn called_outside_a_pool_it_returns_f_s_result() {
+        // From a thread of no pool rayon::scope runs on the global pool (as many threads as
+        // the machine's cores); a helper may or may not be taken, the result is f's either way.
+        assert_eq!(with_spinning_helper(|| sum_of_squares(1_000)), 332_833_500);
     }
 }

@@ -57,6 +57,12 @@ impl Default for Readings {
 }
 
 impl Readings {
+    /// Whether `robots` robots' meters are fed beside the world's next sub-step: with `par` on
+    /// a pool of more than one thread, from `pipeline_from` ([`PIPELINE_ROBOTS`]) robots.
+    pub(super) fn pipelined(&self, par: bool, robots: usize) -> bool {
+        par && robots >= self.pipeline_from && rayon::current_num_threads() > 1
+    }
+
     /// Appends every robot's reading of the sub-step of `len` states the world just made, in
     /// chunks on the pool with `par` from [`GATHER_PAR_ROBOTS`] robots.
     fn gather(&mut self, world: &World, len: u64, par: bool) -> Result<()> {
@@ -172,8 +178,7 @@ pub(super) fn advance_world(
     // world makes the next sub-step (the other thread has the meters to do during the world's
     // one-thread stages); otherwise they wait for a batch, which keeps each robot's meters in
     // cache and costs one parallel region a step rather than one a sub-step.
-    let pipelined =
-        par && meters.len() >= readings.pipeline_from && rayon::current_num_threads() > 1;
+    let pipelined = readings.pipelined(par, meters.len());
     let advance = |world: &mut World, len: u64| {
         if par {
             world.advance_states_par(len);

@@ -537,7 +537,7 @@ impl Swarm {
         let par = self.par();
         // The helper pays where the meters are fed beside each sub-step (it has a job every
         // sub-step); in a smaller swarm it would spin through one-thread stages for nothing.
-        let spin = par && self.spinning_helper && self.meters.len() >= self.readings.pipeline_from;
+        let spin = self.spinning_helper && self.readings.pipelined(par, self.meters.len());
         let (collided, contact_states) = if spin {
             self.advance_helped(t_states)?
         } else {
