@@ -6,7 +6,7 @@ use std::fmt::Write as _;
 
 use swarm::experiment::RunOutput;
 use swarm::runner::Analysed;
-use swarm::scenario::Scenario;
+use swarm::scenario::{Scenario, SolverKind};
 use swarm::summary::{Analysis, Claim, Estimate};
 
 /// The report of a run on `threads` threads: what ran and how fast, the warnings, the battery
@@ -25,6 +25,7 @@ pub fn render(s: &Scenario, r: &Analysed, threads: usize) -> String {
     for w in &r.warnings {
         let _ = writeln!(t, "WARNING {w}");
     }
+    render_solver(&mut t, s, &r.runs);
     render_battery(&mut t, &r.battery);
     let _ = writeln!(t);
     report(&mut t, s, &r.analysis);
@@ -63,6 +64,35 @@ fn render_header(
         plural(u32::try_from(threads).unwrap_or(u32::MAX), "thread"),
         robot_steps / wall_s,
         factor_text(simulated_s / wall_s)
+    );
+}
+
+/// The contact solver's line: the islands solved over every run, their sweeps, and how many
+/// the sweep cap (`world.solver`) stopped before they converged.
+fn render_solver(t: &mut String, s: &Scenario, runs: &[RunOutput]) {
+    let (mut islands, mut sweeps, mut capped) = (0u64, 0u64, 0u64);
+    for r in runs {
+        islands += r.solver.islands;
+        sweeps += r.solver.solver_sweeps;
+        capped += r.solver.capped_islands;
+    }
+    if islands == 0 {
+        let _ = writeln!(
+            t,
+            "contact solver: no robot touched a wall or another robot"
+        );
+        return;
+    }
+    let _ = writeln!(
+        t,
+        "contact solver ({}): {islands} islands solved, {:.1} sweeps each; {capped} ({:.2} %) stopped at the cap of {} sweeps before converging",
+        match s.world.solver {
+            SolverKind::Capped => "capped, world.solver",
+            SolverKind::Converged => "converged, world.solver",
+        },
+        sweeps as f64 / islands as f64,
+        100.0 * capped as f64 / islands as f64,
+        s.world.solver.params().0
     );
 }
 

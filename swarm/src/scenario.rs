@@ -84,6 +84,44 @@ pub struct WorldSpec {
     /// figure suggests: robots in one line that cannot pass each other). The square arena
     /// ignores it.
     pub corridor_clearance_m: f64,
+    /// The contact solver: `capped` (default: an island of robots in contact is solved until a
+    /// sweep changes no impulse by more than 1e-6 N·s, at most 12 sweeps; every result in
+    /// docs/claims.md was made with it) or `converged` (until a sweep changes no robot's
+    /// velocity by more than 2 µm/s, at most 256 sweeps, the cap counted and reported); see
+    /// docs/physics.md, "The contact solver's cap".
+    pub solver: SolverKind,
+}
+
+/// The world's contact solver (`world.solver`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SolverKind {
+    /// At most [`world::params::SOLVER_ITERATIONS`] sweeps, stopped when no impulse changes by
+    /// more than 1e-6 N·s.
+    Capped,
+    /// At most [`CONVERGED_SOLVER_SWEEPS`] sweeps, stopped when no robot's velocity changes by
+    /// more than 2 µm/s.
+    Converged,
+}
+
+/// The cap of the converged solver, a safety net that is counted ([`world::SolverStats`]).
+pub const CONVERGED_SOLVER_SWEEPS: u32 = 256;
+
+impl SolverKind {
+    /// The world's sweep cap and convergence test for this solver.
+    #[must_use]
+    pub fn params(self) -> (u32, world::params::Convergence) {
+        match self {
+            SolverKind::Capped => (
+                world::params::SOLVER_ITERATIONS,
+                world::params::Convergence::Impulse,
+            ),
+            SolverKind::Converged => (
+                CONVERGED_SOLVER_SWEEPS,
+                world::params::Convergence::Velocity,
+            ),
+        }
+    }
 }
 
 /// The IR sensors (defaults: docs/design.md §3.1 and the `sensors` crate).
@@ -205,7 +243,7 @@ macro_rules! patch {
 
 patch!(LearnerPatch for LearnerSpec { behaviours: usize, eta: f64, threshold: i32, history: usize, bias: bool, save_every: u32 });
 patch!(TimingPatch for TimingSpec { step_period_s: f64, clock_hz: u32 });
-patch!(WorldPatch for WorldSpec { top_speed_m_per_s: f64, motor_time_constant_s: f64, motor_gain_spread: f64, wheel_track_m: f64, substep_s: f64, sensor_range_m: f64, sensor_setback_m: f64, mu_wall: f64, corridor_clearance_m: f64 });
+patch!(WorldPatch for WorldSpec { top_speed_m_per_s: f64, motor_time_constant_s: f64, motor_gain_spread: f64, wheel_track_m: f64, substep_s: f64, sensor_range_m: f64, sensor_setback_m: f64, mu_wall: f64, corridor_clearance_m: f64, solver: SolverKind });
 patch!(SensorPatch for SensorSpec { noise_sigma_v: f64, spike_probability: f64, spread: bool, channels: Channels });
 
 /// `sensors.channels` as a file gives it: exactly four whole numbers 0-255, checked when read
@@ -313,6 +351,7 @@ impl Default for WorldSpec {
             sensor_setback_m: sensors::curve::FAR_BRANCH_MIN_MM / 1000.0,
             mu_wall: world::params::MU_WALL,
             corridor_clearance_m: world::arena::CORRIDOR_EXTRA_WIDTH_M,
+            solver: SolverKind::Capped,
         }
     }
 }
@@ -776,6 +815,19 @@ mod tests {
             Scenario::from_toml("steps = 200\nwindow = 300\n").unwrap_err()
         );
         assert!(e.contains("window"), "{e}");
+        // The contact solver by name; another name is an error naming the key.
+        let s = Scenario::from_toml("[world]\nsolver = \"converged\"\n").unwrap();
+        assert_eq!(s.world.solver, SolverKind::Converged);
+        assert_eq!(
+            s.world.solver.params(),
+            (256, world::params::Convergence::Velocity)
+        );
+        assert_eq!(Scenario::arena().world.solver, SolverKind::Capped);
+        let e = format!(
+            "{:#}",
+            Scenario::from_toml("[world]\nsolver = \"exact\"\n").unwrap_err()
+        );
+        assert!(e.contains("solver") && e.contains("converged"), "{e}");
         // Channels: exactly four whole numbers, never silently cut.
         for (text, expected) in [
             (

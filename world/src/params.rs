@@ -171,13 +171,29 @@ pub struct WorldParams {
     pub bumper_force_n: f64,
     /// Force below which a pressed bumper releases, N (at most `bumper_force_n`).
     pub bumper_release_force_n: f64,
-    /// Gauss–Seidel sweeps of the velocity solver per sub-step.
+    /// Gauss–Seidel sweeps of the velocity solver per sub-step, at most.
     pub solver_iterations: u32,
+    /// When a sub-step's velocity solve of an island stops before `solver_iterations`.
+    pub solver_convergence: Convergence,
     /// Position-correction sweeps per sub-step.
     pub position_iterations: u32,
     /// The clock the world's time is counted in (MCU states per second): the world advances
     /// in whole states of the clock the robots' MCUs count.
     pub clock_hz: u64,
+}
+
+/// When an island's solve stops (before its cap of sweeps).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Convergence {
+    /// When a sweep changes no impulse by more than 1e-6 N·s (the solver every published result
+    /// was made with, under a cap of 12 sweeps).
+    #[default]
+    Impulse,
+    /// When a sweep changes no robot's velocity by more than 2 µm/s (its turn rate counted at
+    /// the body's half-diagonal): the answer the sweeps converge to, whether or not the
+    /// impulses that give it are unique (a robot pushed by its wheels against another is
+    /// statically indeterminate: the impulses can drift along a direction that moves nothing).
+    Velocity,
 }
 
 impl WorldParams {
@@ -208,6 +224,7 @@ impl WorldParams {
             bumper_force_n: BUMPER_FORCE_N,
             bumper_release_force_n: BUMPER_RELEASE_FORCE_N,
             solver_iterations: SOLVER_ITERATIONS,
+            solver_convergence: Convergence::Impulse,
             position_iterations: POSITION_ITERATIONS,
             clock_hz,
         }

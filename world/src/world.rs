@@ -54,8 +54,13 @@ pub struct SolverStats {
     pub contacts: u64,
     /// Robot-sub-steps in a contact (solved rather than moved freely).
     pub active_robot_substeps: u64,
+    /// Islands (robots joined by contacts) whose velocities were solved, over all sub-steps.
+    pub islands: u64,
     /// Gauss–Seidel sweeps of the velocity solver run (over all sub-steps).
     pub solver_sweeps: u64,
+    /// Islands whose solve the sweep cap (`WorldParams::solver_iterations`) stopped before a
+    /// sweep changed no impulse by more than 1e-6 N·s.
+    pub capped_islands: u64,
     /// Sub-steps whose velocity solve left an overlap for the position correction.
     pub overlap_substeps: u64,
     /// Position-correction sweeps run.
@@ -689,13 +694,17 @@ impl World {
             &self.wmean,
             &self.wheel_imp,
         );
-        self.stats.solver_sweeps += self.islands.solve(
+        let (sweeps, capped) = self.islands.solve(
             &mut self.narrow.contacts,
             &self.body,
             h,
             self.params.solver_iterations,
+            self.params.solver_convergence,
             parallel,
         );
+        self.stats.islands += self.islands.len() as u64;
+        self.stats.solver_sweeps += sweeps;
+        self.stats.capped_islands += capped;
         // Each solved robot's motion over the sub-step (per robot, so on any thread), then
         // written back in order.
         let pose = &self.pose;

@@ -33,6 +33,9 @@ pub struct RunOutput {
     pub energy: crate::energy::Charge,
     /// How often the drive voltage's bound cut a motor's current, summed over the robots.
     pub motor_cap: crate::energy::CurrentCap,
+    /// What the world's contact solver did over the run (islands solved, sweeps, islands the
+    /// sweep cap stopped).
+    pub solver: world::SolverStats,
 }
 
 /// A robot whose controller failed in a run with `--keep-going`: it is dead from then on (its

@@ -34,6 +34,8 @@ pub fn world_params(s: &Scenario) -> WorldParams {
         max_substep_s: s.world.substep_s,
         sensor_max_range_m: s.world.sensor_range_m,
         mu_wall: s.world.mu_wall,
+        solver_iterations: s.world.solver.params().0,
+        solver_convergence: s.world.solver.params().1,
         sensor_mounts: SensorMount::default_mounts(
             world::params::BODY_LENGTH_M,
             world::params::BODY_WIDTH_M,

@@ -667,6 +667,7 @@ impl Swarm {
             io_warnings,
             energy: self.energy,
             motor_cap,
+            solver: self.world.solver_stats(),
             condition: self.condition,
             repeat: self.repeat,
             metrics: self.metrics,

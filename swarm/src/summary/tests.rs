@@ -225,6 +225,7 @@ fn run_of(
         io_warnings: Vec::new(),
         energy: crate::energy::Charge::default(),
         motor_cap: crate::energy::CurrentCap::default(),
+        solver: world::SolverStats::default(),
     }
 }
 

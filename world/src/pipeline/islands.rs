@@ -6,6 +6,7 @@ use core::ops::Range;
 use rayon::prelude::*;
 
 use crate::body::{BodyConst, BodyPose};
+use crate::params::Convergence;
 use crate::pipeline::par::PAR_ISLAND_ROBOTS;
 use crate::pipeline::solver::{Contact, IslandBody, WALL, solve_island};
 
@@ -32,6 +33,9 @@ pub(crate) struct Islands {
     active_scratch: Vec<u32>,
     /// `contacts` being sorted into islands (scratch).
     contact_scratch: Vec<Contact>,
+    /// Each body's velocity at the start of a sweep (scratch, like `bodies`, for a solve
+    /// converged by velocity; empty otherwise).
+    vel0: Vec<[f64; 3]>,
 }
 
 /// Union–find root of `i`, halving the path on the way.
@@ -57,6 +61,7 @@ impl Islands {
             isl_fill: Vec::new(),
             active_scratch: Vec::new(),
             contact_scratch: Vec::new(),
+            vel0: Vec::new(),
         }
     }
 
@@ -191,47 +196,74 @@ impl Islands {
         core::mem::swap(contacts, &mut self.contact_scratch);
     }
 
+    /// The islands [`Islands::build`] made.
+    pub(crate) fn len(&self) -> usize {
+        self.ranges.len()
+    }
+
     /// Solves every island (its `bodies` and its share of `contacts`, as [`Islands::build`]
     /// sorted them) over a sub-step of `h` seconds with at most `iterations` sweeps each;
     /// with `parallel` and enough robots, islands on rayon's pool (each island's solve is the
-    /// same on any thread). Returns the sweeps run, summed over the islands.
+    /// same on any thread). Returns the sweeps run, summed over the islands, and the islands
+    /// the cap stopped before they converged.
     pub(crate) fn solve(
         &mut self,
         contacts: &mut [Contact],
         body: &BodyConst,
         h: f64,
         iterations: u32,
+        until: Convergence,
         parallel: bool,
-    ) -> u64 {
-        let mut sweeps = 0;
+    ) -> (u64, u64) {
+        // Each body's velocity at a sweep's start, for a solve converged by velocity.
+        let n = if until == Convergence::Velocity {
+            self.bodies.len()
+        } else {
+            0
+        };
+        self.vel0.resize(n, [0.0; 3]);
+        let count = |(sweeps, converged): (u32, bool)| (u64::from(sweeps), u64::from(!converged));
+        let add = |a: (u64, u64), b: (u64, u64)| (a.0 + b.0, a.1 + b.1);
         if parallel && self.bodies.len() > PAR_ISLAND_ROBOTS && self.ranges.len() > 1 {
             // Islands share nothing: each is solved on whichever thread, with the same
             // result as in order.
             let mut jobs = Vec::with_capacity(self.ranges.len());
             let (mut bodies, mut contacts) = (&mut self.bodies[..], contacts);
+            let mut vel0 = &mut self.vel0[..];
             for (b, c) in &self.ranges {
                 let (bi, rest) = core::mem::take(&mut bodies).split_at_mut(b.len());
                 bodies = rest;
                 let (ci, rest) = core::mem::take(&mut contacts).split_at_mut(c.len());
                 contacts = rest;
-                jobs.push((bi, ci));
+                let (vi, rest) = core::mem::take(&mut vel0).split_at_mut(b.len().min(n));
+                vel0 = rest;
+                jobs.push((bi, ci, vi));
             }
-            sweeps += jobs
-                .par_iter_mut()
+            jobs.par_iter_mut()
                 .with_min_len(16)
-                .map(|(b, c)| u64::from(solve_island(b, c, body, h, iterations)))
-                .sum::<u64>();
+                .map(|(b, c, v)| count(solve_island(b, c, body, h, iterations, until, v)))
+                .reduce(|| (0, 0), add)
         } else {
+            let mut total = (0, 0);
             for (b, c) in &self.ranges {
-                sweeps += u64::from(solve_island(
-                    &mut self.bodies[b.clone()],
-                    &mut contacts[c.clone()],
-                    body,
-                    h,
-                    iterations,
-                ));
+                total = add(
+                    total,
+                    count(solve_island(
+                        &mut self.bodies[b.clone()],
+                        &mut contacts[c.clone()],
+                        body,
+                        h,
+                        iterations,
+                        until,
+                        if n == 0 {
+                            &mut []
+                        } else {
+                            &mut self.vel0[b.clone()]
+                        },
+                    )),
+                );
             }
+            total
         }
-        sweeps
     }
 }

@@ -18,6 +18,7 @@
 
 use crate::body::BodyConst;
 use crate::contact::Manifold;
+use crate::params::Convergence;
 
 /// The gap the solver closes a contact to, and pushes an overlap apart to (10 nm), so that
 /// bodies do not touch even after rounding; far below anything a sensor or a metric resolves.
@@ -160,14 +161,38 @@ pub(crate) struct IslandBody {
 /// One sub-step's velocity solve of an island (robots connected by contacts; contacts refer
 /// to them by `la`, `lb`): the warm-start impulses are applied, then up to `iterations`
 /// Gauss–Seidel sweeps, each over the bodies' wheels in order, then the contacts in order,
-/// until a sweep changes no impulse by more than [`CONVERGED_N_S`]. Returns the sweeps run.
+/// until a sweep has converged by `until` ([`Convergence`]; `vel0` holds the velocities at a
+/// sweep's start, one entry per body, and may be empty for [`Convergence::Impulse`]). Returns
+/// the sweeps run and whether the last of them converged (`false`: the cap stopped the solve).
 pub(crate) fn solve_island(
     bodies: &mut [IslandBody],
     contacts: &mut [Contact],
     body: &BodyConst,
     h: f64,
     iterations: u32,
-) -> u32 {
+    until: Convergence,
+    vel0: &mut [[f64; 3]],
+) -> (u32, bool) {
+    match until {
+        Convergence::Impulse => {
+            solve_island_until::<false>(bodies, contacts, body, h, iterations, &mut [])
+        }
+        Convergence::Velocity => {
+            solve_island_until::<true>(bodies, contacts, body, h, iterations, vel0)
+        }
+    }
+}
+
+/// [`solve_island`], converged by velocity (`BY_VELOCITY`) or by impulse.
+#[inline(always)]
+fn solve_island_until<const BY_VELOCITY: bool>(
+    bodies: &mut [IslandBody],
+    contacts: &mut [Contact],
+    body: &BodyConst,
+    h: f64,
+    iterations: u32,
+    vel0: &mut [[f64; 3]],
+) -> (u32, bool) {
     let inv_h = 1.0 / h;
     let wheel_bound = body.wheel_force_n * h;
     // Warm start: the impulses the caller kept from the previous sub-step (the same contact,
@@ -192,6 +217,11 @@ pub(crate) fn solve_island(
     let mut sweeps = 0;
     for _ in 0..iterations {
         sweeps += 1;
+        if BY_VELOCITY {
+            for (v0, b) in vel0.iter_mut().zip(bodies.iter()) {
+                *v0 = b.vel;
+            }
+        }
         // The largest impulse change of the sweep: below CONVERGED_N_S the sweep changed no
         // velocity by more than a few µm/s and the rest would change nothing that shows.
         let mut change: f64 = 0.0;
@@ -246,11 +276,21 @@ pub(crate) fn solve_island(
             change = larger(change, d);
             store(bodies, ct.la, ct.lb, va, vb);
         }
-        if change < CONVERGED_N_S {
-            break;
+        if BY_VELOCITY {
+            let mut moved: f64 = 0.0;
+            for (v0, b) in vel0.iter().zip(bodies.iter()) {
+                moved = larger(moved, (b.vel[0] - v0[0]).abs());
+                moved = larger(moved, (b.vel[1] - v0[1]).abs());
+                moved = larger(moved, (b.vel[2] - v0[2]).abs() * body.radius_m);
+            }
+            if moved < CONVERGED_M_PER_S {
+                return (sweeps, true);
+            }
+        } else if change < CONVERGED_N_S {
+            return (sweeps, true);
         }
     }
-    sweeps
+    (sweeps, false)
 }
 
 /// One sweep's rows of contact `ct` between velocities `va` and `vb` (`TO_WALL`: b is a wall,
@@ -334,6 +374,10 @@ fn larger(change: f64, x: f64) -> f64 {
 /// 2 µm/s on a 0.5 kg robot (40 nm over a 20 ms sub-step; what it leaves of an overlap the
 /// position sweeps remove).
 const CONVERGED_N_S: f64 = 1e-6;
+
+/// A velocity change small enough to call a sweep converged by velocity: 2 µm/s (40 nm over a
+/// 20 ms sub-step), what [`CONVERGED_N_S`] makes of a 0.5 kg robot's velocity.
+const CONVERGED_M_PER_S: f64 = 2e-6;
 
 /// Applies the impulse (px, py) to robot `lb` of the island at its lever arm (unless it is a
 /// wall) and (−px, −py) to robot `la`.

@@ -1113,6 +1113,68 @@ fn thread_count_does_not_change_the_result() {
     }
 }
 
+/// `n` robots in an arena at 6× the paper's density, driven for 250 sub-steps of 10 ms under
+/// the given solver (on `threads` of a pool, or in order): their state and what the solver did.
+fn crowded_run(
+    n: usize,
+    iterations: u32,
+    until: crate::params::Convergence,
+    threads: Option<usize>,
+) -> (Vec<u64>, SolverStats) {
+    let side = Arena::scaled_square(n).unwrap().width_m() / 6f64.sqrt();
+    let params = WorldParams {
+        solver_iterations: iterations,
+        solver_convergence: until,
+        ..WorldParams::with_clock(crate::params::TEST_CLOCK_HZ)
+    };
+    let mut w = World::new(Arena::rectangle(side, side).unwrap(), params, n, 31).unwrap();
+    match threads {
+        None => drive_run(&mut w, 250, 5, false),
+        Some(t) => rayon::ThreadPoolBuilder::new()
+            .num_threads(t)
+            .build()
+            .unwrap()
+            .install(|| drive_run(&mut w, 250, 5, true)),
+    }
+    assert_no_penetration(&w);
+    (state_bits(&w), w.solver_stats())
+}
+
+#[test]
+fn the_capped_solver_depends_on_its_cap_and_the_converged_one_does_not() {
+    use crate::params::Convergence::{Impulse, Velocity};
+    // Stopped on the impulses, 12 sweeps are not enough for many islands (counted), and one
+    // sweep more changes the answer.
+    let (capped12, st12) = crowded_run(300, 12, Impulse, None);
+    let (capped13, _) = crowded_run(300, 13, Impulse, None);
+    assert!(st12.capped_islands * 20 > st12.islands, "{st12:?}");
+    assert_ne!(capped12, capped13);
+    // Stopped on the velocities, every island of this run converges before 200 sweeps, so
+    // the answer is the same under any cap it does not reach.
+    let (conv256, st256) = crowded_run(300, 256, Velocity, None);
+    let (conv200, st200) = crowded_run(300, 200, Velocity, None);
+    assert_eq!(st256.capped_islands, 0, "{st256:?}");
+    assert_eq!(st200, st256);
+    assert_eq!(conv200, conv256);
+}
+
+#[test]
+fn the_converged_solver_gives_the_same_answer_on_any_thread_count() {
+    use crate::params::Convergence::Velocity;
+    // Enough robots in contact that the islands are solved on the pool, each with its share
+    // of the sweep-start velocities.
+    let (conv256, st256) = crowded_run(600, 256, Velocity, None);
+    assert!(
+        st256.active_robot_substeps
+            > st256.substeps * crate::pipeline::par::PAR_ISLAND_ROBOTS as u64
+    );
+    for threads in [1, 2, 3] {
+        let (par, st) = crowded_run(600, 256, Velocity, Some(threads));
+        assert_eq!(par, conv256, "{threads} threads");
+        assert_eq!(st, st256, "{threads} threads");
+    }
+}
+
 // ----- errors ---------------------------------------------------------------------------------
 
 #[test]
