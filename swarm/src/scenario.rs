@@ -88,7 +88,9 @@ pub struct WorldSpec {
     /// sweep changes no impulse by more than 1e-6 N·s, at most 12 sweeps; every result in
     /// docs/claims.md was made with it) or `converged` (until a sweep changes no robot's
     /// velocity by more than 2 µm/s, at most 256 sweeps, the cap counted and reported); see
-    /// docs/physics.md, "The contact solver's cap".
+    /// docs/physics.md, "The contact solver's cap". Written into a run's outputs only when it
+    /// is not the default, so that the outputs of every run made before it existed stay the same.
+    #[serde(skip_serializing_if = "SolverKind::is_capped")]
     pub solver: SolverKind,
 }
 
@@ -108,6 +110,12 @@ pub enum SolverKind {
 pub const CONVERGED_SOLVER_SWEEPS: u32 = 256;
 
 impl SolverKind {
+    /// Whether this is the default, capped solver.
+    #[must_use]
+    pub fn is_capped(&self) -> bool {
+        *self == SolverKind::Capped
+    }
+
     /// The world's sweep cap and convergence test for this solver.
     #[must_use]
     pub fn params(self) -> (u32, world::params::Convergence) {
@@ -511,7 +519,13 @@ impl Scenario {
         // One line: where (line, column, the line's text) and what.
         let file: ScenarioFile = toml::from_str(text)
             .map_err(|e| anyhow::anyhow!("{}", crate::terminal_text::toml_error(text, &e)))?;
-        let mut s = Self::builtin(file.base.as_deref().unwrap_or("arena")).context("key `base`")?;
+        let base = file.base.as_deref().unwrap_or("arena");
+        if base != "arena" && base != "corridor" {
+            bail!(
+                "key `base`: `{base}` is not a built-in scenario: a scenario file changes `arena` or `corridor` (it cannot be based on another file)"
+            );
+        }
+        let mut s = Self::builtin(base)?;
         if let Some(v) = file.name {
             s.name = v;
         }
@@ -815,6 +829,15 @@ mod tests {
             Scenario::from_toml("steps = 200\nwindow = 300\n").unwrap_err()
         );
         assert!(e.contains("window"), "{e}");
+        // A base is a built-in, and the error says so (not "or a path").
+        let e = format!(
+            "{:#}",
+            Scenario::from_toml("base = \"arena-learning-only.toml\"\n").unwrap_err()
+        );
+        assert!(
+            e.contains("key `base`") && e.contains("cannot be based on another file"),
+            "{e}"
+        );
         // The contact solver by name; another name is an error naming the key.
         let s = Scenario::from_toml("[world]\nsolver = \"converged\"\n").unwrap();
         assert_eq!(s.world.solver, SolverKind::Converged);
