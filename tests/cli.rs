@@ -400,6 +400,60 @@ fn one_repeat_is_worded_as_one_and_promises_no_intervals() {
 }
 
 #[test]
+fn the_report_counts_the_contact_solves_the_cap_stopped_under_either_solver() {
+    let dir = temp_dir("solver-line");
+    let file = dir.with_extension("toml");
+    std::fs::write(&file, "[world]\nsolver = \"converged\"\n").expect("scenario file");
+    let line = |scenario: &str| {
+        let out = h8swarm(
+            &[
+                "run",
+                scenario,
+                "--steps",
+                "300",
+                "--repeats",
+                "1",
+                "--out",
+                dir.to_str().expect("utf-8 path"),
+            ],
+            None,
+        );
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let stdout = String::from_utf8_lossy(&out.stdout).to_string();
+        stdout
+            .lines()
+            .find(|l| l.starts_with("contact solver"))
+            .unwrap_or_else(|| panic!("no solver line: {stdout}"))
+            .to_string()
+    };
+    let capped = line("arena");
+    let converged = line(file.to_str().expect("utf-8 path"));
+    let _ = std::fs::remove_dir_all(&dir);
+    let _ = std::fs::remove_file(&file);
+    // The numbers of the line: islands, sweeps each, islands at the cap, their share, the cap.
+    let numbers = |l: &str| -> Vec<f64> {
+        l.split(|c: char| !(c.is_ascii_digit() || c == '.'))
+            .filter_map(|w| w.parse().ok())
+            .collect()
+    };
+    let (a, b) = (numbers(&capped), numbers(&converged));
+    assert!(capped.contains("(capped, world.solver)"), "{capped}");
+    assert!(
+        converged.contains("(converged, world.solver)"),
+        "{converged}"
+    );
+    assert_eq!((a[4], b[4]), (12.0, 256.0), "{capped} / {converged}");
+    // 300 steps of three robots in the arena meet the walls; the capped solve stops at its
+    // cap in some islands, the converged one in far fewer.
+    assert!(a[0] > 1000.0 && a[2] > 0.0, "{capped}");
+    assert!(b[3] < a[3], "{capped} / {converged}");
+}
+
+#[test]
 fn run_reports_bad_scenarios_and_folders_clearly() {
     let dir = temp_dir("bad");
     std::fs::create_dir_all(&dir).expect("temp dir");
