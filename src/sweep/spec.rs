@@ -290,9 +290,32 @@ impl Point {
                 "point {} ({}): {}",
                 self.index,
                 self.id,
-                one_line(&format!("{e:#}"))
+                without_position(&one_line(&format!("{e:#}")))
             ))
         })
+    }
+}
+
+/// A point's scenario error without the line and column it gives (`line 41, column 10
+/// (`solver = "fast"`): …`): they count lines of the point's generated scenario, not of the
+/// user's sweep file; the quoted key and value stay.
+fn without_position(message: &str) -> String {
+    let Some(rest) = message.strip_prefix("line ") else {
+        return message.to_string();
+    };
+    let Some(at) = rest.find(" (`") else {
+        return message.to_string();
+    };
+    let mut numbers = rest[..at].split(", column ");
+    let position = matches!(
+        (numbers.next(), numbers.next(), numbers.next()),
+        (Some(l), Some(c), None) if l.parse::<u64>().is_ok() && c.parse::<u64>().is_ok()
+    );
+    // What follows the position: `` `key = value`): what is wrong ``.
+    let source = &rest[at + 2..];
+    match source.find("`): ") {
+        Some(end) if position => format!("{}{}", &source[..=end], &source[end + 2..]),
+        _ => message.to_string(),
     }
 }
 
@@ -988,6 +1011,14 @@ mod tests {
         assert!(e.contains("grids") && e.contains("t.toml"), "{e}");
         let e = sweep("[grid]\n\"learner.eta\" = [0.5, 2.0]\n").unwrap_err();
         assert!(e.contains("learner.eta") && e.contains("point 1"), "{e}");
+        // A value the scenario cannot read names the point, the key and the value, not a line
+        // of the point's generated scenario.
+        let e = sweep("[grid]\n\"world.solver\" = [\"capped\", \"fast\"]\n").unwrap_err();
+        assert!(
+            e.contains("point 1") && e.contains("`solver = \"fast\"`: unknown variant"),
+            "{e}"
+        );
+        assert!(!e.contains("line ") && !e.contains("column"), "{e}");
         let e = sweep("base = \"moon\"\n").unwrap_err();
         assert!(e.contains("base") && e.contains("moon"), "{e}");
         let e = sweep("[grid]\nrobots = [3]\n[[zip]]\nrobots = [4]\n").unwrap_err();
