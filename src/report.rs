@@ -87,8 +87,8 @@ fn render_solver(t: &mut String, s: &Scenario, runs: &[RunOutput]) {
         t,
         "contact solver ({}): {islands} islands solved, {:.1} sweeps each; {capped} ({:.2} %) stopped at the cap of {} sweeps before converging",
         match s.world.solver {
-            SolverKind::Capped => "capped, world.solver",
-            SolverKind::Converged => "converged, world.solver",
+            SolverKind::Capped => "world.solver = \"capped\"",
+            SolverKind::Converged => "world.solver = \"converged\"",
         },
         sweeps as f64 / islands as f64,
         100.0 * capped as f64 / islands as f64,

@@ -441,9 +441,9 @@ fn the_report_counts_the_contact_solves_the_cap_stopped_under_either_solver() {
             .collect()
     };
     let (a, b) = (numbers(&capped), numbers(&converged));
-    assert!(capped.contains("(capped, world.solver)"), "{capped}");
+    assert!(capped.contains("(world.solver = \"capped\")"), "{capped}");
     assert!(
-        converged.contains("(converged, world.solver)"),
+        converged.contains("(world.solver = \"converged\")"),
         "{converged}"
     );
     assert_eq!((a[4], b[4]), (12.0, 256.0), "{capped} / {converged}");
