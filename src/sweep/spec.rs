@@ -284,38 +284,14 @@ impl Point {
     /// # Errors
     /// A value out of range (naming the key).
     pub fn resolve(&self) -> Result<Scenario, SweepError> {
-        let text = self.scenario_toml()?;
-        Scenario::from_toml(&text).map_err(|e| {
+        Scenario::from_table(&self.scenario).map_err(|e| {
             SweepError::input(format!(
                 "point {} ({}): {}",
                 self.index,
                 self.id,
-                without_position(&one_line(&format!("{e:#}")))
+                one_line(&format!("{e:#}"))
             ))
         })
-    }
-}
-
-/// A point's scenario error without the line and column it gives (`line 41, column 10
-/// (`solver = "fast"`): …`): they count lines of the point's generated scenario, not of the
-/// user's sweep file; the quoted key and value stay.
-fn without_position(message: &str) -> String {
-    let Some(rest) = message.strip_prefix("line ") else {
-        return message.to_string();
-    };
-    let Some(at) = rest.find(" (`") else {
-        return message.to_string();
-    };
-    let mut numbers = rest[..at].split(", column ");
-    let position = matches!(
-        (numbers.next(), numbers.next(), numbers.next()),
-        (Some(l), Some(c), None) if l.parse::<u64>().is_ok() && c.parse::<u64>().is_ok()
-    );
-    // What follows the position: `` `key = value`): what is wrong ``.
-    let source = &rest[at + 2..];
-    match source.find("`): ") {
-        Some(end) if position => format!("{}{}", &source[..=end], &source[end + 2..]),
-        _ => message.to_string(),
     }
 }
 
@@ -476,7 +452,7 @@ impl Keys {
     fn check(&self, key: &str, where_: &str) -> Result<(), SweepError> {
         let valid = || {
             format!(
-                "valid keys are {} (and the optional controller.image, controller.symbols, controller.robots)",
+                "valid keys are {} (and the optional controller.image, controller.symbols, controller.robots, world.solver)",
                 self.leaves.join(", ")
             )
         };
@@ -1009,13 +985,22 @@ mod tests {
         assert!(e.contains("seeds"), "{e}");
         let e = sweep("grids = 1\n").unwrap_err();
         assert!(e.contains("grids") && e.contains("t.toml"), "{e}");
+        // A key the base's table leaves out while it has its default is named among the
+        // valid ones.
+        let e = sweep("[grid]\n\"world.solverr\" = [\"capped\"]\n").unwrap_err();
+        assert!(
+            e.contains("unknown key") && e.contains("world.solver)"),
+            "{e}"
+        );
         let e = sweep("[grid]\n\"learner.eta\" = [0.5, 2.0]\n").unwrap_err();
         assert!(e.contains("learner.eta") && e.contains("point 1"), "{e}");
         // A value the scenario cannot read names the point, the key and the value, not a line
         // of the point's generated scenario.
         let e = sweep("[grid]\n\"world.solver\" = [\"capped\", \"fast\"]\n").unwrap_err();
         assert!(
-            e.contains("point 1") && e.contains("`solver = \"fast\"`: unknown variant"),
+            e.contains("point 1")
+                && e.contains("unknown variant `fast`")
+                && e.contains("in `world.solver`"),
             "{e}"
         );
         assert!(!e.contains("line ") && !e.contains("column"), "{e}");

@@ -519,6 +519,27 @@ impl Scenario {
         // One line: where (line, column, the line's text) and what.
         let file: ScenarioFile = toml::from_str(text)
             .map_err(|e| anyhow::anyhow!("{}", crate::terminal_text::toml_error(text, &e)))?;
+        Self::from_file(file)
+    }
+
+    /// A scenario file already read as a TOML table (a sweep's point), over its base and
+    /// checked; an error names the key (`… in `world.solver``), there being no text to point
+    /// into.
+    ///
+    /// # Errors
+    /// An unknown key, a value of the wrong kind, or a value out of range.
+    pub fn from_table(table: &toml::Table) -> Result<Self> {
+        // The message and the key it is in (`… in `world.solver``), on one line.
+        let file = ScenarioFile::deserialize(table.clone()).map_err(|e| {
+            let text = e.to_string();
+            let words: Vec<&str> = text.split_whitespace().collect();
+            anyhow::anyhow!("{}", crate::terminal_text::one_line(&words.join(" ")))
+        })?;
+        Self::from_file(file)
+    }
+
+    /// A scenario file over its base, checked.
+    fn from_file(file: ScenarioFile) -> Result<Self> {
         let base = file.base.as_deref().unwrap_or("arena");
         if base != "arena" && base != "corridor" {
             bail!(
