@@ -6,7 +6,7 @@ use std::fmt::Write as _;
 
 use swarm::experiment::RunOutput;
 use swarm::runner::Analysed;
-use swarm::scenario::{Scenario, SolverKind};
+use swarm::scenario::Scenario;
 use swarm::summary::{Analysis, Claim, Estimate};
 
 /// The report of a run on `threads` threads: what ran and how fast, the warnings, the battery
@@ -85,11 +85,8 @@ fn render_solver(t: &mut String, s: &Scenario, runs: &[RunOutput]) {
     }
     let _ = writeln!(
         t,
-        "contact solver ({}): {islands} islands solved, {:.1} sweeps each; {capped} ({:.2} %) stopped at the cap of {} sweeps before converging",
-        match s.world.solver {
-            SolverKind::Capped => "world.solver = \"capped\"",
-            SolverKind::Converged => "world.solver = \"converged\"",
-        },
+        "contact solver (world.solver = \"{}\"): {islands} islands solved, {:.1} sweeps each; {capped} ({:.2} %) stopped at the cap of {} sweeps before converging",
+        s.world.solver.name(),
         sweeps as f64 / islands as f64,
         100.0 * capped as f64 / islands as f64,
         s.world.solver.params().0

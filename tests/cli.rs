@@ -306,6 +306,17 @@ fn temp_dir(name: &str) -> std::path::PathBuf {
     d
 }
 
+/// Runs h8swarm with `args`, which must succeed; its standard output.
+fn succeeds(args: &[&str]) -> String {
+    let out = h8swarm(args, None);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).to_string()
+}
+
 #[test]
 fn run_writes_identical_metrics_for_any_thread_count() {
     // Runs spread over the threads (3 and 80 robots, six runs), and one run of 4 200 robots
@@ -324,29 +335,20 @@ fn run_writes_identical_metrics_for_any_thread_count() {
         let mut files = Vec::new();
         for threads in ["1", "2", "8"] {
             let dir = temp_dir(&format!("det-{robots}-{threads}"));
-            let out = h8swarm(
-                &[
-                    "run",
-                    scenario,
-                    "--steps",
-                    "40",
-                    "--repeats",
-                    repeats,
-                    "--robots",
-                    robots,
-                    "--threads",
-                    threads,
-                    "--out",
-                    dir.to_str().expect("utf-8 path"),
-                ],
-                None,
-            );
-            assert!(
-                out.status.success(),
-                "{}",
-                String::from_utf8_lossy(&out.stderr)
-            );
-            let stdout = String::from_utf8_lossy(&out.stdout);
+            let stdout = succeeds(&[
+                "run",
+                scenario,
+                "--steps",
+                "40",
+                "--repeats",
+                repeats,
+                "--robots",
+                robots,
+                "--threads",
+                threads,
+                "--out",
+                dir.to_str().expect("utf-8 path"),
+            ]);
             assert!(stdout.contains("learning.png"), "{stdout}");
             for f in h8swarm::outputs::OUTPUT_FILES
                 .iter()
@@ -405,25 +407,16 @@ fn the_report_counts_the_contact_solves_the_cap_stopped_under_either_solver() {
     let file = dir.with_extension("toml");
     std::fs::write(&file, "[world]\nsolver = \"converged\"\n").expect("scenario file");
     let line = |scenario: &str| {
-        let out = h8swarm(
-            &[
-                "run",
-                scenario,
-                "--steps",
-                "300",
-                "--repeats",
-                "1",
-                "--out",
-                dir.to_str().expect("utf-8 path"),
-            ],
-            None,
-        );
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let stdout = String::from_utf8_lossy(&out.stdout).to_string();
+        let stdout = succeeds(&[
+            "run",
+            scenario,
+            "--steps",
+            "300",
+            "--repeats",
+            "1",
+            "--out",
+            dir.to_str().expect("utf-8 path"),
+        ]);
         stdout
             .lines()
             .find(|l| l.starts_with("contact solver"))

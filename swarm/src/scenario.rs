@@ -116,6 +116,15 @@ impl SolverKind {
         *self == SolverKind::Capped
     }
 
+    /// Its name in a scenario file.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            SolverKind::Capped => "capped",
+            SolverKind::Converged => "converged",
+        }
+    }
+
     /// The world's sweep cap and convergence test for this solver.
     #[must_use]
     pub fn params(self) -> (u32, world::params::Convergence) {
@@ -867,6 +876,11 @@ mod tests {
             (256, world::params::Convergence::Velocity)
         );
         assert_eq!(Scenario::arena().world.solver, SolverKind::Capped);
+        // The name the report prints is the one a file gives.
+        for k in [SolverKind::Capped, SolverKind::Converged] {
+            let text = format!("[world]\nsolver = \"{}\"\n", k.name());
+            assert_eq!(Scenario::from_toml(&text).unwrap().world.solver, k);
+        }
         let e = format!(
             "{:#}",
             Scenario::from_toml("[world]\nsolver = \"exact\"\n").unwrap_err()

@@ -26,6 +26,7 @@ pub fn arena_of(s: &Scenario) -> Result<Arena> {
 /// The world parameters of a scenario.
 #[must_use]
 pub fn world_params(s: &Scenario) -> WorldParams {
+    let (solver_iterations, solver_convergence) = s.world.solver.params();
     WorldParams {
         top_speed_m_per_s: s.world.top_speed_m_per_s,
         motor_time_constant_s: s.world.motor_time_constant_s,
@@ -34,8 +35,8 @@ pub fn world_params(s: &Scenario) -> WorldParams {
         max_substep_s: s.world.substep_s,
         sensor_max_range_m: s.world.sensor_range_m,
         mu_wall: s.world.mu_wall,
-        solver_iterations: s.world.solver.params().0,
-        solver_convergence: s.world.solver.params().1,
+        solver_iterations,
+        solver_convergence,
         sensor_mounts: SensorMount::default_mounts(
             world::params::BODY_LENGTH_M,
             world::params::BODY_WIDTH_M,
