@@ -30,13 +30,12 @@ const SUBSTEPS_PER_BEHAVIOUR: u64 = 45;
 
 /// A world of `n` robots in the scaled arena, driven for 2 s of random behaviours.
 fn moving_world(n: usize, rng: &mut Pcg64) -> World {
-    let mut w = World::new(
-        Arena::scaled_square(n).unwrap(),
-        WorldParams::with_clock(CLOCK_HZ),
-        n,
-        2008,
-    )
-    .unwrap();
+    moving_world_with(n, rng, WorldParams::with_clock(CLOCK_HZ))
+}
+
+/// [`moving_world`] with the given parameters.
+fn moving_world_with(n: usize, rng: &mut Pcg64, params: WorldParams) -> World {
+    let mut w = World::new(Arena::scaled_square(n).unwrap(), params, n, 2008).unwrap();
     for k in 0..200 {
         if k % SUBSTEPS_PER_BEHAVIOUR == 0 {
             new_behaviours(&mut w, rng);
@@ -97,6 +96,34 @@ fn advance(c: &mut Criterion) {
                 k += 1;
                 pool.install(|| w.advance_par(black_box(SUBSTEP_S)))
                     .unwrap();
+            })
+        });
+    }
+    g.finish();
+
+    // The solver that sweeps each island until its velocities converge (a scenario's
+    // `world.solver = "converged"`), beside `advance_10ms` at the same sizes.
+    let mut g = c.benchmark_group("advance_10ms_converged");
+    g.sample_size(20)
+        .measurement_time(Duration::from_secs(4))
+        .warm_up_time(Duration::from_secs(1));
+    let converged = WorldParams {
+        solver_iterations: 256,
+        solver_convergence: world::params::Convergence::Velocity,
+        ..WorldParams::with_clock(CLOCK_HZ)
+    };
+    for n in [100, 1_000] {
+        let mut rng = Pcg64::seed_from_u64(1);
+        let mut w = moving_world_with(n, &mut rng, converged.clone());
+        let mut k = 0u64;
+        g.throughput(Throughput::Elements(n as u64));
+        g.bench_function(BenchmarkId::from_parameter(n), |b| {
+            b.iter(|| {
+                if k.is_multiple_of(SUBSTEPS_PER_BEHAVIOUR) {
+                    new_behaviours(&mut w, &mut rng);
+                }
+                k += 1;
+                w.advance(black_box(SUBSTEP_S)).unwrap();
             })
         });
     }
