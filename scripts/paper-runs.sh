@@ -30,11 +30,17 @@ for scenario in arena corridor scenarios/arena-surface.toml scenarios/corridor-s
         # files end in their [world] table, so the key lands in it).
         file=$out/scenarios/$name.toml
         if [ -f "$scenario" ]; then
-            cat "$scenario" >"$file"
+            text=$(cat "$scenario")
         else
-            printf 'base = "%s"\n\n[world]\n' "$scenario" >"$file"
+            text=$(printf 'base = "%s"\n\n[world]' "$scenario")
         fi
-        printf 'solver = "%s"\n' "$solver" >>"$file"
+        text=$(printf '%s\nsolver = "%s"' "$text" "$solver")
+        # A file of the same name that this script did not write (a user's own) is kept.
+        if [ -e "$file" ] && [ "$(cat "$file")" != "$text" ]; then
+            echo "paper-runs.sh: $file exists and is not this script's: give another OUT" >&2
+            exit 2
+        fi
+        printf '%s\n' "$text" >"$file"
     fi
     for seed in 1 2 3 4 5; do
         echo "## $name seed $seed"
