@@ -1158,6 +1158,58 @@ fn the_capped_solver_depends_on_its_cap_and_the_converged_one_does_not() {
     assert_eq!(conv200, conv256);
 }
 
+/// Over 40 sub-steps of a crowded arena after 100 of driving, each solved with
+/// `iterations`/`until` and, from the same state, with the impulse test and 256 sweeps (a
+/// fixed point of the sweeps: no row's impulse changes by 1e-6 N·s): the largest and the mean
+/// difference of a solved robot's velocity (turn rate at the half-diagonal), m/s.
+fn apart_from_the_fixed_point(iterations: u32, until: crate::params::Convergence) -> (f64, f64) {
+    let n = 300;
+    let side = Arena::scaled_square(n).unwrap().width_m() / 6f64.sqrt();
+    let params = WorldParams {
+        solver_iterations: iterations,
+        solver_convergence: until,
+        ..WorldParams::with_clock(crate::params::TEST_CLOCK_HZ)
+    };
+    let mut w = World::new(Arena::rectangle(side, side).unwrap(), params, n, 31).unwrap();
+    drive_run(&mut w, 100, 5, false);
+    let radius = w.body.radius_m;
+    let (mut worst, mut sum, mut count) = (0.0f64, 0.0, 0u32);
+    for _ in 0..40 {
+        let mut reference = w.clone();
+        reference.params.solver_convergence = crate::params::Convergence::Impulse;
+        reference.params.solver_iterations = 256;
+        w.advance(0.01).unwrap();
+        reference.advance(0.01).unwrap();
+        for (a, b) in w.vel.iter().zip(&reference.vel) {
+            let d = (a[0] - b[0])
+                .abs()
+                .max((a[1] - b[1]).abs())
+                .max((a[2] - b[2]).abs() * radius);
+            if d > 0.0 {
+                worst = worst.max(d);
+                sum += d;
+                count += 1;
+            }
+        }
+    }
+    (worst, sum / f64::from(count.max(1)))
+}
+
+#[test]
+fn the_velocity_test_stops_near_the_fixed_point_not_at_it() {
+    use crate::params::Convergence::{Impulse, Velocity};
+    // Measured (docs/physics.md): stopped on the velocities the solve is 0.23 mm/s from the
+    // sweeps' fixed point on average and up to 10.8 mm/s; capped at 12 sweeps 0.30 and 3.8;
+    // one sweep 2.7 and 43. A solve that stopped after a sweep or two and called itself
+    // converged fails the bound on the mean.
+    let converged = apart_from_the_fixed_point(256, Velocity);
+    let capped = apart_from_the_fixed_point(12, Impulse);
+    let one_sweep = apart_from_the_fixed_point(1, Impulse);
+    assert!(converged.1 < 5e-4 && converged.0 < 0.02, "{converged:?}");
+    assert!(capped.1 < 5e-4, "{capped:?}");
+    assert!(one_sweep.1 > 1e-3, "{one_sweep:?}");
+}
+
 #[test]
 fn the_converged_solver_gives_the_same_answer_on_any_thread_count() {
     use crate::params::Convergence::Velocity;
