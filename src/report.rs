@@ -71,15 +71,31 @@ fn render_header(
 /// the sweep cap (`world.solver`) stopped before they converged.
 fn render_solver(t: &mut String, s: &Scenario, runs: &[RunOutput]) {
     let (mut islands, mut sweeps, mut capped) = (0u64, 0u64, 0u64);
+    let (mut newton, mut steps) = (0u64, 0u64);
     for r in runs {
         islands += r.solver.islands;
         sweeps += r.solver.solver_sweeps;
         capped += r.solver.capped_islands;
+        newton += r.solver.newton_islands;
+        steps += r.solver.newton_steps;
     }
     if islands == 0 {
         let _ = writeln!(
             t,
             "contact solver: no robot touched a wall or another robot"
+        );
+        return;
+    }
+    if s.world.solver == swarm::scenario::SolverKind::Newton {
+        let swept = islands - newton;
+        let _ = writeln!(
+            t,
+            "contact solver (world.solver = \"newton\"): {islands} islands solved, {newton} by Newton's method ({:.1} steps each), {swept} larger by sweeps ({:.1} each); {capped} ({:.2} %) stopped at a cap ({} outer iterations, {} sweeps) before converging",
+            steps as f64 / newton.max(1) as f64,
+            sweeps as f64 / swept.max(1) as f64,
+            100.0 * capped as f64 / islands as f64,
+            world::params::NEWTON_MAX_OUTER,
+            s.world.solver.params().0
         );
         return;
     }

@@ -402,10 +402,12 @@ fn one_repeat_is_worded_as_one_and_promises_no_intervals() {
 }
 
 #[test]
-fn the_report_counts_the_contact_solves_the_cap_stopped_under_either_solver() {
+fn the_report_counts_the_contact_solves_the_cap_stopped_under_each_solver() {
     let dir = temp_dir("solver-line");
     let file = dir.with_extension("toml");
     std::fs::write(&file, "[world]\nsolver = \"converged\"\n").expect("scenario file");
+    let newton_file = dir.with_extension("newton.toml");
+    std::fs::write(&newton_file, "[world]\nsolver = \"newton\"\n").expect("scenario file");
     let line = |scenario: &str| {
         let stdout = succeeds(&[
             "run",
@@ -425,8 +427,10 @@ fn the_report_counts_the_contact_solves_the_cap_stopped_under_either_solver() {
     };
     let capped = line("arena");
     let converged = line(file.to_str().expect("utf-8 path"));
+    let newton = line(newton_file.to_str().expect("utf-8 path"));
     let _ = std::fs::remove_dir_all(&dir);
     let _ = std::fs::remove_file(&file);
+    let _ = std::fs::remove_file(&newton_file);
     // The numbers of the line: islands, sweeps each, islands at the cap, their share, the cap.
     let numbers = |l: &str| -> Vec<f64> {
         l.split(|c: char| !(c.is_ascii_digit() || c == '.'))
@@ -444,6 +448,15 @@ fn the_report_counts_the_contact_solves_the_cap_stopped_under_either_solver() {
     // cap in some islands, the converged one in far fewer.
     assert!(a[0] > 1000.0 && a[2] > 0.0, "{capped}");
     assert!(b[3] < a[3], "{capped} / {converged}");
+    // Newton's method: every island of three robots is small enough for it (none by sweeps),
+    // and its cap stops fewer solves than the capped solver's.
+    assert!(newton.contains("(world.solver = \"newton\")"), "{newton}");
+    let c = numbers(&newton);
+    // islands, Newton's, steps each, by sweeps, sweeps each, capped, share, outer cap, sweep cap
+    assert_eq!(c.len(), 9, "{newton}");
+    assert!(c[0] > 1000.0 && c[1] == c[0] && c[3] == 0.0, "{newton}");
+    assert!(c[2] >= 1.0 && c[6] < a[3], "{capped} / {newton}");
+    assert_eq!((c[7], c[8]), (64.0, 256.0), "{newton}");
 }
 
 #[test]

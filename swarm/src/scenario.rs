@@ -86,8 +86,10 @@ pub struct WorldSpec {
     pub corridor_clearance_m: f64,
     /// The contact solver: `capped` (default: an island of robots in contact is solved until a
     /// sweep changes no impulse by more than 1e-6 N·s, at most 12 sweeps; every result in
-    /// docs/claims.md was made with it) or `converged` (until a sweep changes no robot's
-    /// velocity by more than 2 µm/s, at most 256 sweeps, the cap counted and reported); see
+    /// docs/claims.md was made with it), `converged` (until a sweep changes no robot's
+    /// velocity by more than 2 µm/s, at most 256 sweeps, the cap counted and reported) or
+    /// `newton` (islands of up to 16 robots solved by Newton's method to the sweeps' fixed
+    /// point, larger ones by sweeps under the impulse test, at most 256; caps counted); see
     /// docs/physics.md, "The contact solver's cap". Written into a run's outputs only when it
     /// is not the default, so that the outputs of every run made before it existed stay the same.
     #[serde(skip_serializing_if = "SolverKind::is_capped")]
@@ -104,6 +106,10 @@ pub enum SolverKind {
     /// At most [`CONVERGED_SOLVER_SWEEPS`] sweeps, stopped when no robot's velocity changes by
     /// more than 2 µm/s.
     Converged,
+    /// Islands of up to 16 robots solved by Newton's method until every row's velocity error
+    /// is below 0.1 µm/s; larger ones by at most [`CONVERGED_SOLVER_SWEEPS`] sweeps, stopped
+    /// when no impulse changes by more than 1e-6 N·s.
+    Newton,
 }
 
 /// The cap of the converged solver, a safety net that is counted ([`world::SolverStats`]).
@@ -122,6 +128,7 @@ impl SolverKind {
         match self {
             SolverKind::Capped => "capped",
             SolverKind::Converged => "converged",
+            SolverKind::Newton => "newton",
         }
     }
 
@@ -137,6 +144,7 @@ impl SolverKind {
                 CONVERGED_SOLVER_SWEEPS,
                 world::params::Convergence::Velocity,
             ),
+            SolverKind::Newton => (CONVERGED_SOLVER_SWEEPS, world::params::Convergence::Newton),
         }
     }
 }
@@ -877,7 +885,11 @@ mod tests {
         );
         assert_eq!(Scenario::arena().world.solver, SolverKind::Capped);
         // The name the report prints is the one a file gives.
-        for k in [SolverKind::Capped, SolverKind::Converged] {
+        for k in [
+            SolverKind::Capped,
+            SolverKind::Converged,
+            SolverKind::Newton,
+        ] {
             let text = format!("[world]\nsolver = \"{}\"\n", k.name());
             assert_eq!(Scenario::from_toml(&text).unwrap().world.solver, k);
         }
@@ -885,7 +897,10 @@ mod tests {
             "{:#}",
             Scenario::from_toml("[world]\nsolver = \"exact\"\n").unwrap_err()
         );
-        assert!(e.contains("solver") && e.contains("converged"), "{e}");
+        assert!(
+            e.contains("solver") && e.contains("converged") && e.contains("newton"),
+            "{e}"
+        );
         // Channels: exactly four whole numbers, never silently cut.
         for (text, expected) in [
             (

@@ -4,8 +4,9 @@
 //! a 60 ms motor lag, no motor-gain spread):
 //!
 //! - **own**: the world crate's solver (20 ms sub-steps), as every run uses it by default
-//!   (`world.solver = "capped"`: at most 12 sweeps) and converged (`"converged"`: until no
-//!   velocity changes by more than 2 µm/s in a sweep, at most 256 sweeps);
+//!   (`world.solver = "capped"`: at most 12 sweeps), converged (`"converged"`: until no
+//!   velocity changes by more than 2 µm/s in a sweep, at most 256 sweeps) and by Newton's
+//!   method (`"newton"`: to the sweeps' fixed point);
 //! - **rapier2d**: rapier2d 0.36.1 with the wheel forces applied explicitly before each 20 ms
 //!   step (the set-up of `solver_compare`);
 //! - **Coulomb**: a reference written for this scene (`world/tests/coulomb_reference`):
@@ -64,21 +65,21 @@ fn inertia() -> f64 {
     MASS * (4.0 * HX * HX + 4.0 * HY * HY) / 12.0
 }
 
-/// The world crate's solver, capped (12 sweeps, stopped on the impulses: `converged` false)
-/// or converged (up to 256 sweeps, stopped on the velocities).
-fn own(theta: f64, duty: [f64; 2], converged: bool) -> Track {
+/// The world crate's solver: capped (`Impulse`: 12 sweeps, stopped on the impulses),
+/// converged (`Velocity`: up to 256 sweeps, stopped on the velocities) or `Newton`.
+fn own(theta: f64, duty: [f64; 2], until: world::params::Convergence) -> Track {
     let params = WorldParams {
         motor_gain_spread: 0.0,
         ..WorldParams::with_clock(CLOCK_HZ)
     };
-    let params = if converged {
+    let params = if until == world::params::Convergence::Impulse {
+        params
+    } else {
         WorldParams {
             solver_iterations: 256,
-            solver_convergence: world::params::Convergence::Velocity,
+            solver_convergence: until,
             ..params
         }
-    } else {
-        params
     };
     let (x, y) = start(theta);
     let pose = Pose {
@@ -222,8 +223,15 @@ fn main() {
         let theta = f64::to_radians(deg);
         let reference = coulomb(theta, duty);
         for (name, track) in [
-            ("own", own(theta, duty, false)),
-            ("own, converged", own(theta, duty, true)),
+            ("own", own(theta, duty, world::params::Convergence::Impulse)),
+            (
+                "own, converged",
+                own(theta, duty, world::params::Convergence::Velocity),
+            ),
+            (
+                "own, newton",
+                own(theta, duty, world::params::Convergence::Newton),
+            ),
             ("rapier2d", rapier(theta, duty)),
             ("Coulomb", reference.clone()),
         ] {

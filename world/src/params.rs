@@ -47,6 +47,14 @@ pub const PLACEMENT_CLEARANCE_M: f64 = 0.050;
 /// five bodies within a few per cent of the exact impulses, and what the velocities leave of an
 /// overlap is removed by the position correction.
 pub const SOLVER_ITERATIONS: u32 = 12;
+
+/// Newton's method's cap of outer (impulse) iterations on an island ([`Convergence::Newton`]),
+/// a safety net that is counted (`SolverStats::capped_islands`).
+pub const NEWTON_MAX_OUTER: u32 = 64;
+
+/// The largest island ([`Convergence::Newton`]) solved by Newton's method; larger ones are
+/// solved by sweeps.
+pub const NEWTON_MAX_ROBOTS: usize = 16;
 /// Default number of position-correction sweeps over the overlaps the velocity solve leaves
 /// (our choice): each sweep removes an overlap along its normal with rotation; a cluster that
 /// is still not clear after them stops its robots' motion early (see the crate docs).
@@ -194,6 +202,10 @@ pub enum Convergence {
     /// impulses that give it are unique (a robot pushed by its wheels against another is
     /// statically indeterminate: the impulses can drift along a direction that moves nothing).
     Velocity,
+    /// Islands of up to 16 robots solved by Newton's method on the whole island to its fixed
+    /// point (every row's velocity error below 1 nm/s, at most 64 outer iterations); larger
+    /// islands by sweeps converged by impulse under the sweep cap.
+    Newton,
 }
 
 impl WorldParams {

@@ -59,8 +59,13 @@ pub struct SolverStats {
     /// Gauss–Seidel sweeps of the velocity solver run (over all sub-steps).
     pub solver_sweeps: u64,
     /// Islands whose solve the sweep cap (`WorldParams::solver_iterations`) stopped before a
-    /// sweep changed no impulse by more than 1e-6 N·s.
+    /// sweep changed no impulse by more than 1e-6 N·s, or (under `Convergence::Newton`) whose
+    /// Newton solve its cap of outer iterations stopped.
     pub capped_islands: u64,
+    /// Islands solved by Newton's method (`Convergence::Newton`; the rest by sweeps).
+    pub newton_islands: u64,
+    /// Newton steps run, over those islands.
+    pub newton_steps: u64,
     /// Sub-steps whose velocity solve left an overlap for the position correction.
     pub overlap_substeps: u64,
     /// Position-correction sweeps run.
@@ -694,7 +699,7 @@ impl World {
             &self.wmean,
             &self.wheel_imp,
         );
-        let (sweeps, capped) = self.islands.solve(
+        let done = self.islands.solve(
             &mut self.narrow.contacts,
             &self.body,
             h,
@@ -703,8 +708,10 @@ impl World {
             parallel,
         );
         self.stats.islands += self.islands.len() as u64;
-        self.stats.solver_sweeps += sweeps;
-        self.stats.capped_islands += capped;
+        self.stats.solver_sweeps += done.sweeps;
+        self.stats.capped_islands += done.capped;
+        self.stats.newton_islands += done.newton_islands;
+        self.stats.newton_steps += done.newton_steps;
         // Each solved robot's motion over the sub-step (per robot, so on any thread), then
         // written back in order.
         let pose = &self.pose;

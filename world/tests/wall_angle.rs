@@ -39,23 +39,30 @@ fn scene(deg: f64, duty: [f64; 2], mu_wall: f64, run_s: f64) -> Scene {
     }
 }
 
-/// The same scene in the world (no motor-gain spread), with the solver every run uses by
-/// default (at most 12 sweeps, stopped on the impulses) or, `converged`, the one that sweeps
-/// until no velocity changes by more than 2 µm/s (at most 256 sweeps).
-fn own(s: &Scene, converged: bool) -> Vec<Sample> {
+/// Each solver a scenario can choose: the one every run uses by default (`Impulse`, at most 12
+/// sweeps), the one that sweeps until no velocity changes by more than 2 µm/s (`Velocity`,
+/// at most 256 sweeps) and Newton's method (`Newton`).
+const SOLVERS: [Convergence; 3] = [
+    Convergence::Impulse,
+    Convergence::Velocity,
+    Convergence::Newton,
+];
+
+/// The same scene in the world (no motor-gain spread), with the solver `until`.
+fn own(s: &Scene, until: Convergence) -> Vec<Sample> {
     let params = WorldParams {
         motor_gain_spread: 0.0,
         mu_wall: s.mu_wall,
         ..WorldParams::with_clock(CLOCK_HZ)
     };
-    let params = if converged {
+    let params = if until == Convergence::Impulse {
+        params
+    } else {
         WorldParams {
             solver_iterations: 256,
-            solver_convergence: Convergence::Velocity,
+            solver_convergence: until,
             ..params
         }
-    } else {
-        params
     };
     let pose = Pose {
         x_m: s.x,
@@ -82,17 +89,20 @@ fn own(s: &Scene, converged: bool) -> Vec<Sample> {
 
 #[test]
 fn squares_up_below_the_critical_angle_and_turns_along_the_wall_above_it() {
-    for (mu_wall, converged) in [(0.3f64, false), (0.6, false), (0.3, true), (0.6, true)] {
+    for (mu_wall, solver) in [0.3f64, 0.6]
+        .into_iter()
+        .flat_map(|mu| SOLVERS.map(|s| (mu, s)))
+    {
         let critical =
             (BODY_WIDTH_M / BODY_LENGTH_M).atan().to_degrees() + mu_wall.atan().to_degrees();
         for (deg, squares) in [(critical - 5.0, true), (critical + 5.0, false)] {
-            let track = own(&scene(deg, [1.0, 1.0], mu_wall, 6.0), converged);
+            let track = own(&scene(deg, [1.0, 1.0], mu_wall, 6.0), solver);
             let end = *track.last().unwrap();
             let second_before = track[track.len() - 1 - (1.0 / EVERY_S) as usize];
             let moved = (end.1 - second_before.1).hypot(end.2 - second_before.2);
             let heading = end.3.to_degrees();
             let what = format!(
-                "converged {converged}, μ_wall {mu_wall}, {deg:.1}° (critical {critical:.1}°): heading {heading:.2}°, moved {:.1} mm in the last s, y {:.3} m",
+                "{solver:?}, μ_wall {mu_wall}, {deg:.1}° (critical {critical:.1}°): heading {heading:.2}°, moved {:.1} mm in the last s, y {:.3} m",
                 1e3 * moved,
                 end.2
             );
@@ -118,8 +128,8 @@ fn follows_plain_coulomb_friction_at_the_wheels_and_the_wall() {
     for (deg, duty) in [(45.0, [1.0, 1.0]), (30.0, [0.3, 1.0]), (60.0, [1.0, 0.3])] {
         let s = scene(deg, duty, world::params::MU_WALL, 3.0);
         let reference = coulomb_reference::run(&s);
-        for converged in [false, true] {
-            let ours = own(&s, converged);
+        for solver in SOLVERS {
+            let ours = own(&s, solver);
             let (mut worst, mut at) = (0.0f64, 0.0);
             for (a, b) in ours.iter().zip(&reference) {
                 let d = (a.1 - b.1).hypot(a.2 - b.2);
@@ -129,7 +139,7 @@ fn follows_plain_coulomb_friction_at_the_wheels_and_the_wall() {
             }
             assert!(
                 worst < 5e-3,
-                "{deg}° wheels {duty:?}, converged {converged}: {:.1} mm from the Coulomb reference at {at:.2} s",
+                "{deg}° wheels {duty:?}, {solver:?}: {:.1} mm from the Coulomb reference at {at:.2} s",
                 1e3 * worst
             );
         }

@@ -7,8 +7,71 @@ use rayon::prelude::*;
 
 use crate::body::{BodyConst, BodyPose};
 use crate::params::Convergence;
+use crate::pipeline::newton::{NEWTON_MAX_ROBOTS, NewtonScratch, solve_island_newton};
 use crate::pipeline::par::PAR_ISLAND_ROBOTS;
 use crate::pipeline::solver::{Contact, IslandBody, WALL, solve_island};
+
+/// What a sub-step's solve of its islands did.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Solved {
+    /// Gauss–Seidel sweeps, summed over the islands solved by sweeps.
+    pub sweeps: u64,
+    /// Islands a cap stopped before they converged.
+    pub capped: u64,
+    /// Islands solved by Newton's method.
+    pub newton_islands: u64,
+    /// Newton steps, summed over them.
+    pub newton_steps: u64,
+}
+
+impl Solved {
+    /// The sum of two counts.
+    fn add(self, o: Solved) -> Solved {
+        Solved {
+            sweeps: self.sweeps + o.sweeps,
+            capped: self.capped + o.capped,
+            newton_islands: self.newton_islands + o.newton_islands,
+            newton_steps: self.newton_steps + o.newton_steps,
+        }
+    }
+}
+
+/// Solves one island by the solver `until` chooses (Newton's method for a small island under
+/// [`Convergence::Newton`], sweeps otherwise) and counts what it did.
+#[allow(clippy::too_many_arguments)]
+fn solve_one(
+    bodies: &mut [IslandBody],
+    contacts: &mut [Contact],
+    body: &BodyConst,
+    h: f64,
+    iterations: u32,
+    until: Convergence,
+    vel0: &mut [[f64; 3]],
+    (newton, max_outer): (&mut NewtonScratch, u32),
+) -> Solved {
+    if until == Convergence::Newton && bodies.len() <= NEWTON_MAX_ROBOTS {
+        let (steps, converged) = solve_island_newton(bodies, contacts, body, h, max_outer, newton);
+        Solved {
+            sweeps: 0,
+            capped: u64::from(!converged),
+            newton_islands: 1,
+            newton_steps: u64::from(steps),
+        }
+    } else {
+        let until = if until == Convergence::Newton {
+            Convergence::Impulse
+        } else {
+            until
+        };
+        let (sweeps, converged) = solve_island(bodies, contacts, body, h, iterations, until, vel0);
+        Solved {
+            sweeps: u64::from(sweeps),
+            capped: u64::from(!converged),
+            newton_islands: 0,
+            newton_steps: 0,
+        }
+    }
+}
 
 /// The islands of the latest sub-step and the scratch that sorts robots and contacts into
 /// them.
@@ -36,6 +99,15 @@ pub(crate) struct Islands {
     /// Each body's velocity at the start of a sweep (scratch, like `bodies`, for a solve
     /// converged by velocity; empty otherwise).
     vel0: Vec<[f64; 3]>,
+    /// Newton's method's scratch (for islands solved in order).
+    newton: NewtonScratch,
+    /// Newton's method's cap of outer iterations ([`crate::params::NEWTON_MAX_OUTER`]; a test
+    /// lowers it to show what a solve stopped early leaves).
+    pub(crate) newton_max_outer: u32,
+    /// When set, each solve appends every island's size and its distance from the fixed point
+    /// after the solve (m/s, `newton::fixed_point_residual`).
+    #[cfg(test)]
+    pub(crate) residuals: Option<Vec<(usize, f64)>>,
 }
 
 /// Union–find root of `i`, halving the path on the way.
@@ -62,6 +134,10 @@ impl Islands {
             active_scratch: Vec::new(),
             contact_scratch: Vec::new(),
             vel0: Vec::new(),
+            newton: NewtonScratch::default(),
+            newton_max_outer: crate::params::NEWTON_MAX_OUTER,
+            #[cfg(test)]
+            residuals: None,
         }
     }
 
@@ -204,8 +280,7 @@ impl Islands {
     /// Solves every island (its `bodies` and its share of `contacts`, as [`Islands::build`]
     /// sorted them) over a sub-step of `h` seconds with at most `iterations` sweeps each;
     /// with `parallel` and enough robots, islands on rayon's pool (each island's solve is the
-    /// same on any thread). Returns the sweeps run, summed over the islands, and the islands
-    /// the cap stopped before they converged.
+    /// same on any thread). Returns what the solves did.
     pub(crate) fn solve(
         &mut self,
         contacts: &mut [Contact],
@@ -214,7 +289,38 @@ impl Islands {
         iterations: u32,
         until: Convergence,
         parallel: bool,
-    ) -> (u64, u64) {
+    ) -> Solved {
+        #[cfg(test)]
+        let before: Vec<[f64; 3]> = self.bodies.iter().map(|b| b.vel).collect();
+        let done = self.solve_all(contacts, body, h, iterations, until, parallel);
+        #[cfg(test)]
+        if let Some(out) = self.residuals.as_mut() {
+            for (b, c) in &self.ranges {
+                out.push((
+                    b.len(),
+                    crate::pipeline::newton::fixed_point_residual(
+                        &before[b.clone()],
+                        &self.bodies[b.clone()],
+                        &contacts[c.clone()],
+                        body,
+                        h,
+                    ),
+                ));
+            }
+        }
+        done
+    }
+
+    /// [`Islands::solve`] without the test's probe.
+    fn solve_all(
+        &mut self,
+        contacts: &mut [Contact],
+        body: &BodyConst,
+        h: f64,
+        iterations: u32,
+        until: Convergence,
+        parallel: bool,
+    ) -> Solved {
         // Each body's velocity at a sweep's start, for a solve converged by velocity.
         let n = if until == Convergence::Velocity {
             self.bodies.len()
@@ -222,8 +328,6 @@ impl Islands {
             0
         };
         self.vel0.resize(n, [0.0; 3]);
-        let count = |(sweeps, converged): (u32, bool)| (u64::from(sweeps), u64::from(!converged));
-        let add = |a: (u64, u64), b: (u64, u64)| (a.0 + b.0, a.1 + b.1);
         if parallel && self.bodies.len() > PAR_ISLAND_ROBOTS && self.ranges.len() > 1 {
             // Islands share nothing: each is solved on whichever thread, with the same
             // result as in order.
@@ -239,29 +343,30 @@ impl Islands {
                 vel0 = rest;
                 jobs.push((bi, ci, vi));
             }
+            let max_outer = self.newton_max_outer;
             jobs.par_iter_mut()
                 .with_min_len(16)
-                .map(|(b, c, v)| count(solve_island(b, c, body, h, iterations, until, v)))
-                .reduce(|| (0, 0), add)
+                .map_init(NewtonScratch::default, |newton, (b, c, v)| {
+                    solve_one(b, c, body, h, iterations, until, v, (newton, max_outer))
+                })
+                .reduce(Solved::default, Solved::add)
         } else {
-            let mut total = (0, 0);
+            let mut total = Solved::default();
             for (b, c) in &self.ranges {
-                total = add(
-                    total,
-                    count(solve_island(
-                        &mut self.bodies[b.clone()],
-                        &mut contacts[c.clone()],
-                        body,
-                        h,
-                        iterations,
-                        until,
-                        if n == 0 {
-                            &mut []
-                        } else {
-                            &mut self.vel0[b.clone()]
-                        },
-                    )),
-                );
+                total = total.add(solve_one(
+                    &mut self.bodies[b.clone()],
+                    &mut contacts[c.clone()],
+                    body,
+                    h,
+                    iterations,
+                    until,
+                    if n == 0 {
+                        &mut []
+                    } else {
+                        &mut self.vel0[b.clone()]
+                    },
+                    (&mut self.newton, self.newton_max_outer),
+                ));
             }
             total
         }

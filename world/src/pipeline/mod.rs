@@ -16,6 +16,7 @@ pub(crate) mod corrections;
 pub(crate) mod drive;
 pub(crate) mod islands;
 pub(crate) mod narrow_phase;
+pub(crate) mod newton;
 pub mod par;
 pub(crate) mod sensing;
 pub(crate) mod solver;

@@ -174,7 +174,8 @@ pub(crate) fn solve_island(
     vel0: &mut [[f64; 3]],
 ) -> (u32, bool) {
     match until {
-        Convergence::Impulse => {
+        // Sweeps under the Newton solver (its large islands) are converged by impulse.
+        Convergence::Impulse | Convergence::Newton => {
             solve_island_until::<false>(bodies, contacts, body, h, iterations, &mut [])
         }
         Convergence::Velocity => {
