@@ -6,7 +6,7 @@
 #   scripts/paper-runs.sh [OUT] [THREADS] [SOLVER]
 #
 # (default OUT: out/paper, THREADS: 2, SOLVER: each scenario's own, the capped contact solver;
-# `converged` runs every setting with world.solver = "converged": docs/claims.md, "Under the
+# `converged` or `newton` runs every setting with that world.solver: docs/claims.md, "Under the
 # converged solver". The scenario files run are written into OUT/scenarios.)
 #
 # About 10 minutes on this 2-core machine (shared with other jobs) with model robots.
@@ -16,8 +16,8 @@ out=${1:-out/paper}
 threads=${2:-2}
 solver=${3:-}
 case "$solver" in
-    "" | capped | converged) ;;
-    *) echo "paper-runs.sh: SOLVER is capped or converged, not \`$solver\`" >&2; exit 2 ;;
+    "" | capped | converged | newton) ;;
+    *) echo "paper-runs.sh: SOLVER is capped, converged or newton, not \`$solver\`" >&2; exit 2 ;;
 esac
 cargo build --release --quiet
 bin=${CARGO_TARGET_DIR:-target}/release/h8swarm
