@@ -139,9 +139,10 @@ pub(crate) fn solve_island_newton(
         steps += minimise(s, n, body.radius_m);
         // λ̂ ← P_K(λ̂ + ρ r(v)): the proj of the minimiser.
         project(s, false);
+        // Each row's velocity error at the minimiser: its impulse's change over its penalty.
         let mut change: f64 = 0.0;
         for (i, row) in s.rows.iter().enumerate() {
-            let d = (s.proj[i] - s.lam[i]).abs() / row.m;
+            let d = (s.proj[i] - s.lam[i]).abs() / row.rho;
             change = if d > change || d.is_nan() { d } else { change };
         }
         core::mem::swap(&mut s.lam, &mut s.proj);
@@ -152,6 +153,7 @@ pub(crate) fn solve_island_newton(
             converged = true;
             break;
         }
+        // A velocity error that has stopped falling: a stiffer penalty.
         if change > 0.25 * last && boost < MAX_BOOST {
             boost *= 2.0;
             for row in s.rows.iter_mut() {
