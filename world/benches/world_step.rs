@@ -102,32 +102,41 @@ fn advance(c: &mut Criterion) {
     g.finish();
 
     // The solver that sweeps each island until its velocities converge (a scenario's
-    // `world.solver = "converged"`), beside `advance_10ms` at the same sizes.
-    let mut g = c.benchmark_group("advance_10ms_converged");
-    g.sample_size(20)
-        .measurement_time(Duration::from_secs(4))
-        .warm_up_time(Duration::from_secs(1));
-    let converged = WorldParams {
-        solver_iterations: 256,
-        solver_convergence: world::params::Convergence::Velocity,
-        ..WorldParams::with_clock(CLOCK_HZ)
-    };
-    for n in [100, 1_000] {
-        let mut rng = Pcg64::seed_from_u64(1);
-        let mut w = moving_world_with(n, &mut rng, converged.clone());
-        let mut k = 0u64;
-        g.throughput(Throughput::Elements(n as u64));
-        g.bench_function(BenchmarkId::from_parameter(n), |b| {
-            b.iter(|| {
-                if k.is_multiple_of(SUBSTEPS_PER_BEHAVIOUR) {
-                    new_behaviours(&mut w, &mut rng);
-                }
-                k += 1;
-                w.advance(black_box(SUBSTEP_S)).unwrap();
-            })
-        });
+    // `world.solver = "converged"`) and Newton's method (`"newton"`), beside `advance_10ms` at
+    // the same sizes.
+    for (group, until) in [
+        (
+            "advance_10ms_converged",
+            world::params::Convergence::Velocity,
+        ),
+        ("advance_10ms_newton", world::params::Convergence::Newton),
+    ] {
+        let mut g = c.benchmark_group(group);
+        g.sample_size(20)
+            .measurement_time(Duration::from_secs(4))
+            .warm_up_time(Duration::from_secs(1));
+        let params = WorldParams {
+            solver_iterations: 256,
+            solver_convergence: until,
+            ..WorldParams::with_clock(CLOCK_HZ)
+        };
+        for n in [100, 1_000] {
+            let mut rng = Pcg64::seed_from_u64(1);
+            let mut w = moving_world_with(n, &mut rng, params.clone());
+            let mut k = 0u64;
+            g.throughput(Throughput::Elements(n as u64));
+            g.bench_function(BenchmarkId::from_parameter(n), |b| {
+                b.iter(|| {
+                    if k.is_multiple_of(SUBSTEPS_PER_BEHAVIOUR) {
+                        new_behaviours(&mut w, &mut rng);
+                    }
+                    k += 1;
+                    w.advance(black_box(SUBSTEP_S)).unwrap();
+                })
+            });
+        }
+        g.finish();
     }
-    g.finish();
 }
 
 fn sense(c: &mut Criterion) {
