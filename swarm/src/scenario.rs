@@ -112,7 +112,8 @@ pub enum SolverKind {
     Newton,
 }
 
-/// The cap of the converged solver, a safety net that is counted ([`world::SolverStats`]).
+/// The cap of the converged solver's sweeps (and of the newton solver's, for islands too large
+/// for Newton's method), a safety net that is counted ([`world::SolverStats`]).
 pub const CONVERGED_SOLVER_SWEEPS: u32 = 256;
 
 impl SolverKind {

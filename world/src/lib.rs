@@ -76,7 +76,9 @@
 //!   grip, the contacts' normal impulses (push, never pull; a gap may close to the 10 nm skin,
 //!   no further) and Coulomb friction along them (μ 0.3 robot–robot and robot–wall). The solve
 //!   runs island by island (robots joined by robot–robot contacts, found by union–find), each
-//!   until a sweep changes no impulse by more than 1e-6 N·s (2 µm/s on a 0.5 kg robot), and
+//!   until a sweep changes no impulse by more than 1e-6 N·s (2 µm/s on a 0.5 kg robot; other
+//!   stopping rules, and Newton's method on a whole island, by `WorldParams::solver_convergence`),
+//!   and
 //!   contacts and wheels with a driving motor are warm-started from the previous sub-step's
 //!   impulses (braked or coasting ones start from nothing: a braked robot held against a wall
 //!   is statically indeterminate, and a kept push would outlive what sustained it). So bodies push each other (two equal tractions
