@@ -1579,7 +1579,7 @@ fn newton_reaches_the_fixed_point_where_the_sweeps_do_not() {
     // capped solve leaves 120 of 208 more than 1 µm/s from the fixed point, the worst 5.7
     // mm/s).
     let corridor = Arena::corridor_with_clearance(BODY_WIDTH_M, 0.04).unwrap();
-    let (r, st) = residuals_in(corridor.clone(), 10, 256, Newton, NEWTON_MAX_OUTER);
+    let (r, st) = residuals_in(corridor, 10, 256, Newton, NEWTON_MAX_OUTER);
     assert!(r.len() > 100, "{st:?}");
     assert_eq!(apart(&r, 2e-7), 0, "{st:?}");
     let (r, _) = residuals_in(corridor, 10, 12, Impulse, 0);
