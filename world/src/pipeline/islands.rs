@@ -11,6 +11,17 @@ use crate::pipeline::newton::{NEWTON_MAX_ROBOTS, NewtonScratch, solve_island_new
 use crate::pipeline::par::PAR_ISLAND_ROBOTS;
 use crate::pipeline::solver::{Contact, IslandBody, WALL, solve_island};
 
+/// Newton's method's limits under [`Convergence::Newton`]: its cap of outer iterations
+/// ([`crate::params::NEWTON_MAX_OUTER`]) and the largest island it solves
+/// ([`NEWTON_MAX_ROBOTS`]; larger ones are swept).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct NewtonLimits {
+    /// Outer iterations, at most.
+    pub(crate) max_outer: u32,
+    /// Robots in an island, at most.
+    pub(crate) max_robots: usize,
+}
+
 /// What a sub-step's solve of its islands did.
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct Solved {
@@ -47,10 +58,11 @@ fn solve_one(
     iterations: u32,
     until: Convergence,
     vel0: &mut [[f64; 3]],
-    (newton, max_outer): (&mut NewtonScratch, u32),
+    (newton, limits): (&mut NewtonScratch, NewtonLimits),
 ) -> Solved {
-    if until == Convergence::Newton && bodies.len() <= NEWTON_MAX_ROBOTS {
-        let (steps, converged) = solve_island_newton(bodies, contacts, body, h, max_outer, newton);
+    if until == Convergence::Newton && bodies.len() <= limits.max_robots {
+        let (steps, converged) =
+            solve_island_newton(bodies, contacts, body, h, limits.max_outer, newton);
         Solved {
             sweeps: 0,
             capped: u64::from(!converged),
@@ -101,9 +113,8 @@ pub(crate) struct Islands {
     vel0: Vec<[f64; 3]>,
     /// Newton's method's scratch (for islands solved in order).
     newton: NewtonScratch,
-    /// Newton's method's cap of outer iterations ([`crate::params::NEWTON_MAX_OUTER`]; a test
-    /// lowers it to show what a solve stopped early leaves).
-    pub(crate) newton_max_outer: u32,
+    /// Newton's method's limits (the params' constants; tests lower them).
+    pub(crate) newton_limits: NewtonLimits,
     /// When set, each solve appends every island's size and its distance from the fixed point
     /// after the solve (m/s, `newton::fixed_point_residual`).
     #[cfg(test)]
@@ -135,7 +146,10 @@ impl Islands {
             contact_scratch: Vec::new(),
             vel0: Vec::new(),
             newton: NewtonScratch::default(),
-            newton_max_outer: crate::params::NEWTON_MAX_OUTER,
+            newton_limits: NewtonLimits {
+                max_outer: crate::params::NEWTON_MAX_OUTER,
+                max_robots: NEWTON_MAX_ROBOTS,
+            },
             #[cfg(test)]
             residuals: None,
         }
@@ -343,11 +357,11 @@ impl Islands {
                 vel0 = rest;
                 jobs.push((bi, ci, vi));
             }
-            let max_outer = self.newton_max_outer;
+            let limits = self.newton_limits;
             jobs.par_iter_mut()
                 .with_min_len(16)
                 .map_init(NewtonScratch::default, |newton, (b, c, v)| {
-                    solve_one(b, c, body, h, iterations, until, v, (newton, max_outer))
+                    solve_one(b, c, body, h, iterations, until, v, (newton, limits))
                 })
                 .reduce(Solved::default, Solved::add)
         } else {
@@ -365,7 +379,7 @@ impl Islands {
                     } else {
                         &mut self.vel0[b.clone()]
                     },
-                    (&mut self.newton, self.newton_max_outer),
+                    (&mut self.newton, self.newton_limits),
                 ));
             }
             total

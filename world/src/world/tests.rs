@@ -1548,7 +1548,7 @@ fn residuals_in(
     };
     let mut w = World::new(arena, params, n, 31).unwrap();
     drive_run(&mut w, 100, 5, false);
-    w.islands.newton_max_outer = newton_outer;
+    w.islands.newton_limits.max_outer = newton_outer;
     w.islands.residuals = Some(Vec::new());
     for _ in 0..40 {
         w.advance(0.01).unwrap();
@@ -1588,6 +1588,42 @@ fn newton_reaches_the_fixed_point_where_the_sweeps_do_not() {
     // finds it.
     let (early, _) = fixed_point_residuals(256, Newton, 1);
     assert!(apart(&early, 1e-6) * 10 > early.len());
+}
+
+#[test]
+fn islands_too_large_for_newton_are_swept_and_counted() {
+    use crate::params::Convergence::{Impulse, Newton};
+    // With Newton's largest island lowered to one robot, every island of two or more is swept
+    // under the impulse test, counted apart, and gives the answer the sweeps give.
+    let run = |until, limit: Option<usize>| {
+        let n = 300;
+        let side = Arena::scaled_square(n).unwrap().width_m() / 6f64.sqrt();
+        let params = WorldParams {
+            solver_iterations: 256,
+            solver_convergence: until,
+            ..WorldParams::with_clock(crate::params::TEST_CLOCK_HZ)
+        };
+        let mut w = World::new(Arena::rectangle(side, side).unwrap(), params, n, 31).unwrap();
+        if let Some(k) = limit {
+            w.islands.newton_limits.max_robots = k;
+        }
+        drive_run(&mut w, 60, 5, false);
+        (state_bits(&w), w.solver_stats())
+    };
+    let (_, all) = run(Newton, None);
+    let (_, some) = run(Newton, Some(1));
+    assert_eq!(all.newton_islands, all.islands);
+    assert_eq!(all.solver_sweeps, 0);
+    assert!(
+        some.newton_islands > 0 && some.newton_islands < some.islands,
+        "{some:?}"
+    );
+    assert!(
+        some.solver_sweeps > some.islands - some.newton_islands,
+        "{some:?}"
+    );
+    // Nothing but sweeps: the same as the impulse test under the same cap.
+    assert_eq!(run(Newton, Some(0)).0, run(Impulse, None).0);
 }
 
 #[test]
