@@ -321,6 +321,53 @@ fn driving_into_a_wall_stops_at_it_and_presses_the_front_bumper() {
 }
 
 #[test]
+fn newton_pushes_with_full_traction_at_a_vanishing_slip_where_the_cap_lets_go() {
+    // A robot drives into a wall, then brakes. The braked wheels' speed decays exponentially
+    // (the motor's lag) and never reaches zero, so they still slip against the blocked body by
+    // nanometres a second. Coulomb friction is the full traction at any slip: Newton's method,
+    // solving to the fixed point, keeps the robot pressed to the wall with both wheels' traction
+    // and the bumper pressed; the capped sweeps add m·slip a sweep, far below the traction in 12
+    // sweeps, and let the bumper go.
+    let braked = |until: crate::params::Convergence| {
+        let params = if until == crate::params::Convergence::Impulse {
+            exact_params()
+        } else {
+            WorldParams {
+                solver_iterations: 256,
+                solver_convergence: until,
+                ..exact_params()
+            }
+        };
+        let mut w = world_at(Arena::square(), params, &[pose(1.2, 0.9, 0.0)]);
+        w.set_wheels(0, WheelCommand::forward(1.0), WheelCommand::forward(1.0))
+            .unwrap();
+        run(&mut w, 5.0, 0.01);
+        w.set_wheels(0, WheelCommand::brake(), WheelCommand::brake())
+            .unwrap();
+        run(&mut w, 1.0, 0.01);
+        let rim = w.wheel_speeds(0).unwrap()[0];
+        let push: f64 = w.narrow.contacts.iter().map(|c| c.normal_impulse()).sum();
+        (
+            w.bumpers(0).unwrap()[FRONT],
+            rim,
+            push,
+            w.body.wheel_force_n,
+        )
+    };
+    let (pressed, rim, push, traction) = braked(crate::params::Convergence::Newton);
+    assert!(rim > 0.0 && rim < 1e-7, "{rim}");
+    assert!(pressed);
+    let h = 0.01;
+    assert!(
+        (push - 2.0 * traction * h).abs() < 1e-6,
+        "{push} against {}",
+        2.0 * traction * h
+    );
+    let (pressed, _, push, _) = braked(crate::params::Convergence::Impulse);
+    assert!(!pressed && push < 1e-6, "{push}");
+}
+
+#[test]
 fn reversing_into_a_wall_presses_the_rear_bumper() {
     let mut w = world_at(Arena::square(), exact_params(), &[pose(0.5, 0.9, 0.0)]);
     w.set_wheels(0, WheelCommand::reverse(1.0), WheelCommand::reverse(1.0))
