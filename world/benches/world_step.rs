@@ -52,14 +52,16 @@ fn new_behaviours(w: &mut World, rng: &mut Pcg64) {
     }
 }
 
-fn advance(c: &mut Criterion) {
-    let mut g = c.benchmark_group("advance_10ms");
+/// One serial benchmark group: at each size, robots drawing random behaviours, one 10 ms
+/// sub-step an iteration, under `params`.
+fn serial_group(c: &mut Criterion, name: &str, sizes: &[usize], params: &WorldParams) {
+    let mut g = c.benchmark_group(name);
     g.sample_size(20)
         .measurement_time(Duration::from_secs(4))
         .warm_up_time(Duration::from_secs(1));
-    for n in SIZES {
+    for &n in sizes {
         let mut rng = Pcg64::seed_from_u64(1);
-        let mut w = moving_world(n, &mut rng);
+        let mut w = moving_world_with(n, &mut rng, params.clone());
         let mut k = 0u64;
         g.throughput(Throughput::Elements(n as u64));
         g.bench_function(BenchmarkId::from_parameter(n), |b| {
@@ -73,6 +75,15 @@ fn advance(c: &mut Criterion) {
         });
     }
     g.finish();
+}
+
+fn advance(c: &mut Criterion) {
+    serial_group(
+        c,
+        "advance_10ms",
+        &SIZES,
+        &WorldParams::with_clock(CLOCK_HZ),
+    );
 
     // The parallel path on two threads (results identical to `advance`).
     let mut g = c.benchmark_group("advance_par_10ms_2_threads");
@@ -111,31 +122,12 @@ fn advance(c: &mut Criterion) {
         ),
         ("advance_10ms_newton", world::params::Convergence::Newton),
     ] {
-        let mut g = c.benchmark_group(group);
-        g.sample_size(20)
-            .measurement_time(Duration::from_secs(4))
-            .warm_up_time(Duration::from_secs(1));
         let params = WorldParams {
             solver_iterations: 256,
             solver_convergence: until,
             ..WorldParams::with_clock(CLOCK_HZ)
         };
-        for n in [100, 1_000] {
-            let mut rng = Pcg64::seed_from_u64(1);
-            let mut w = moving_world_with(n, &mut rng, params.clone());
-            let mut k = 0u64;
-            g.throughput(Throughput::Elements(n as u64));
-            g.bench_function(BenchmarkId::from_parameter(n), |b| {
-                b.iter(|| {
-                    if k.is_multiple_of(SUBSTEPS_PER_BEHAVIOUR) {
-                        new_behaviours(&mut w, &mut rng);
-                    }
-                    k += 1;
-                    w.advance(black_box(SUBSTEP_S)).unwrap();
-                })
-            });
-        }
-        g.finish();
+        serial_group(c, group, &[100, 1_000], &params);
     }
 }
 

@@ -203,7 +203,7 @@ pub enum Convergence {
     /// statically indeterminate: the impulses can drift along a direction that moves nothing).
     Velocity,
     /// Islands of up to 16 robots solved by Newton's method on the whole island to its fixed
-    /// point (every row's velocity error below 1 nm/s, at most 64 outer iterations); larger
+    /// point (every row's velocity error below 0.1 µm/s, at most 64 outer iterations); larger
     /// islands by sweeps converged by impulse under the sweep cap.
     Newton,
 }

@@ -70,11 +70,8 @@ fn solve_one(
             newton_steps: u64::from(steps),
         }
     } else {
-        let until = if until == Convergence::Newton {
-            Convergence::Impulse
-        } else {
-            until
-        };
+        // Under `Newton` an island too large for it is swept under the impulse test
+        // (`solve_island` takes `Newton` so).
         let (sweeps, converged) = solve_island(bodies, contacts, body, h, iterations, until, vel0);
         Solved {
             sweeps: u64::from(sweeps),
@@ -304,37 +301,12 @@ impl Islands {
         until: Convergence,
         parallel: bool,
     ) -> Solved {
+        // The test's probe: each island's velocities before the solve.
         #[cfg(test)]
-        let before: Vec<[f64; 3]> = self.bodies.iter().map(|b| b.vel).collect();
-        let done = self.solve_all(contacts, body, h, iterations, until, parallel);
-        #[cfg(test)]
-        if let Some(out) = self.residuals.as_mut() {
-            for (b, c) in &self.ranges {
-                out.push((
-                    b.len(),
-                    crate::pipeline::newton::fixed_point_residual(
-                        &before[b.clone()],
-                        &self.bodies[b.clone()],
-                        &contacts[c.clone()],
-                        body,
-                        h,
-                    ),
-                ));
-            }
-        }
-        done
-    }
-
-    /// [`Islands::solve`] without the test's probe.
-    fn solve_all(
-        &mut self,
-        contacts: &mut [Contact],
-        body: &BodyConst,
-        h: f64,
-        iterations: u32,
-        until: Convergence,
-        parallel: bool,
-    ) -> Solved {
+        let before: Option<Vec<[f64; 3]>> = self
+            .residuals
+            .as_ref()
+            .map(|_| self.bodies.iter().map(|b| b.vel).collect());
         // Each body's velocity at a sweep's start, for a solve converged by velocity.
         let n = if until == Convergence::Velocity {
             self.bodies.len()
@@ -342,11 +314,11 @@ impl Islands {
             0
         };
         self.vel0.resize(n, [0.0; 3]);
-        if parallel && self.bodies.len() > PAR_ISLAND_ROBOTS && self.ranges.len() > 1 {
+        let done = if parallel && self.bodies.len() > PAR_ISLAND_ROBOTS && self.ranges.len() > 1 {
             // Islands share nothing: each is solved on whichever thread, with the same
             // result as in order.
             let mut jobs = Vec::with_capacity(self.ranges.len());
-            let (mut bodies, mut contacts) = (&mut self.bodies[..], contacts);
+            let (mut bodies, mut contacts) = (&mut self.bodies[..], &mut *contacts);
             let mut vel0 = &mut self.vel0[..];
             for (b, c) in &self.ranges {
                 let (bi, rest) = core::mem::take(&mut bodies).split_at_mut(b.len());
@@ -383,6 +355,22 @@ impl Islands {
                 ));
             }
             total
+        };
+        #[cfg(test)]
+        if let (Some(out), Some(before)) = (self.residuals.as_mut(), before) {
+            for (b, c) in &self.ranges {
+                out.push((
+                    b.len(),
+                    crate::pipeline::newton::fixed_point_residual(
+                        &before[b.clone()],
+                        &self.bodies[b.clone()],
+                        &contacts[c.clone()],
+                        body,
+                        h,
+                    ),
+                ));
+            }
         }
+        done
     }
 }

@@ -606,8 +606,6 @@ pub(crate) fn fixed_point_residual(
     for row in s.rows.iter_mut() {
         row.rho = row.m;
     }
-    let n = s.v.len();
-    s.hess.resize(n * n, 0.0);
     project(&mut s, false);
     let mut worst: f64 = 0.0;
     for (i, row) in s.rows.iter().enumerate() {

@@ -1160,6 +1160,27 @@ fn thread_count_does_not_change_the_result() {
     }
 }
 
+/// A square arena at 6× the paper's density for `n` robots.
+fn crowded_arena(n: usize) -> Arena {
+    let side = Arena::scaled_square(n).unwrap().width_m() / 6f64.sqrt();
+    Arena::rectangle(side, side).unwrap()
+}
+
+/// `n` robots placed in `arena` (seed 31) under the given solver.
+fn solver_world(
+    arena: Arena,
+    n: usize,
+    iterations: u32,
+    until: crate::params::Convergence,
+) -> World {
+    let params = WorldParams {
+        solver_iterations: iterations,
+        solver_convergence: until,
+        ..WorldParams::with_clock(crate::params::TEST_CLOCK_HZ)
+    };
+    World::new(arena, params, n, 31).unwrap()
+}
+
 /// `n` robots in an arena at 6× the paper's density, driven for 250 sub-steps of 10 ms under
 /// the given solver (on `threads` of a pool, or in order): their state and what the solver did.
 fn crowded_run(
@@ -1168,13 +1189,7 @@ fn crowded_run(
     until: crate::params::Convergence,
     threads: Option<usize>,
 ) -> (Vec<u64>, SolverStats) {
-    let side = Arena::scaled_square(n).unwrap().width_m() / 6f64.sqrt();
-    let params = WorldParams {
-        solver_iterations: iterations,
-        solver_convergence: until,
-        ..WorldParams::with_clock(crate::params::TEST_CLOCK_HZ)
-    };
-    let mut w = World::new(Arena::rectangle(side, side).unwrap(), params, n, 31).unwrap();
+    let mut w = solver_world(crowded_arena(n), n, iterations, until);
     match threads {
         None => drive_run(&mut w, 250, 5, false),
         Some(t) => rayon::ThreadPoolBuilder::new()
@@ -1214,13 +1229,7 @@ fn apart_from(
     reference: crate::params::Convergence,
 ) -> (f64, f64) {
     let n = 300;
-    let side = Arena::scaled_square(n).unwrap().width_m() / 6f64.sqrt();
-    let params = WorldParams {
-        solver_iterations: iterations,
-        solver_convergence: until,
-        ..WorldParams::with_clock(crate::params::TEST_CLOCK_HZ)
-    };
-    let mut w = World::new(Arena::rectangle(side, side).unwrap(), params, n, 31).unwrap();
+    let mut w = solver_world(crowded_arena(n), n, iterations, until);
     drive_run(&mut w, 100, 5, false);
     let radius = w.body.radius_m;
     let (mut worst, mut sum, mut count) = (0.0f64, 0.0, 0u32);
@@ -1569,15 +1578,7 @@ fn fixed_point_residuals(
     until: crate::params::Convergence,
     newton_outer: u32,
 ) -> (Vec<(usize, f64)>, SolverStats) {
-    let n = 300;
-    let side = Arena::scaled_square(n).unwrap().width_m() / 6f64.sqrt();
-    residuals_in(
-        Arena::rectangle(side, side).unwrap(),
-        n,
-        iterations,
-        until,
-        newton_outer,
-    )
+    residuals_in(crowded_arena(300), 300, iterations, until, newton_outer)
 }
 
 /// [`fixed_point_residuals`] in any arena, `n` robots.
@@ -1588,12 +1589,7 @@ fn residuals_in(
     until: crate::params::Convergence,
     newton_outer: u32,
 ) -> (Vec<(usize, f64)>, SolverStats) {
-    let params = WorldParams {
-        solver_iterations: iterations,
-        solver_convergence: until,
-        ..WorldParams::with_clock(crate::params::TEST_CLOCK_HZ)
-    };
-    let mut w = World::new(arena, params, n, 31).unwrap();
+    let mut w = solver_world(arena, n, iterations, until);
     drive_run(&mut w, 100, 5, false);
     w.islands.newton_limits.max_outer = newton_outer;
     w.islands.residuals = Some(Vec::new());
@@ -1644,13 +1640,7 @@ fn islands_too_large_for_newton_are_swept_and_counted() {
     // under the impulse test, counted apart, and gives the answer the sweeps give.
     let run = |until, limit: Option<usize>| {
         let n = 300;
-        let side = Arena::scaled_square(n).unwrap().width_m() / 6f64.sqrt();
-        let params = WorldParams {
-            solver_iterations: 256,
-            solver_convergence: until,
-            ..WorldParams::with_clock(crate::params::TEST_CLOCK_HZ)
-        };
-        let mut w = World::new(Arena::rectangle(side, side).unwrap(), params, n, 31).unwrap();
+        let mut w = solver_world(crowded_arena(n), n, 256, until);
         if let Some(k) = limit {
             w.islands.newton_limits.max_robots = k;
         }
