@@ -467,10 +467,25 @@ mod tests {
                     (None, None) => {}
                     (None, Some(c)) if c.dist >= 0.0 => {}
                     (o, c) => {
-                        // Only allowed within f32 reach of touching.
+                        // Allowed within f32 reach of touching; beyond it parry2d has been seen
+                        // to miss a shallow overlap of nearly parallel boxes (80 µm, parry 9 µm
+                        // apart), so the separating-axis test over the four face normals, exact
+                        // for two rectangles, decides: ours must equal it.
                         let d = o.map_or(0.0, |o| o.depth_m);
                         let pd = c.map_or(0.0, |c| f64::from(c.dist));
-                        prop_assert!(d.abs() < 1e-5 && pd.abs() < 1e-5, "ours {o:?} parry {c:?}");
+                        let sat = [(a.c, a.s), (-a.s, a.c), (b.c, b.s), (-b.s, b.c)]
+                            .iter()
+                            .map(|&(px, py)| {
+                                let along = |bx: &Obb| bx.hx * (px * bx.c + py * bx.s).abs()
+                                    + bx.hy * (-px * bx.s + py * bx.c).abs();
+                                along(&a) + along(&b) - ((b.x - a.x) * px + (b.y - a.y) * py).abs()
+                            })
+                            .fold(f64::INFINITY, f64::min)
+                            .max(0.0);
+                        prop_assert!(
+                            (d.abs() < 1e-5 && pd.abs() < 1e-5) || (d - sat).abs() < 1e-9,
+                            "ours {o:?} parry {c:?} separating axes {sat}"
+                        );
                     }
                 }
             }
